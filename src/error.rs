@@ -1,0 +1,40 @@
+//! The pipeline's error type: bad input apart from internal failures, each saying how to
+//! fix it.
+
+use crate::scene::SceneError;
+use crate::view::BehindEye;
+use std::path::PathBuf;
+
+/// Everything that can stop a build.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The scene file is unreadable or invalid.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// The view puts a surface at or behind the 4D eye.
+    #[error("surface `{surface}` in the view of scene `{scene}`: {source}")]
+    View {
+        /// The scene.
+        scene: String,
+        /// The surface.
+        surface: String,
+        /// The offending vertex.
+        source: BehindEye,
+    },
+    /// An output could not be written.
+    #[error("cannot write {}: {source}; check that the output folder is writable (choose another with --out)", path.display())]
+    Write {
+        /// The file or folder.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A stage produced something it must not (a bug, not bad input).
+    #[error("internal error in stage {stage}: {message}")]
+    Internal {
+        /// The stage.
+        stage: &'static str,
+        /// What went wrong.
+        message: String,
+    },
+}

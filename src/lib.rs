@@ -1,0 +1,23 @@
+//! halo4d turns surfaces that live in four dimensions into verified 3D geometry.
+//!
+//! The pipeline, one module per stage (see the README's architecture section):
+//! [`scene`] (what to build) -> [`surfaces`] (4D parametric surfaces with exact derivatives)
+//! -> [`sample`] (meshes welded by domain rules) -> [`view`] (4D rotation and projection)
+//! -> [`export`] (glTF, PLY, OBJ, report). [`pipeline`] runs them in order.
+#![warn(missing_docs)]
+
+pub mod error;
+pub mod export;
+pub mod halo;
+pub mod pipeline;
+pub mod sample;
+pub mod scene;
+pub mod surfaces;
+pub mod view;
+
+pub use error::Error;
+pub use pipeline::{Report, build, run};
+pub use sample::{Mesh4, MeshStats, Sampling, sample_uniform};
+pub use scene::{Scene, SceneError};
+pub use surfaces::{Domain, Eval4, Surface, Topology};
+pub use view::{Projected, Projection, Rotation4, View};

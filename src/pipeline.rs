@@ -1,0 +1,261 @@
+//! The build: runs the stages a scene needs and writes its outputs.
+//!
+//! scene -> surfaces -> sample -> view -> export. Each stage hands a plain value to the
+//! next and is timed; [`Report`] collects counts, bounds, mesh statistics and timings.
+
+use crate::error::Error;
+use crate::export::{self, SurfaceData};
+use crate::sample::{Mesh4, MeshStats, Sampling, sample_uniform};
+use crate::scene::Scene;
+use crate::surfaces::{Surface, Topology};
+use crate::view::Projected;
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// One surface after sampling and projection.
+#[derive(Clone, Debug)]
+pub struct SurfaceProduct {
+    /// Name in the outputs.
+    pub name: String,
+    /// The surface.
+    pub surface: Surface,
+    /// Its 4D mesh.
+    pub mesh: Mesh4,
+    /// The mesh's statistics.
+    pub stats: MeshStats,
+    /// Its 3D projection.
+    pub projected: Projected,
+}
+
+impl SurfaceProduct {
+    /// The view the writers take.
+    pub fn data(&self) -> SurfaceData<'_> {
+        SurfaceData {
+            name: &self.name,
+            surface_type: self.surface.type_name(),
+            patches: self.surface.patch_count(),
+            mesh: &self.mesh,
+            projected: &self.projected,
+        }
+    }
+}
+
+/// Milliseconds spent in each stage.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Timings {
+    /// Sampling, all surfaces.
+    pub sample: f64,
+    /// View (rotation, projection, normals), all surfaces.
+    pub view: f64,
+    /// Writing the outputs.
+    pub export: f64,
+    /// The whole build.
+    pub total: f64,
+}
+
+/// Bounding box.
+#[derive(Clone, Debug, Serialize)]
+pub struct Bounds {
+    /// Lower corner.
+    pub min: Vec<f64>,
+    /// Upper corner.
+    pub max: Vec<f64>,
+}
+
+/// What the report says of one surface.
+#[derive(Clone, Debug, Serialize)]
+pub struct SurfaceReport {
+    /// Mesh name.
+    pub name: String,
+    /// Catalogue type.
+    #[serde(rename = "type")]
+    pub type_name: String,
+    /// Parameter patches.
+    pub patches: usize,
+    /// Sampling used.
+    pub sampling: Sampling,
+    /// Vertices.
+    pub vertices: usize,
+    /// Triangles.
+    pub triangles: usize,
+    /// Expected topology.
+    pub topology: Topology,
+    /// Measured combinatorics.
+    pub mesh: MeshStats,
+    /// Bounding box in R^4 before the view.
+    pub bounds_4d: Option<Bounds>,
+    /// Bounding box of the projection.
+    pub bounds_3d: Option<Bounds>,
+    /// Range of w-depth after the view.
+    pub w_range: Option<[f64; 2]>,
+}
+
+/// `report.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Version of halo4d that wrote it.
+    pub halo4d: &'static str,
+    /// Scene name.
+    pub scene_name: String,
+    /// Per surface.
+    pub surfaces: Vec<SurfaceReport>,
+    /// Milliseconds per stage.
+    pub timings_ms: Timings,
+    /// Files written, relative to the output folder.
+    pub files: Vec<String>,
+    /// The scene as parsed, with every default filled in.
+    pub scene: Scene,
+}
+
+fn ms(since: Instant) -> f64 {
+    since.elapsed().as_secs_f64() * 1e3
+}
+
+/// A progress bar on stderr (hidden when stderr is not a terminal or `quiet`).
+fn progress(len: usize, quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(len as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+/// Samples and projects every surface of the scene.
+pub fn run(scene: &Scene, quiet: bool) -> Result<(Vec<SurfaceProduct>, Timings), Error> {
+    let bar = progress(scene.surfaces.len() * 2, quiet);
+    let mut timings = Timings::default();
+    let mut products = Vec::with_capacity(scene.surfaces.len());
+    for (i, entry) in scene.surfaces.iter().enumerate() {
+        let name = scene.surface_name(i);
+        bar.set_message(format!("sampling {name}"));
+        let start = Instant::now();
+        let Sampling::Uniform { u, v } = *scene.surface_sampling(i);
+        let mesh = sample_uniform(&entry.surface, u, v);
+        let stats = mesh.validate();
+        timings.sample += ms(start);
+        bar.inc(1);
+
+        bar.set_message(format!("projecting {name}"));
+        let start = Instant::now();
+        let projected = scene.view.project(&mesh).map_err(|source| Error::View {
+            scene: scene.name.clone(),
+            surface: name.clone(),
+            source,
+        })?;
+        timings.view += ms(start);
+        bar.inc(1);
+        if let Some(bad) = projected.positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::Internal {
+                stage: "view",
+                message: format!("vertex {bad} of `{name}` is not finite"),
+            });
+        }
+        products.push(SurfaceProduct {
+            name,
+            surface: entry.surface.clone(),
+            mesh,
+            stats,
+            projected,
+        });
+    }
+    bar.finish_and_clear();
+    Ok((products, timings))
+}
+
+/// Builds a scene into `out_dir`: runs the stages and writes the outputs the scene asks for.
+pub fn build(scene: &Scene, out_dir: &Path, quiet: bool) -> Result<Report, Error> {
+    let start = Instant::now();
+    let (products, mut timings) = run(scene, quiet)?;
+    let export_start = Instant::now();
+    std::fs::create_dir_all(out_dir).map_err(|source| Error::Write {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
+    let data: Vec<SurfaceData> = products.iter().map(SurfaceProduct::data).collect();
+    let write = |file: String, bytes: &[u8]| -> Result<String, Error> {
+        let path: PathBuf = out_dir.join(&file);
+        export::write_atomic(&path, bytes).map_err(|source| Error::Write { path, source })?;
+        Ok(file)
+    };
+    let mut files = Vec::new();
+    let name = &scene.name;
+    if scene.outputs.glb {
+        let scene_json = serde_json::to_value(scene).map_err(|e| Error::Internal {
+            stage: "export",
+            message: e.to_string(),
+        })?;
+        let glb = export::to_glb(&data, &scene_json).map_err(|message| Error::Internal {
+            stage: "export",
+            message,
+        })?;
+        files.push(write(format!("{name}.glb"), &glb)?);
+    }
+    if scene.outputs.ply {
+        files.push(write(format!("{name}.ply"), &export::to_ply(&data, name))?);
+    }
+    if scene.outputs.obj {
+        files.push(write(
+            format!("{name}.obj"),
+            export::to_obj(&data, name).as_bytes(),
+        )?);
+    }
+    timings.export = ms(export_start);
+    if scene.outputs.report {
+        files.push("report.json".into());
+    }
+    timings.total = ms(start);
+    let report = Report {
+        halo4d: env!("CARGO_PKG_VERSION"),
+        scene_name: scene.name.clone(),
+        surfaces: products
+            .iter()
+            .enumerate()
+            .map(|(i, p)| surface_report(scene, i, p))
+            .collect(),
+        timings_ms: timings,
+        files,
+        scene: scene.clone(),
+    };
+    if scene.outputs.report {
+        let text = serde_json::to_vec_pretty(&report).map_err(|e| Error::Internal {
+            stage: "export",
+            message: e.to_string(),
+        })?;
+        write("report.json".into(), &text)?;
+    }
+    Ok(report)
+}
+
+fn surface_report(scene: &Scene, i: usize, p: &SurfaceProduct) -> SurfaceReport {
+    let w = &p.projected.w;
+    SurfaceReport {
+        name: p.name.clone(),
+        type_name: p.surface.type_name().to_string(),
+        patches: p.surface.patch_count(),
+        sampling: scene.surface_sampling(i).clone(),
+        vertices: p.mesh.vertex_count(),
+        triangles: p.mesh.triangles.len(),
+        topology: p.surface.topology(),
+        mesh: p.stats,
+        bounds_4d: p.mesh.bounds().map(|(lo, hi)| Bounds {
+            min: lo.to_array().to_vec(),
+            max: hi.to_array().to_vec(),
+        }),
+        bounds_3d: p.projected.bounds().map(|(lo, hi)| Bounds {
+            min: lo.to_array().to_vec(),
+            max: hi.to_array().to_vec(),
+        }),
+        w_range: (!w.is_empty()).then(|| {
+            [
+                w.iter().copied().fold(f64::INFINITY, f64::min),
+                w.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            ]
+        }),
+    }
+}

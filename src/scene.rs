@@ -1,0 +1,258 @@
+//! Scene files: JSON describing surfaces, view, sampling, halo parameters and outputs.
+//!
+//! Takes: a file path or JSON text. Gives: a validated [`Scene`]. Guarantees: unknown keys
+//! are rejected (a typo is an error, not a silent default); every number is finite and in
+//! range; every error names the file and the field (`surfaces[0].surface.n`) and says what
+//! is allowed. No input makes the parser panic.
+
+use crate::halo::HaloParams;
+use crate::sample::Sampling;
+use crate::surfaces::Surface;
+use crate::view::View;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The scene built when none is given: a spun trefoil in an oblique 4D view.
+pub const DEFAULT_SCENE: &str = include_str!("../fixtures/scenes/default.json");
+
+/// The most triangles a scene may ask for, over all its surfaces.
+pub const MAX_TRIANGLES: usize = 20_000_000;
+
+/// A scene: what to build and what to write.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Name of the scene; names the output folder and files (letters, digits, `-`, `_`, `.`).
+    pub name: String,
+    /// Free text.
+    #[serde(default)]
+    pub description: String,
+    /// The surfaces.
+    pub surfaces: Vec<SceneSurface>,
+    /// The 4D view.
+    #[serde(default)]
+    pub view: View,
+    /// Default sampling for surfaces that set none.
+    #[serde(default)]
+    pub sampling: Sampling,
+    /// Halo parameters.
+    #[serde(default)]
+    pub halo: HaloParams,
+    /// Which files to write.
+    #[serde(default)]
+    pub outputs: Outputs,
+}
+
+/// One surface of a scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSurface {
+    /// Name of the surface's mesh in the outputs; defaults to its type, which must then be
+    /// unique in the scene.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// The surface and its parameters.
+    pub surface: Surface,
+    /// Sampling for this surface, overriding the scene's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sampling: Option<Sampling>,
+}
+
+/// Which files `halo4d build` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Outputs {
+    /// `<name>.glb`: glTF 2.0 binary.
+    pub glb: bool,
+    /// `<name>.ply`: the surfaces for MeshLab, w as vertex quality.
+    pub ply: bool,
+    /// `<name>.obj`: the surfaces as Wavefront OBJ.
+    pub obj: bool,
+    /// `report.json`: counts, bounds, timings and the parsed scene.
+    pub report: bool,
+}
+
+impl Default for Outputs {
+    fn default() -> Self {
+        Outputs {
+            glb: true,
+            ply: true,
+            obj: false,
+            report: true,
+        }
+    }
+}
+
+/// Why a scene could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("{file}: cannot read the scene file: {source}")]
+    Io {
+        /// The file.
+        file: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The text is not a scene: bad JSON, a wrong type, an unknown key or surface type.
+    #[error("{file}:{line}:{column}: {field}: {message}")]
+    Syntax {
+        /// The file.
+        file: String,
+        /// Path of the field, like `surfaces[0].surface.n`.
+        field: String,
+        /// What is wrong.
+        message: String,
+        /// Line of the error.
+        line: usize,
+        /// Column of the error.
+        column: usize,
+    },
+    /// A value is out of range or inconsistent.
+    #[error("{file}: {field}: {message}")]
+    Invalid {
+        /// The file.
+        file: String,
+        /// Path of the field.
+        field: String,
+        /// What is wrong and what is allowed.
+        message: String,
+    },
+}
+
+impl Scene {
+    /// Reads and validates a scene file.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            file: file.clone(),
+            source,
+        })?;
+        Scene::parse(&text, &file)
+    }
+
+    /// The embedded default scene.
+    pub fn default_scene() -> Scene {
+        Scene::parse(DEFAULT_SCENE, "<default scene>").expect("the embedded default scene is valid")
+    }
+
+    /// Parses and validates scene text; `file` names it in errors.
+    pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
+        let syntax = |field: String, inner: serde_json::Error| SceneError::Syntax {
+            file: file.to_string(),
+            field,
+            message: strip_position(&inner.to_string()),
+            line: inner.line(),
+            column: inner.column(),
+        };
+        let mut de = serde_json::Deserializer::from_str(text);
+        let scene: Scene = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+            let field = match e.path().to_string() {
+                p if p == "." => "(top level)".to_string(),
+                p => p,
+            };
+            syntax(field, e.into_inner())
+        })?;
+        de.end()
+            .map_err(|e| syntax("(after the scene)".into(), e))?;
+        scene
+            .validate()
+            .map_err(|(field, message)| SceneError::Invalid {
+                file: file.to_string(),
+                field,
+                message,
+            })?;
+        Ok(scene)
+    }
+
+    /// The name of surface `i` in the outputs.
+    pub fn surface_name(&self, i: usize) -> String {
+        self.surfaces[i]
+            .name
+            .clone()
+            .unwrap_or_else(|| self.surfaces[i].surface.type_name().to_string())
+    }
+
+    /// The sampling of surface `i`.
+    pub fn surface_sampling(&self, i: usize) -> &Sampling {
+        self.surfaces[i].sampling.as_ref().unwrap_or(&self.sampling)
+    }
+
+    /// Checks every value; `Err((field, message))` names the first bad one.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        check_name(&self.name).map_err(|m| ("name".to_string(), m))?;
+        if self.surfaces.is_empty() || self.surfaces.len() > 64 {
+            return Err((
+                "surfaces".into(),
+                format!("must list 1 to 64 surfaces, got {}", self.surfaces.len()),
+            ));
+        }
+        self.sampling
+            .check()
+            .map_err(|(f, m)| (format!("sampling.{f}"), m))?;
+        let mut names = Vec::new();
+        let mut triangles = 0usize;
+        for (i, s) in self.surfaces.iter().enumerate() {
+            s.surface
+                .check()
+                .map_err(|(f, m)| (format!("surfaces[{i}].surface.{f}"), m))?;
+            if let Some(sampling) = &s.sampling {
+                sampling
+                    .check()
+                    .map_err(|(f, m)| (format!("surfaces[{i}].sampling.{f}"), m))?;
+            }
+            let name = self.surface_name(i);
+            check_name(&name).map_err(|m| (format!("surfaces[{i}].name"), m))?;
+            if names.contains(&name) {
+                return Err((
+                    format!("surfaces[{i}].name"),
+                    format!(
+                        "`{name}` is used by an earlier surface; give each surface a unique `name`"
+                    ),
+                ));
+            }
+            names.push(name);
+            let Sampling::Uniform { u, v } = *self.surface_sampling(i);
+            triangles = triangles.saturating_add(u * v * 2 * s.surface.patch_count());
+        }
+        if triangles > MAX_TRIANGLES {
+            return Err((
+                "sampling".into(),
+                format!(
+                    "the scene asks for {triangles} triangles, more than the limit of {MAX_TRIANGLES}; lower u and v"
+                ),
+            ));
+        }
+        self.view
+            .check()
+            .map_err(|(f, m)| (format!("view.{f}"), m))?;
+        self.halo
+            .check()
+            .map_err(|(f, m)| (format!("halo.{f}"), m))?;
+        Ok(())
+    }
+}
+
+fn check_name(name: &str) -> Result<(), String> {
+    let ok = !name.is_empty()
+        && name.len() <= 64
+        && !name.starts_with('.')
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c));
+    if ok {
+        Ok(())
+    } else {
+        Err(format!(
+            "`{name}` is not a usable name: use 1 to 64 letters, digits, `-`, `_` or `.`, not starting with `.`"
+        ))
+    }
+}
+
+/// serde_json appends " at line L column C"; we report the position ourselves.
+fn strip_position(message: &str) -> String {
+    match message.rfind(" at line ") {
+        Some(i) => message[..i].to_string(),
+        None => message.to_string(),
+    }
+}

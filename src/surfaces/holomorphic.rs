@@ -1,0 +1,210 @@
+//! Complex curves in C^2 = R^4 (Hanson's Fermat surfaces and the product polynomial of
+//! paper 000 section 5.3), drawn in coordinates (Re z1, Re z2, Im z1, Im z2).
+//!
+//! Each patch is holomorphic in ζ = u + i v, so its exact derivatives follow from f, f' and
+//! f'' by the Cauchy-Riemann equations: ∂u f = f', ∂v f = i f', ∂uu f = f'', ∂uv f = i f'',
+//! ∂vv f = -f''.
+
+use super::{Domain, Eval4, Glue, Jet, Parametric, Side, SideRule, Topology, positive};
+use num_complex::Complex64 as C64;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
+/// Real and imaginary part of a holomorphic function of ζ = u + iv as jets in (u, v).
+fn holomorphic(f: C64, f1: C64, f2: C64) -> (Jet, Jet) {
+    let re = Jet {
+        v: f.re,
+        du: f1.re,
+        dv: -f1.im,
+        duu: f2.re,
+        duv: -f2.im,
+        dvv: -f2.re,
+    };
+    let im = Jet {
+        v: f.im,
+        du: f1.im,
+        dv: f1.re,
+        duu: f2.im,
+        duv: f2.re,
+        dvv: -f2.im,
+    };
+    (re, im)
+}
+
+/// Builds the point (Re z1, Re z2, Im z1, Im z2) from the jets of z1 and z2.
+fn point(z1: (C64, C64, C64), z2: (C64, C64, C64)) -> Eval4 {
+    let (r1, i1) = holomorphic(z1.0, z1.1, z1.2);
+    let (r2, i2) = holomorphic(z2.0, z2.1, z2.2);
+    Eval4::from_jets([r1, r2, i1, i2])
+}
+
+/// g^p with its first and second derivatives, given g, g', g'' (principal branch). Where
+/// g = 0 and p < 2 the derivatives are infinite or NaN: a branch point of the patch.
+fn power(p: f64, g: C64, g1: C64, g2: C64) -> (C64, C64, C64) {
+    let h = if g == C64::new(0.0, 0.0) {
+        g
+    } else {
+        g.powf(p)
+    };
+    let hm1 = h / g;
+    let hm2 = hm1 / g;
+    (
+        h,
+        hm1 * g1 * p,
+        hm2 * g1 * g1 * (p * (p - 1.0)) + hm1 * g2 * p,
+    )
+}
+
+/// Fermat surface z1^n + z2^n = 1 (Hanson): patch (k1, k2), k1, k2 in 0..n, is
+/// z1 = e^{2πi k1/n} cos(ζ)^{2/n}, z2 = e^{2πi k2/n} sin(ζ)^{2/n}, ζ = x + iy,
+/// x in [0, π/2], y in [-a, a]. Patch index k1 n + k2.
+///
+/// Seams, derived from the branch of the powers: on x = 0, the half y > 0 of patch (k1, k2)
+/// is the half y < 0 of patch (k1, k2 + 1) at -y; on x = π/2, the half y > 0 of (k1, k2) is
+/// the half y < 0 of (k1 - 1, k2) at -y. The points y = 0 on those sides (z2 = 0 and z1 = 0)
+/// are shared by n patches each: branch points of the parametrization where the
+/// derivatives are infinite for n > 2, although the surface is smooth there.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Fermat {
+    /// The degree n, 2 to 6 (2: quadratic Fermat, 4: Calabi-Yau quartic cross-section).
+    pub n: u32,
+    /// Half-range a of the imaginary part y of ζ.
+    pub y_range: f64,
+}
+
+impl Default for Fermat {
+    fn default() -> Self {
+        Fermat { n: 4, y_range: 1.0 }
+    }
+}
+
+impl Fermat {
+    fn patch_index(&self, k1: i64, k2: i64) -> usize {
+        let n = self.n as i64;
+        (k1.rem_euclid(n) * n + k2.rem_euclid(n)) as usize
+    }
+}
+
+impl Parametric for Fermat {
+    fn patch_count(&self) -> usize {
+        (self.n * self.n) as usize
+    }
+    fn domain(&self, patch: usize) -> Domain {
+        let n = self.n as i64;
+        let (k1, k2) = (patch as i64 / n, patch as i64 % n);
+        let half = |from: f64, patch: usize, side: Side| Glue {
+            from,
+            to: from + 0.5,
+            patch,
+            side,
+            offset: 1.0,
+            reversed: true,
+        };
+        let side = |lower: usize, upper: usize, side: Side| {
+            SideRule::Glued(vec![half(0.0, lower, side), half(0.5, upper, side)])
+        };
+        Domain::open([0.0, FRAC_PI_2], [-self.y_range, self.y_range])
+            .with(
+                Side::U0,
+                side(
+                    self.patch_index(k1, k2 - 1),
+                    self.patch_index(k1, k2 + 1),
+                    Side::U0,
+                ),
+            )
+            .with(
+                Side::U1,
+                side(
+                    self.patch_index(k1 + 1, k2),
+                    self.patch_index(k1 - 1, k2),
+                    Side::U1,
+                ),
+            )
+    }
+    fn eval(&self, patch: usize, u: f64, v: f64) -> Eval4 {
+        let n = self.n as usize;
+        let (k1, k2) = (patch / n, patch % n);
+        let p = 2.0 / self.n as f64;
+        let zeta = C64::new(u, v);
+        let (c, s) = (zeta.cos(), zeta.sin());
+        let phase = |k: usize| C64::from_polar(1.0, TAU * k as f64 / self.n as f64);
+        let scale = |(a, b, c): (C64, C64, C64), w: C64| (a * w, b * w, c * w);
+        point(
+            scale(power(p, c, -s, -c), phase(k1)),
+            scale(power(p, s, c, -s), phase(k2)),
+        )
+    }
+    fn topology(&self) -> Topology {
+        Topology {
+            closed: false,
+            orientable: true,
+            euler_characteristic: None,
+        }
+    }
+    fn check(&self) -> Result<(), (&'static str, String)> {
+        if !(2..=6).contains(&self.n) {
+            return Err(("n", format!("must be between 2 and 6, got {}", self.n)));
+        }
+        positive("y_range", self.y_range)?;
+        if self.y_range > 4.0 {
+            return Err((
+                "y_range",
+                format!(
+                    "must be at most 4 (coordinates grow like e^(2a/n)), got {}",
+                    self.y_range
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Product polynomial z1^2 z2^2 = 1, i.e. z1 z2 = ±1: two sheets (patch 0: +1, patch 1: -1),
+/// each z1 = e^ζ, z2 = ±e^{-ζ} with ζ = u + iv, u in [-a, a], v in [0, 2π] periodic.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ProductPolynomial {
+    /// Half-range a of u = log |z1|.
+    pub u_range: f64,
+}
+
+impl Default for ProductPolynomial {
+    fn default() -> Self {
+        ProductPolynomial { u_range: 0.8 }
+    }
+}
+
+impl Parametric for ProductPolynomial {
+    fn patch_count(&self) -> usize {
+        2
+    }
+    fn domain(&self, patch: usize) -> Domain {
+        Domain::open([-self.u_range, self.u_range], [0.0, TAU]).glue_v(patch)
+    }
+    fn eval(&self, patch: usize, u: f64, v: f64) -> Eval4 {
+        let e = C64::new(u, v).exp();
+        let f = C64::new(-u, -v).exp() * if patch == 0 { 1.0 } else { -1.0 };
+        point((e, e, e), (f, -f, f))
+    }
+    fn topology(&self) -> Topology {
+        Topology {
+            closed: false,
+            orientable: true,
+            euler_characteristic: None,
+        }
+    }
+    fn check(&self) -> Result<(), (&'static str, String)> {
+        positive("u_range", self.u_range)?;
+        if self.u_range > PI {
+            return Err((
+                "u_range",
+                format!(
+                    "must be at most π (coordinates grow like e^a), got {}",
+                    self.u_range
+                ),
+            ));
+        }
+        Ok(())
+    }
+}

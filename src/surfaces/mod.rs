@@ -1,0 +1,359 @@
+//! The catalogue of 4D parametric surfaces.
+//!
+//! Takes: a surface entry of a scene (its type and parameters).
+//! Gives: points of R^4 with exact first and second derivatives ([`Eval4`]) over one or more
+//! rectangular parameter patches, and the [`Domain`] topology of each patch: which sides are
+//! open, which collapse to a pole, and which are glued to which (periodic, with a flip, or to
+//! another patch). The samplers weld meshes with these rules, never by distance.
+//!
+//! Guarantees: points are finite everywhere on the domain. Derivatives are exact (dual-number
+//! [`Jet`]s, or closed forms for the holomorphic surfaces), never finite differences; they are
+//! finite everywhere except at the isolated branch points of the Fermat parametrization, where
+//! the parametrization (not the surface) is singular.
+
+mod holomorphic;
+mod jet;
+mod knots;
+mod simple;
+
+pub use holomorphic::{Fermat, ProductPolynomial};
+pub use jet::Jet;
+pub use knots::{SpunTrefoil, TwistSpunTrefoil};
+pub use simple::{FlatTorus, KleinBottle, Patches, ProjectivePlane};
+
+use glam::DVec4;
+use serde::{Deserialize, Serialize};
+
+/// A surface point with its exact first and second partial derivatives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Eval4 {
+    /// The point.
+    pub p: DVec4,
+    /// ∂p/∂u.
+    pub du: DVec4,
+    /// ∂p/∂v.
+    pub dv: DVec4,
+    /// ∂²p/∂u².
+    pub duu: DVec4,
+    /// ∂²p/∂u∂v.
+    pub duv: DVec4,
+    /// ∂²p/∂v².
+    pub dvv: DVec4,
+}
+
+impl Eval4 {
+    /// Collects four coordinate jets into points and derivative vectors.
+    pub fn from_jets(c: [Jet; 4]) -> Self {
+        let pick = |f: fn(&Jet) -> f64| DVec4::new(f(&c[0]), f(&c[1]), f(&c[2]), f(&c[3]));
+        Eval4 {
+            p: pick(|j| j.v),
+            du: pick(|j| j.du),
+            dv: pick(|j| j.dv),
+            duu: pick(|j| j.duu),
+            duv: pick(|j| j.duv),
+            dvv: pick(|j| j.dvv),
+        }
+    }
+
+    /// Whether the two tangents are finite (they are not at parametrization singularities).
+    pub fn tangents_finite(&self) -> bool {
+        self.du.is_finite() && self.dv.is_finite()
+    }
+}
+
+/// A side of a patch's parameter rectangle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+pub enum Side {
+    /// u = u_min; the side coordinate runs with v.
+    U0,
+    /// u = u_max; the side coordinate runs with v.
+    U1,
+    /// v = v_min; the side coordinate runs with u.
+    V0,
+    /// v = v_max; the side coordinate runs with u.
+    V1,
+}
+
+impl Side {
+    /// All four sides, in the order used by [`Domain::sides`].
+    pub const ALL: [Side; 4] = [Side::U0, Side::U1, Side::V0, Side::V1];
+
+    fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// One piece of a glued side: the part `sigma` in `[from, to]` of the side (normalized side
+/// coordinate, 0 at the low parameter end, 1 at the high end) is identified with the side
+/// `side` of patch `patch`, at `offset + sigma` (or `offset - sigma` when `reversed`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Glue {
+    /// Start of the piece on this side.
+    pub from: f64,
+    /// End of the piece on this side.
+    pub to: f64,
+    /// The patch this piece is glued to (may be the same patch).
+    pub patch: usize,
+    /// The side of that patch.
+    pub side: Side,
+    /// Offset of the affine map of side coordinates.
+    pub offset: f64,
+    /// Whether the side coordinate runs backwards on the other side.
+    pub reversed: bool,
+}
+
+impl Glue {
+    /// The whole side glued to `side` of `patch`, straight (periodic) or with a flip.
+    pub fn whole(patch: usize, side: Side, reversed: bool) -> Self {
+        Glue {
+            from: 0.0,
+            to: 1.0,
+            patch,
+            side,
+            offset: if reversed { 1.0 } else { 0.0 },
+            reversed,
+        }
+    }
+
+    /// The side coordinate on the other side for `sigma` on this one.
+    pub fn map(&self, sigma: f64) -> f64 {
+        if self.reversed {
+            self.offset - sigma
+        } else {
+            self.offset + sigma
+        }
+    }
+}
+
+/// What happens at one side of a patch.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub enum SideRule {
+    /// An open boundary of the surface.
+    Open,
+    /// The whole side is one point of the surface (a pole).
+    Pole,
+    /// The side is glued, piece by piece, to sides of this or other patches.
+    Glued(Vec<Glue>),
+}
+
+/// The parameter rectangle of a patch and the rule of each of its sides.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Domain {
+    /// Range of u.
+    pub u: [f64; 2],
+    /// Range of v.
+    pub v: [f64; 2],
+    /// Rules for the sides, in the order of [`Side::ALL`].
+    pub sides: [SideRule; 4],
+}
+
+impl Domain {
+    /// A rectangle with all four sides open.
+    pub fn open(u: [f64; 2], v: [f64; 2]) -> Self {
+        Domain {
+            u,
+            v,
+            sides: [
+                SideRule::Open,
+                SideRule::Open,
+                SideRule::Open,
+                SideRule::Open,
+            ],
+        }
+    }
+
+    /// The rule of one side.
+    pub fn side(&self, side: Side) -> &SideRule {
+        &self.sides[side.index()]
+    }
+
+    /// Sets the rule of one side.
+    pub fn with(mut self, side: Side, rule: SideRule) -> Self {
+        self.sides[side.index()] = rule;
+        self
+    }
+
+    /// Makes u periodic (patch `patch` glued to itself across the u sides), optionally with
+    /// a flip of v (Klein bottle).
+    pub fn glue_u(self, patch: usize, flip: bool) -> Self {
+        self.with(
+            Side::U0,
+            SideRule::Glued(vec![Glue::whole(patch, Side::U1, flip)]),
+        )
+        .with(
+            Side::U1,
+            SideRule::Glued(vec![Glue::whole(patch, Side::U0, flip)]),
+        )
+    }
+
+    /// Makes v periodic.
+    pub fn glue_v(self, patch: usize) -> Self {
+        self.with(
+            Side::V0,
+            SideRule::Glued(vec![Glue::whole(patch, Side::V1, false)]),
+        )
+        .with(
+            Side::V1,
+            SideRule::Glued(vec![Glue::whole(patch, Side::V0, false)]),
+        )
+    }
+
+    /// The parameters of the point at side coordinate `sigma` of `side`.
+    pub fn side_point(&self, side: Side, sigma: f64) -> (f64, f64) {
+        let lerp = |r: [f64; 2], t: f64| r[0] + (r[1] - r[0]) * t;
+        match side {
+            Side::U0 => (self.u[0], lerp(self.v, sigma)),
+            Side::U1 => (self.u[1], lerp(self.v, sigma)),
+            Side::V0 => (lerp(self.u, sigma), self.v[0]),
+            Side::V1 => (lerp(self.u, sigma), self.v[1]),
+        }
+    }
+}
+
+/// Global topology of a surface, for checks on its meshes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Topology {
+    /// Whether the surface is closed (no boundary).
+    pub closed: bool,
+    /// Whether the surface is orientable.
+    pub orientable: bool,
+    /// The Euler characteristic, for closed surfaces.
+    pub euler_characteristic: Option<i64>,
+}
+
+/// A surface of the catalogue with its parameters, as written in a scene file
+/// (`{"type": "spun_trefoil", "scale": 0.5}`). Every parameter has a default.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum Surface {
+    /// Flat (Clifford) torus.
+    FlatTorus(FlatTorus),
+    /// Klein bottle embedded in R^4.
+    KleinBottle(KleinBottle),
+    /// Real projective plane embedded in R^4 (Veronese-type map).
+    ProjectivePlane(ProjectivePlane),
+    /// Artin spin of a knotted trefoil arc: a knotted 2-sphere.
+    SpunTrefoil(SpunTrefoil),
+    /// Zeeman twist spin of the trefoil arc with m >= 2 twists: a knotted 2-sphere.
+    TwistSpunTrefoil(TwistSpunTrefoil),
+    /// Fermat surface z1^n + z2^n = 1 (n^2 patches).
+    Fermat(Fermat),
+    /// Product polynomial z1^2 z2^2 = 1.
+    ProductPolynomial(ProductPolynomial),
+    /// The test scene of paper 000 fig. 1: planar patches at different w crossing a white one.
+    Patches(Patches),
+}
+
+/// What every catalogue entry provides.
+pub(crate) trait Parametric {
+    fn patch_count(&self) -> usize;
+    fn domain(&self, patch: usize) -> Domain;
+    fn eval(&self, patch: usize, u: f64, v: f64) -> Eval4;
+    fn topology(&self) -> Topology;
+    /// Checks parameter values; returns (field, message) for the first bad one.
+    fn check(&self) -> Result<(), (&'static str, String)>;
+}
+
+macro_rules! dispatch {
+    ($self:expr, $s:ident => $e:expr) => {
+        match $self {
+            Surface::FlatTorus($s) => $e,
+            Surface::KleinBottle($s) => $e,
+            Surface::ProjectivePlane($s) => $e,
+            Surface::SpunTrefoil($s) => $e,
+            Surface::TwistSpunTrefoil($s) => $e,
+            Surface::Fermat($s) => $e,
+            Surface::ProductPolynomial($s) => $e,
+            Surface::Patches($s) => $e,
+        }
+    };
+}
+
+impl Surface {
+    /// One default-parametrized instance of every catalogue entry.
+    pub fn catalogue() -> Vec<Surface> {
+        vec![
+            Surface::FlatTorus(FlatTorus::default()),
+            Surface::KleinBottle(KleinBottle::default()),
+            Surface::ProjectivePlane(ProjectivePlane::default()),
+            Surface::SpunTrefoil(SpunTrefoil::default()),
+            Surface::TwistSpunTrefoil(TwistSpunTrefoil::default()),
+            Surface::Fermat(Fermat::default()),
+            Surface::ProductPolynomial(ProductPolynomial::default()),
+            Surface::Patches(Patches::default()),
+        ]
+    }
+
+    /// The `type` name used in scene files.
+    pub fn type_name(&self) -> &'static str {
+        match self {
+            Surface::FlatTorus(_) => "flat_torus",
+            Surface::KleinBottle(_) => "klein_bottle",
+            Surface::ProjectivePlane(_) => "projective_plane",
+            Surface::SpunTrefoil(_) => "spun_trefoil",
+            Surface::TwistSpunTrefoil(_) => "twist_spun_trefoil",
+            Surface::Fermat(_) => "fermat",
+            Surface::ProductPolynomial(_) => "product_polynomial",
+            Surface::Patches(_) => "patches",
+        }
+    }
+
+    /// A one-line description for `halo4d list`.
+    pub fn description(&self) -> &'static str {
+        match self {
+            Surface::FlatTorus(_) => {
+                "flat (Clifford) torus (r1 cos s, r1 sin s, r2 cos t, r2 sin t)"
+            }
+            Surface::KleinBottle(_) => "Klein bottle embedded in R^4",
+            Surface::ProjectivePlane(_) => "real projective plane, Veronese-type embedding in R^4",
+            Surface::SpunTrefoil(_) => "Artin-spun trefoil: a knotted 2-sphere",
+            Surface::TwistSpunTrefoil(_) => {
+                "Zeeman twist-spun trefoil (m >= 2): a knotted 2-sphere"
+            }
+            Surface::Fermat(_) => {
+                "Fermat surface z1^n + z2^n = 1 (n^2 patches; n = 4: Calabi-Yau quartic section)"
+            }
+            Surface::ProductPolynomial(_) => "product polynomial z1^2 z2^2 = 1 (two sheets)",
+            Surface::Patches(_) => {
+                "paper 000 fig. 1: planar patches at different w crossing a white one"
+            }
+        }
+    }
+
+    /// Number of parameter patches.
+    pub fn patch_count(&self) -> usize {
+        dispatch!(self, s => s.patch_count())
+    }
+
+    /// The domain and side rules of a patch.
+    pub fn domain(&self, patch: usize) -> Domain {
+        dispatch!(self, s => s.domain(patch))
+    }
+
+    /// The point and its exact derivatives at (u, v) of a patch.
+    pub fn eval(&self, patch: usize, u: f64, v: f64) -> Eval4 {
+        dispatch!(self, s => s.eval(patch, u, v))
+    }
+
+    /// Closedness, orientability and Euler characteristic.
+    pub fn topology(&self) -> Topology {
+        dispatch!(self, s => s.topology())
+    }
+
+    /// Checks the parameters: `Err((field, message))` names the first bad one.
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        dispatch!(self, s => s.check())
+    }
+}
+
+/// Checks that a parameter is finite and positive.
+pub(crate) fn positive(field: &'static str, x: f64) -> Result<(), (&'static str, String)> {
+    if x.is_finite() && x > 0.0 {
+        Ok(())
+    } else {
+        Err((
+            field,
+            format!("must be a finite number greater than 0, got {x}"),
+        ))
+    }
+}

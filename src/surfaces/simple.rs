@@ -1,0 +1,265 @@
+//! The classical closed surfaces of Fourphront (paper 001) and the planar test scene of
+//! paper 000 fig. 1.
+
+use super::{Domain, Eval4, Glue, Jet, Parametric, Side, SideRule, Topology, positive};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{FRAC_PI_2, TAU};
+
+/// Flat (Clifford) torus (r1 cos s, r1 sin s, r2 cos t, r2 sin t), s, t in [0, 2π), both
+/// periodic.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FlatTorus {
+    /// Radius of the circle in the xy plane.
+    pub r1: f64,
+    /// Radius of the circle in the zw plane.
+    pub r2: f64,
+}
+
+impl Default for FlatTorus {
+    fn default() -> Self {
+        FlatTorus { r1: 1.0, r2: 1.0 }
+    }
+}
+
+impl Parametric for FlatTorus {
+    fn patch_count(&self) -> usize {
+        1
+    }
+    fn domain(&self, _: usize) -> Domain {
+        Domain::open([0.0, TAU], [0.0, TAU])
+            .glue_u(0, false)
+            .glue_v(0)
+    }
+    fn eval(&self, _: usize, u: f64, v: f64) -> Eval4 {
+        let (s, t) = (Jet::u(u), Jet::v(v));
+        Eval4::from_jets([
+            s.cos() * self.r1,
+            s.sin() * self.r1,
+            t.cos() * self.r2,
+            t.sin() * self.r2,
+        ])
+    }
+    fn topology(&self) -> Topology {
+        Topology {
+            closed: true,
+            orientable: true,
+            euler_characteristic: Some(0),
+        }
+    }
+    fn check(&self) -> Result<(), (&'static str, String)> {
+        positive("r1", self.r1)?;
+        positive("r2", self.r2)
+    }
+}
+
+/// Klein bottle ((R + r cos v) cos u, (R + r cos v) sin u, r sin v cos(u/2), r sin v sin(u/2)),
+/// u, v in [0, 2π]. v is periodic; the u sides are glued with a flip of v, since
+/// (u + 2π, v) and (u, -v) are the same point.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct KleinBottle {
+    /// Radius R of the core circle.
+    pub major_radius: f64,
+    /// Radius r of the tube; must be smaller than R.
+    pub minor_radius: f64,
+}
+
+impl Default for KleinBottle {
+    fn default() -> Self {
+        KleinBottle {
+            major_radius: 1.0,
+            minor_radius: 0.5,
+        }
+    }
+}
+
+impl Parametric for KleinBottle {
+    fn patch_count(&self) -> usize {
+        1
+    }
+    fn domain(&self, _: usize) -> Domain {
+        Domain::open([0.0, TAU], [0.0, TAU])
+            .glue_u(0, true)
+            .glue_v(0)
+    }
+    fn eval(&self, _: usize, u: f64, v: f64) -> Eval4 {
+        let (u, v) = (Jet::u(u), Jet::v(v));
+        let ring = v.cos() * self.minor_radius + self.major_radius;
+        let lift = v.sin() * self.minor_radius;
+        let half = u * 0.5;
+        Eval4::from_jets([
+            ring * u.cos(),
+            ring * u.sin(),
+            lift * half.cos(),
+            lift * half.sin(),
+        ])
+    }
+    fn topology(&self) -> Topology {
+        Topology {
+            closed: true,
+            orientable: false,
+            euler_characteristic: Some(0),
+        }
+    }
+    fn check(&self) -> Result<(), (&'static str, String)> {
+        positive("major_radius", self.major_radius)?;
+        positive("minor_radius", self.minor_radius)?;
+        if self.minor_radius >= self.major_radius {
+            return Err((
+                "minor_radius",
+                format!(
+                    "must be smaller than major_radius ({}) or the surface is not embedded, got {}",
+                    self.major_radius, self.minor_radius
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Real projective plane as the image of the unit sphere under
+/// (x, y, z) -> (xy, xz, y² - z², 2yz), scaled by `radius`. Parametrized by the hemisphere
+/// x = cos θ, y = sin θ cos φ, z = sin θ sin φ with θ in [0, π/2] (u) and φ in [0, 2π] (v):
+/// θ = 0 is a pole, φ is periodic, and the equator θ = π/2 is glued to itself with
+/// φ -> φ + π (antipodal points).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ProjectivePlane {
+    /// Scale of the embedding.
+    pub radius: f64,
+}
+
+impl Default for ProjectivePlane {
+    fn default() -> Self {
+        ProjectivePlane { radius: 1.0 }
+    }
+}
+
+impl Parametric for ProjectivePlane {
+    fn patch_count(&self) -> usize {
+        1
+    }
+    fn domain(&self, _: usize) -> Domain {
+        let half_turn = |from: f64, offset: f64| Glue {
+            from,
+            to: from + 0.5,
+            patch: 0,
+            side: Side::U1,
+            offset,
+            reversed: false,
+        };
+        Domain::open([0.0, FRAC_PI_2], [0.0, TAU])
+            .glue_v(0)
+            .with(Side::U0, SideRule::Pole)
+            .with(
+                Side::U1,
+                SideRule::Glued(vec![half_turn(0.0, 0.5), half_turn(0.5, -0.5)]),
+            )
+    }
+    fn eval(&self, _: usize, u: f64, v: f64) -> Eval4 {
+        let (theta, phi) = (Jet::u(u), Jet::v(v));
+        let x = theta.cos();
+        let y = theta.sin() * phi.cos();
+        let z = theta.sin() * phi.sin();
+        let r = self.radius;
+        Eval4::from_jets([
+            x * y * r,
+            x * z * r,
+            (y.sqr() - z.sqr()) * r,
+            y * z * (2.0 * r),
+        ])
+    }
+    fn topology(&self) -> Topology {
+        Topology {
+            closed: true,
+            orientable: false,
+            euler_characteristic: Some(1),
+        }
+    }
+    fn check(&self) -> Result<(), (&'static str, String)> {
+        positive("radius", self.radius)
+    }
+}
+
+/// Paper 000 fig. 1: a white square in the plane z = w = 0 (patch 0) and `count` coloured
+/// rectangles (patches 1..=count), each standing in a plane y = const across the white
+/// square, at w-depth ±spacing, ±2 spacing, ... (alternating, never 0), so that their 3D
+/// projections cut the white square while in 4D they pass in front of or behind it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Patches {
+    /// Number of coloured patches (1 to 16).
+    pub count: usize,
+    /// Half the side of the white square.
+    pub size: f64,
+    /// Step in w between coloured patches.
+    pub spacing: f64,
+}
+
+impl Default for Patches {
+    fn default() -> Self {
+        Patches {
+            count: 5,
+            size: 1.0,
+            spacing: 0.3,
+        }
+    }
+}
+
+impl Patches {
+    /// The w-depth of coloured patch k (1-based): -s, +s, -2s, +2s, ...
+    pub fn depth(&self, k: usize) -> f64 {
+        let step = k.div_ceil(2) as f64 * self.spacing;
+        if k % 2 == 1 { -step } else { step }
+    }
+
+    /// The y of the plane of coloured patch k (1-based), spread across the white square.
+    pub fn offset(&self, k: usize) -> f64 {
+        if self.count == 1 {
+            return 0.0;
+        }
+        self.size * 0.8 * (2.0 * (k - 1) as f64 / (self.count - 1) as f64 - 1.0)
+    }
+}
+
+impl Parametric for Patches {
+    fn patch_count(&self) -> usize {
+        self.count + 1
+    }
+    fn domain(&self, _: usize) -> Domain {
+        Domain::open([-1.0, 1.0], [-1.0, 1.0])
+    }
+    fn eval(&self, patch: usize, u: f64, v: f64) -> Eval4 {
+        let (u, v) = (Jet::u(u), Jet::v(v));
+        let s = self.size;
+        let c = Jet::constant;
+        Eval4::from_jets(if patch == 0 {
+            [u * s, v * s, c(0.0), c(0.0)]
+        } else {
+            [
+                u * (0.8 * s),
+                c(self.offset(patch)),
+                v * (0.6 * s),
+                c(self.depth(patch)),
+            ]
+        })
+    }
+    fn topology(&self) -> Topology {
+        Topology {
+            closed: false,
+            orientable: true,
+            euler_characteristic: None,
+        }
+    }
+    fn check(&self) -> Result<(), (&'static str, String)> {
+        if !(1..=16).contains(&self.count) {
+            return Err((
+                "count",
+                format!("must be between 1 and 16, got {}", self.count),
+            ));
+        }
+        positive("size", self.size)?;
+        positive("spacing", self.spacing)
+    }
+}
