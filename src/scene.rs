@@ -213,6 +213,21 @@ impl Scene {
             }
             names.push(name);
             let Sampling::Uniform { u, v } = *self.surface_sampling(i);
+            let [min_u, min_v] = s.surface.min_cells();
+            if u < min_u || v < min_v {
+                let field = if s.sampling.is_some() {
+                    format!("surfaces[{i}].sampling")
+                } else {
+                    "sampling".into()
+                };
+                return Err((
+                    field,
+                    format!(
+                        "{} needs at least {min_u} x {min_v} cells, got {u} x {v}",
+                        s.surface.type_name()
+                    ),
+                ));
+            }
             triangles = triangles.saturating_add(u * v * 2 * s.surface.patch_count());
         }
         if triangles > MAX_TRIANGLES {

@@ -85,6 +85,37 @@ pub enum Projection {
     },
 }
 
+impl Projection {
+    /// The w of the eye (minus infinity for orthographic projection).
+    pub fn eye_w(&self) -> f64 {
+        match *self {
+            Projection::Orthographic => f64::NEG_INFINITY,
+            Projection::Perspective { eye_distance } => -eye_distance,
+        }
+    }
+
+    /// Projects a rotated and translated point: its 3D position, and the Jacobian of the
+    /// projection at it as a map of 4D tangents to 3D tangents. `None` when the point is at
+    /// or behind the eye (or so close to it that the position overflows).
+    pub fn apply(&self, p: DVec4) -> Option<(DVec3, impl Fn(DVec4) -> DVec3 + use<>)> {
+        let xyz = p.truncate();
+        let (f, g) = match *self {
+            Projection::Orthographic => (1.0, 0.0),
+            Projection::Perspective { eye_distance: e } => {
+                let depth = p.w + e;
+                if !(depth > 0.0) {
+                    return None;
+                }
+                // d(f xyz) = f dxyz - (f / depth) xyz dw, with f = e / depth.
+                (e / depth, e / (depth * depth))
+            }
+        };
+        let pos = xyz * f;
+        pos.is_finite()
+            .then_some((pos, move |t: DVec4| t.truncate() * f - xyz * (g * t.w)))
+    }
+}
+
 /// A 4D view: rotation, then translation, then projection.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -192,29 +223,15 @@ impl View {
         };
         for i in 0..n {
             let p = rot * mesh.positions[i] + shift;
-            let (tu, tv) = (rot * mesh.tangent_u[i], rot * mesh.tangent_v[i]);
-            let xyz = p.truncate();
-            let (pos, ju, jv) = match self.projection {
-                Projection::Orthographic => (xyz, tu.truncate(), tv.truncate()),
-                Projection::Perspective { eye_distance: e } => {
-                    let depth = p.w + e;
-                    let f = e / depth;
-                    if !(depth > 0.0 && (xyz * f).is_finite()) {
-                        return Err(BehindEye {
-                            vertex: i,
-                            w: p.w,
-                            eye: -e,
-                        });
-                    }
-                    // d(f xyz) = f dxyz - (f / depth) xyz dw.
-                    let jac = |t: DVec4| t.truncate() * f - xyz * (f / depth * t.w);
-                    (xyz * f, jac(tu), jac(tv))
-                }
-            };
+            let (pos, jac) = self.projection.apply(p).ok_or(BehindEye {
+                vertex: i,
+                w: p.w,
+                eye: self.projection.eye_w(),
+            })?;
             out.positions.push(pos);
             out.w.push(p.w);
-            out.tangent_u.push(ju);
-            out.tangent_v.push(jv);
+            out.tangent_u.push(jac(rot * mesh.tangent_u[i]));
+            out.tangent_v.push(jac(rot * mesh.tangent_v[i]));
         }
         out.normals = vertex_normals(&out, &mesh.triangles);
         Ok(out)

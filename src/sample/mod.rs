@@ -24,9 +24,9 @@ use std::collections::HashMap;
 pub enum Sampling {
     /// A uniform grid of `u` by `v` cells on every patch.
     Uniform {
-        /// Cells along u per patch (even, 2 to 4096).
+        /// Cells along u per patch (even, 4 to 4096).
         u: usize,
-        /// Cells along v per patch (even, 2 to 4096).
+        /// Cells along v per patch (even, 4 to 4096).
         v: usize,
     },
 }

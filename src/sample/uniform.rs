@@ -23,7 +23,8 @@ impl Classes {
     }
 }
 
-/// Samples every patch of `surface` on a grid of `nu` by `nv` cells (both even), welds the
+/// Samples every patch of `surface` on a grid of `nu` by `nv` cells (both even and at least
+/// 4, as [`super::Sampling::check`] demands), welds the
 /// nodes that the domain rules identify, and splits every cell into two triangles along
 /// the diagonal (i, j)-(i+1, j+1), dropping the triangles that a pole collapses.
 pub fn sample_uniform(surface: &Surface, nu: usize, nv: usize) -> Mesh4 {

@@ -55,6 +55,19 @@ fn total() -> f64 {
     PIECES.iter().sum()
 }
 
+/// The values of u where two pieces of the arc meet (the surface is C2 but not C3 there).
+#[cfg(test)]
+pub(crate) fn joins() -> Vec<f64> {
+    PIECES
+        .iter()
+        .scan(0.0, |g, len| {
+            *g += len;
+            Some(*g / total())
+        })
+        .take(PIECES.len() - 1)
+        .collect()
+}
+
 /// Quintic smoothstep 6t^5 - 15t^4 + 10t^3: first and second derivatives vanish at 0 and 1.
 fn smoothstep(t: Jet) -> Jet {
     t.cube() * ((t * 6.0 - 15.0) * t + 10.0)

@@ -223,7 +223,7 @@ pub struct Topology {
 
 /// A surface of the catalogue with its parameters, as written in a scene file
 /// (`{"type": "spun_trefoil", "scale": 0.5}`). Every parameter has a default.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(tag = "type", rename_all = "snake_case")]
 pub enum Surface {
     /// Flat (Clifford) torus.
@@ -244,6 +244,49 @@ pub enum Surface {
     Patches(Patches),
 }
 
+/// Reads `{"type": ..., params}` in two steps so that an error in a parameter names it
+/// (serde's internally tagged enums lose the field's path).
+impl<'de> Deserialize<'de> for Surface {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let mut map = serde_json::Map::deserialize(d)?;
+        let ty = match map.remove("type") {
+            Some(serde_json::Value::String(t)) => t,
+            Some(other) => {
+                return Err(D::Error::custom(format!(
+                    "`type` must be a string, got {other}"
+                )));
+            }
+            None => return Err(D::Error::missing_field("type")),
+        };
+        let params = serde_json::Value::Object(map);
+        fn read<T: serde::de::DeserializeOwned, E: Error>(v: serde_json::Value) -> Result<T, E> {
+            serde_path_to_error::deserialize(v)
+                .map_err(|e| E::custom(format!("{}: {}", e.path(), e.inner())))
+        }
+        Ok(match ty.as_str() {
+            "flat_torus" => Surface::FlatTorus(read(params)?),
+            "klein_bottle" => Surface::KleinBottle(read(params)?),
+            "projective_plane" => Surface::ProjectivePlane(read(params)?),
+            "spun_trefoil" => Surface::SpunTrefoil(read(params)?),
+            "twist_spun_trefoil" => Surface::TwistSpunTrefoil(read(params)?),
+            "fermat" => Surface::Fermat(read(params)?),
+            "product_polynomial" => Surface::ProductPolynomial(read(params)?),
+            "patches" => Surface::Patches(read(params)?),
+            _ => {
+                let known: Vec<&str> = Surface::catalogue()
+                    .iter()
+                    .map(Surface::type_name)
+                    .collect();
+                return Err(D::Error::custom(format!(
+                    "unknown surface type `{ty}`, expected one of {}",
+                    known.join(", ")
+                )));
+            }
+        })
+    }
+}
+
 /// What every catalogue entry provides.
 pub(crate) trait Parametric {
     fn patch_count(&self) -> usize;
@@ -252,6 +295,11 @@ pub(crate) trait Parametric {
     fn topology(&self) -> Topology;
     /// Checks parameter values; returns (field, message) for the first bad one.
     fn check(&self) -> Result<(), (&'static str, String)>;
+    /// The fewest grid cells along (u, v) that give a simplicial mesh: 4 across a seam or
+    /// a pole, more where a side is glued to itself.
+    fn min_cells(&self) -> [usize; 2] {
+        [4, 4]
+    }
 }
 
 macro_rules! dispatch {
@@ -340,6 +388,11 @@ impl Surface {
         dispatch!(self, s => s.topology())
     }
 
+    /// The fewest uniform grid cells along (u, v) that give a simplicial mesh.
+    pub fn min_cells(&self) -> [usize; 2] {
+        dispatch!(self, s => s.min_cells())
+    }
+
     /// Checks the parameters: `Err((field, message))` names the first bad one.
     pub fn check(&self) -> Result<(), (&'static str, String)> {
         dispatch!(self, s => s.check())
@@ -355,5 +408,136 @@ pub(crate) fn positive(field: &'static str, x: f64) -> Result<(), (&'static str,
             field,
             format!("must be a finite number greater than 0, got {x}"),
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::FRAC_PI_2;
+
+    /// SplitMix64: a small seeded generator for reproducible random parameters.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f64 {
+            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = self.0;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    fn surfaces_under_test() -> Vec<Surface> {
+        let mut all = Surface::catalogue();
+        for n in [2, 3, 5, 6] {
+            all.push(Surface::Fermat(Fermat { n, y_range: 1.2 }));
+        }
+        all.push(Surface::TwistSpunTrefoil(TwistSpunTrefoil {
+            scale: 0.7,
+            twists: 5,
+        }));
+        all
+    }
+
+    /// Parameters too close to where a fourth-order stencil of step h is not valid: the
+    /// joins of the knotted arc (C2, not C3) and the Fermat branch points.
+    fn near_trouble(s: &Surface, u: f64, v: f64, h: f64) -> bool {
+        match s {
+            Surface::SpunTrefoil(_) | Surface::TwistSpunTrefoil(_) => {
+                knots::joins().iter().any(|j| (u - j).abs() < 4.0 * h)
+            }
+            Surface::Fermat(_) => v.abs() < 0.05 && (u < 0.05 || u > FRAC_PI_2 - 0.05),
+            _ => false,
+        }
+    }
+
+    #[test]
+    fn exact_derivatives_match_fourth_order_finite_differences() {
+        let mut rng = Rng(0x4D_5EED);
+        let mut worst = 0.0f64;
+        for s in surfaces_under_test() {
+            for patch in 0..s.patch_count() {
+                let d = s.domain(patch);
+                let (hu, hv) = ((d.u[1] - d.u[0]) * 2e-4, (d.v[1] - d.v[0]) * 2e-4);
+                let mut tested = 0;
+                while tested < 12 {
+                    // Stay 2h inside the domain so the stencil does not leave it.
+                    let u = d.u[0] + 2.0 * hu + (d.u[1] - d.u[0] - 4.0 * hu) * rng.next();
+                    let v = d.v[0] + 2.0 * hv + (d.v[1] - d.v[0] - 4.0 * hv) * rng.next();
+                    if near_trouble(&s, u, v, hu) {
+                        continue;
+                    }
+                    tested += 1;
+                    let p = |i: i32, j: i32| s.eval(patch, u + i as f64 * hu, v + j as f64 * hv).p;
+                    let d1 = |f: &dyn Fn(i32) -> DVec4, h: f64| {
+                        (-f(2) + f(1) * 8.0 - f(-1) * 8.0 + f(-2)) / (12.0 * h)
+                    };
+                    let d2 = |f: &dyn Fn(i32) -> DVec4, h: f64| {
+                        (-f(2) + f(1) * 16.0 - f(0) * 30.0 + f(-1) * 16.0 - f(-2)) / (12.0 * h * h)
+                    };
+                    let fd = [
+                        d1(&|i| p(i, 0), hu),
+                        d1(&|j| p(0, j), hv),
+                        d2(&|i| p(i, 0), hu),
+                        d1(&|i| d1(&|j| p(i, j), hv), hu),
+                        d2(&|j| p(0, j), hv),
+                    ];
+                    let e = s.eval(patch, u, v);
+                    let exact = [e.du, e.dv, e.duu, e.duv, e.dvv];
+                    for (k, (x, y)) in exact.iter().zip(fd).enumerate() {
+                        let rel = (*x - y).length() / x.length().max(1.0);
+                        worst = worst.max(rel);
+                        assert!(
+                            rel < 1e-6,
+                            "{} patch {patch} at ({u}, {v}): derivative {k} exact {x} vs finite differences {y} (relative {rel:e})",
+                            s.type_name()
+                        );
+                    }
+                }
+            }
+        }
+        eprintln!("worst relative disagreement: {worst:e}");
+    }
+
+    #[test]
+    fn glued_sides_and_poles_are_the_same_points() {
+        let mut rng = Rng(7);
+        for s in surfaces_under_test() {
+            let scale = (0..s.patch_count())
+                .map(|p| s.eval(p, s.domain(p).u[0], s.domain(p).v[0]).p.length())
+                .fold(1.0, f64::max);
+            for patch in 0..s.patch_count() {
+                let d = s.domain(patch);
+                for side in Side::ALL {
+                    for _ in 0..20 {
+                        let sigma = rng.next();
+                        let (u, v) = d.side_point(side, sigma);
+                        let here = s.eval(patch, u, v).p;
+                        match d.side(side) {
+                            SideRule::Open => {}
+                            SideRule::Pole => {
+                                let (u0, v0) = d.side_point(side, 0.0);
+                                assert!((here - s.eval(patch, u0, v0).p).length() < 1e-12 * scale);
+                            }
+                            SideRule::Glued(pieces) => {
+                                let g = pieces
+                                    .iter()
+                                    .find(|g| g.from <= sigma && sigma <= g.to)
+                                    .expect("pieces cover the side");
+                                let other = s.domain(g.patch);
+                                let (u1, v1) = other.side_point(g.side, g.map(sigma));
+                                let there = s.eval(g.patch, u1, v1).p;
+                                assert!(
+                                    (here - there).length() < 1e-12 * scale,
+                                    "{} patch {patch} side {side:?} at {sigma}: {here} is not {there}",
+                                    s.type_name()
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
     }
 }

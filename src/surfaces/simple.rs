@@ -177,6 +177,11 @@ impl Parametric for ProjectivePlane {
             euler_characteristic: Some(1),
         }
     }
+    /// The equator is glued to itself by a half turn: 4 cells along it would fold into 2
+    /// vertices joined by one edge four times over.
+    fn min_cells(&self) -> [usize; 2] {
+        [4, 6]
+    }
     fn check(&self) -> Result<(), (&'static str, String)> {
         positive("radius", self.radius)
     }

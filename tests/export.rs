@@ -1,0 +1,160 @@
+//! Export round trips through real readers: gltf for .glb, ply-rs for .ply, tobj for .obj.
+
+use crate::common::fixture_scenes;
+use halo4d::Scene;
+use ply_rs::ply::Property;
+
+fn float(p: &Property) -> f64 {
+    match p {
+        Property::Float(x) => f64::from(*x),
+        Property::Int(x) => f64::from(*x),
+        other => panic!("unexpected property {other:?}"),
+    }
+}
+
+#[test]
+fn every_fixture_builds_and_reads_back() {
+    let dir = tempfile::tempdir().unwrap();
+    for path in fixture_scenes() {
+        let mut scene = Scene::load(&path).unwrap();
+        scene.outputs.obj = true;
+        let out = dir.path().join(&scene.name);
+        let report =
+            halo4d::build(&scene, &out, true).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let (products, _) = halo4d::run(&scene, true).unwrap();
+        let name = &scene.name;
+
+        // glTF: one mesh per surface, named after it, with the custom attributes.
+        let glb = std::fs::read(out.join(format!("{name}.glb"))).unwrap();
+        let gltf = gltf::Gltf::from_slice(&glb).unwrap_or_else(|e| panic!("{name}.glb: {e}"));
+        let blob = gltf.blob.as_deref().expect("binary chunk");
+        assert_eq!(gltf.meshes().count(), products.len());
+        let extras = gltf
+            .document
+            .as_json()
+            .asset
+            .extras
+            .as_ref()
+            .expect("asset extras");
+        let recorded: serde_json::Value = serde_json::from_str(extras.get()).unwrap();
+        assert_eq!(
+            recorded["halo4d"]["scene"],
+            serde_json::to_value(&scene).unwrap()
+        );
+        for (mesh, p) in gltf.meshes().zip(&products) {
+            assert_eq!(mesh.name(), Some(p.name.as_str()));
+            let prim = mesh.primitives().next().unwrap();
+            assert_eq!(prim.mode(), gltf::mesh::Mode::Triangles);
+            let reader = prim.reader(|_| Some(blob));
+            let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
+            assert_eq!(positions.len(), p.mesh.vertex_count());
+            let indices: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
+            assert_eq!(indices.len(), 3 * p.mesh.triangles.len());
+            assert!(indices.iter().all(|i| (*i as usize) < positions.len()));
+            for n in reader.read_normals().unwrap() {
+                let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                assert!((len - 1.0).abs() < 1e-5);
+            }
+            // POSITION min/max are exactly the extremes of the stored f32 values.
+            let acc = prim.get(&gltf::Semantic::Positions).unwrap();
+            let min: Vec<f32> = serde_json::from_value(acc.min().unwrap()).unwrap();
+            for k in 0..3 {
+                let lo = positions.iter().map(|q| q[k]).fold(f32::INFINITY, f32::min);
+                assert_eq!(min[k], lo);
+            }
+            for (attr, expect) in [
+                ("_W", p.projected.w.clone()),
+                ("_U", p.mesh.uv.iter().map(|x| x[0]).collect()),
+                ("_V", p.mesh.uv.iter().map(|x| x[1]).collect()),
+                (
+                    "_PATCH",
+                    p.mesh.patch.iter().map(|x| f64::from(*x)).collect(),
+                ),
+            ] {
+                let acc = prim
+                    .attributes()
+                    .find(|(s, _)| s.to_string() == attr)
+                    .unwrap_or_else(|| panic!("{name}: no {attr}"))
+                    .1;
+                assert_eq!(acc.data_type(), gltf::accessor::DataType::F32);
+                assert_eq!(acc.dimensions(), gltf::accessor::Dimensions::Scalar);
+                let view = acc.view().unwrap();
+                let bytes = &blob[view.offset() + acc.offset()..][..acc.count() * 4];
+                for (chunk, e) in bytes.chunks_exact(4).zip(&expect) {
+                    let got = f32::from_le_bytes(chunk.try_into().unwrap());
+                    assert_eq!(got, *e as f32, "{name}: {attr}");
+                }
+            }
+        }
+
+        // PLY: same vertex and face counts, w as quality.
+        let ply_bytes = std::fs::read(out.join(format!("{name}.ply"))).unwrap();
+        let parser = ply_rs::parser::Parser::<ply_rs::ply::DefaultElement>::new();
+        let ply = parser.read_ply(&mut ply_bytes.as_slice()).unwrap();
+        let vertices = &ply.payload["vertex"];
+        let faces = &ply.payload["face"];
+        assert_eq!(
+            vertices.len(),
+            products
+                .iter()
+                .map(|p| p.mesh.vertex_count())
+                .sum::<usize>()
+        );
+        assert_eq!(
+            faces.len(),
+            products
+                .iter()
+                .map(|p| p.mesh.triangles.len())
+                .sum::<usize>()
+        );
+        let w: Vec<f64> = products
+            .iter()
+            .flat_map(|p| p.projected.w.iter().copied())
+            .collect();
+        for (v, w) in vertices.iter().zip(&w) {
+            assert_eq!(float(&v["quality"]), f64::from(*w as f32));
+        }
+
+        // OBJ through tobj: one model per surface with the same counts.
+        let (models, _) =
+            tobj::load_obj(out.join(format!("{name}.obj")), &tobj::GPU_LOAD_OPTIONS).unwrap();
+        assert_eq!(models.len(), products.len());
+        for (m, p) in models.iter().zip(&products) {
+            assert_eq!(m.name, p.name);
+            assert_eq!(m.mesh.indices.len(), 3 * p.mesh.triangles.len());
+            assert_eq!(m.mesh.positions.len(), 3 * p.mesh.vertex_count());
+        }
+
+        // The report lists what was written and counts what was built.
+        let text = std::fs::read_to_string(out.join("report.json")).unwrap();
+        let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(json["surfaces"].as_array().unwrap().len(), products.len());
+        assert_eq!(
+            json["surfaces"][0]["triangles"],
+            products[0].mesh.triangles.len()
+        );
+        assert_eq!(report.files.len(), 4);
+        assert!(
+            !text.contains("NaN") && !text.contains("null,"),
+            "report has a non-number"
+        );
+    }
+}
+
+#[test]
+fn a_failed_write_leaves_no_partial_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Scene::default_scene();
+    // The output "folder" is a file: the build must fail with a clear error.
+    let blocker = dir.path().join("occupied");
+    std::fs::write(&blocker, b"x").unwrap();
+    let err = halo4d::build(&scene, &blocker, true)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("cannot write") && err.contains("--out"),
+        "{err}"
+    );
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(leftovers.len(), 1);
+}

@@ -1,0 +1,8 @@
+//! Integration tests, one module per stage.
+
+mod cli;
+mod common;
+mod export;
+mod sample;
+mod scene;
+mod view;

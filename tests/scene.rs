@@ -1,0 +1,187 @@
+//! Scene files: every fixture parses; broken scenes get errors that name the file and the
+//! field; no input panics the parser.
+
+use crate::common::{Rng, fixture, fixture_scenes};
+use halo4d::{Scene, SceneError};
+
+#[test]
+fn every_fixture_scene_parses_and_the_default_is_the_fixture() {
+    for path in fixture_scenes() {
+        Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    }
+    assert_eq!(
+        Scene::default_scene(),
+        Scene::load(&fixture("scenes/default.json")).unwrap()
+    );
+    assert_eq!(
+        Scene::default_scene().surfaces[0].surface.type_name(),
+        "spun_trefoil"
+    );
+}
+
+#[test]
+fn every_catalogue_surface_has_a_fixture_scene() {
+    let used: Vec<&str> = fixture_scenes()
+        .iter()
+        .flat_map(|p| {
+            Scene::load(p)
+                .unwrap()
+                .surfaces
+                .into_iter()
+                .map(|s| s.surface.type_name())
+        })
+        .collect();
+    for s in halo4d::Surface::catalogue() {
+        assert!(
+            used.contains(&s.type_name()),
+            "no fixture scene uses {}",
+            s.type_name()
+        );
+    }
+}
+
+/// Each broken scene with words its error must contain (the field and what is allowed).
+const BROKEN: &[(&str, &[&str])] = &[
+    (
+        "unknown-surface.json",
+        &[
+            "surfaces[0].surface",
+            "unknown surface type `moebius_strip`",
+            "flat_torus",
+        ],
+    ),
+    (
+        "fermat-n-out-of-range.json",
+        &["surfaces[0].surface.n", "between 2 and 6", "9"],
+    ),
+    (
+        "unknown-surface-key.json",
+        &["surfaces[0].surface", "unknown field `raduis`", "r2"],
+    ),
+    (
+        "unknown-halo-key.json",
+        &["halo", "unknown field `rhoo`", "rho"],
+    ),
+    ("zero-resolution.json", &["sampling.u", "even number"]),
+    ("odd-resolution.json", &["sampling.u", "even number", "9"]),
+    ("negative-rho.json", &["halo.rho", "greater than 0"]),
+    ("zero-rho.json", &["halo.rho", "greater than 0"]),
+    (
+        "infinite-number.json",
+        &["surfaces[0].surface", "out of range"],
+    ),
+    (
+        "nan-literal.json",
+        &["surfaces[0].surface", "expected value"],
+    ),
+    (
+        "one-twist.json",
+        &["surfaces[0].surface.twists", "unknotted"],
+    ),
+    (
+        "klein-not-embedded.json",
+        &[
+            "surfaces[0].surface.minor_radius",
+            "smaller than major_radius",
+        ],
+    ),
+    ("path-in-name.json", &["name", "../evil", "letters, digits"]),
+    ("no-surfaces.json", &["surfaces", "1 to 64"]),
+    ("duplicate-names.json", &["surfaces[1].name", "unique"]),
+    (
+        "negative-eye.json",
+        &["view.projection.eye_distance", "greater than 0"],
+    ),
+    (
+        "unknown-plane.json",
+        &["view.rotation", "unknown field `xq`"],
+    ),
+    ("too-many-triangles.json", &["sampling", "limit"]),
+    ("trailing-text.json", &["after the scene", "trailing"]),
+    (
+        "unknown-sampling-method.json",
+        &["sampling", "unknown variant `adaptive`"],
+    ),
+    ("not-an-object.json", &["invalid type"]),
+    (
+        "negative-count.json",
+        &["surfaces[0].surface: count: invalid value"],
+    ),
+    ("empty.json", &["EOF"]),
+    ("delta-t-out-of-range.json", &["halo.delta_t", "[0, 1)"]),
+    (
+        "projective-plane-too-coarse.json",
+        &["sampling", "projective_plane needs at least 4 x 6 cells"],
+    ),
+];
+
+#[test]
+fn broken_scenes_get_errors_naming_file_and_field() {
+    let dir = fixture("broken");
+    let mut files: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    let mut listed: Vec<String> = BROKEN.iter().map(|(f, _)| f.to_string()).collect();
+    listed.sort();
+    assert_eq!(
+        files, listed,
+        "every broken fixture needs its expected message here"
+    );
+    for (file, words) in BROKEN {
+        let path = dir.join(file);
+        let err = Scene::load(&path).expect_err(file).to_string();
+        assert!(
+            err.starts_with(&path.display().to_string()),
+            "{file}: error does not name the file: {err}"
+        );
+        for w in *words {
+            assert!(err.contains(w), "{file}: error lacks `{w}`: {err}");
+        }
+    }
+}
+
+#[test]
+fn missing_file_is_an_io_error_naming_it() {
+    let err = Scene::load(&fixture("scenes/no-such-scene.json")).unwrap_err();
+    assert!(matches!(err, SceneError::Io { .. }));
+    assert!(err.to_string().contains("no-such-scene.json"), "{err}");
+}
+
+#[test]
+fn truncated_and_mutated_scenes_never_panic() {
+    // Every prefix of every fixture, and seeded random byte edits: errors or scenes, never a
+    // panic (a panic fails the test).
+    let mut rng = Rng(2026);
+    let alphabet = b"{}[]\":,-.0123456789eE truefalsnul\\x";
+    for path in fixture_scenes() {
+        let text = std::fs::read_to_string(&path).unwrap();
+        for cut in 0..text.len() {
+            if text.is_char_boundary(cut) && !text[cut..].trim().is_empty() {
+                assert!(
+                    Scene::parse(&text[..cut], "cut.json").is_err(),
+                    "a cut scene cannot be whole"
+                );
+            }
+        }
+        for _ in 0..300 {
+            let mut bytes = text.clone().into_bytes();
+            for _ in 0..1 + rng.below(4) {
+                let i = rng.below(bytes.len());
+                match rng.below(3) {
+                    0 => bytes[i] = alphabet[rng.below(alphabet.len())],
+                    1 => {
+                        bytes.remove(i);
+                    }
+                    _ => bytes.insert(i, alphabet[rng.below(alphabet.len())]),
+                }
+            }
+            if let Ok(text) = String::from_utf8(bytes) {
+                if let Ok(scene) = Scene::parse(&text, "mutated.json") {
+                    assert!(scene.validate().is_ok());
+                }
+            }
+        }
+    }
+}
