@@ -1,9 +1,10 @@
-// Runs the Khronos glTF-Validator on every .glb given on the command line. Prints each
+// Runs the Khronos glTF-Validator (installed beside this script by .ci/run) on every .glb
+// given on the command line. Prints each
 // message; exits non-zero when any file has an error or a warning, or cannot be read.
 import { readFile } from 'node:fs/promises';
 import { createRequire } from 'node:module';
 
-const require = createRequire(process.cwd() + '/');
+const require = createRequire(import.meta.url);
 const validator = require('gltf-validator');
 
 let bad = 0;

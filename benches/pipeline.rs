@@ -1,1 +1,47 @@
-fn main() {}
+//! Stage costs of the build: uniform sampling, projection and export, on a sweep of grid
+//! sizes, for the default scene's spun trefoil and the quartic Fermat.
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use halo4d::export::{SurfaceData, to_glb, to_ply};
+use halo4d::surfaces::{Fermat, SpunTrefoil};
+use halo4d::{Surface, View, sample_uniform};
+use std::hint::black_box;
+
+fn surfaces() -> [(&'static str, Surface); 2] {
+    [
+        ("spun_trefoil", Surface::SpunTrefoil(SpunTrefoil::default())),
+        ("fermat_quartic", Surface::Fermat(Fermat::default())),
+    ]
+}
+
+fn stages(c: &mut Criterion) {
+    let view = halo4d::Scene::default_scene().view;
+    for (name, surface) in surfaces() {
+        let mut group = c.benchmark_group(format!("sample/{name}"));
+        for cells in [16, 64, 256] {
+            group.bench_with_input(BenchmarkId::from_parameter(cells), &cells, |b, &n| {
+                b.iter(|| sample_uniform(black_box(&surface), n, n))
+            });
+        }
+        group.finish();
+
+        let mesh = sample_uniform(&surface, 128, 128);
+        c.bench_function(&format!("view/{name}/128"), |b| b.iter(|| black_box(&view).project(&mesh).unwrap()));
+
+        let projected = View::project(&view, &mesh).unwrap();
+        let data = [SurfaceData {
+            name,
+            surface_type: surface.type_name(),
+            patches: surface.patch_count(),
+            mesh: &mesh,
+            projected: &projected,
+        }];
+        c.bench_function(&format!("export_glb/{name}/128"), |b| {
+            b.iter(|| to_glb(black_box(&data), &serde_json::Value::Null).unwrap())
+        });
+        c.bench_function(&format!("export_ply/{name}/128"), |b| b.iter(|| to_ply(black_box(&data), name)));
+    }
+}
+
+criterion_group!(benches, stages);
+criterion_main!(benches);

@@ -103,7 +103,7 @@ impl Projection {
             Projection::Orthographic => (1.0, 0.0),
             Projection::Perspective { eye_distance: e } => {
                 let depth = p.w + e;
-                if !(depth > 0.0) {
+                if depth.is_nan() || depth <= 0.0 {
                     return None;
                 }
                 // d(f xyz) = f dxyz - (f / depth) xyz dw, with f = e / depth.

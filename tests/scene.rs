@@ -177,10 +177,10 @@ fn truncated_and_mutated_scenes_never_panic() {
                     _ => bytes.insert(i, alphabet[rng.below(alphabet.len())]),
                 }
             }
-            if let Ok(text) = String::from_utf8(bytes) {
-                if let Ok(scene) = Scene::parse(&text, "mutated.json") {
-                    assert!(scene.validate().is_ok());
-                }
+            if let Ok(text) = String::from_utf8(bytes)
+                && let Ok(scene) = Scene::parse(&text, "mutated.json")
+            {
+                assert!(scene.validate().is_ok());
             }
         }
     }

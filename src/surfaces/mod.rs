@@ -447,7 +447,7 @@ mod tests {
             Surface::SpunTrefoil(_) | Surface::TwistSpunTrefoil(_) => {
                 knots::joins().iter().any(|j| (u - j).abs() < 4.0 * h)
             }
-            Surface::Fermat(_) => v.abs() < 0.05 && (u < 0.05 || u > FRAC_PI_2 - 0.05),
+            Surface::Fermat(_) => v.abs() < 0.05 && !(0.05..=FRAC_PI_2 - 0.05).contains(&u),
             _ => false,
         }
     }
