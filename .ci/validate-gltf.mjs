@@ -1,6 +1,6 @@
 // Runs the Khronos glTF-Validator (installed beside this script by .ci/run) on every .glb
-// given on the command line. Prints each
-// message; exits non-zero when any file has an error or a warning, or cannot be read.
+// given on the command line. Prints each message; exits non-zero when any file has an error
+// or a warning, or cannot be read.
 import { readFile } from 'node:fs/promises';
 import { createRequire } from 'node:module';
 
