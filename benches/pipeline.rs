@@ -26,7 +26,9 @@ fn stages(c: &mut Criterion) {
         group.finish();
 
         let mesh = sample_uniform(&surface, 128, 128);
-        c.bench_function(&format!("view/{name}/128"), |b| b.iter(|| black_box(&view).project(&mesh).unwrap()));
+        c.bench_function(&format!("view/{name}/128"), |b| {
+            b.iter(|| black_box(&view).project(&mesh).unwrap())
+        });
 
         let projected = View::project(&view, &mesh).unwrap();
         let data = [SurfaceData {
@@ -39,7 +41,9 @@ fn stages(c: &mut Criterion) {
         c.bench_function(&format!("export_glb/{name}/128"), |b| {
             b.iter(|| to_glb(black_box(&data), &serde_json::Value::Null).unwrap())
         });
-        c.bench_function(&format!("export_ply/{name}/128"), |b| b.iter(|| to_ply(black_box(&data), name)));
+        c.bench_function(&format!("export_ply/{name}/128"), |b| {
+            b.iter(|| to_ply(black_box(&data), name))
+        });
     }
 }
 
