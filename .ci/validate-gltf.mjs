@@ -27,4 +27,6 @@ if (process.argv.length <= 2) {
   console.log('no .glb files given');
   bad += 1;
 }
+const total = Math.max(process.argv.length - 2, 0);
+console.log(`glTF-Validator: ${total - Math.min(bad, total)} passed, ${bad} failed`);
 process.exit(bad > 0 ? 1 : 0);
