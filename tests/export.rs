@@ -142,7 +142,7 @@ fn every_fixture_builds_and_reads_back() {
 }
 
 #[test]
-fn a_failed_write_leaves_no_partial_file() {
+fn an_unwritable_output_folder_is_a_clear_error_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let scene = Scene::default_scene();
     // The output "folder" is a file: the build must fail with a clear error.
