@@ -16,7 +16,7 @@ pub mod surfaces;
 pub mod view;
 
 pub use error::Error;
-pub use pipeline::{Report, build, run};
+pub use pipeline::{Report, build, run, write};
 pub use sample::{Mesh4, MeshStats, Sampling, sample_uniform};
 pub use scene::{Scene, SceneError};
 pub use surfaces::{Domain, Eval4, Surface, Topology};

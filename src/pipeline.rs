@@ -51,7 +51,7 @@ pub struct Timings {
     pub view: f64,
     /// Writing the outputs.
     pub export: f64,
-    /// The whole build.
+    /// Sum of the stages.
     pub total: f64,
 }
 
@@ -170,8 +170,19 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<(Vec<SurfaceProduct>, Timings),
 
 /// Builds a scene into `out_dir`: runs the stages and writes the outputs the scene asks for.
 pub fn build(scene: &Scene, out_dir: &Path, quiet: bool) -> Result<Report, Error> {
-    let start = Instant::now();
-    let (products, mut timings) = run(scene, quiet)?;
+    let (products, timings) = run(scene, quiet)?;
+    write(scene, &products, timings, out_dir)
+}
+
+/// Writes the outputs the scene asks for from the products of [`run`] into `out_dir`, and
+/// returns the report (also written as `report.json` when asked for). `timings` are those
+/// of [`run`]; the export time is added, and the total is the sum of the stages.
+pub fn write(
+    scene: &Scene,
+    products: &[SurfaceProduct],
+    mut timings: Timings,
+    out_dir: &Path,
+) -> Result<Report, Error> {
     let export_start = Instant::now();
     std::fs::create_dir_all(out_dir).map_err(|source| Error::Write {
         path: out_dir.to_path_buf(),
@@ -209,7 +220,7 @@ pub fn build(scene: &Scene, out_dir: &Path, quiet: bool) -> Result<Report, Error
     if scene.outputs.report {
         files.push("report.json".into());
     }
-    timings.total = ms(start);
+    timings.total = timings.sample + timings.view + timings.export;
     let report = Report {
         halo4d: env!("CARGO_PKG_VERSION"),
         scene_name: scene.name.clone(),
@@ -233,7 +244,6 @@ pub fn build(scene: &Scene, out_dir: &Path, quiet: bool) -> Result<Report, Error
 }
 
 fn surface_report(scene: &Scene, i: usize, p: &SurfaceProduct) -> SurfaceReport {
-    let w = &p.projected.w;
     SurfaceReport {
         name: p.name.clone(),
         type_name: p.surface.type_name().to_string(),
@@ -251,11 +261,6 @@ fn surface_report(scene: &Scene, i: usize, p: &SurfaceProduct) -> SurfaceReport 
             min: lo.to_array().to_vec(),
             max: hi.to_array().to_vec(),
         }),
-        w_range: (!w.is_empty()).then(|| {
-            [
-                w.iter().copied().fold(f64::INFINITY, f64::min),
-                w.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            ]
-        }),
+        w_range: p.projected.w_range(),
     }
 }

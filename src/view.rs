@@ -159,6 +159,16 @@ pub struct Projected {
 }
 
 impl Projected {
+    /// The smallest and largest w-depth, or `None` for an empty mesh.
+    pub fn w_range(&self) -> Option<[f64; 2]> {
+        let first = *self.w.first()?;
+        Some(
+            self.w
+                .iter()
+                .fold([first, first], |[lo, hi], w| [lo.min(*w), hi.max(*w)]),
+        )
+    }
+
     /// Axis-aligned bounding box of the 3D positions, or `None` for an empty mesh.
     pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
         let first = *self.positions.first()?;

@@ -19,9 +19,9 @@ fn every_fixture_builds_and_reads_back() {
         let mut scene = Scene::load(&path).unwrap();
         scene.outputs.obj = true;
         let out = dir.path().join(&scene.name);
-        let report =
-            halo4d::build(&scene, &out, true).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let (products, _) = halo4d::run(&scene, true).unwrap();
+        let (products, timings) = halo4d::run(&scene, true).unwrap();
+        let report = halo4d::write(&scene, &products, timings, &out)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let name = &scene.name;
 
         // glTF: one mesh per surface, named after it, with the custom attributes.

@@ -5,4 +5,5 @@ mod common;
 mod export;
 mod sample;
 mod scene;
+mod surfaces;
 mod view;

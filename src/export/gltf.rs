@@ -193,7 +193,7 @@ pub fn to_glb(surfaces: &[SurfaceData], scene_json: &serde_json::Value) -> Resul
             extras: extras(serde_json::json!({
                 "surface": s.surface_type,
                 "patches": s.patches,
-                "w_range": [p.w.iter().copied().fold(f64::INFINITY, f64::min), p.w.iter().copied().fold(f64::NEG_INFINITY, f64::max)],
+                "w_range": p.w_range(),
             }))?,
             extensions: None,
             primitives: vec![json::mesh::Primitive {
