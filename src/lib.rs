@@ -13,11 +13,12 @@ pub mod pipeline;
 pub mod sample;
 pub mod scene;
 pub mod surfaces;
+pub mod sweep;
 pub mod view;
 
 pub use error::Error;
 pub use pipeline::{Report, build, run, write};
-pub use sample::{Mesh4, MeshStats, Sampling, sample_uniform};
+pub use sample::{Mesh4, MeshStats, Sampling, sample, sample_adaptive, sample_uniform};
 pub use scene::{Scene, SceneError};
 pub use surfaces::{Domain, Eval4, Surface, Topology};
 pub use view::{Projected, Projection, Rotation4, View};

@@ -27,20 +27,43 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Speed against error: for each surface of a scene, the adaptive sampler and the
+    /// coarsest uniform grid at relative tolerances 1e-2 to 1e-5, audited alike. Writes
+    /// speed_vs_error.csv and speed_vs_error.png.
+    Sweep {
+        /// Scene file (JSON) [default: the built-in default scene].
+        scene: Option<PathBuf>,
+        /// Output folder.
+        #[arg(long, default_value = "exports/reports")]
+        out: PathBuf,
+        /// Relative tolerances, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = halo4d::sweep::TOLERANCES)]
+        tolerances: Vec<f64>,
+        /// The most triangles of any one mesh.
+        #[arg(long, default_value_t = 8_000_000)]
+        max_triangles: usize,
+        /// No progress messages.
+        #[arg(long, short)]
+        quiet: bool,
+    },
     /// List the surface catalogue with each surface's parameters and defaults.
     List,
+}
+
+fn load(scene: Option<PathBuf>) -> Result<Scene, halo4d::SceneError> {
+    match scene {
+        Some(path) => Scene::load(&path),
+        None => Ok(Scene::default_scene()),
+    }
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
         Command::Build { scene, out, quiet } => {
-            let scene = match scene {
-                Some(path) => match Scene::load(&path) {
-                    Ok(s) => s,
-                    Err(e) => return fail(&e),
-                },
-                None => Scene::default_scene(),
+            let scene = match load(scene) {
+                Ok(s) => s,
+                Err(e) => return fail(&e),
             };
             let out = out.unwrap_or_else(|| PathBuf::from("exports").join(&scene.name));
             match halo4d::build(&scene, &out, quiet) {
@@ -53,11 +76,58 @@ fn main() -> ExitCode {
                     }
                     let t = report.timings_ms;
                     eprintln!(
-                        "sample {:.1} ms, view {:.1} ms, export {:.1} ms, total {:.1} ms",
-                        t.sample, t.view, t.export, t.total
+                        "sample {:.1} ms, audit {:.1} ms, view {:.1} ms, export {:.1} ms, total {:.1} ms",
+                        t.sample, t.audit, t.view, t.export, t.total
                     );
                     for f in &report.files {
                         println!("{}", out.join(f).display());
+                    }
+                    ExitCode::SUCCESS
+                }
+                Err(e) => fail(&e),
+            }
+        }
+        Command::Sweep {
+            scene,
+            out,
+            tolerances,
+            max_triangles,
+            quiet,
+        } => {
+            let scene = match load(scene) {
+                Ok(s) => s,
+                Err(e) => return fail(&e),
+            };
+            if let Some(bad) = tolerances.iter().find(|t| !(1e-9..=0.5).contains(*t)) {
+                eprintln!(
+                    "error: --tolerances: every tolerance must be from 1e-9 to 0.5 (a share of the bounding diagonal), got {bad}"
+                );
+                return ExitCode::FAILURE;
+            }
+            if !(64..=halo4d::scene::MAX_TRIANGLES).contains(&max_triangles) {
+                eprintln!(
+                    "error: --max-triangles must be from 64 to {}, got {max_triangles}",
+                    halo4d::scene::MAX_TRIANGLES
+                );
+                return ExitCode::FAILURE;
+            }
+            let surfaces: Vec<_> = (0..scene.surfaces.len())
+                .map(|i| (scene.surface_name(i), scene.surfaces[i].surface.clone()))
+                .collect();
+            let settings = halo4d::sweep::Settings {
+                tolerances,
+                max_triangles,
+            };
+            let mut progress = |msg: &str| {
+                if !quiet {
+                    eprintln!("{msg}");
+                }
+            };
+            match halo4d::sweep::run(&surfaces, &settings, &out, &mut progress) {
+                Ok((rows, files)) => {
+                    print!("{}", halo4d::sweep::table(&rows));
+                    for f in files {
+                        println!("{}", f.display());
                     }
                     ExitCode::SUCCESS
                 }

@@ -5,7 +5,7 @@
 
 use crate::error::Error;
 use crate::export::{self, SurfaceData};
-use crate::sample::{Mesh4, MeshStats, Sampling, sample_uniform};
+use crate::sample::{self, Audit, Mesh4, MeshStats, Sampling, audit};
 use crate::scene::Scene;
 use crate::surfaces::{Surface, Topology};
 use crate::view::Projected;
@@ -25,8 +25,93 @@ pub struct SurfaceProduct {
     pub mesh: Mesh4,
     /// The mesh's statistics.
     pub stats: MeshStats,
+    /// How it was sampled and how far it is from the surface.
+    pub sampling: SamplingReport,
     /// Its 3D projection.
     pub projected: Projected,
+}
+
+/// How a surface was sampled, and the audit of the mesh (`report.json`'s `sampling`).
+#[derive(Clone, Debug, Serialize)]
+pub struct SamplingReport {
+    /// `adaptive` or `uniform`.
+    pub method: &'static str,
+    /// The absolute tolerance the adaptive sampler aimed at.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
+    /// The same, relative to `diagonal`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub relative_tolerance: Option<f64>,
+    /// The adaptive sampler's triangle budget.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_triangles: Option<usize>,
+    /// Diagonal of the surface's 4D bounding box, the length relative values refer to.
+    pub diagonal: f64,
+    /// Triangles.
+    pub triangles: usize,
+    /// Vertices.
+    pub vertices: usize,
+    /// Audited largest distance, triangle to surface, in R^4.
+    pub max_error: f64,
+    /// Audited root mean square distance.
+    pub rms_error: f64,
+    /// `max_error / diagonal`.
+    pub max_error_relative: f64,
+    /// `rms_error / diagonal`.
+    pub rms_error_relative: f64,
+    /// Whether the sampler met its tolerance everywhere (false when its triangle budget
+    /// stopped it).
+    pub complete: bool,
+    /// Milliseconds spent sampling.
+    pub ms: f64,
+    /// Milliseconds spent auditing.
+    pub audit_ms: f64,
+}
+
+impl SamplingReport {
+    fn new(
+        sampling: &Sampling,
+        sampled: &sample::Sampled,
+        audit: &Audit,
+        ms: f64,
+        audit_ms: f64,
+    ) -> Self {
+        let (max_rel, rms_rel) = audit.relative(sampled.diagonal);
+        SamplingReport {
+            method: sampling.method(),
+            max_triangles: match *sampling {
+                Sampling::Adaptive { max_triangles, .. } => Some(max_triangles),
+                Sampling::Uniform { .. } => None,
+            },
+            tolerance: sampled.tolerance,
+            relative_tolerance: sampled.tolerance.map(|t| t / sampled.diagonal),
+            diagonal: sampled.diagonal,
+            triangles: sampled.mesh.triangles.len(),
+            vertices: sampled.mesh.vertex_count(),
+            max_error: audit.max_error,
+            rms_error: audit.rms_error,
+            max_error_relative: max_rel,
+            rms_error_relative: rms_rel,
+            complete: sampled.complete,
+            ms,
+            audit_ms,
+        }
+    }
+
+    /// The warning a build prints when the sampler stopped short of its tolerance.
+    pub fn warning(&self, surface: &str) -> Option<String> {
+        if self.complete {
+            return None;
+        }
+        Some(format!(
+            "surface `{surface}`: the triangle budget (max_triangles = {}) stopped refinement at {} triangles before every triangle met the tolerance {:.3e}; the audited max error is {:.3e} ({:.3e} of the diagonal). Raise max_triangles or the tolerance.",
+            self.max_triangles.unwrap_or(0),
+            self.triangles,
+            self.tolerance.unwrap_or(f64::NAN),
+            self.max_error,
+            self.max_error_relative,
+        ))
+    }
 }
 
 impl SurfaceProduct {
@@ -47,6 +132,8 @@ impl SurfaceProduct {
 pub struct Timings {
     /// Sampling, all surfaces.
     pub sample: f64,
+    /// Auditing the samples, all surfaces.
+    pub audit: f64,
     /// View (rotation, projection, normals), all surfaces.
     pub view: f64,
     /// Writing the outputs.
@@ -74,8 +161,8 @@ pub struct SurfaceReport {
     pub type_name: String,
     /// Parameter patches.
     pub patches: usize,
-    /// Sampling used.
-    pub sampling: Sampling,
+    /// Sampling and its audit.
+    pub sampling: SamplingReport,
     /// Vertices.
     pub vertices: usize,
     /// Triangles.
@@ -103,6 +190,8 @@ pub struct Report {
     pub surfaces: Vec<SurfaceReport>,
     /// Milliseconds per stage.
     pub timings_ms: Timings,
+    /// Warnings, also printed on stderr.
+    pub warnings: Vec<String>,
     /// Files written, relative to the output folder.
     pub files: Vec<String>,
     /// The scene as parsed, with every default filled in.
@@ -134,11 +223,21 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<(Vec<SurfaceProduct>, Timings),
     for (i, entry) in scene.surfaces.iter().enumerate() {
         let name = scene.surface_name(i);
         bar.set_message(format!("sampling {name}"));
+        let sampling = scene.surface_sampling(i);
         let start = Instant::now();
-        let Sampling::Uniform { u, v } = *scene.surface_sampling(i);
-        let mesh = sample_uniform(&entry.surface, u, v);
+        let sampled = sample::sample(&entry.surface, sampling);
+        let sample_ms = ms(start);
+        timings.sample += sample_ms;
+        let start = Instant::now();
+        let audited = audit(&entry.surface, &sampled.mesh);
+        let audit_ms = ms(start);
+        timings.audit += audit_ms;
+        let report = SamplingReport::new(sampling, &sampled, &audited, sample_ms, audit_ms);
+        if let Some(w) = report.warning(&name) {
+            bar.suspend(|| eprintln!("warning: {w}"));
+        }
+        let mesh = sampled.mesh;
         let stats = mesh.validate();
-        timings.sample += ms(start);
         bar.inc(1);
 
         bar.set_message(format!("projecting {name}"));
@@ -161,6 +260,7 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<(Vec<SurfaceProduct>, Timings),
             surface: entry.surface.clone(),
             mesh,
             stats,
+            sampling: report,
             projected,
         });
     }
@@ -220,16 +320,16 @@ pub fn write(
     if scene.outputs.report {
         files.push("report.json".into());
     }
-    timings.total = timings.sample + timings.view + timings.export;
+    timings.total = timings.sample + timings.audit + timings.view + timings.export;
     let report = Report {
         halo4d: env!("CARGO_PKG_VERSION"),
         scene_name: scene.name.clone(),
-        surfaces: products
-            .iter()
-            .enumerate()
-            .map(|(i, p)| surface_report(scene, i, p))
-            .collect(),
+        surfaces: products.iter().map(surface_report).collect(),
         timings_ms: timings,
+        warnings: products
+            .iter()
+            .filter_map(|p| p.sampling.warning(&p.name))
+            .collect(),
         files,
         scene: scene.clone(),
     };
@@ -243,12 +343,12 @@ pub fn write(
     Ok(report)
 }
 
-fn surface_report(scene: &Scene, i: usize, p: &SurfaceProduct) -> SurfaceReport {
+fn surface_report(p: &SurfaceProduct) -> SurfaceReport {
     SurfaceReport {
         name: p.name.clone(),
         type_name: p.surface.type_name().to_string(),
         patches: p.surface.patch_count(),
-        sampling: scene.surface_sampling(i).clone(),
+        sampling: p.sampling.clone(),
         vertices: p.mesh.vertex_count(),
         triangles: p.mesh.triangles.len(),
         topology: p.surface.topology(),

@@ -212,29 +212,35 @@ impl Scene {
                 ));
             }
             names.push(name);
-            let Sampling::Uniform { u, v } = *self.surface_sampling(i);
-            let [min_u, min_v] = s.surface.min_cells();
-            if u < min_u || v < min_v {
-                let field = if s.sampling.is_some() {
-                    format!("surfaces[{i}].sampling")
-                } else {
-                    "sampling".into()
-                };
-                return Err((
-                    field,
-                    format!(
-                        "{} needs at least {min_u} x {min_v} cells, got {u} x {v}",
-                        s.surface.type_name()
-                    ),
-                ));
+            let sampling = self.surface_sampling(i);
+            let field = if s.sampling.is_some() {
+                format!("surfaces[{i}].sampling")
+            } else {
+                "sampling".into()
+            };
+            if let Sampling::Uniform { u, v } = *sampling {
+                let [min_u, min_v] = s.surface.min_cells();
+                if u < min_u || v < min_v {
+                    return Err((
+                        field,
+                        format!(
+                            "{} needs at least {min_u} x {min_v} cells, got {u} x {v}",
+                            s.surface.type_name()
+                        ),
+                    ));
+                }
             }
-            triangles = triangles.saturating_add(u * v * 2 * s.surface.patch_count());
+            // Adaptive budgets are bounded one by one in `Sampling::check`.
+            if let Sampling::Uniform { .. } = sampling {
+                triangles =
+                    triangles.saturating_add(sampling.max_triangles(s.surface.patch_count()));
+            }
         }
         if triangles > MAX_TRIANGLES {
             return Err((
                 "sampling".into(),
                 format!(
-                    "the scene asks for {triangles} triangles, more than the limit of {MAX_TRIANGLES}; lower u and v"
+                    "the scene's grids make {triangles} triangles, more than the limit of {MAX_TRIANGLES}; lower u and v"
                 ),
             ));
         }

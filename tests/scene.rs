@@ -100,7 +100,19 @@ const BROKEN: &[(&str, &[&str])] = &[
     ("trailing-text.json", &["after the scene", "trailing"]),
     (
         "unknown-sampling-method.json",
-        &["sampling", "unknown variant `adaptive`"],
+        &["sampling", "unknown variant `voronoi`"],
+    ),
+    (
+        "both-tolerances.json",
+        &["sampling.absolute_tolerance", "not both"],
+    ),
+    (
+        "tolerance-too-large.json",
+        &["sampling.tolerance", "from 1e-9 to 0.5", "got 2"],
+    ),
+    (
+        "tiny-budget.json",
+        &["surfaces[0].sampling.max_triangles", "from 64", "got 10"],
     ),
     ("not-an-object.json", &["invalid type"]),
     (

@@ -12,7 +12,7 @@ fn one_vertex(s: &Surface, u: f64, v: f64) -> Mesh4 {
         tangent_v: vec![e.dv],
         uv: vec![[u, v]],
         patch: vec![0],
-        triangles: vec![],
+        ..Mesh4::default()
     }
 }
 

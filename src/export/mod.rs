@@ -7,10 +7,12 @@
 
 mod gltf;
 mod obj;
+mod plot;
 mod ply;
 
 pub use gltf::to_glb;
 pub use obj::to_obj;
+pub use plot::{encode_png, speed_vs_error_png};
 pub use ply::to_ply;
 
 use crate::sample::Mesh4;

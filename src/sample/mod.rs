@@ -9,8 +9,12 @@
 //! triangles) with the surface's Euler characteristic; orientable surfaces give consistently
 //! oriented meshes; no triangle repeats a vertex. [`Mesh4::validate`] measures all of this.
 
+mod adaptive;
+mod audit;
 mod uniform;
 
+pub use adaptive::{AdaptiveMesh, metric_aspect, sample_adaptive};
+pub use audit::{AUDIT_POINTS, Audit, audit};
 pub use uniform::sample_uniform;
 
 use crate::surfaces::{Eval4, Surface};
@@ -22,6 +26,20 @@ use std::collections::HashMap;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "method", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Sampling {
+    /// Adaptive refinement until every triangle is within a tolerance of the surface.
+    Adaptive {
+        /// Largest distance in R^4 from a triangle to the surface, relative to the diagonal
+        /// of the surface's 4D bounding box (default 1e-3 when no tolerance is given).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        tolerance: Option<f64>,
+        /// The same bound as an absolute length, instead of `tolerance`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        absolute_tolerance: Option<f64>,
+        /// Refinement stops (with a warning, and `complete: false` in the report) before
+        /// the mesh exceeds this many triangles.
+        #[serde(default = "default_max_triangles")]
+        max_triangles: usize,
+    },
     /// A uniform grid of `u` by `v` cells on every patch.
     Uniform {
         /// Cells along u per patch (even, 4 to 4096).
@@ -31,16 +49,114 @@ pub enum Sampling {
     },
 }
 
+/// Relative tolerance of an adaptive sampling that gives none.
+pub const DEFAULT_TOLERANCE: f64 = 1e-3;
+
+/// Triangle budget of an adaptive sampling that gives none.
+pub const DEFAULT_MAX_TRIANGLES: usize = 2_000_000;
+
+fn default_max_triangles() -> usize {
+    DEFAULT_MAX_TRIANGLES
+}
+
 impl Default for Sampling {
     fn default() -> Self {
-        Sampling::Uniform { u: 64, v: 64 }
+        Sampling::adaptive(DEFAULT_TOLERANCE)
     }
 }
 
+/// The tolerance an adaptive sampling asks for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Tolerance {
+    /// Relative to the diagonal of the surface's 4D bounding box.
+    Relative(f64),
+    /// An absolute length in R^4.
+    Absolute(f64),
+}
+
 impl Sampling {
+    /// Adaptive sampling at a relative tolerance, with the default budget.
+    pub fn adaptive(relative: f64) -> Self {
+        Sampling::Adaptive {
+            tolerance: Some(relative),
+            absolute_tolerance: None,
+            max_triangles: DEFAULT_MAX_TRIANGLES,
+        }
+    }
+
+    /// The tolerance of an adaptive sampling, `None` for a grid.
+    pub fn tolerance(&self) -> Option<Tolerance> {
+        match *self {
+            Sampling::Adaptive {
+                absolute_tolerance: Some(a),
+                ..
+            } => Some(Tolerance::Absolute(a)),
+            Sampling::Adaptive { tolerance, .. } => {
+                Some(Tolerance::Relative(tolerance.unwrap_or(DEFAULT_TOLERANCE)))
+            }
+            Sampling::Uniform { .. } => None,
+        }
+    }
+
+    /// The method's name, as in scene files.
+    pub fn method(&self) -> &'static str {
+        match self {
+            Sampling::Adaptive { .. } => "adaptive",
+            Sampling::Uniform { .. } => "uniform",
+        }
+    }
+
+    /// The most triangles a surface of `patches` patches can get.
+    pub fn max_triangles(&self, patches: usize) -> usize {
+        match *self {
+            Sampling::Adaptive { max_triangles, .. } => max_triangles,
+            Sampling::Uniform { u, v } => u.saturating_mul(v).saturating_mul(2 * patches),
+        }
+    }
+
     /// Checks the settings: `Err((field, message))` names the first bad one.
     pub fn check(&self) -> Result<(), (&'static str, String)> {
         match *self {
+            Sampling::Adaptive {
+                tolerance,
+                absolute_tolerance,
+                max_triangles,
+            } => {
+                if tolerance.is_some() && absolute_tolerance.is_some() {
+                    return Err((
+                        "absolute_tolerance",
+                        "give either `tolerance` (relative to the bounding diagonal) or `absolute_tolerance`, not both".into(),
+                    ));
+                }
+                if let Some(t) = tolerance
+                    && !(1e-9..=0.5).contains(&t)
+                {
+                    return Err((
+                        "tolerance",
+                        format!(
+                            "must be from 1e-9 to 0.5 (a share of the 4D bounding diagonal), got {t}"
+                        ),
+                    ));
+                }
+                if let Some(a) = absolute_tolerance
+                    && !(a.is_finite() && a > 0.0)
+                {
+                    return Err((
+                        "absolute_tolerance",
+                        format!("must be a finite length greater than 0, got {a}"),
+                    ));
+                }
+                if !(64..=crate::scene::MAX_TRIANGLES).contains(&max_triangles) {
+                    return Err((
+                        "max_triangles",
+                        format!(
+                            "must be from 64 to {}, got {max_triangles}",
+                            crate::scene::MAX_TRIANGLES
+                        ),
+                    ));
+                }
+                Ok(())
+            }
             Sampling::Uniform { u, v } => {
                 for (field, n) in [("u", u), ("v", v)] {
                     if !(2..=4096).contains(&n) || n % 2 != 0 {
@@ -55,6 +171,74 @@ impl Sampling {
                 Ok(())
             }
         }
+    }
+}
+
+/// A sampled surface.
+#[derive(Clone, Debug)]
+pub struct Sampled {
+    /// The mesh.
+    pub mesh: Mesh4,
+    /// The absolute tolerance the sampler aimed at (adaptive sampling only).
+    pub tolerance: Option<f64>,
+    /// The diagonal of the surface's 4D bounding box ([`bounding_diagonal`]).
+    pub diagonal: f64,
+    /// Whether the sampler met its tolerance everywhere (always true for a grid).
+    pub complete: bool,
+}
+
+/// Samples a surface as `sampling` says.
+pub fn sample(surface: &Surface, sampling: &Sampling) -> Sampled {
+    let diagonal = bounding_diagonal(surface);
+    match (sampling, sampling.tolerance()) {
+        (&Sampling::Uniform { u, v }, _) => Sampled {
+            mesh: sample_uniform(surface, u, v),
+            tolerance: None,
+            diagonal,
+            complete: true,
+        },
+        (&Sampling::Adaptive { max_triangles, .. }, Some(t)) => {
+            let tolerance = match t {
+                Tolerance::Relative(r) => r * diagonal,
+                Tolerance::Absolute(a) => a,
+            };
+            let out = sample_adaptive(surface, tolerance, max_triangles);
+            Sampled {
+                mesh: out.mesh,
+                tolerance: Some(tolerance),
+                diagonal,
+                complete: out.complete,
+            }
+        }
+        (Sampling::Adaptive { .. }, None) => unreachable!("adaptive sampling has a tolerance"),
+    }
+}
+
+/// The diagonal of the surface's bounding box in R^4, from its points on a 64 x 64 grid of
+/// every patch: the length that relative tolerances and errors refer to.
+pub fn bounding_diagonal(surface: &Surface) -> f64 {
+    const N: usize = 64;
+    let mut lo = DVec4::splat(f64::INFINITY);
+    let mut hi = DVec4::splat(f64::NEG_INFINITY);
+    for patch in 0..surface.patch_count() {
+        let d = surface.domain(patch);
+        for j in 0..=N {
+            for i in 0..=N {
+                let u = d.u[0] + (d.u[1] - d.u[0]) * i as f64 / N as f64;
+                let v = d.v[0] + (d.v[1] - d.v[0]) * j as f64 / N as f64;
+                let p = surface.eval(patch, u, v).p;
+                if p.is_finite() {
+                    lo = lo.min(p);
+                    hi = hi.max(p);
+                }
+            }
+        }
+    }
+    let diagonal = (hi - lo).length();
+    if diagonal.is_finite() && diagonal > 0.0 {
+        diagonal
+    } else {
+        1.0
     }
 }
 
@@ -73,6 +257,12 @@ pub struct Mesh4 {
     pub patch: Vec<u32>,
     /// Triangles, counter-clockwise in (u, v).
     pub triangles: Vec<[u32; 3]>,
+    /// The patch each triangle was cut from.
+    pub triangle_patch: Vec<u32>,
+    /// The (u, v) of each triangle's corners on its own patch. A vertex welded across a seam
+    /// or collapsed into a pole has other parameters on other patches; the audit compares
+    /// each triangle with the surface through these.
+    pub triangle_uv: Vec<[[f64; 2]; 3]>,
 }
 
 /// Statistics of a mesh's combinatorics, from [`Mesh4::validate`].
@@ -173,6 +363,26 @@ impl Mesh4 {
                 .iter()
                 .fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p))),
         )
+    }
+}
+
+/// Union-find over sample points, for welding by the domain rules.
+pub(super) struct Classes(pub(super) Vec<usize>);
+
+impl Classes {
+    pub(super) fn find(&mut self, mut i: usize) -> usize {
+        while self.0[i] != i {
+            self.0[i] = self.0[self.0[i]];
+            i = self.0[i];
+        }
+        i
+    }
+
+    /// Joins two classes, keeping the smaller node as the representative.
+    pub(super) fn union(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        let (lo, hi) = (ra.min(rb), ra.max(rb));
+        self.0[hi] = lo;
     }
 }
 

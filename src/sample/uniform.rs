@@ -1,27 +1,7 @@
 //! The uniform (u, v) grid sampler.
 
-use super::{Mesh4, eval_vertex};
+use super::{Classes, Mesh4, eval_vertex};
 use crate::surfaces::{Side, SideRule, Surface};
-
-/// Union-find over grid nodes, for welding by the domain rules.
-struct Classes(Vec<usize>);
-
-impl Classes {
-    fn find(&mut self, mut i: usize) -> usize {
-        while self.0[i] != i {
-            self.0[i] = self.0[self.0[i]];
-            i = self.0[i];
-        }
-        i
-    }
-
-    /// Joins two classes, keeping the smaller node as the representative.
-    fn union(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        let (lo, hi) = (ra.min(rb), ra.max(rb));
-        self.0[hi] = lo;
-    }
-}
 
 /// Samples every patch of `surface` on a grid of `nu` by `nv` cells (both even and at least
 /// 4, as [`super::Sampling::check`] demands), welds the
@@ -101,14 +81,23 @@ pub fn sample_uniform(surface: &Surface, nu: usize, nv: usize) -> Mesh4 {
         vertex_of[id] = vertex_of[rep];
     }
 
-    for patch in 0..patches {
+    for (patch, d) in domains.iter().enumerate() {
+        let uv = |i: usize, j: usize| {
+            [
+                d.u[0] + (d.u[1] - d.u[0]) * i as f64 / nu as f64,
+                d.v[0] + (d.v[1] - d.v[0]) * j as f64 / nv as f64,
+            ]
+        };
         for j in 0..nv {
             for i in 0..nu {
-                let [a, b, c, d] = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)]
-                    .map(|(i, j)| vertex_of[node(patch, i, j)]);
-                for t in [[a, b, c], [a, c, d]] {
+                let corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
+                let [a, b, c, d] = corners.map(|(i, j)| vertex_of[node(patch, i, j)]);
+                let [pa, pb, pc, pd] = corners.map(|(i, j)| uv(i, j));
+                for (t, t_uv) in [([a, b, c], [pa, pb, pc]), ([a, c, d], [pa, pc, pd])] {
                     if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
                         mesh.triangles.push(t);
+                        mesh.triangle_patch.push(patch as u32);
+                        mesh.triangle_uv.push(t_uv);
                     }
                 }
             }

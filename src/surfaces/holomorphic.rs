@@ -55,6 +55,17 @@ fn power(p: f64, g: C64, g1: C64, g2: C64) -> (C64, C64, C64) {
     )
 }
 
+/// e^{2πi k/n} for n up to 6, computed once.
+fn unit_root(k: usize, n: usize) -> C64 {
+    static ROOTS: std::sync::OnceLock<[[C64; 6]; 7]> = std::sync::OnceLock::new();
+    let roots = ROOTS.get_or_init(|| {
+        std::array::from_fn(|n| {
+            std::array::from_fn(|k| C64::from_polar(1.0, TAU * k as f64 / n.max(1) as f64))
+        })
+    });
+    roots[n][k % n]
+}
+
 /// Fermat surface z1^n + z2^n = 1 (Hanson): patch (k1, k2), k1, k2 in 0..n, is
 /// z1 = e^{2πi k1/n} cos(ζ)^{2/n}, z2 = e^{2πi k2/n} sin(ζ)^{2/n}, ζ = x + iy,
 /// x in [0, π/2], y in [-a, a]. Patch index k1 n + k2.
@@ -126,9 +137,12 @@ impl Parametric for Fermat {
         let n = self.n as usize;
         let (k1, k2) = (patch / n, patch % n);
         let p = 2.0 / self.n as f64;
-        let zeta = C64::new(u, v);
-        let (c, s) = (zeta.cos(), zeta.sin());
-        let phase = |k: usize| C64::from_polar(1.0, TAU * k as f64 / self.n as f64);
+        // cos ζ and sin ζ from one sincos and one exp (the sampler's hot path).
+        let (sx, cx) = u.sin_cos();
+        let (e, ie) = (v.exp(), (-v).exp());
+        let (ch, sh) = ((e + ie) / 2.0, (e - ie) / 2.0);
+        let (c, s) = (C64::new(cx * ch, -sx * sh), C64::new(sx * ch, cx * sh));
+        let phase = |k: usize| unit_root(k, n);
         let scale = |(a, b, c): (C64, C64, C64), w: C64| (a * w, b * w, c * w);
         point(
             scale(power(p, c, -s, -c), phase(k1)),

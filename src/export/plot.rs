@@ -1,0 +1,151 @@
+//! PNG plots of the sweeps: audited error against triangles, log-log.
+
+use crate::sweep::Row;
+use plotters::prelude::*;
+use plotters::style::FontStyle;
+
+/// The font of every label, embedded so that plots look the same on every machine
+/// (DejaVu Sans Mono; licence in `assets/fonts/DejaVu-LICENSE.txt`).
+const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSansMono.ttf");
+const FAMILY: &str = "halo4d-mono";
+
+fn register_font() -> Result<(), String> {
+    static DONE: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
+    DONE.get_or_init(|| {
+        plotters::style::register_font(FAMILY, FontStyle::Normal, FONT)
+            .map_err(|_| "the embedded plot font is not a valid font".to_string())
+    })
+    .clone()
+}
+
+const COLOURS: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
+    RGBColor(140, 86, 75),
+    RGBColor(127, 127, 127),
+];
+
+/// Encodes an RGB buffer as PNG.
+pub fn encode_png(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>, String> {
+    use image::ImageEncoder;
+    let mut out = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut out)
+        .write_image(rgb, width, height, image::ExtendedColorType::Rgb8)
+        .map_err(|e| format!("PNG encoding failed: {e}"))?;
+    Ok(out)
+}
+
+/// Audited max error (relative to the diagonal) against triangles, one line per surface and
+/// method: solid with dots for the adaptive sampler, dashed with crosses for uniform grids.
+/// Rows that did not meet their tolerance are drawn hollow.
+pub fn speed_vs_error_png(rows: &[Row], title: &str) -> Result<Vec<u8>, String> {
+    register_font()?;
+    let (w, h) = (1200u32, 800u32);
+    let mut rgb = vec![255u8; (w * h * 3) as usize];
+    let finite: Vec<&Row> = rows
+        .iter()
+        .filter(|r| r.triangles > 0 && r.max_error.is_finite() && r.max_error > 0.0)
+        .collect();
+    if finite.is_empty() {
+        return Err("no rows with a finite error to plot".into());
+    }
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
+    for r in &finite {
+        x0 = x0.min(r.triangles as f64);
+        x1 = x1.max(r.triangles as f64);
+        y0 = y0.min(r.max_error.min(r.tolerance));
+        y1 = y1.max(r.max_error.max(r.tolerance));
+    }
+    let draw = |rgb: &mut [u8]| -> Result<(), Box<dyn std::error::Error>> {
+        let root = BitMapBackend::with_buffer(rgb, (w, h)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, (FAMILY, 26))
+            .margin(20)
+            .x_label_area_size(60)
+            .y_label_area_size(90)
+            .build_cartesian_2d(
+                (x0 / 1.5..x1 * 1.5).log_scale(),
+                (y0 / 2.0..y1 * 2.0).log_scale(),
+            )?;
+        chart
+            .configure_mesh()
+            .x_desc("triangles")
+            .y_desc("audited max error / 4D bounding diagonal")
+            .label_style((FAMILY, 16))
+            .axis_desc_style((FAMILY, 18))
+            .x_label_formatter(&|x| format!("{x:.0e}"))
+            .y_label_formatter(&|y| format!("{y:.0e}"))
+            .draw()?;
+        let mut surfaces: Vec<&str> = Vec::new();
+        for r in &finite {
+            if !surfaces.contains(&r.surface.as_str()) {
+                surfaces.push(&r.surface);
+            }
+        }
+        for (i, surface) in surfaces.iter().enumerate() {
+            let colour = COLOURS[i % COLOURS.len()];
+            for method in ["adaptive", "uniform"] {
+                let mut pts: Vec<(f64, f64, bool)> = finite
+                    .iter()
+                    .filter(|r| r.surface == *surface && r.method == method)
+                    .map(|r| (r.triangles as f64, r.max_error, r.met))
+                    .collect();
+                pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+                if pts.is_empty() {
+                    continue;
+                }
+                let line = pts.iter().map(|p| (p.0, p.1));
+                let label = format!("{surface} ({method})");
+                if method == "adaptive" {
+                    chart
+                        .draw_series(LineSeries::new(line, colour.stroke_width(2)))?
+                        .label(label)
+                        .legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(2))
+                        });
+                    chart.draw_series(pts.iter().map(|p| {
+                        Circle::new((p.0, p.1), 4, colour.stroke_width(2).filled_if(p.2))
+                    }))?;
+                } else {
+                    chart
+                        .draw_series(DashedLineSeries::new(line, 8, 5, colour.stroke_width(1)))?
+                        .label(label)
+                        .legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 8, y)], colour.stroke_width(1))
+                        });
+                    chart.draw_series(
+                        pts.iter()
+                            .map(|p| Cross::new((p.0, p.1), 5, colour.stroke_width(2))),
+                    )?;
+                }
+            }
+        }
+        chart
+            .configure_series_labels()
+            .label_font((FAMILY, 15))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::LowerLeft)
+            .draw()?;
+        root.present()?;
+        Ok(())
+    };
+    draw(&mut rgb).map_err(|e| format!("plot failed: {e}"))?;
+    encode_png(&rgb, w, h)
+}
+
+/// A style filled or not.
+trait FilledIf {
+    fn filled_if(self, filled: bool) -> ShapeStyle;
+}
+
+impl FilledIf for ShapeStyle {
+    fn filled_if(self, filled: bool) -> ShapeStyle {
+        if filled { self.filled() } else { self }
+    }
+}

@@ -1,0 +1,599 @@
+//! The adaptive sampler: Delaunay refinement in the parameter domain until every triangle
+//! meets a tolerance on its distance to the surface.
+//!
+//! Each patch is a constrained Delaunay triangulation (spade) of points in its normalized
+//! rectangle (s, t) in [0, 1]^2, with the rectangle's sides as constraint edges. The
+//! triangulation is taken in scaled coordinates (S_u s, S_v t), where S_u and S_v are the
+//! patch's root mean square lengths |∂p/∂u| (u1 - u0) and |∂p/∂v| (v1 - v0): this removes the
+//! global anisotropy of a parametrization (the spun knots' long arc against their short
+//! circles). A local anisotropy that is conformal (the Fermat patches, whose metric is
+//! λ(x, y)^2 (dx^2 + dy^2) with λ growing like e^{2|y|/n}) needs no warp: a conformal metric
+//! is isotropic, so a Delaunay triangle stays well shaped on the surface, and the refinement
+//! grades its size with λ.
+//!
+//! Refinement works through a queue of triangles. A triangle passes when the surface at the
+//! audit's edge and interior points ([`super::AUDIT_POINTS`]) lies within the tolerance of
+//! its linear interpolant; otherwise one of its edges is split at its midpoint: the edge
+//! whose error is largest, measured at its midpoint or predicted from the surface's second
+//! derivatives at the centroid (|d^T H d| / 8 for the edge vector d, the curvature term of
+//! the chordal error), or, when only interior points fail, the longest edge in scaled
+//! coordinates. The new point's triangles join the queue. A midpoint on a side splits the
+//! side, and the same point is inserted on every side glued to it, so seams stay conforming:
+//! side points are dyadic fractions of the side, and glue maps send them to dyadic fractions
+//! exactly. At the end the patches are welded by the domain rules, as in the uniform sampler.
+//!
+//! Guarantees: when `complete`, every triangle passes the audit's test at the tolerance;
+//! closed surfaces give closed manifold meshes, welded by rule, consistently oriented where
+//! the surface is orientable. When the triangle budget stops the refinement, the mesh is
+//! still a valid mesh, only coarser than asked.
+
+use super::{AUDIT_POINTS, Classes, Mesh4, eval_vertex};
+use crate::surfaces::{Domain, Side, SideRule, Surface};
+use glam::DVec4;
+use spade::handles::FixedVertexHandle;
+use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+use std::collections::{BTreeSet, HashMap, VecDeque};
+
+type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
+
+/// The outcome of [`sample_adaptive`].
+#[derive(Clone, Debug)]
+pub struct AdaptiveMesh {
+    /// The mesh.
+    pub mesh: Mesh4,
+    /// Whether every triangle met the tolerance (false when the triangle budget stopped the
+    /// refinement, or an edge became too short to split in floating point).
+    pub complete: bool,
+    /// Triangles that still failed the tolerance when refinement stopped.
+    pub failing: usize,
+}
+
+/// One patch being refined.
+struct Patch {
+    domain: Domain,
+    /// Scale from normalized (s, t) to the triangulation's coordinates.
+    scale: [f64; 2],
+    cdt: Cdt,
+    /// Normalized parameters of each point, indexed by the spade vertex index.
+    st: Vec<[f64; 2]>,
+    /// The surface point of each point.
+    p: Vec<DVec4>,
+    /// Which sides are poles.
+    pole: [bool; 4],
+    /// The side coordinates of the points on each side (as bits: non-negative floats sort
+    /// like their bits).
+    sides: [BTreeSet<u64>; 4],
+}
+
+impl Patch {
+    fn uv(&self, st: [f64; 2]) -> [f64; 2] {
+        let lerp = |r: [f64; 2], x: f64| r[0] + (r[1] - r[0]) * x;
+        [lerp(self.domain.u, st[0]), lerp(self.domain.v, st[1])]
+    }
+
+    /// Inserts a point; returns its vertex and whether it is new.
+    fn insert(
+        &mut self,
+        surface: &Surface,
+        patch: usize,
+        st: [f64; 2],
+    ) -> Option<(FixedVertexHandle, bool)> {
+        let pos = Point2::new(self.scale[0] * st[0], self.scale[1] * st[1]);
+        let h = self.cdt.insert(pos).ok()?;
+        if h.index() < self.st.len() {
+            return Some((h, false));
+        }
+        debug_assert_eq!(h.index(), self.st.len());
+        for (side, sigma) in sides_of_point(st) {
+            self.sides[side as usize].insert(sigma.to_bits());
+        }
+        let [u, v] = self.uv(st);
+        self.st.push(st);
+        self.p.push(surface.eval(patch, u, v).p);
+        Some((h, true))
+    }
+
+    /// The side segment that `st` encroaches on, if any: the point lies inside the circle
+    /// whose diameter is the segment (in the triangulation's coordinates). Inserting such a
+    /// point would make a sliver against the side; Delaunay refinement (Ruppert) splits the
+    /// segment instead. Returns the side and the segment's midpoint.
+    fn encroached(&self, st: [f64; 2]) -> Option<(Side, f64)> {
+        for side in Side::ALL {
+            let (along, across, dist) = match side {
+                Side::U0 => (st[1], self.scale[0] * st[0], self.scale[1]),
+                Side::U1 => (st[1], self.scale[0] * (1.0 - st[0]), self.scale[1]),
+                Side::V0 => (st[0], self.scale[1] * st[1], self.scale[0]),
+                Side::V1 => (st[0], self.scale[1] * (1.0 - st[1]), self.scale[0]),
+            };
+            let set = &self.sides[side as usize];
+            let key = along.to_bits();
+            let (Some(lo), Some(hi)) = (set.range(..=key).next_back(), set.range(key..).next())
+            else {
+                continue;
+            };
+            let (lo, hi) = (f64::from_bits(*lo), f64::from_bits(*hi));
+            let half = (hi - lo) / 2.0 * dist;
+            let off = (along - (lo + hi) / 2.0) * dist;
+            if off * off + across * across < half * half {
+                return Some((side, (lo + hi) / 2.0));
+            }
+        }
+        None
+    }
+
+    /// Whether the triangle has an edge on a pole side (the weld collapses it).
+    fn collapses(&self, t: [usize; 3]) -> bool {
+        (0..3).any(|k| {
+            let (a, b) = (self.st[t[k]], self.st[t[(k + 1) % 3]]);
+            side_of_edge(a, b).is_some_and(|(side, _, _)| self.pole[side as usize])
+        })
+    }
+}
+
+/// The side an edge lies on, with the side coordinates of its ends.
+fn side_of_edge(a: [f64; 2], b: [f64; 2]) -> Option<(Side, f64, f64)> {
+    if a[0] == b[0] && (a[0] == 0.0 || a[0] == 1.0) {
+        let side = if a[0] == 0.0 { Side::U0 } else { Side::U1 };
+        return Some((side, a[1], b[1]));
+    }
+    if a[1] == b[1] && (a[1] == 0.0 || a[1] == 1.0) {
+        let side = if a[1] == 0.0 { Side::V0 } else { Side::V1 };
+        return Some((side, a[0], b[0]));
+    }
+    None
+}
+
+/// The sides a point lies on (two at a corner), with its side coordinate on each.
+fn sides_of_point(st: [f64; 2]) -> impl Iterator<Item = (Side, f64)> {
+    let [s, t] = st;
+    [
+        (s == 0.0).then_some((Side::U0, t)),
+        (s == 1.0).then_some((Side::U1, t)),
+        (t == 0.0).then_some((Side::V0, s)),
+        (t == 1.0).then_some((Side::V1, s)),
+    ]
+    .into_iter()
+    .flatten()
+}
+
+/// Normalized parameters of side coordinate `sigma` on `side`.
+fn side_st(side: Side, sigma: f64) -> [f64; 2] {
+    match side {
+        Side::U0 => [0.0, sigma],
+        Side::U1 => [1.0, sigma],
+        Side::V0 => [sigma, 0.0],
+        Side::V1 => [sigma, 1.0],
+    }
+}
+
+/// The points a side point is glued to: `(patch, side, sigma)` on the other side of every
+/// glue piece that contains it.
+fn glued_images(domain: &Domain, side: Side, sigma: f64) -> Vec<(usize, Side, f64)> {
+    match domain.side(side) {
+        SideRule::Glued(pieces) => pieces
+            .iter()
+            .filter(|g| g.from <= sigma && sigma <= g.to)
+            .map(|g| (g.patch, g.side, g.map(sigma)))
+            .collect(),
+        SideRule::Open | SideRule::Pole => Vec::new(),
+    }
+}
+
+/// Root mean square lengths of ∂p/∂u and ∂p/∂v over the patch, times the side lengths, from
+/// the cell centres of a 16 x 16 grid (branch points lie on sides, so the centres avoid
+/// them); 1 where the surface gives nothing finite.
+fn patch_scale(surface: &Surface, patch: usize, domain: &Domain) -> [f64; 2] {
+    const N: usize = 16;
+    let (mut su, mut sv, mut n) = (0.0, 0.0, 0usize);
+    for j in 0..N {
+        for i in 0..N {
+            let s = (i as f64 + 0.5) / N as f64;
+            let t = (j as f64 + 0.5) / N as f64;
+            let u = domain.u[0] + (domain.u[1] - domain.u[0]) * s;
+            let v = domain.v[0] + (domain.v[1] - domain.v[0]) * t;
+            let e = surface.eval(patch, u, v);
+            if e.tangents_finite() {
+                su += e.du.length_squared();
+                sv += e.dv.length_squared();
+                n += 1;
+            }
+        }
+    }
+    let lu = (domain.u[1] - domain.u[0]).abs() * (su / n.max(1) as f64).sqrt();
+    let lv = (domain.v[1] - domain.v[0]).abs() * (sv / n.max(1) as f64).sqrt();
+    if lu.is_finite() && lv.is_finite() && lu > 0.0 && lv > 0.0 {
+        // Normalize so the larger side is 1: spade's coordinates stay in a tame range.
+        let m = lu.max(lv);
+        [lu / m, lv / m]
+    } else {
+        [1.0, 1.0]
+    }
+}
+
+/// The geometric mean over the patches of the ratio of the scaled lengths of the u and v
+/// sides (see the module documentation): the shape of a grid whose cells are square on the
+/// surface on average.
+pub fn metric_aspect(surface: &Surface) -> f64 {
+    let n = surface.patch_count();
+    let log_sum: f64 = (0..n)
+        .map(|patch| {
+            let [a, b] = patch_scale(surface, patch, &surface.domain(patch));
+            (a / b).ln()
+        })
+        .sum();
+    (log_sum / n.max(1) as f64).exp()
+}
+
+/// A power of two of cells, at least `min` and 2, near `x`. Powers of two keep every side
+/// point a dyadic fraction, which the glue maps (σ ↦ offset ± σ, offsets multiples of 1/2)
+/// send to dyadic fractions exactly, so glued points meet bit for bit.
+fn grid_cells(x: f64, min: usize) -> usize {
+    (x.round() as usize).max(min).max(2).next_power_of_two()
+}
+
+/// The verdict on one triangle.
+enum Verdict {
+    Pass,
+    /// Split the edges from corner k to corner k + 1, for each listed k.
+    Split(Vec<usize>),
+}
+
+/// Samples `surface` so that every triangle lies within `tolerance` (an absolute length in
+/// R^4) of the surface at the audit points, stopping when the mesh would exceed
+/// `max_triangles` triangles.
+pub fn sample_adaptive(surface: &Surface, tolerance: f64, max_triangles: usize) -> AdaptiveMesh {
+    let mut sampler = Sampler::new(surface, tolerance * (1.0 - 1e-9));
+    let complete = sampler.refine(max_triangles);
+    let failing = if complete { 0 } else { sampler.count_failing() };
+    AdaptiveMesh {
+        mesh: sampler.weld(),
+        complete: complete && failing == 0,
+        failing,
+    }
+}
+
+struct Sampler<'a> {
+    surface: &'a Surface,
+    tolerance: f64,
+    patches: Vec<Patch>,
+    queue: VecDeque<(usize, [FixedVertexHandle; 3])>,
+    /// Edges too short to split in floating point.
+    stuck: usize,
+}
+
+impl<'a> Sampler<'a> {
+    /// Starts every patch from a coarse grid shaped like its scaled rectangle, with the
+    /// rectangle's sides as constraint edges, and makes the glued sides conform.
+    fn new(surface: &'a Surface, tolerance: f64) -> Self {
+        let [min_u, min_v] = surface.min_cells();
+        let mut patches = Vec::new();
+        for patch in 0..surface.patch_count() {
+            let domain = surface.domain(patch);
+            let scale = patch_scale(surface, patch, &domain);
+            let pole = Side::ALL.map(|s| matches!(domain.side(s), SideRule::Pole));
+            // About 16 cells, shaped like the scaled rectangle.
+            let aspect = scale[0] / scale[1];
+            let nu = grid_cells(4.0 * aspect.sqrt(), min_u);
+            let nv = grid_cells(4.0 / aspect.sqrt(), min_v);
+            let mut p = Patch {
+                domain,
+                scale,
+                cdt: Cdt::new(),
+                st: Vec::new(),
+                p: Vec::new(),
+                pole,
+                sides: Default::default(),
+            };
+            let mut handles = vec![vec![None; nu + 1]; nv + 1];
+            for (j, row) in handles.iter_mut().enumerate() {
+                for (i, h) in row.iter_mut().enumerate() {
+                    let st = [i as f64 / nu as f64, j as f64 / nv as f64];
+                    *h = p.insert(surface, patch, st).map(|(h, _)| h);
+                }
+            }
+            let mut boundary = Vec::new();
+            boundary.extend((0..nu).map(|i| (handles[0][i], handles[0][i + 1])));
+            boundary.extend((0..nu).map(|i| (handles[nv][i], handles[nv][i + 1])));
+            boundary.extend((0..nv).map(|j| (handles[j][0], handles[j + 1][0])));
+            boundary.extend((0..nv).map(|j| (handles[j][nu], handles[j + 1][nu])));
+            for (a, b) in boundary {
+                if let (Some(a), Some(b)) = (a, b) {
+                    p.cdt.add_constraint(a, b);
+                }
+            }
+            patches.push(p);
+        }
+        let mut sampler = Sampler {
+            surface,
+            tolerance,
+            patches,
+            queue: VecDeque::new(),
+            stuck: 0,
+        };
+        // Glued sides of different grids: insert every side point's images.
+        for patch in 0..sampler.patches.len() {
+            let side_points: Vec<(Side, f64)> = sampler.patches[patch]
+                .st
+                .iter()
+                .flat_map(|st| sides_of_point(*st))
+                .collect();
+            for (side, sigma) in side_points {
+                sampler.insert_side_point(patch, side, sigma);
+            }
+        }
+        for (patch, p) in sampler.patches.iter().enumerate() {
+            for f in p.cdt.inner_faces() {
+                sampler
+                    .queue
+                    .push_back((patch, f.vertices().map(|v| v.fix())));
+            }
+        }
+        sampler
+    }
+
+    fn triangles(&self) -> usize {
+        self.patches.iter().map(|p| p.cdt.num_inner_faces()).sum()
+    }
+
+    /// Inserts a point on a side and, recursively, its images on the sides glued to it;
+    /// queues the triangles around every new point.
+    /// The images of the first point are visited even when the point itself was there.
+    fn insert_side_point(&mut self, patch: usize, side: Side, sigma: f64) {
+        let mut work = vec![(patch, side, sigma)];
+        let mut first = true;
+        while let Some((patch, side, sigma)) = work.pop() {
+            let p = &mut self.patches[patch];
+            let new = match p.insert(self.surface, patch, side_st(side, sigma)) {
+                Some((h, new)) => {
+                    if new {
+                        self.queue_around(patch, h);
+                    }
+                    new
+                }
+                None => {
+                    self.stuck += 1;
+                    false
+                }
+            };
+            if new || first {
+                work.extend(glued_images(&self.patches[patch].domain, side, sigma));
+            }
+            first = false;
+        }
+    }
+
+    fn queue_around(&mut self, patch: usize, h: FixedVertexHandle) {
+        let cdt = &self.patches[patch].cdt;
+        for e in cdt.vertex(h).out_edges() {
+            if let Some(f) = e.face().as_inner() {
+                self.queue.push_back((patch, f.vertices().map(|v| v.fix())));
+            }
+        }
+    }
+
+    /// Refines until every triangle passes (true) or the budget is reached (false).
+    fn refine(&mut self, max_triangles: usize) -> bool {
+        while let Some((patch, tri)) = self.queue.pop_front() {
+            let cdt = &self.patches[patch].cdt;
+            let alive = cdt
+                .get_edge_from_neighbors(tri[0], tri[1])
+                .and_then(|e| e.opposite_vertex())
+                .is_some_and(|v| v.fix() == tri[2]);
+            if !alive {
+                continue;
+            }
+            let Verdict::Split(edges) = self.check(patch, tri.map(|h| h.index())) else {
+                continue;
+            };
+            if self.triangles() + 2 * edges.len() > max_triangles {
+                self.queue.push_front((patch, tri));
+                return false;
+            }
+            let t = tri.map(|h| h.index());
+            let st = &self.patches[patch].st;
+            let ends: Vec<_> = edges
+                .iter()
+                .map(|&k| (st[t[k]], st[t[(k + 1) % 3]]))
+                .collect();
+            let mut added = false;
+            for (a, b) in ends {
+                added |= self.split(patch, a, b);
+            }
+            // A split elsewhere (an encroached side) may leave this triangle standing.
+            if added {
+                self.queue.push_back((patch, tri));
+            }
+        }
+        self.stuck == 0
+    }
+
+    /// Splits the edge from `sa` to `sb` (normalized parameters) of a patch at its midpoint,
+    /// or the side segment that midpoint encroaches on. Returns whether a point was added.
+    fn split(&mut self, patch: usize, sa: [f64; 2], sb: [f64; 2]) -> bool {
+        let mid = [(sa[0] + sb[0]) / 2.0, (sa[1] + sb[1]) / 2.0];
+        if mid == sa || mid == sb {
+            self.stuck += 1;
+            return false;
+        }
+        let before = self.points();
+        if let Some((side, x, y)) = side_of_edge(sa, sb) {
+            self.insert_side_point(patch, side, (x + y) / 2.0);
+        } else if let Some((side, sigma)) = self.patches[patch].encroached(mid) {
+            self.insert_side_point(patch, side, sigma);
+        } else {
+            match self.patches[patch].insert(self.surface, patch, mid) {
+                Some((h, true)) => self.queue_around(patch, h),
+                _ => self.stuck += 1,
+            }
+        }
+        self.points() > before
+    }
+
+    fn points(&self) -> usize {
+        self.patches.iter().map(|p| p.st.len()).sum()
+    }
+
+    /// Tests a triangle at the audit's edge and interior points.
+    fn check(&self, patch: usize, t: [usize; 3]) -> Verdict {
+        let p = &self.patches[patch];
+        if p.collapses(t) {
+            return Verdict::Pass;
+        }
+        let uv = t.map(|i| p.uv(p.st[i]));
+        let corners = t.map(|i| p.p[i]);
+        let mut worst = 0.0f64;
+        let mut edge_error = [0.0f64; 3];
+        for (k, b) in AUDIT_POINTS.iter().enumerate().skip(3) {
+            let u = b[0] * uv[0][0] + b[1] * uv[1][0] + b[2] * uv[2][0];
+            let v = b[0] * uv[0][1] + b[1] * uv[1][1] + b[2] * uv[2][1];
+            let chord = corners[0] * b[0] + corners[1] * b[1] + corners[2] * b[2];
+            let d = (self.surface.eval(patch, u, v).p - chord).length();
+            let d = if d.is_finite() { d } else { f64::INFINITY };
+            worst = worst.max(d);
+            if k < 6 {
+                // The midpoints of the edges from corner k - 3 to the next corner.
+                edge_error[k - 3] = d;
+            }
+        }
+        if worst <= self.tolerance {
+            return Verdict::Pass;
+        }
+        // The curvature term of each edge's chordal error, from the centroid's Hessian.
+        let c = [
+            (uv[0][0] + uv[1][0] + uv[2][0]) / 3.0,
+            (uv[0][1] + uv[1][1] + uv[2][1]) / 3.0,
+        ];
+        let e = self.surface.eval(patch, c[0], c[1]);
+        let mut score = [0.0f64; 3];
+        let mut longest = (0.0f64, 0usize);
+        for k in 0..3 {
+            let (a, b) = (uv[k], uv[(k + 1) % 3]);
+            let (du, dv) = (b[0] - a[0], b[1] - a[1]);
+            let predicted =
+                (e.duu * (du * du) + e.duv * (2.0 * du * dv) + e.dvv * (dv * dv)).length() / 8.0;
+            score[k] = edge_error[k].max(if predicted.is_finite() {
+                predicted
+            } else {
+                0.0
+            });
+            let (sa, sb) = (p.st[t[k]], p.st[t[(k + 1) % 3]]);
+            let len = ((sb[0] - sa[0]) * p.scale[0]).hypot((sb[1] - sa[1]) * p.scale[1]);
+            if len > longest.0 {
+                longest = (len, k);
+            }
+        }
+        let over: Vec<usize> = (0..3).filter(|&k| score[k] > self.tolerance).collect();
+        match over.len() {
+            0 => Verdict::Split(vec![longest.1]),
+            // Every edge too long: split all three (a 1-to-4 refinement, one check for
+            // what single splits would take two levels of checks to reach).
+            3 => Verdict::Split(over),
+            _ => Verdict::Split(vec![
+                (0..3).fold(0, |m, k| if score[k] > score[m] { k } else { m }),
+            ]),
+        }
+    }
+
+    /// Triangles that fail the test now (after the budget stopped refinement).
+    fn count_failing(&self) -> usize {
+        self.patches
+            .iter()
+            .enumerate()
+            .map(|(patch, p)| {
+                p.cdt
+                    .inner_faces()
+                    .filter(|f| {
+                        let t = f.vertices().map(|v| v.fix().index());
+                        matches!(self.check(patch, t), Verdict::Split(_))
+                    })
+                    .count()
+            })
+            .sum()
+    }
+
+    /// Welds the patches by the domain rules into one mesh.
+    fn weld(self) -> Mesh4 {
+        let offsets: Vec<usize> = self
+            .patches
+            .iter()
+            .scan(0, |acc, p| {
+                let o = *acc;
+                *acc += p.st.len();
+                Some(o)
+            })
+            .collect();
+        let total = offsets
+            .last()
+            .map_or(0, |o| o + self.patches.last().map_or(0, |p| p.st.len()));
+        // Side points by exact parameters.
+        let mut at: HashMap<(usize, u64, u64), usize> = HashMap::new();
+        for (patch, p) in self.patches.iter().enumerate() {
+            for (i, st) in p.st.iter().enumerate() {
+                if sides_of_point(*st).next().is_some() {
+                    at.insert(
+                        (patch, st[0].to_bits(), st[1].to_bits()),
+                        offsets[patch] + i,
+                    );
+                }
+            }
+        }
+        let find = |patch: usize, st: [f64; 2]| {
+            at.get(&(patch, st[0].to_bits(), st[1].to_bits())).copied()
+        };
+        let mut classes = Classes((0..total).collect());
+        for (patch, p) in self.patches.iter().enumerate() {
+            for (i, st) in p.st.iter().enumerate() {
+                for (side, sigma) in sides_of_point(*st) {
+                    let me = offsets[patch] + i;
+                    if p.pole[side as usize]
+                        && let Some(first) = find(patch, side_st(side, 0.0))
+                    {
+                        classes.union(me, first);
+                    }
+                    for (q, side_q, sigma_q) in glued_images(&p.domain, side, sigma) {
+                        let other = find(q, side_st(side_q, sigma_q));
+                        debug_assert!(other.is_some(), "seam point without its image");
+                        if let Some(other) = other {
+                            classes.union(me, other);
+                        }
+                    }
+                }
+            }
+        }
+
+        let mut mesh = Mesh4::default();
+        let mut vertex_of = vec![u32::MAX; total];
+        let locate = |id: usize| {
+            let patch = offsets.partition_point(|&o| o <= id) - 1;
+            (patch, id - offsets[patch])
+        };
+        for id in 0..total {
+            let rep = classes.find(id);
+            if vertex_of[rep] == u32::MAX {
+                let (patch, i) = locate(rep);
+                let p = &self.patches[patch];
+                let [u, v] = p.uv(p.st[i]);
+                let e = eval_vertex(self.surface, patch, u, v);
+                vertex_of[rep] = mesh.positions.len() as u32;
+                mesh.positions.push(e.p);
+                mesh.tangent_u.push(e.du);
+                mesh.tangent_v.push(e.dv);
+                mesh.uv.push([u, v]);
+                mesh.patch.push(patch as u32);
+            }
+            vertex_of[id] = vertex_of[rep];
+        }
+        for (patch, p) in self.patches.iter().enumerate() {
+            for f in p.cdt.inner_faces() {
+                let local = f.vertices().map(|v| v.fix().index());
+                let t = local.map(|i| vertex_of[offsets[patch] + i]);
+                if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+                    mesh.triangles.push(t);
+                    mesh.triangle_patch.push(patch as u32);
+                    mesh.triangle_uv.push(local.map(|i| p.uv(p.st[i])));
+                }
+            }
+        }
+        mesh
+    }
+}

@@ -1,0 +1,373 @@
+//! Speed against error: what each tolerance costs with the adaptive sampler and with the
+//! best uniform grid, audited the same way.
+//!
+//! For every surface and relative tolerance (share of the 4D bounding diagonal): the
+//! adaptive sampler at that tolerance, and the coarsest uniform grid whose audited maximum
+//! error meets it. The grid is found by a search over its size (multiplicative steps
+//! extrapolated from the error's order, then bisection to 3%), for three shapes: the
+//! patch's metric aspect ratio, and that ratio halved and doubled; the shape that needs the
+//! fewest triangles wins. Rows give triangles, sampling milliseconds (the final mesh only,
+//! not the search) and the audited errors relative to the diagonal.
+
+use crate::error::Error;
+use crate::sample::{self, audit, bounding_diagonal, sample_adaptive, sample_uniform};
+use crate::surfaces::Surface;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Relative tolerances of the default sweep, 1e-2 down to 1e-5.
+pub const TOLERANCES: [f64; 7] = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5];
+
+/// One line of the sweep.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Row {
+    /// Surface name.
+    pub surface: String,
+    /// `adaptive` or `uniform`.
+    pub method: &'static str,
+    /// Relative tolerance asked for.
+    pub tolerance: f64,
+    /// Triangles of the mesh.
+    pub triangles: usize,
+    /// Milliseconds to sample it (wall, release build).
+    pub ms: f64,
+    /// Audited max error, relative to the diagonal.
+    pub max_error: f64,
+    /// Audited RMS error, relative to the diagonal.
+    pub rms_error: f64,
+    /// Whether the mesh meets the tolerance (false: the triangle budget ran out first).
+    pub met: bool,
+    /// The grid, for uniform rows (cells along u and v per patch).
+    pub grid: Option<[usize; 2]>,
+}
+
+/// Settings of a sweep.
+#[derive(Clone, Debug)]
+pub struct Settings {
+    /// Relative tolerances.
+    pub tolerances: Vec<f64>,
+    /// The most triangles any one mesh may have.
+    pub max_triangles: usize,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            tolerances: TOLERANCES.to_vec(),
+            max_triangles: 8_000_000,
+        }
+    }
+}
+
+fn ms(since: Instant) -> f64 {
+    since.elapsed().as_secs_f64() * 1e3
+}
+
+/// Sweeps one surface: an adaptive and a uniform row per tolerance. `progress` is told what
+/// is being done.
+pub fn sweep_surface(
+    name: &str,
+    surface: &Surface,
+    settings: &Settings,
+    progress: &mut dyn FnMut(&str),
+) -> Vec<Row> {
+    let diagonal = bounding_diagonal(surface);
+    let mut rows = Vec::new();
+    let mut grids = GridSearch::new(surface, diagonal, settings.max_triangles);
+    for &tolerance in &settings.tolerances {
+        progress(&format!("{name}: adaptive at {tolerance:.0e}"));
+        let start = Instant::now();
+        let out = sample_adaptive(surface, tolerance * diagonal, settings.max_triangles);
+        let took = ms(start);
+        let a = audit(surface, &out.mesh);
+        let (max, rms) = a.relative(diagonal);
+        rows.push(Row {
+            surface: name.to_string(),
+            method: "adaptive",
+            tolerance,
+            triangles: out.mesh.triangles.len(),
+            ms: took,
+            max_error: max,
+            rms_error: rms,
+            met: out.complete && max <= tolerance,
+            grid: None,
+        });
+        progress(&format!("{name}: uniform grids at {tolerance:.0e}"));
+        rows.push(grids.coarsest(name, tolerance));
+    }
+    rows
+}
+
+/// A uniform grid and its audited relative errors.
+#[derive(Clone, Copy)]
+struct Measured {
+    cells: [usize; 2],
+    triangles: usize,
+    max: f64,
+    rms: f64,
+}
+
+/// Finds the coarsest uniform grids that meet tolerances, remembering every grid audited.
+struct GridSearch<'a> {
+    surface: &'a Surface,
+    diagonal: f64,
+    max_triangles: usize,
+    aspect: f64,
+    seen: Vec<Measured>,
+}
+
+impl<'a> GridSearch<'a> {
+    fn new(surface: &'a Surface, diagonal: f64, max_triangles: usize) -> Self {
+        GridSearch {
+            surface,
+            diagonal,
+            max_triangles,
+            aspect: sample::metric_aspect(surface),
+            seen: Vec::new(),
+        }
+    }
+
+    /// The grid of size `k` (about k^2 cells per patch) and shape `aspect`.
+    fn cells(&self, k: f64, aspect: f64) -> [usize; 2] {
+        let [min_u, min_v] = self.surface.min_cells();
+        let even = |x: f64, min: usize| {
+            let n = (x.round().clamp(2.0, 4096.0) as usize).max(min);
+            (n + n % 2).min(4096)
+        };
+        [
+            even(k * aspect.sqrt(), min_u),
+            even(k / aspect.sqrt(), min_v),
+        ]
+    }
+
+    fn triangles(&self, cells: [usize; 2]) -> usize {
+        2 * cells[0] * cells[1] * self.surface.patch_count()
+    }
+
+    fn measure(&mut self, cells: [usize; 2]) -> Measured {
+        if let Some(m) = self.seen.iter().find(|m| m.cells == cells) {
+            return *m;
+        }
+        let mesh = sample_uniform(self.surface, cells[0], cells[1]);
+        let (max, rms) = audit(self.surface, &mesh).relative(self.diagonal);
+        let m = Measured {
+            cells,
+            triangles: mesh.triangles.len(),
+            max,
+            rms,
+        };
+        self.seen.push(m);
+        m
+    }
+
+    /// The coarsest grid of one shape that meets `tolerance`, or the finest allowed.
+    fn search(&mut self, tolerance: f64, aspect: f64) -> (Measured, bool) {
+        let mut fail: Option<(f64, Measured)> = None;
+        let mut pass: Option<(f64, Measured)> = None;
+        let mut k = 8.0;
+        for _ in 0..24 {
+            let cells = self.cells(k, aspect);
+            if self.triangles(cells) > self.max_triangles || cells.contains(&4096) {
+                // Beyond the budget: step back towards the last failing size, or stop.
+                match fail {
+                    Some((kf, _)) if k / kf > 1.03 => {
+                        k = (k * kf).sqrt();
+                        continue;
+                    }
+                    _ => break,
+                }
+            }
+            let m = self.measure(cells);
+            if m.max <= tolerance {
+                pass = Some((k, m));
+            } else {
+                fail = Some((k, m));
+            }
+            k = match (fail, pass) {
+                (Some((kf, _)), Some((kp, _))) => {
+                    if kp / kf < 1.03 {
+                        break;
+                    }
+                    (kf * kp).sqrt()
+                }
+                // Errors fall like k^-2 where the surface is smooth; overshoot a little.
+                (Some((kf, mf)), None) => kf * ((mf.max / tolerance).sqrt() * 1.1).clamp(1.2, 8.0),
+                (None, Some((kp, mp))) => kp / ((tolerance / mp.max).sqrt() * 1.1).clamp(1.2, 8.0),
+                (None, None) => unreachable!("a size was measured"),
+            };
+        }
+        match (pass, fail) {
+            (Some((_, m)), _) => (m, true),
+            (None, Some((_, m))) => (m, false),
+            (None, None) => (self.measure(self.cells(2.0, aspect)), false),
+        }
+    }
+
+    /// The row of the coarsest grid (over three shapes) that meets `tolerance`.
+    fn coarsest(&mut self, name: &str, tolerance: f64) -> Row {
+        let mut best: Option<(Measured, bool)> = None;
+        for f in [1.0, 0.5, 2.0] {
+            let found = self.search(tolerance, self.aspect * f);
+            best = Some(match best {
+                None => found,
+                Some(b) => match (b.1, found.1) {
+                    (true, true) if found.0.triangles < b.0.triangles => found,
+                    (false, true) => found,
+                    (false, false) if found.0.max < b.0.max => found,
+                    _ => b,
+                },
+            });
+        }
+        let (m, met) = best.expect("three shapes were searched");
+        let start = Instant::now();
+        let mesh = sample_uniform(self.surface, m.cells[0], m.cells[1]);
+        let took = ms(start);
+        drop(mesh);
+        Row {
+            surface: name.to_string(),
+            method: "uniform",
+            tolerance,
+            triangles: m.triangles,
+            ms: took,
+            max_error: m.max,
+            rms_error: m.rms,
+            met,
+            grid: Some(m.cells),
+        }
+    }
+}
+
+/// The rows as CSV: `surface,method,tolerance,triangles,ms,max_error,rms_error,met,grid`.
+pub fn to_csv(rows: &[Row]) -> String {
+    let mut out =
+        String::from("surface,method,tolerance,triangles,ms,max_error,rms_error,met,grid\n");
+    for r in rows {
+        let grid = r.grid.map_or(String::new(), |[u, v]| format!("{u}x{v}"));
+        out.push_str(&format!(
+            "{},{},{:e},{},{:.3},{:.6e},{:.6e},{},{}\n",
+            r.surface,
+            r.method,
+            r.tolerance,
+            r.triangles,
+            r.ms,
+            r.max_error,
+            r.rms_error,
+            r.met,
+            grid
+        ));
+    }
+    out
+}
+
+/// Uniform triangles over adaptive triangles at one tolerance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Ratio {
+    /// Both met the tolerance.
+    Exact(f64),
+    /// Only the adaptive sampler met it: the best uniform grid within the budget did not,
+    /// so the ratio is at least this.
+    AtLeast(f64),
+    /// The adaptive sampler did not meet it.
+    Unknown,
+}
+
+impl std::fmt::Display for Ratio {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Ratio::Exact(r) => write!(f, "{r:.2}"),
+            Ratio::AtLeast(r) => write!(f, ">{r:.2}"),
+            Ratio::Unknown => write!(f, "-"),
+        }
+    }
+}
+
+/// The ratio of uniform to adaptive triangles for the adaptive row `a`.
+pub fn ratio(rows: &[Row], a: &Row) -> Ratio {
+    let u = rows
+        .iter()
+        .find(|r| r.method == "uniform" && r.surface == a.surface && r.tolerance == a.tolerance);
+    match u {
+        Some(u) if a.met => {
+            let r = u.triangles as f64 / a.triangles.max(1) as f64;
+            if u.met {
+                Ratio::Exact(r)
+            } else {
+                Ratio::AtLeast(r)
+            }
+        }
+        _ => Ratio::Unknown,
+    }
+}
+
+/// A table for the terminal: per surface and tolerance, both methods and their ratio.
+pub fn table(rows: &[Row]) -> String {
+    let mut out = format!(
+        "{:<22} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>7}\n",
+        "surface", "tolerance", "adaptive", "ms", "max err", "uniform", "ms", "max err", "ratio"
+    );
+    for a in rows.iter().filter(|r| r.method == "adaptive") {
+        let u = rows.iter().find(|r| {
+            r.method == "uniform" && r.surface == a.surface && r.tolerance == a.tolerance
+        });
+        let mark = |met: bool| if met { ' ' } else { '!' };
+        let (ut, ums, uerr, umet) = u.map_or((0, 0.0, f64::NAN, false), |u| {
+            (u.triangles, u.ms, u.max_error, u.met)
+        });
+        out.push_str(&format!(
+            "{:<22} {:>9.0e} {:>10} {:>10.1} {:>9.2e}{} {:>10} {:>10.1} {:>9.2e}{} {:>7}\n",
+            a.surface,
+            a.tolerance,
+            a.triangles,
+            a.ms,
+            a.max_error,
+            mark(a.met),
+            ut,
+            ums,
+            uerr,
+            mark(umet),
+            ratio(rows, a).to_string(),
+        ));
+    }
+    out.push_str("(! = tolerance not met within the triangle budget)\n");
+    out
+}
+
+/// Sweeps the surfaces and writes `speed_vs_error.csv` and `speed_vs_error.png` into
+/// `out_dir`. Returns the rows and the paths written.
+pub fn run(
+    surfaces: &[(String, Surface)],
+    settings: &Settings,
+    out_dir: &Path,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(Vec<Row>, Vec<PathBuf>), Error> {
+    let mut rows = Vec::new();
+    for (name, surface) in surfaces {
+        rows.extend(sweep_surface(name, surface, settings, progress));
+    }
+    std::fs::create_dir_all(out_dir).map_err(|source| Error::Write {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
+    let png = crate::export::speed_vs_error_png(
+        &rows,
+        "halo4d: audited error against triangles, adaptive and uniform",
+    )
+    .map_err(|message| Error::Internal {
+        stage: "sweep",
+        message,
+    })?;
+    let mut written = Vec::new();
+    for (file, bytes) in [
+        ("speed_vs_error.csv", to_csv(&rows).into_bytes()),
+        ("speed_vs_error.png", png),
+    ] {
+        let path = out_dir.join(file);
+        crate::export::write_atomic(&path, &bytes).map_err(|source| Error::Write {
+            path: path.clone(),
+            source,
+        })?;
+        written.push(path);
+    }
+    Ok((rows, written))
+}
