@@ -1,5 +1,6 @@
 //! Integration tests, one module per stage.
 
+mod adaptive;
 mod cli;
 mod common;
 mod export;

@@ -51,8 +51,8 @@ pub struct AdaptiveMesh {
 /// One patch being refined.
 struct Patch {
     domain: Domain,
-    /// Scale from normalized (s, t) to the triangulation's coordinates.
-    scale: [f64; 2],
+    /// From normalized (s, t) to the triangulation's coordinates.
+    warp: Warp,
     cdt: Cdt,
     /// Normalized parameters of each point, indexed by the spade vertex index.
     st: Vec<[f64; 2]>,
@@ -78,7 +78,7 @@ impl Patch {
         patch: usize,
         st: [f64; 2],
     ) -> Option<(FixedVertexHandle, bool)> {
-        let pos = Point2::new(self.scale[0] * st[0], self.scale[1] * st[1]);
+        let pos = self.warp.apply(st);
         let h = self.cdt.insert(pos).ok()?;
         if h.index() < self.st.len() {
             return Some((h, false));
@@ -98,12 +98,11 @@ impl Patch {
     /// point would make a sliver against the side; Delaunay refinement (Ruppert) splits the
     /// segment instead. Returns the side and the segment's midpoint.
     fn encroached(&self, st: [f64; 2]) -> Option<(Side, f64)> {
+        let p = self.warp.apply(st);
         for side in Side::ALL {
-            let (along, across, dist) = match side {
-                Side::U0 => (st[1], self.scale[0] * st[0], self.scale[1]),
-                Side::U1 => (st[1], self.scale[0] * (1.0 - st[0]), self.scale[1]),
-                Side::V0 => (st[0], self.scale[1] * st[1], self.scale[0]),
-                Side::V1 => (st[0], self.scale[1] * (1.0 - st[1]), self.scale[0]),
+            let along = match side {
+                Side::U0 | Side::U1 => st[1],
+                Side::V0 | Side::V1 => st[0],
             };
             let set = &self.sides[side as usize];
             let key = along.to_bits();
@@ -112,9 +111,13 @@ impl Patch {
                 continue;
             };
             let (lo, hi) = (f64::from_bits(*lo), f64::from_bits(*hi));
-            let half = (hi - lo) / 2.0 * dist;
-            let off = (along - (lo + hi) / 2.0) * dist;
-            if off * off + across * across < half * half {
+            let (a, b) = (
+                self.warp.apply(side_st(side, lo)),
+                self.warp.apply(side_st(side, hi)),
+            );
+            let (cx, cy) = ((a.x + b.x) / 2.0, (a.y + b.y) / 2.0);
+            let r2 = ((b.x - a.x).powi(2) + (b.y - a.y).powi(2)) / 4.0;
+            if (p.x - cx).powi(2) + (p.y - cy).powi(2) < r2 {
                 return Some((side, (lo + hi) / 2.0));
             }
         }
@@ -179,34 +182,121 @@ fn glued_images(domain: &Domain, side: Side, sigma: f64) -> Vec<(usize, Side, f6
     }
 }
 
-/// Root mean square lengths of ∂p/∂u and ∂p/∂v over the patch, times the side lengths, from
-/// the cell centres of a 16 x 16 grid (branch points lie on sides, so the centres avoid
-/// them); 1 where the surface gives nothing finite.
-fn patch_scale(surface: &Surface, patch: usize, domain: &Domain) -> [f64; 2] {
-    const N: usize = 16;
-    let (mut su, mut sv, mut n) = (0.0, 0.0, 0usize);
+/// A monotone piecewise-linear map of [0, 1] onto [0, end], in equal pieces. It maps 0 to
+/// 0 and 1 to `end` exactly, so the points of a side stay exactly collinear.
+#[derive(Clone, Debug)]
+struct Axis {
+    knots: Vec<f64>,
+}
+
+impl Axis {
+    fn from_slopes(slopes: &[f64]) -> Axis {
+        let n = slopes.len() as f64;
+        let mut knots = vec![0.0];
+        for s in slopes {
+            knots.push(knots[knots.len() - 1] + s / n);
+        }
+        Axis { knots }
+    }
+
+    fn end(&self) -> f64 {
+        self.knots[self.knots.len() - 1]
+    }
+
+    fn scaled(mut self, k: f64) -> Axis {
+        self.knots.iter_mut().for_each(|x| *x *= k);
+        self
+    }
+
+    fn at(&self, x: f64) -> f64 {
+        let n = self.knots.len() - 1;
+        if x <= 0.0 {
+            return 0.0;
+        }
+        if x >= 1.0 {
+            return self.knots[n];
+        }
+        let y = x * n as f64;
+        let i = (y as usize).min(n - 1);
+        self.knots[i] + (self.knots[i + 1] - self.knots[i]) * (y - i as f64)
+    }
+}
+
+/// The map from a patch's normalized parameters to the plane where it is triangulated: a
+/// separable warp (F(s), G(t)) whose local aspect ratio F'/G' follows the ratio of the
+/// curvature terms of the chordal error, sqrt(|∂ss p| / |∂tt p|), so that a triangle that is
+/// well shaped in the plane has about the same error along all its edges.
+#[derive(Clone, Debug)]
+struct Warp {
+    s: Axis,
+    t: Axis,
+}
+
+impl Warp {
+    fn apply(&self, st: [f64; 2]) -> Point2<f64> {
+        Point2::new(self.s.at(st[0]), self.t.at(st[1]))
+    }
+}
+
+/// Builds a patch's warp from the second derivatives at the cell centres of a 32 x 32 grid
+/// (branch points lie on sides, so the centres avoid them). The log of the local ratio is
+/// split into a part in s and a part in t (a two-way additive fit), limited to a factor 30
+/// around its median and a factor 2 from one piece to the next, so the warp stays gentle.
+fn patch_warp(surface: &Surface, patch: usize, domain: &Domain) -> Warp {
+    const N: usize = 32;
+    let (lu, lv) = (domain.u[1] - domain.u[0], domain.v[1] - domain.v[0]);
+    let mut q = vec![[f64::NAN; 2]; N * N];
+    let (mut sum, mut count) = (0.0, 0usize);
     for j in 0..N {
         for i in 0..N {
             let s = (i as f64 + 0.5) / N as f64;
             let t = (j as f64 + 0.5) / N as f64;
-            let u = domain.u[0] + (domain.u[1] - domain.u[0]) * s;
-            let v = domain.v[0] + (domain.v[1] - domain.v[0]) * t;
-            let e = surface.eval(patch, u, v);
-            if e.tangents_finite() {
-                su += e.du.length_squared();
-                sv += e.dv.length_squared();
-                n += 1;
+            let e = surface.eval(patch, domain.u[0] + lu * s, domain.v[0] + lv * t);
+            let pair = [e.duu.length() * lu * lu, e.dvv.length() * lv * lv];
+            if pair[0].is_finite() && pair[1].is_finite() {
+                q[j * N + i] = pair;
+                sum += pair[0] + pair[1];
+                count += 1;
             }
         }
     }
-    let lu = (domain.u[1] - domain.u[0]).abs() * (su / n.max(1) as f64).sqrt();
-    let lv = (domain.v[1] - domain.v[0]).abs() * (sv / n.max(1) as f64).sqrt();
-    if lu.is_finite() && lv.is_finite() && lu > 0.0 && lv > 0.0 {
-        // Normalize so the larger side is 1: spade's coordinates stay in a tame range.
-        let m = lu.max(lv);
-        [lu / m, lv / m]
-    } else {
-        [1.0, 1.0]
+    let floor = 0.05 * sum / (2 * count.max(1)) as f64 + f64::MIN_POSITIVE;
+    let r = |i: usize, j: usize| {
+        let [a, b] = q[j * N + i];
+        (a.is_finite() && b.is_finite()).then(|| 0.5 * ((a + floor) / (b + floor)).ln())
+    };
+    let mean = |it: &mut dyn Iterator<Item = Option<f64>>| {
+        let (s, n) = it.flatten().fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
+        if n == 0 { 0.0 } else { s / n as f64 }
+    };
+    let all = mean(&mut (0..N * N).map(|k| r(k % N, k / N)));
+    let a: Vec<f64> = (0..N)
+        .map(|i| mean(&mut (0..N).map(|j| r(i, j))) - all / 2.0)
+        .collect();
+    let b: Vec<f64> = (0..N)
+        .map(|j| all / 2.0 - mean(&mut (0..N).map(|i| r(i, j))))
+        .collect();
+    let slopes = |logs: Vec<f64>| -> Vec<f64> {
+        let mut sorted = logs.clone();
+        sorted.sort_by(f64::total_cmp);
+        let median = sorted[N / 2];
+        let mut l: Vec<f64> = logs
+            .iter()
+            .map(|x| x.clamp(median - 30f64.ln(), median + 30f64.ln()))
+            .collect();
+        for k in 1..N {
+            l[k] = l[k].clamp(l[k - 1] - 2f64.ln(), l[k - 1] + 2f64.ln());
+        }
+        for k in (0..N - 1).rev() {
+            l[k] = l[k].clamp(l[k + 1] - 2f64.ln(), l[k + 1] + 2f64.ln());
+        }
+        l.into_iter().map(f64::exp).collect()
+    };
+    let (s, t) = (Axis::from_slopes(&slopes(a)), Axis::from_slopes(&slopes(b)));
+    let m = s.end().max(t.end());
+    Warp {
+        s: s.scaled(1.0 / m),
+        t: t.scaled(1.0 / m),
     }
 }
 
@@ -217,8 +307,8 @@ pub fn metric_aspect(surface: &Surface) -> f64 {
     let n = surface.patch_count();
     let log_sum: f64 = (0..n)
         .map(|patch| {
-            let [a, b] = patch_scale(surface, patch, &surface.domain(patch));
-            (a / b).ln()
+            let w = patch_warp(surface, patch, &surface.domain(patch));
+            (w.s.end() / w.t.end()).ln()
         })
         .sum();
     (log_sum / n.max(1) as f64).exp()
@@ -269,15 +359,15 @@ impl<'a> Sampler<'a> {
         let mut patches = Vec::new();
         for patch in 0..surface.patch_count() {
             let domain = surface.domain(patch);
-            let scale = patch_scale(surface, patch, &domain);
+            let warp = patch_warp(surface, patch, &domain);
             let pole = Side::ALL.map(|s| matches!(domain.side(s), SideRule::Pole));
             // About 16 cells, shaped like the scaled rectangle.
-            let aspect = scale[0] / scale[1];
+            let aspect = warp.s.end() / warp.t.end();
             let nu = grid_cells(4.0 * aspect.sqrt(), min_u);
             let nv = grid_cells(4.0 / aspect.sqrt(), min_v);
             let mut p = Patch {
                 domain,
-                scale,
+                warp,
                 cdt: Cdt::new(),
                 st: Vec::new(),
                 p: Vec::new(),
@@ -336,8 +426,8 @@ impl<'a> Sampler<'a> {
     }
 
     /// Inserts a point on a side and, recursively, its images on the sides glued to it;
-    /// queues the triangles around every new point.
-    /// The images of the first point are visited even when the point itself was there.
+    /// queues the triangles around every new point. The images of the first point are
+    /// visited even when the point itself was there.
     fn insert_side_point(&mut self, patch: usize, side: Side, sigma: f64) {
         let mut work = vec![(patch, side, sigma)];
         let mut first = true;
@@ -423,7 +513,9 @@ impl<'a> Sampler<'a> {
         } else {
             match self.patches[patch].insert(self.surface, patch, mid) {
                 Some((h, true)) => self.queue_around(patch, h),
-                _ => self.stuck += 1,
+                // Already there: a neighbour split the same edge.
+                Some((_, false)) => {}
+                None => self.stuck += 1,
             }
         }
         self.points() > before
@@ -455,7 +547,14 @@ impl<'a> Sampler<'a> {
                 edge_error[k - 3] = d;
             }
         }
-        if worst <= self.tolerance {
+        // The warp is curved, so a triangle counter-clockwise in the warped plane can be
+        // folded over in (u, v); refinement straightens the warp until it is not.
+        let [a, b, c] = t.map(|i| {
+            let [x, y] = p.st[i];
+            robust::Coord { x, y }
+        });
+        let folded = robust::orient2d(a, b, c) <= 0.0;
+        if worst <= self.tolerance && !folded {
             return Verdict::Pass;
         }
         // The curvature term of each edge's chordal error, from the centroid's Hessian.
@@ -477,12 +576,15 @@ impl<'a> Sampler<'a> {
                 0.0
             });
             let (sa, sb) = (p.st[t[k]], p.st[t[(k + 1) % 3]]);
-            let len = ((sb[0] - sa[0]) * p.scale[0]).hypot((sb[1] - sa[1]) * p.scale[1]);
+            let (wa, wb) = (p.warp.apply(sa), p.warp.apply(sb));
+            let len = (wb.x - wa.x).hypot(wb.y - wa.y);
             if len > longest.0 {
                 longest = (len, k);
             }
         }
-        let over: Vec<usize> = (0..3).filter(|&k| score[k] > self.tolerance).collect();
+        let over: Vec<usize> = (0..3)
+            .filter(|&k| score[k] > self.tolerance && !folded)
+            .collect();
         match over.len() {
             0 => Verdict::Split(vec![longest.1]),
             // Every edge too long: split all three (a 1-to-4 refinement, one check for

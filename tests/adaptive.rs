@@ -1,0 +1,214 @@
+//! The adaptive sampler and the audit: the tolerance is met as audited (allowing nothing),
+//! meshes keep the uniform sampler's guarantees, the audit is exact on a known case, and the
+//! budget stops refinement cleanly.
+
+use halo4d::sample::{Sampling, audit, bounding_diagonal, sample, sample_adaptive};
+use halo4d::surfaces::{Fermat, FlatTorus, SpunTrefoil, TwistSpunTrefoil};
+use halo4d::{Mesh4, Surface};
+
+/// Relative tolerances every catalogue surface is checked at.
+const TOLERANCES: [f64; 3] = [2e-2, 5e-3, 1e-3];
+
+fn surfaces() -> Vec<Surface> {
+    let mut v = Surface::catalogue();
+    v.push(Surface::Fermat(Fermat { n: 4, y_range: 1.0 }));
+    v.push(Surface::TwistSpunTrefoil(TwistSpunTrefoil {
+        scale: 0.4,
+        twists: 3,
+    }));
+    v
+}
+
+/// Every triangle counter-clockwise in its own (u, v): the mesh does not fold over in the
+/// parameter domain.
+fn folded_triangles(mesh: &Mesh4) -> usize {
+    mesh.triangle_uv
+        .iter()
+        .filter(|[a, b, c]| {
+            let coord = |p: &[f64; 2]| robust::Coord { x: p[0], y: p[1] };
+            robust::orient2d(coord(a), coord(b), coord(c)) <= 0.0
+        })
+        .count()
+}
+
+#[test]
+fn every_surface_meets_every_tolerance_as_audited_with_its_topology() {
+    for s in surfaces() {
+        let diagonal = bounding_diagonal(&s);
+        let topo = s.topology();
+        let uniform = halo4d::sample_uniform(&s, 8, 8).validate();
+        for rel in TOLERANCES {
+            let tol = rel * diagonal;
+            let out = sample_adaptive(&s, tol, 2_000_000);
+            let mesh = &out.mesh;
+            let stats = mesh.validate();
+            let a = audit(&s, mesh);
+            let what = format!(
+                "{} at {rel:e}: {} triangles, audit {a:?}, {stats:?}",
+                s.type_name(),
+                mesh.triangles.len()
+            );
+            assert!(out.complete && out.failing == 0, "{what}");
+            assert!(a.max_error <= tol, "{what}");
+            assert_eq!(a.non_finite, 0, "{what}");
+            assert_eq!(a.points, 10 * mesh.triangles.len(), "{what}");
+            assert!(stats.is_manifold(), "{what}");
+            assert_eq!(stats.degenerate_triangles, 0, "{what}");
+            assert_eq!(folded_triangles(mesh), 0, "{what}");
+            assert_eq!(
+                stats.euler_characteristic, uniform.euler_characteristic,
+                "{what}"
+            );
+            if let Some(chi) = topo.euler_characteristic {
+                assert_eq!(stats.euler_characteristic, chi, "{what}");
+            }
+            if topo.closed {
+                assert_eq!(stats.boundary_edges, 0, "{what}");
+            }
+            if topo.orientable {
+                assert_eq!(stats.orientation_conflicts, 0, "{what}");
+            } else {
+                assert!(stats.orientation_conflicts > 0, "{what}");
+            }
+            assert_eq!(mesh.triangle_uv.len(), mesh.triangles.len());
+            assert_eq!(mesh.triangle_patch.len(), mesh.triangles.len());
+        }
+    }
+}
+
+#[test]
+fn refinement_adapts_and_converges() {
+    // Tighter tolerances give more triangles and smaller audited errors, roughly as the
+    // square of the edge length: ten times the accuracy costs about ten times the
+    // triangles, not a hundred.
+    let s = Surface::SpunTrefoil(SpunTrefoil::default());
+    let d = bounding_diagonal(&s);
+    let coarse = sample_adaptive(&s, 1e-2 * d, 1_000_000).mesh;
+    let fine = sample_adaptive(&s, 1e-3 * d, 1_000_000).mesh;
+    let (ec, ef) = (audit(&s, &coarse).max_error, audit(&s, &fine).max_error);
+    let growth = fine.triangles.len() as f64 / coarse.triangles.len() as f64;
+    assert!(ef < ec / 5.0, "{ec} -> {ef}");
+    assert!((5.0..20.0).contains(&growth), "triangles grew {growth}x");
+}
+
+#[test]
+fn the_audit_is_exact_on_the_flat_torus_sagitta() {
+    // On the product of two circles, the linear interpolant of a grid triangle is farthest
+    // from the surface at the midpoint of its diagonal, where the error in each circle is
+    // its sagitta r (1 - cos(Δ/2)).
+    for (r1, r2, nu, nv) in [(1.0, 1.0, 8, 8), (1.5, 0.5, 12, 6), (2.0, 1.0, 64, 40)] {
+        let s = Surface::FlatTorus(FlatTorus { r1, r2 });
+        let mesh = halo4d::sample_uniform(&s, nu, nv);
+        let a = audit(&s, &mesh);
+        let tau = std::f64::consts::TAU;
+        let sag = |r: f64, n: usize| r * (1.0 - (tau / n as f64 / 2.0).cos());
+        let exact = sag(r1, nu).hypot(sag(r2, nv));
+        assert!(
+            (a.max_error - exact).abs() <= 1e-12 * exact,
+            "{r1} {r2} {nu}x{nv}: audit {} exact {exact}",
+            a.max_error
+        );
+        assert!(a.rms_error > 0.0 && a.rms_error < a.max_error);
+    }
+}
+
+#[test]
+fn the_audit_catches_a_planted_fault() {
+    // A vertex moved off the surface, and a triangle given another triangle's parameters:
+    // the sampler's own bookkeeping is not trusted.
+    let s = Surface::SpunTrefoil(SpunTrefoil::default());
+    let tol = 1e-3 * bounding_diagonal(&s);
+    let good = sample_adaptive(&s, tol, 1_000_000).mesh;
+    assert!(audit(&s, &good).max_error <= tol);
+    let mut moved = good.clone();
+    moved.positions[17].x += 10.0 * tol;
+    let a = audit(&s, &moved);
+    assert!(a.max_error >= 9.0 * tol, "{a:?}");
+    let worst = a.worst_triangle.unwrap();
+    assert!(moved.triangles[worst].contains(&17), "{a:?}");
+    let mut swapped = good;
+    swapped.triangle_uv.swap(0, swapped.triangles.len() / 2);
+    let far = audit(&s, &swapped);
+    assert!(far.max_error > 50.0 * tol, "{far:?} {tol}");
+}
+
+#[test]
+fn poles_and_stretched_fermat_ends_meet_the_tolerance() {
+    // The spun spheres' poles collapse a whole side; the Fermat patches stretch like
+    // e^{2|y|/n} towards y = ±a, and their branch points are parametrization singularities.
+    for s in [
+        Surface::SpunTrefoil(SpunTrefoil { scale: 1.0 }),
+        Surface::Fermat(Fermat { n: 4, y_range: 3.0 }),
+        Surface::Fermat(Fermat { n: 6, y_range: 2.0 }),
+    ] {
+        let tol = 1e-3 * bounding_diagonal(&s);
+        let out = sample_adaptive(&s, tol, 2_000_000);
+        let a = audit(&s, &out.mesh);
+        let stats = out.mesh.validate();
+        assert!(out.complete && a.max_error <= tol, "{a:?}");
+        assert!(stats.is_manifold() && stats.degenerate_triangles == 0);
+        // Triangles pile up where the surface needs them: the smallest is far smaller in
+        // (u, v) than the largest.
+        let areas: Vec<f64> = out
+            .mesh
+            .triangle_uv
+            .iter()
+            .map(|[a, b, c]| ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])) / 2.0)
+            .collect();
+        let (lo, hi) = areas
+            .iter()
+            .fold((f64::MAX, 0.0f64), |(lo, hi), x| (lo.min(*x), hi.max(*x)));
+        assert!(hi / lo > 16.0, "{}: areas {lo}..{hi}", s.type_name());
+    }
+    // At the pole of a spun sphere every pole triangle shares one vertex.
+    let s = Surface::SpunTrefoil(SpunTrefoil::default());
+    let mesh = sample_adaptive(&s, 1e-3 * bounding_diagonal(&s), 1_000_000).mesh;
+    let at_pole: std::collections::HashSet<u32> = mesh
+        .triangles
+        .iter()
+        .zip(&mesh.triangle_uv)
+        .flat_map(|(t, uv)| (0..3).filter(|&k| uv[k][0] == 0.0).map(move |k| t[k]))
+        .collect();
+    assert_eq!(at_pole.len(), 1, "{at_pole:?}");
+}
+
+#[test]
+fn the_budget_stops_refinement_with_a_valid_incomplete_mesh() {
+    let s = Surface::TwistSpunTrefoil(TwistSpunTrefoil::default());
+    let tol = 1e-7 * bounding_diagonal(&s);
+    let out = sample_adaptive(&s, tol, 3000);
+    let stats = out.mesh.validate();
+    assert!(!out.complete && out.failing > 0);
+    assert!(
+        out.mesh.triangles.len() <= 3000,
+        "{}",
+        out.mesh.triangles.len()
+    );
+    assert!(
+        stats.is_manifold() && stats.boundary_edges == 0,
+        "{stats:?}"
+    );
+    assert_eq!(stats.euler_characteristic, 2);
+    assert!(audit(&s, &out.mesh).max_error > tol);
+}
+
+#[test]
+fn scene_sampling_takes_relative_and_absolute_tolerances() {
+    let s = Surface::FlatTorus(FlatTorus::default());
+    let d = bounding_diagonal(&s);
+    let rel = sample(&s, &Sampling::adaptive(1e-3));
+    assert_eq!(rel.tolerance, Some(1e-3 * d));
+    assert!(rel.complete && audit(&s, &rel.mesh).max_error <= 1e-3 * d);
+    let abs = sample(
+        &s,
+        &Sampling::Adaptive {
+            tolerance: None,
+            absolute_tolerance: Some(0.01),
+            max_triangles: 100_000,
+        },
+    );
+    assert_eq!(abs.tolerance, Some(0.01));
+    assert!(audit(&s, &abs.mesh).max_error <= 0.01);
+    let grid = sample(&s, &Sampling::Uniform { u: 8, v: 6 });
+    assert_eq!((grid.tolerance, grid.mesh.triangles.len()), (None, 96));
+}
