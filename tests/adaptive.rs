@@ -190,6 +190,27 @@ fn the_budget_stops_refinement_with_a_valid_incomplete_mesh() {
     );
     assert_eq!(stats.euler_characteristic, 2);
     assert!(audit(&s, &out.mesh).max_error > tol);
+    // Patches refine in parallel and trade seam points between rounds: stopped mid-round,
+    // the seams still conform.
+    let s = Surface::Fermat(Fermat { n: 4, y_range: 1.0 });
+    let out = sample_adaptive(&s, 1e-7 * bounding_diagonal(&s), 5000);
+    let stats = out.mesh.validate();
+    assert!(!out.complete && out.mesh.triangles.len() <= 5000);
+    assert!(
+        stats.is_manifold() && stats.euler_characteristic == -8,
+        "{stats:?}"
+    );
+}
+
+#[test]
+fn parallel_refinement_is_deterministic() {
+    let s = Surface::Fermat(Fermat { n: 3, y_range: 1.5 });
+    let tol = 3e-4 * bounding_diagonal(&s);
+    let (a, b) = (
+        sample_adaptive(&s, tol, 1_000_000),
+        sample_adaptive(&s, tol, 1_000_000),
+    );
+    assert_eq!(a.mesh, b.mesh);
 }
 
 #[test]

@@ -119,3 +119,27 @@ fn glued_sides_and_poles_are_the_same_points() {
         }
     }
 }
+
+#[test]
+fn the_point_alone_is_the_point_of_the_full_evaluation() {
+    // `point` is the samplers' fast path; it must agree with `eval` everywhere, branch
+    // points and patch corners included.
+    let mut rng = Rng(11);
+    for s in surfaces_under_test() {
+        for patch in 0..s.patch_count() {
+            let d = s.domain(patch);
+            let corners = [(0.0, 0.0), (1.0, 1.0), (0.0, 0.5), (1.0, 0.5)];
+            let random = (0..200).map(|_| (rng.unit(), rng.unit()));
+            for (a, b) in corners.into_iter().chain(random) {
+                let u = d.u[0] + (d.u[1] - d.u[0]) * a;
+                let v = d.v[0] + (d.v[1] - d.v[0]) * b;
+                let (fast, full) = (s.point(patch, u, v), s.eval(patch, u, v).p);
+                assert!(
+                    (fast - full).length() <= 1e-13 * (1.0 + full.length()),
+                    "{} patch {patch} at ({u}, {v}): {fast} vs {full}",
+                    s.type_name()
+                );
+            }
+        }
+    }
+}

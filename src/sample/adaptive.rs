@@ -33,6 +33,7 @@ use glam::DVec4;
 use spade::handles::FixedVertexHandle;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 use std::collections::{BTreeSet, HashMap, VecDeque};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
@@ -63,6 +64,12 @@ struct Patch {
     /// The side coordinates of the points on each side (as bits: non-negative floats sort
     /// like their bits).
     sides: [BTreeSet<u64>; 4],
+    /// Triangles to check.
+    queue: VecDeque<[FixedVertexHandle; 3]>,
+    /// New side points whose images on glued sides are still to be inserted.
+    outbox: Vec<(Side, f64)>,
+    /// Edges too short to split in floating point, or points spade refused.
+    stuck: usize,
 }
 
 impl Patch {
@@ -89,7 +96,7 @@ impl Patch {
         }
         let [u, v] = self.uv(st);
         self.st.push(st);
-        self.p.push(surface.eval(patch, u, v).p);
+        self.p.push(surface.point(patch, u, v));
         Some((h, true))
     }
 
@@ -330,7 +337,7 @@ enum Verdict {
 
 /// Samples `surface` so that every triangle lies within `tolerance` (an absolute length in
 /// R^4) of the surface at the audit points, stopping when the mesh would exceed
-/// `max_triangles` triangles.
+/// `max_triangles` triangles. Patches are refined in parallel.
 pub fn sample_adaptive(surface: &Surface, tolerance: f64, max_triangles: usize) -> AdaptiveMesh {
     let mut sampler = Sampler::new(surface, tolerance * (1.0 - 1e-9));
     let complete = sampler.refine(max_triangles);
@@ -342,204 +349,116 @@ pub fn sample_adaptive(surface: &Surface, tolerance: f64, max_triangles: usize) 
     }
 }
 
-struct Sampler<'a> {
+/// What a patch needs to refine itself.
+struct Context<'a> {
     surface: &'a Surface,
     tolerance: f64,
-    patches: Vec<Patch>,
-    queue: VecDeque<(usize, [FixedVertexHandle; 3])>,
-    /// Edges too short to split in floating point.
-    stuck: usize,
+    /// Triangles of all patches together, and the most allowed.
+    triangles: &'a AtomicUsize,
+    max_triangles: usize,
 }
 
-impl<'a> Sampler<'a> {
-    /// Starts every patch from a coarse grid shaped like its scaled rectangle, with the
-    /// rectangle's sides as constraint edges, and makes the glued sides conform.
-    fn new(surface: &'a Surface, tolerance: f64) -> Self {
-        let [min_u, min_v] = surface.min_cells();
-        let mut patches = Vec::new();
-        for patch in 0..surface.patch_count() {
-            let domain = surface.domain(patch);
-            let warp = patch_warp(surface, patch, &domain);
-            let pole = Side::ALL.map(|s| matches!(domain.side(s), SideRule::Pole));
-            // About 16 cells, shaped like the scaled rectangle.
-            let aspect = warp.s.end() / warp.t.end();
-            let nu = grid_cells(4.0 * aspect.sqrt(), min_u);
-            let nv = grid_cells(4.0 / aspect.sqrt(), min_v);
-            let mut p = Patch {
-                domain,
-                warp,
-                cdt: Cdt::new(),
-                st: Vec::new(),
-                p: Vec::new(),
-                pole,
-                sides: Default::default(),
-            };
-            let mut handles = vec![vec![None; nu + 1]; nv + 1];
-            for (j, row) in handles.iter_mut().enumerate() {
-                for (i, h) in row.iter_mut().enumerate() {
-                    let st = [i as f64 / nu as f64, j as f64 / nv as f64];
-                    *h = p.insert(surface, patch, st).map(|(h, _)| h);
-                }
-            }
-            let mut boundary = Vec::new();
-            boundary.extend((0..nu).map(|i| (handles[0][i], handles[0][i + 1])));
-            boundary.extend((0..nu).map(|i| (handles[nv][i], handles[nv][i + 1])));
-            boundary.extend((0..nv).map(|j| (handles[j][0], handles[j + 1][0])));
-            boundary.extend((0..nv).map(|j| (handles[j][nu], handles[j + 1][nu])));
-            for (a, b) in boundary {
-                if let (Some(a), Some(b)) = (a, b) {
-                    p.cdt.add_constraint(a, b);
-                }
-            }
-            patches.push(p);
-        }
-        let mut sampler = Sampler {
-            surface,
-            tolerance,
-            patches,
-            queue: VecDeque::new(),
-            stuck: 0,
-        };
-        // Glued sides of different grids: insert every side point's images.
-        for patch in 0..sampler.patches.len() {
-            let side_points: Vec<(Side, f64)> = sampler.patches[patch]
-                .st
-                .iter()
-                .flat_map(|st| sides_of_point(*st))
-                .collect();
-            for (side, sigma) in side_points {
-                sampler.insert_side_point(patch, side, sigma);
-            }
-        }
-        for (patch, p) in sampler.patches.iter().enumerate() {
-            for f in p.cdt.inner_faces() {
-                sampler
-                    .queue
-                    .push_back((patch, f.vertices().map(|v| v.fix())));
-            }
-        }
-        sampler
-    }
-
-    fn triangles(&self) -> usize {
-        self.patches.iter().map(|p| p.cdt.num_inner_faces()).sum()
-    }
-
-    /// Inserts a point on a side and, recursively, its images on the sides glued to it;
-    /// queues the triangles around every new point. The images of the first point are
-    /// visited even when the point itself was there.
-    fn insert_side_point(&mut self, patch: usize, side: Side, sigma: f64) {
-        let mut work = vec![(patch, side, sigma)];
-        let mut first = true;
-        while let Some((patch, side, sigma)) = work.pop() {
-            let p = &mut self.patches[patch];
-            let new = match p.insert(self.surface, patch, side_st(side, sigma)) {
-                Some((h, new)) => {
-                    if new {
-                        self.queue_around(patch, h);
-                    }
-                    new
-                }
-                None => {
-                    self.stuck += 1;
-                    false
-                }
-            };
-            if new || first {
-                work.extend(glued_images(&self.patches[patch].domain, side, sigma));
-            }
-            first = false;
-        }
-    }
-
-    fn queue_around(&mut self, patch: usize, h: FixedVertexHandle) {
-        let cdt = &self.patches[patch].cdt;
-        for e in cdt.vertex(h).out_edges() {
+impl Patch {
+    fn queue_around(&mut self, h: FixedVertexHandle) {
+        for e in self.cdt.vertex(h).out_edges() {
             if let Some(f) = e.face().as_inner() {
-                self.queue.push_back((patch, f.vertices().map(|v| v.fix())));
+                self.queue.push_back(f.vertices().map(|v| v.fix()));
             }
         }
     }
 
-    /// Refines until every triangle passes (true) or the budget is reached (false).
-    fn refine(&mut self, max_triangles: usize) -> bool {
-        while let Some((patch, tri)) = self.queue.pop_front() {
-            let cdt = &self.patches[patch].cdt;
-            let alive = cdt
+    /// Inserts a point and queues its triangles; records it in the outbox when it is a new
+    /// side point, for the sides glued to it. Returns whether the point is new.
+    fn add(&mut self, surface: &Surface, patch: usize, st: [f64; 2]) -> bool {
+        match self.insert(surface, patch, st) {
+            Some((h, true)) => {
+                self.queue_around(h);
+                self.outbox.extend(sides_of_point(st));
+                true
+            }
+            Some((_, false)) => false,
+            None => {
+                self.stuck += 1;
+                false
+            }
+        }
+    }
+
+    /// Refines this patch until its queue is empty (true) or the budget is reached (false).
+    fn refine(&mut self, patch: usize, cx: &Context) -> bool {
+        while let Some(tri) = self.queue.pop_front() {
+            let alive = self
+                .cdt
                 .get_edge_from_neighbors(tri[0], tri[1])
                 .and_then(|e| e.opposite_vertex())
                 .is_some_and(|v| v.fix() == tri[2]);
             if !alive {
                 continue;
             }
-            let Verdict::Split(edges) = self.check(patch, tri.map(|h| h.index())) else {
+            let t = tri.map(|h| h.index());
+            let Verdict::Split(edges) = self.check(cx.surface, patch, cx.tolerance, t) else {
                 continue;
             };
-            if self.triangles() + 2 * edges.len() > max_triangles {
-                self.queue.push_front((patch, tri));
+            // Reserve what the splits can add: per edge, two triangles here and, for a side
+            // point, four on the sides glued to it (inserted after this round).
+            let reserve = 6 * edges.len();
+            if cx.triangles.fetch_add(reserve, Ordering::Relaxed) + reserve > cx.max_triangles {
+                cx.triangles.fetch_sub(reserve, Ordering::Relaxed);
+                self.queue.push_front(tri);
                 return false;
             }
-            let t = tri.map(|h| h.index());
-            let st = &self.patches[patch].st;
+            let (faces, sent) = (self.cdt.num_inner_faces(), self.outbox.len());
             let ends: Vec<_> = edges
                 .iter()
-                .map(|&k| (st[t[k]], st[t[(k + 1) % 3]]))
+                .map(|&k| (self.st[t[k]], self.st[t[(k + 1) % 3]]))
                 .collect();
             let mut added = false;
             for (a, b) in ends {
-                added |= self.split(patch, a, b);
+                added |= self.split(cx.surface, patch, a, b);
             }
+            let used = self.cdt.num_inner_faces() - faces + 4 * (self.outbox.len() - sent);
+            cx.triangles
+                .fetch_sub(reserve.saturating_sub(used), Ordering::Relaxed);
             // A split elsewhere (an encroached side) may leave this triangle standing.
             if added {
-                self.queue.push_back((patch, tri));
+                self.queue.push_back(tri);
             }
         }
-        self.stuck == 0
+        true
     }
 
-    /// Splits the edge from `sa` to `sb` (normalized parameters) of a patch at its midpoint,
-    /// or the side segment that midpoint encroaches on. Returns whether a point was added.
-    fn split(&mut self, patch: usize, sa: [f64; 2], sb: [f64; 2]) -> bool {
+    /// Splits the edge from `sa` to `sb` (normalized parameters) at its midpoint, or the
+    /// side segment that midpoint encroaches on. Returns whether a point was added.
+    fn split(&mut self, surface: &Surface, patch: usize, sa: [f64; 2], sb: [f64; 2]) -> bool {
         let mid = [(sa[0] + sb[0]) / 2.0, (sa[1] + sb[1]) / 2.0];
         if mid == sa || mid == sb {
             self.stuck += 1;
             return false;
         }
-        let before = self.points();
-        if let Some((side, x, y)) = side_of_edge(sa, sb) {
-            self.insert_side_point(patch, side, (x + y) / 2.0);
-        } else if let Some((side, sigma)) = self.patches[patch].encroached(mid) {
-            self.insert_side_point(patch, side, sigma);
+        let at = if side_of_edge(sa, sb).is_some() {
+            mid
+        } else if let Some((side, sigma)) = self.encroached(mid) {
+            side_st(side, sigma)
         } else {
-            match self.patches[patch].insert(self.surface, patch, mid) {
-                Some((h, true)) => self.queue_around(patch, h),
-                // Already there: a neighbour split the same edge.
-                Some((_, false)) => {}
-                None => self.stuck += 1,
-            }
-        }
-        self.points() > before
-    }
-
-    fn points(&self) -> usize {
-        self.patches.iter().map(|p| p.st.len()).sum()
+            mid
+        };
+        self.add(surface, patch, at)
     }
 
     /// Tests a triangle at the audit's edge and interior points.
-    fn check(&self, patch: usize, t: [usize; 3]) -> Verdict {
-        let p = &self.patches[patch];
-        if p.collapses(t) {
+    fn check(&self, surface: &Surface, patch: usize, tolerance: f64, t: [usize; 3]) -> Verdict {
+        if self.collapses(t) {
             return Verdict::Pass;
         }
-        let uv = t.map(|i| p.uv(p.st[i]));
-        let corners = t.map(|i| p.p[i]);
+        let uv = t.map(|i| self.uv(self.st[i]));
+        let corners = t.map(|i| self.p[i]);
         let mut worst = 0.0f64;
         let mut edge_error = [0.0f64; 3];
         for (k, b) in AUDIT_POINTS.iter().enumerate().skip(3) {
             let u = b[0] * uv[0][0] + b[1] * uv[1][0] + b[2] * uv[2][0];
             let v = b[0] * uv[0][1] + b[1] * uv[1][1] + b[2] * uv[2][1];
             let chord = corners[0] * b[0] + corners[1] * b[1] + corners[2] * b[2];
-            let d = (self.surface.eval(patch, u, v).p - chord).length();
+            let d = (surface.point(patch, u, v) - chord).length();
             let d = if d.is_finite() { d } else { f64::INFINITY };
             worst = worst.max(d);
             if k < 6 {
@@ -550,11 +469,11 @@ impl<'a> Sampler<'a> {
         // The warp is curved, so a triangle counter-clockwise in the warped plane can be
         // folded over in (u, v); refinement straightens the warp until it is not.
         let [a, b, c] = t.map(|i| {
-            let [x, y] = p.st[i];
+            let [x, y] = self.st[i];
             robust::Coord { x, y }
         });
         let folded = robust::orient2d(a, b, c) <= 0.0;
-        if worst <= self.tolerance && !folded {
+        if worst <= tolerance && !folded {
             return Verdict::Pass;
         }
         // The curvature term of each edge's chordal error, from the centroid's Hessian.
@@ -562,7 +481,7 @@ impl<'a> Sampler<'a> {
             (uv[0][0] + uv[1][0] + uv[2][0]) / 3.0,
             (uv[0][1] + uv[1][1] + uv[2][1]) / 3.0,
         ];
-        let e = self.surface.eval(patch, c[0], c[1]);
+        let e = surface.eval(patch, c[0], c[1]);
         let mut score = [0.0f64; 3];
         let mut longest = (0.0f64, 0usize);
         for k in 0..3 {
@@ -575,15 +494,17 @@ impl<'a> Sampler<'a> {
             } else {
                 0.0
             });
-            let (sa, sb) = (p.st[t[k]], p.st[t[(k + 1) % 3]]);
-            let (wa, wb) = (p.warp.apply(sa), p.warp.apply(sb));
+            let (wa, wb) = (
+                self.warp.apply(self.st[t[k]]),
+                self.warp.apply(self.st[t[(k + 1) % 3]]),
+            );
             let len = (wb.x - wa.x).hypot(wb.y - wa.y);
             if len > longest.0 {
                 longest = (len, k);
             }
         }
         let over: Vec<usize> = (0..3)
-            .filter(|&k| score[k] > self.tolerance && !folded)
+            .filter(|&k| score[k] > tolerance && !folded)
             .collect();
         match over.len() {
             0 => Verdict::Split(vec![longest.1]),
@@ -593,6 +514,146 @@ impl<'a> Sampler<'a> {
             _ => Verdict::Split(vec![
                 (0..3).fold(0, |m, k| if score[k] > score[m] { k } else { m }),
             ]),
+        }
+    }
+}
+
+struct Sampler<'a> {
+    surface: &'a Surface,
+    tolerance: f64,
+    patches: Vec<Patch>,
+}
+
+impl<'a> Sampler<'a> {
+    /// Starts every patch from a coarse grid shaped like its warped rectangle, with the
+    /// rectangle's sides as constraint edges, and makes the glued sides conform.
+    fn new(surface: &'a Surface, tolerance: f64) -> Self {
+        let [min_u, min_v] = surface.min_cells();
+        let mut patches = Vec::new();
+        for patch in 0..surface.patch_count() {
+            let domain = surface.domain(patch);
+            let warp = patch_warp(surface, patch, &domain);
+            let pole = Side::ALL.map(|s| matches!(domain.side(s), SideRule::Pole));
+            // About 16 cells, shaped like the warped rectangle.
+            let aspect = warp.s.end() / warp.t.end();
+            let nu = grid_cells(4.0 * aspect.sqrt(), min_u);
+            let nv = grid_cells(4.0 / aspect.sqrt(), min_v);
+            let mut p = Patch {
+                domain,
+                warp,
+                cdt: Cdt::new(),
+                st: Vec::new(),
+                p: Vec::new(),
+                pole,
+                sides: Default::default(),
+                queue: VecDeque::new(),
+                outbox: Vec::new(),
+                stuck: 0,
+            };
+            let mut handles = vec![vec![None; nu + 1]; nv + 1];
+            for (j, row) in handles.iter_mut().enumerate() {
+                for (i, h) in row.iter_mut().enumerate() {
+                    let st = [i as f64 / nu as f64, j as f64 / nv as f64];
+                    *h = p.insert(surface, patch, st).map(|(h, _)| h);
+                    p.outbox.extend(sides_of_point(st));
+                }
+            }
+            let mut boundary = Vec::new();
+            boundary.extend((0..nu).map(|i| (handles[0][i], handles[0][i + 1])));
+            boundary.extend((0..nu).map(|i| (handles[nv][i], handles[nv][i + 1])));
+            boundary.extend((0..nv).map(|j| (handles[j][0], handles[j + 1][0])));
+            boundary.extend((0..nv).map(|j| (handles[j][nu], handles[j + 1][nu])));
+            for (a, b) in boundary {
+                if let (Some(a), Some(b)) = (a, b) {
+                    p.cdt.add_constraint(a, b);
+                }
+            }
+            let faces: Vec<_> = p
+                .cdt
+                .inner_faces()
+                .map(|f| f.vertices().map(|v| v.fix()))
+                .collect();
+            p.queue.extend(faces);
+            patches.push(p);
+        }
+        let mut sampler = Sampler {
+            surface,
+            tolerance,
+            patches,
+        };
+        sampler.exchange();
+        sampler
+    }
+
+    fn triangles(&self) -> usize {
+        self.patches.iter().map(|p| p.cdt.num_inner_faces()).sum()
+    }
+
+    /// Empties the outboxes: inserts the images of every new side point on the sides glued
+    /// to it, recursively (an image on a piece end has images of its own).
+    fn exchange(&mut self) {
+        let mut work: Vec<(usize, Side, f64)> = Vec::new();
+        for p in &mut self.patches {
+            for (side, sigma) in p.outbox.drain(..) {
+                work.extend(glued_images(&p.domain, side, sigma));
+            }
+        }
+        while let Some((patch, side, sigma)) = work.pop() {
+            let p = &mut self.patches[patch];
+            if p.add(self.surface, patch, side_st(side, sigma)) {
+                work.extend(glued_images(&p.domain, side, sigma));
+            }
+            p.outbox.clear();
+        }
+    }
+
+    /// Refines until every triangle passes (true), or the budget or floating point stops it
+    /// (false). Rounds: every patch refines on its own, in parallel; then the new side
+    /// points cross the seams, which queues the triangles they split on the other side.
+    fn refine(&mut self, max_triangles: usize) -> bool {
+        let triangles = AtomicUsize::new(self.triangles());
+        let cx = Context {
+            surface: self.surface,
+            tolerance: self.tolerance,
+            triangles: &triangles,
+            max_triangles,
+        };
+        let threads = std::thread::available_parallelism()
+            .map_or(1, |t| t.get())
+            .clamp(1, 16);
+        let chunk = self.patches.len().div_ceil(threads).max(1);
+        loop {
+            let within_budget = std::thread::scope(|scope| {
+                let handles: Vec<_> = self
+                    .patches
+                    .chunks_mut(chunk)
+                    .enumerate()
+                    .map(|(c, patches)| {
+                        let cx = &cx;
+                        scope.spawn(move || {
+                            patches
+                                .iter_mut()
+                                .enumerate()
+                                .all(|(i, p)| p.refine(c * chunk + i, cx))
+                        })
+                    })
+                    .collect();
+                // Join every thread before looking at the verdicts.
+                let done: Vec<bool> = handles
+                    .into_iter()
+                    .map(|h| h.join().expect("refinement thread panicked"))
+                    .collect();
+                done.into_iter().all(|d| d)
+            });
+            // The seams conform even when the budget stopped the round.
+            self.exchange();
+            if !within_budget {
+                return false;
+            }
+            triangles.store(self.triangles(), Ordering::Relaxed);
+            if self.patches.iter().all(|p| p.queue.is_empty()) {
+                return self.patches.iter().all(|p| p.stuck == 0);
+            }
         }
     }
 
@@ -606,7 +667,10 @@ impl<'a> Sampler<'a> {
                     .inner_faces()
                     .filter(|f| {
                         let t = f.vertices().map(|v| v.fix().index());
-                        matches!(self.check(patch, t), Verdict::Split(_))
+                        matches!(
+                            p.check(self.surface, patch, self.tolerance, t),
+                            Verdict::Split(_)
+                        )
                     })
                     .count()
             })

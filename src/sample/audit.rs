@@ -124,7 +124,7 @@ fn audit_range(surface: &Surface, mesh: &Mesh4, range: std::ops::Range<usize>) -
             let u = b[0] * uv[0][0] + b[1] * uv[1][0] + b[2] * uv[2][0];
             let v = b[0] * uv[0][1] + b[1] * uv[1][1] + b[2] * uv[2][1];
             let chord = corners[0] * b[0] + corners[1] * b[1] + corners[2] * b[2];
-            let d = (surface.eval(patch, u, v).p - chord).length();
+            let d = (surface.point(patch, u, v) - chord).length();
             out.points += 1;
             if !d.is_finite() {
                 out.non_finite += 1;

@@ -20,7 +20,6 @@ pub use uniform::sample_uniform;
 use crate::surfaces::{Eval4, Surface};
 use glam::DVec4;
 use serde::{Deserialize, Serialize};
-use std::collections::HashMap;
 
 /// How to sample a surface.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -226,7 +225,7 @@ pub fn bounding_diagonal(surface: &Surface) -> f64 {
             for i in 0..=N {
                 let u = d.u[0] + (d.u[1] - d.u[0]) * i as f64 / N as f64;
                 let v = d.v[0] + (d.v[1] - d.v[0]) * j as f64 / N as f64;
-                let p = surface.eval(patch, u, v).p;
+                let p = surface.point(patch, u, v);
                 if p.is_finite() {
                     lo = lo.min(p);
                     hi = hi.max(p);
@@ -312,8 +311,9 @@ impl Mesh4 {
             triangles: self.triangles.len(),
             ..MeshStats::default()
         };
-        // For each undirected edge: number of uses in each direction.
-        let mut edges: HashMap<(u32, u32), [usize; 2]> = HashMap::new();
+        // Every directed edge as (low, high, direction), sorted so the uses of an undirected
+        // edge are adjacent.
+        let mut directed: Vec<(u32, u32, bool)> = Vec::with_capacity(3 * self.triangles.len());
         let mut used = vec![false; self.positions.len()];
         for t in &self.triangles {
             let [a, b, c] = *t;
@@ -326,18 +326,18 @@ impl Mesh4 {
                 stats.degenerate_triangles += 1;
             }
             for (x, y) in [(a, b), (b, c), (c, a)] {
-                let key = (x.min(y), x.max(y));
-                edges.entry(key).or_default()[usize::from(x > y)] += 1;
+                directed.push((x.min(y), x.max(y), x > y));
             }
             for i in t {
                 used[*i as usize] = true;
             }
         }
-        stats.edges = edges.len();
-        for uses in edges.values() {
-            match uses[0] + uses[1] {
+        directed.sort_unstable();
+        for uses in directed.chunk_by(|p, q| (p.0, p.1) == (q.0, q.1)) {
+            stats.edges += 1;
+            match uses.len() {
                 1 => stats.boundary_edges += 1,
-                2 => stats.orientation_conflicts += usize::from(uses[0] != 1),
+                2 => stats.orientation_conflicts += usize::from(uses[0].2 == uses[1].2),
                 _ => stats.non_manifold_edges += 1,
             }
         }

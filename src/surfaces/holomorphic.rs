@@ -6,6 +6,7 @@
 //! ∂vv f = -f''.
 
 use super::{Domain, Eval4, Glue, Jet, Parametric, Side, SideRule, Topology, positive};
+use glam::DVec4;
 use num_complex::Complex64 as C64;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -90,10 +91,36 @@ impl Default for Fermat {
     }
 }
 
+/// The principal square root (arg in (-π/2, π/2], the branch of `powf(0.5)`), computed
+/// without cancellation on either side of the imaginary axis.
+fn principal_sqrt(g: C64) -> C64 {
+    let r = g.norm_sqr().sqrt();
+    if r == 0.0 {
+        return C64::new(0.0, 0.0);
+    }
+    if g.re >= 0.0 {
+        let t = ((r + g.re) / 2.0).sqrt();
+        C64::new(t, g.im / (2.0 * t))
+    } else {
+        let t = ((r - g.re) / 2.0).sqrt();
+        C64::new(g.im.abs() / (2.0 * t), t.copysign(g.im))
+    }
+}
+
 impl Fermat {
     fn patch_index(&self, k1: i64, k2: i64) -> usize {
         let n = self.n as i64;
         (k1.rem_euclid(n) * n + k2.rem_euclid(n)) as usize
+    }
+}
+
+impl Fermat {
+    /// cos ζ and sin ζ for ζ = u + iv, from one sincos and one exp.
+    fn cos_sin(&self, u: f64, v: f64) -> (C64, C64) {
+        let (sx, cx) = u.sin_cos();
+        let e = v.exp();
+        let (ch, sh) = ((e + 1.0 / e) / 2.0, (e - 1.0 / e) / 2.0);
+        (C64::new(cx * ch, -sx * sh), C64::new(sx * ch, cx * sh))
     }
 }
 
@@ -137,17 +164,33 @@ impl Parametric for Fermat {
         let n = self.n as usize;
         let (k1, k2) = (patch / n, patch % n);
         let p = 2.0 / self.n as f64;
-        // cos ζ and sin ζ from one sincos and one exp (the sampler's hot path).
-        let (sx, cx) = u.sin_cos();
-        let (e, ie) = (v.exp(), (-v).exp());
-        let (ch, sh) = ((e + ie) / 2.0, (e - ie) / 2.0);
-        let (c, s) = (C64::new(cx * ch, -sx * sh), C64::new(sx * ch, cx * sh));
+        let (c, s) = self.cos_sin(u, v);
         let phase = |k: usize| unit_root(k, n);
         let scale = |(a, b, c): (C64, C64, C64), w: C64| (a * w, b * w, c * w);
         point(
             scale(power(p, c, -s, -c), phase(k1)),
             scale(power(p, s, c, -s), phase(k2)),
         )
+    }
+    fn point(&self, patch: usize, u: f64, v: f64) -> DVec4 {
+        let n = self.n as usize;
+        let (k1, k2) = (patch / n, patch % n);
+        let (c, s) = self.cos_sin(u, v);
+        let p = 1.0 / self.n as f64;
+        // g^(2/n) on the principal branch: g itself for n = 2, the principal square root for
+        // n = 4 (no trigonometry), |g|^(2/n) e^{i (2/n) arg g} otherwise.
+        let power = |g: C64| match self.n {
+            2 => g,
+            4 => principal_sqrt(g),
+            _ => {
+                let r = g.norm_sqr().powf(p);
+                let (sin, cos) = (2.0 * p * g.arg()).sin_cos();
+                C64::new(r * cos, r * sin)
+            }
+        };
+        let z1 = power(c) * unit_root(k1, n);
+        let z2 = power(s) * unit_root(k2, n);
+        DVec4::new(z1.re, z2.re, z1.im, z2.im)
     }
     fn topology(&self) -> Topology {
         Topology {
