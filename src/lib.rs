@@ -2,8 +2,9 @@
 //!
 //! The pipeline, one module per stage (see the README's architecture section):
 //! [`scene`] (what to build) -> [`surfaces`] (4D parametric surfaces with exact derivatives)
-//! -> [`sample`] (meshes welded by domain rules) -> [`view`] (4D rotation and projection)
-//! -> [`export`] (glTF, PLY, OBJ, report). [`pipeline`] runs them in order.
+//! -> [`sample`] (meshes to a tolerance, welded by domain rules, audited) -> [`view`] (4D
+//! rotation and projection) -> [`export`] (glTF, PLY, OBJ, report). [`pipeline`] runs them
+//! in order; [`sweep`] measures what each tolerance costs.
 #![warn(missing_docs)]
 
 pub mod error;

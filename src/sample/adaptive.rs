@@ -27,7 +27,7 @@
 //! the surface is orientable. When the triangle budget stops the refinement, the mesh is
 //! still a valid mesh, only coarser than asked.
 
-use super::{AUDIT_POINTS, Classes, Mesh4, eval_vertex};
+use super::{AUDIT_POINTS, Classes, Mesh4};
 use crate::surfaces::{Domain, Side, SideRule, Surface};
 use glam::DVec4;
 use spade::handles::FixedVertexHandle;
@@ -739,13 +739,7 @@ impl<'a> Sampler<'a> {
                 let (patch, i) = locate(rep);
                 let p = &self.patches[patch];
                 let [u, v] = p.uv(p.st[i]);
-                let e = eval_vertex(self.surface, patch, u, v);
-                vertex_of[rep] = mesh.positions.len() as u32;
-                mesh.positions.push(e.p);
-                mesh.tangent_u.push(e.du);
-                mesh.tangent_v.push(e.dv);
-                mesh.uv.push([u, v]);
-                mesh.patch.push(patch as u32);
+                vertex_of[rep] = mesh.push_vertex(self.surface, patch, u, v);
             }
             vertex_of[id] = vertex_of[rep];
         }
@@ -753,11 +747,7 @@ impl<'a> Sampler<'a> {
             for f in p.cdt.inner_faces() {
                 let local = f.vertices().map(|v| v.fix().index());
                 let t = local.map(|i| vertex_of[offsets[patch] + i]);
-                if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
-                    mesh.triangles.push(t);
-                    mesh.triangle_patch.push(patch as u32);
-                    mesh.triangle_uv.push(local.map(|i| p.uv(p.st[i])));
-                }
+                mesh.push_triangle(t, patch, local.map(|i| p.uv(p.st[i])));
             }
         }
         mesh

@@ -1,13 +1,18 @@
 //! Sampling: a surface of the catalogue becomes a triangle mesh in R^4.
 //!
-//! Takes: a [`Surface`] and sampling settings. Gives: a [`Mesh4`] with, per vertex, the
-//! 4D point, the two tangents ∂p/∂u and ∂p/∂v, the parameters (patch, u, v); and triangles
-//! oriented counter-clockwise in (u, v).
+//! Takes: a [`Surface`] and sampling settings: a tolerance for the adaptive sampler
+//! ([`sample_adaptive`], the default) or a grid ([`sample_uniform`]). Gives: a [`Mesh4`]
+//! with, per vertex, the 4D point, the two tangents ∂p/∂u and ∂p/∂v, the parameters
+//! (patch, u, v); and triangles oriented counter-clockwise in (u, v), each with its patch and
+//! its corners' parameters on that patch.
 //!
-//! Guarantees: seams and poles are welded by the domain rules of the surface, never by
-//! distance; closed surfaces give closed manifold meshes (every edge in exactly two
-//! triangles) with the surface's Euler characteristic; orientable surfaces give consistently
-//! oriented meshes; no triangle repeats a vertex. [`Mesh4::validate`] measures all of this.
+//! Guarantees: the adaptive sampler, when it reports `complete`, leaves every triangle within
+//! the tolerance of the surface as [`audit`] measures it (the audit shares no code with the
+//! sampler but the list of points it checks); seams and poles are welded by the domain rules
+//! of the surface, never by distance; closed surfaces give closed manifold meshes (every edge
+//! in exactly two triangles) with the surface's Euler characteristic; orientable surfaces
+//! give consistently oriented meshes; no triangle repeats a vertex or folds over in (u, v).
+//! [`Mesh4::validate`] measures the combinatorics.
 
 mod adaptive;
 mod audit;
@@ -353,6 +358,27 @@ impl Mesh4 {
         stats.euler_characteristic =
             stats.vertices as i64 - stats.edges as i64 + stats.triangles as i64;
         stats
+    }
+
+    /// Appends the vertex at (u, v) of a patch (see [`eval_vertex`]); returns its index.
+    fn push_vertex(&mut self, surface: &Surface, patch: usize, u: f64, v: f64) -> u32 {
+        let e = eval_vertex(surface, patch, u, v);
+        self.positions.push(e.p);
+        self.tangent_u.push(e.du);
+        self.tangent_v.push(e.dv);
+        self.uv.push([u, v]);
+        self.patch.push(patch as u32);
+        (self.positions.len() - 1) as u32
+    }
+
+    /// Appends a triangle cut from `patch` with its corners' parameters, unless welding made
+    /// it repeat a vertex (a triangle with an edge on a pole).
+    fn push_triangle(&mut self, t: [u32; 3], patch: usize, uv: [[f64; 2]; 3]) {
+        if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+            self.triangles.push(t);
+            self.triangle_patch.push(patch as u32);
+            self.triangle_uv.push(uv);
+        }
     }
 
     /// Axis-aligned bounding box of the positions, or `None` for an empty mesh.

@@ -1,6 +1,6 @@
 //! The uniform (u, v) grid sampler.
 
-use super::{Classes, Mesh4, eval_vertex};
+use super::{Classes, Mesh4};
 use crate::surfaces::{Side, SideRule, Surface};
 
 /// Samples every patch of `surface` on a grid of `nu` by `nv` cells (both even and at least
@@ -70,13 +70,7 @@ pub fn sample_uniform(surface: &Surface, nu: usize, nv: usize) -> Mesh4 {
             let d = &domains[patch];
             let u = d.u[0] + (d.u[1] - d.u[0]) * i as f64 / nu as f64;
             let v = d.v[0] + (d.v[1] - d.v[0]) * j as f64 / nv as f64;
-            let e = eval_vertex(surface, patch, u, v);
-            vertex_of[rep] = mesh.positions.len() as u32;
-            mesh.positions.push(e.p);
-            mesh.tangent_u.push(e.du);
-            mesh.tangent_v.push(e.dv);
-            mesh.uv.push([u, v]);
-            mesh.patch.push(patch as u32);
+            vertex_of[rep] = mesh.push_vertex(surface, patch, u, v);
         }
         vertex_of[id] = vertex_of[rep];
     }
@@ -93,13 +87,8 @@ pub fn sample_uniform(surface: &Surface, nu: usize, nv: usize) -> Mesh4 {
                 let corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
                 let [a, b, c, d] = corners.map(|(i, j)| vertex_of[node(patch, i, j)]);
                 let [pa, pb, pc, pd] = corners.map(|(i, j)| uv(i, j));
-                for (t, t_uv) in [([a, b, c], [pa, pb, pc]), ([a, c, d], [pa, pc, pd])] {
-                    if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
-                        mesh.triangles.push(t);
-                        mesh.triangle_patch.push(patch as u32);
-                        mesh.triangle_uv.push(t_uv);
-                    }
-                }
+                mesh.push_triangle([a, b, c], patch, [pa, pb, pc]);
+                mesh.push_triangle([a, c, d], patch, [pa, pc, pd]);
             }
         }
     }
