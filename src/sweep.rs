@@ -115,6 +115,9 @@ struct GridSearch<'a> {
     max_triangles: usize,
     aspect: f64,
     seen: Vec<Measured>,
+    /// Per shape (aspect factor bits): the finest grid within the budget, when it missed a
+    /// tolerance; tighter tolerances cannot do better.
+    exhausted: Vec<(u64, Measured)>,
 }
 
 impl<'a> GridSearch<'a> {
@@ -125,6 +128,7 @@ impl<'a> GridSearch<'a> {
             max_triangles,
             aspect: sample::metric_aspect(surface),
             seen: Vec::new(),
+            exhausted: Vec::new(),
         }
     }
 
@@ -163,6 +167,9 @@ impl<'a> GridSearch<'a> {
 
     /// The coarsest grid of one shape that meets `tolerance`, or the finest allowed.
     fn search(&mut self, tolerance: f64, aspect: f64) -> (Measured, bool) {
+        if let Some((_, m)) = self.exhausted.iter().find(|e| e.0 == aspect.to_bits()) {
+            return (*m, false);
+        }
         let mut fail: Option<(f64, Measured)> = None;
         let mut pass: Option<(f64, Measured)> = None;
         let mut k = 8.0;
@@ -199,7 +206,10 @@ impl<'a> GridSearch<'a> {
         }
         match (pass, fail) {
             (Some((_, m)), _) => (m, true),
-            (None, Some((_, m))) => (m, false),
+            (None, Some((_, m))) => {
+                self.exhausted.push((aspect.to_bits(), m));
+                (m, false)
+            }
             (None, None) => (self.measure(self.cells(2.0, aspect)), false),
         }
     }

@@ -3,24 +3,32 @@
 //!
 //! Each patch is a constrained Delaunay triangulation (spade) of points in its normalized
 //! rectangle (s, t) in [0, 1]^2, with the rectangle's sides as constraint edges. The
-//! triangulation is taken in scaled coordinates (S_u s, S_v t), where S_u and S_v are the
-//! patch's root mean square lengths |∂p/∂u| (u1 - u0) and |∂p/∂v| (v1 - v0): this removes the
-//! global anisotropy of a parametrization (the spun knots' long arc against their short
-//! circles). A local anisotropy that is conformal (the Fermat patches, whose metric is
-//! λ(x, y)^2 (dx^2 + dy^2) with λ growing like e^{2|y|/n}) needs no warp: a conformal metric
-//! is isotropic, so a Delaunay triangle stays well shaped on the surface, and the refinement
-//! grades its size with λ.
+//! triangulation is taken in a warped plane (F(s), G(t)), with F and G monotone and piecewise
+//! linear, chosen so that the local aspect ratio F'/G' follows sqrt(|∂ss p| / |∂tt p|), the
+//! ratio of the curvature terms of the chordal error along the two parameter directions. A
+//! triangle well shaped in that plane then has about the same error along all its edges:
+//! the spun knots get triangles long along their tubes and short around them, and their
+//! poles, where the circles shrink to a point, get triangles long around. A local anisotropy
+//! that is conformal (the Fermat patches, whose metric is λ(x, y)^2 (dx^2 + dy^2) with λ
+//! growing like e^{2|y|/n}) needs no warp, and gets none since |∂xx p| = |∂yy p| there: a
+//! conformal metric is isotropic, so a Delaunay triangle stays well shaped on the surface and
+//! the refinement grades its size with λ. A triangle that the warp folds over in (s, t) is
+//! refined until it does not.
 //!
 //! Refinement works through a queue of triangles. A triangle passes when the surface at the
 //! audit's edge and interior points ([`super::AUDIT_POINTS`]) lies within the tolerance of
 //! its linear interpolant; otherwise one of its edges is split at its midpoint: the edge
 //! whose error is largest, measured at its midpoint or predicted from the surface's second
 //! derivatives at the centroid (|d^T H d| / 8 for the edge vector d, the curvature term of
-//! the chordal error), or, when only interior points fail, the longest edge in scaled
-//! coordinates. The new point's triangles join the queue. A midpoint on a side splits the
-//! side, and the same point is inserted on every side glued to it, so seams stay conforming:
-//! side points are dyadic fractions of the side, and glue maps send them to dyadic fractions
-//! exactly. At the end the patches are welded by the domain rules, as in the uniform sampler.
+//! the chordal error), or, when only interior points fail, the longest edge in the warped
+//! plane. A midpoint that encroaches on a side segment (lies in the circle on it as a
+//! diameter) splits that segment instead, as in Ruppert's refinement, so no sliver forms
+//! against a side. The new point's triangles join the queue. Patches refine in parallel;
+//! between rounds every new side point is inserted on the sides glued to it, so seams
+//! conform: side points are dyadic fractions of the side (the starting grids have powers of
+//! two of cells, and splits halve), and the glue maps (σ ↦ offset ± σ with offsets that are
+//! multiples of 1/2) send them to dyadic fractions exactly. At the end the patches are
+//! welded by the domain rules, as in the uniform sampler.
 //!
 //! Guarantees: when `complete`, every triangle passes the audit's test at the tolerance;
 //! closed surfaces give closed manifold meshes, welded by rule, consistently oriented where
@@ -376,7 +384,14 @@ impl Patch {
                 self.outbox.extend(sides_of_point(st));
                 true
             }
-            Some((_, false)) => false,
+            Some((h, false)) => {
+                // Another point at the same place in the plane: the warp rounded two
+                // parameters together, and this split cannot be made.
+                if self.st[h.index()] != st {
+                    self.stuck += 1;
+                }
+                false
+            }
             None => {
                 self.stuck += 1;
                 false
