@@ -69,15 +69,6 @@ impl Default for Sampling {
     }
 }
 
-/// The tolerance an adaptive sampling asks for.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Tolerance {
-    /// Relative to the diagonal of the surface's 4D bounding box.
-    Relative(f64),
-    /// An absolute length in R^4.
-    Absolute(f64),
-}
-
 impl Sampling {
     /// Adaptive sampling at a relative tolerance, with the default budget.
     pub fn adaptive(relative: f64) -> Self {
@@ -85,20 +76,6 @@ impl Sampling {
             tolerance: Some(relative),
             absolute_tolerance: None,
             max_triangles: DEFAULT_MAX_TRIANGLES,
-        }
-    }
-
-    /// The tolerance of an adaptive sampling, `None` for a grid.
-    pub fn tolerance(&self) -> Option<Tolerance> {
-        match *self {
-            Sampling::Adaptive {
-                absolute_tolerance: Some(a),
-                ..
-            } => Some(Tolerance::Absolute(a)),
-            Sampling::Adaptive { tolerance, .. } => {
-                Some(Tolerance::Relative(tolerance.unwrap_or(DEFAULT_TOLERANCE)))
-            }
-            Sampling::Uniform { .. } => None,
         }
     }
 
@@ -194,18 +171,20 @@ pub struct Sampled {
 /// Samples a surface as `sampling` says.
 pub fn sample(surface: &Surface, sampling: &Sampling) -> Sampled {
     let diagonal = bounding_diagonal(surface);
-    match (sampling, sampling.tolerance()) {
-        (&Sampling::Uniform { u, v }, _) => Sampled {
+    match *sampling {
+        Sampling::Uniform { u, v } => Sampled {
             mesh: sample_uniform(surface, u, v),
             tolerance: None,
             diagonal,
             complete: true,
         },
-        (&Sampling::Adaptive { max_triangles, .. }, Some(t)) => {
-            let tolerance = match t {
-                Tolerance::Relative(r) => r * diagonal,
-                Tolerance::Absolute(a) => a,
-            };
+        Sampling::Adaptive {
+            tolerance,
+            absolute_tolerance,
+            max_triangles,
+        } => {
+            let tolerance =
+                absolute_tolerance.unwrap_or(tolerance.unwrap_or(DEFAULT_TOLERANCE) * diagonal);
             let out = sample_adaptive(surface, tolerance, max_triangles);
             Sampled {
                 mesh: out.mesh,
@@ -214,7 +193,6 @@ pub fn sample(surface: &Surface, sampling: &Sampling) -> Sampled {
                 complete: out.complete,
             }
         }
-        (Sampling::Adaptive { .. }, None) => unreachable!("adaptive sampling has a tolerance"),
     }
 }
 
