@@ -7,6 +7,7 @@
 //! in order; [`sweep`] measures what each tolerance costs.
 #![warn(missing_docs)]
 
+pub mod check;
 pub mod error;
 pub mod export;
 pub mod halo;
@@ -15,6 +16,7 @@ pub mod sample;
 pub mod scene;
 pub mod surfaces;
 pub mod sweep;
+pub mod tets;
 pub mod view;
 
 pub use error::Error;

@@ -5,10 +5,12 @@
 
 use crate::error::Error;
 use crate::export::{self, SurfaceData};
+use crate::halo::{Halo, HaloReport, build_halo};
 use crate::sample::{self, Audit, Mesh4, MeshStats, Sampling, audit};
 use crate::scene::Scene;
 use crate::surfaces::{Surface, Topology};
 use crate::view::Projected;
+use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -29,6 +31,10 @@ pub struct SurfaceProduct {
     pub sampling: SamplingReport,
     /// Its 3D projection.
     pub projected: Projected,
+    /// Its halo and what the checker said of it.
+    pub halo: Halo,
+    /// The halo's report.
+    pub halo_report: HaloReport,
 }
 
 /// How a surface was sampled, and the audit of the mesh (`report.json`'s `sampling`).
@@ -136,6 +142,8 @@ pub struct Timings {
     pub audit: f64,
     /// View (rotation, projection, normals), all surfaces.
     pub view: f64,
+    /// Halos: thickening, tetrahedra, checking, all surfaces.
+    pub halo: f64,
     /// Writing the outputs.
     pub export: f64,
     /// Sum of the stages.
@@ -177,6 +185,8 @@ pub struct SurfaceReport {
     pub bounds_3d: Option<Bounds>,
     /// Range of w-depth after the view.
     pub w_range: Option<[f64; 2]>,
+    /// The halo.
+    pub halo: HaloReport,
 }
 
 /// `report.json`.
@@ -215,11 +225,12 @@ fn progress(len: usize, quiet: bool) -> ProgressBar {
     bar
 }
 
-/// Samples and projects every surface of the scene.
+/// Samples, projects and thickens every surface of the scene.
 pub fn run(scene: &Scene, quiet: bool) -> Result<(Vec<SurfaceProduct>, Timings), Error> {
-    let bar = progress(scene.surfaces.len() * 2, quiet);
+    let bar = progress(scene.surfaces.len() * 3, quiet);
     let mut timings = Timings::default();
     let mut products = Vec::with_capacity(scene.surfaces.len());
+    let mut projections = Vec::with_capacity(scene.surfaces.len());
     for (i, entry) in scene.surfaces.iter().enumerate() {
         let name = scene.surface_name(i);
         bar.set_message(format!("sampling {name}"));
@@ -255,6 +266,22 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<(Vec<SurfaceProduct>, Timings),
                 message: format!("vertex {bad} of `{name}` is not finite"),
             });
         }
+        projections.push((name, entry, mesh, stats, report, projected));
+    }
+
+    // Halos: rho is a share of the whole projected scene's diagonal.
+    let (lo, hi) = projections.iter().filter_map(|p| p.5.bounds()).fold(
+        (DVec3::INFINITY, DVec3::NEG_INFINITY),
+        |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
+    );
+    let diagonal = (hi - lo).length();
+    let rho = scene.halo.rho * if diagonal.is_finite() { diagonal } else { 1.0 };
+    for (name, entry, mesh, stats, report, projected) in projections {
+        bar.set_message(format!("halo of {name}"));
+        let start = Instant::now();
+        let (halo, halo_report) = build_halo(&projected, &mesh.triangles, rho, &scene.halo);
+        timings.halo += ms(start);
+        bar.inc(1);
         products.push(SurfaceProduct {
             name,
             surface: entry.surface.clone(),
@@ -262,6 +289,8 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<(Vec<SurfaceProduct>, Timings),
             stats,
             sampling: report,
             projected,
+            halo,
+            halo_report,
         });
     }
     bar.finish_and_clear();
@@ -320,7 +349,7 @@ pub fn write(
     if scene.outputs.report {
         files.push("report.json".into());
     }
-    timings.total = timings.sample + timings.audit + timings.view + timings.export;
+    timings.total = timings.sample + timings.audit + timings.view + timings.halo + timings.export;
     let report = Report {
         halo4d: env!("CARGO_PKG_VERSION"),
         scene_name: scene.name.clone(),
@@ -362,5 +391,6 @@ fn surface_report(p: &SurfaceProduct) -> SurfaceReport {
             max: hi.to_array().to_vec(),
         }),
         w_range: p.projected.w_range(),
+        halo: p.halo_report.clone(),
     }
 }

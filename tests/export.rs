@@ -24,6 +24,16 @@ fn every_fixture_builds_and_reads_back() {
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let name = &scene.name;
 
+        // Every halo conforms, as the independent checker sees it. (Inverted tetrahedra
+        // remain where the projection has cross-caps and on non-orientable surfaces.)
+        for p in &products {
+            let c = p.halo_report.check;
+            let what = format!("{name}/{}: {c:?}", p.name);
+            assert!(c.conforms(), "{what}");
+            assert_eq!(p.halo_report.split_stats.mismatches_final, 0, "{what}");
+            assert_eq!(c.tets, 3 * p.mesh.triangles.len(), "{what}");
+        }
+
         // glTF: one mesh per surface, named after it, with the custom attributes.
         let glb = std::fs::read(out.join(format!("{name}.glb"))).unwrap();
         let gltf = gltf::Gltf::from_slice(&glb).unwrap_or_else(|e| panic!("{name}.glb: {e}"));

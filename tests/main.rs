@@ -4,6 +4,7 @@ mod adaptive;
 mod cli;
 mod common;
 mod export;
+mod halo;
 mod sample;
 mod scene;
 mod surfaces;

@@ -1,0 +1,421 @@
+//! Prisms to tetrahedra: every triangle of a thickened surface is a prism between its two
+//! offsets, split into three tetrahedra so that neighbouring prisms agree on the diagonal of
+//! the quad they share.
+//!
+//! Takes: the surface's triangles and the halo's vertices (offset vertex i of the negative
+//! side at index i, of the positive side at n + i). Gives: tetrahedra, oriented so that
+//! `robust::orient3d` is positive when the prism is not inverted, and vertices inserted inside
+//! prisms that no consistent split fits.
+//!
+//! A quad's diagonal runs from the bottom (negative side) of one end of its surface edge to
+//! the top of the other: an orientation of the edge. A prism splits into three tetrahedra
+//! exactly when the orientations of its three edges are acyclic (a source p, a middle q and
+//! a sink r: tetrahedra {p0 q0 r0 r1}, {p0 q0 q1 r1}, {p0 p1 q1 r1}); the two cyclic patterns
+//! need a new vertex, here one at the prism's centre joined to its eight boundary triangles.
+//! Three ways to choose the orientations ([`Split`]):
+//! - `global_order`: every edge from its lower to its higher vertex index. Acyclic
+//!   everywhere, conforming, blind to geometry.
+//! - `paper` (paper 000, 5.1): each triangle first orients its edges by its own corner order,
+//!   as a per-triangle GPU program does; the shared quads where two prisms disagree are then
+//!   fixed by flipping one prism's diagonal where that keeps it splittable (fig. 4b), and
+//!   where neither prism can flip, one of them gets an inserted vertex (fig. 4d).
+//! - `quality`: from the global order, flip an edge's diagonal when both its prisms stay
+//!   splittable and their worst tetrahedron (smallest dihedral angle, inverted counts worst)
+//!   gets better.
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+/// How prisms are split into tetrahedra.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Split {
+    /// Per-triangle start, then flips and inserted vertices (paper 000).
+    Paper,
+    /// Each quad split through its lowest-index vertex (Dompierre et al. 1999).
+    GlobalOrder,
+    /// The global order, improved by flips towards larger dihedral angles.
+    #[default]
+    Quality,
+}
+
+impl Split {
+    /// The name used in scene files and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Split::Paper => "paper",
+            Split::GlobalOrder => "global_order",
+            Split::Quality => "quality",
+        }
+    }
+}
+
+/// What the split did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct SplitStats {
+    /// Shared quads whose two prisms disagreed at the start.
+    pub mismatches_initial: usize,
+    /// Diagonals flipped to fix them (paper) or to improve the tetrahedra (quality).
+    pub flips: usize,
+    /// Vertices inserted inside prisms that no consistent split fits.
+    pub inserted_vertices: usize,
+    /// Shared quads whose prisms still disagree (the builder's own count; the checker decides).
+    pub mismatches_final: usize,
+}
+
+/// Tetrahedra of a halo, with the vertices inserted for them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Tetrahedra {
+    /// Four vertex indices each, into the halo's vertices followed by `inserted`.
+    pub tets: Vec<[u32; 4]>,
+    /// Inserted vertices, each at the centre of a prism.
+    pub inserted: Vec<DVec3>,
+    /// The triangle whose prism each inserted vertex is in.
+    pub inserted_in: Vec<u32>,
+    /// What the split did.
+    pub stats: SplitStats,
+}
+
+/// The triangles using each undirected edge of a triangle mesh, as (triangle, k) with edge k
+/// of a triangle running from corner k to corner k + 1; flat, edge after edge.
+struct Edges {
+    uses: Vec<(u32, u8)>,
+    /// Where each edge's uses start in `uses` (one more entry than edges).
+    starts: Vec<usize>,
+}
+
+impl Edges {
+    fn new(triangles: &[[u32; 3]]) -> Edges {
+        let mut keyed: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(3 * triangles.len());
+        for (t, tri) in triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                keyed.push((a.min(b), a.max(b), t as u32, k as u8));
+            }
+        }
+        keyed.sort_unstable();
+        let mut starts = vec![0];
+        for (i, w) in keyed.windows(2).enumerate() {
+            if (w[0].0, w[0].1) != (w[1].0, w[1].1) {
+                starts.push(i + 1);
+            }
+        }
+        starts.push(keyed.len());
+        if keyed.is_empty() {
+            starts = vec![0];
+        }
+        Edges {
+            uses: keyed.iter().map(|k| (k.2, k.3)).collect(),
+            starts,
+        }
+    }
+
+    fn iter(&self) -> impl Iterator<Item = &[(u32, u8)]> {
+        self.starts.windows(2).map(|w| &self.uses[w[0]..w[1]])
+    }
+}
+
+/// Whether a triangle's edge orientations (true: from corner k to corner k + 1) are cyclic.
+fn cyclic(forward: [bool; 3]) -> bool {
+    forward[0] == forward[1] && forward[1] == forward[2]
+}
+
+/// The triangle-local orientation of edge k given the edge's global one (`up`: from its lower
+/// to its higher vertex).
+fn forward_of(tri: [u32; 3], k: usize, up: bool) -> bool {
+    (tri[k] < tri[(k + 1) % 3]) == up
+}
+
+/// Reference coordinates of a prism's six vertices (corners 0, 1, 2 of the triangle at the
+/// bottom, then at the top) and its centre: a right prism over a counter-clockwise triangle.
+const REFERENCE: [[f64; 3]; 7] = [
+    [0.0, 0.0, 0.0],
+    [1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, 1.0],
+    [1.0, 0.0, 1.0],
+    [0.0, 1.0, 1.0],
+    [1.0 / 3.0, 1.0 / 3.0, 0.5],
+];
+
+fn coord(p: [f64; 3]) -> robust::Coord3D<f64> {
+    robust::Coord3D {
+        x: p[0],
+        y: p[1],
+        z: p[2],
+    }
+}
+
+/// Orders four prism-local vertices (0-2 bottom, 3-5 top, 6 centre) so that the tetrahedron
+/// is positive on the reference prism: positive on the real one when it is not inverted.
+fn oriented(local: [usize; 4]) -> [usize; 4] {
+    let [a, b, c, d] = local.map(|i| coord(REFERENCE[i]));
+    if robust::orient3d(a, b, c, d) > 0.0 {
+        local
+    } else {
+        [local[0], local[1], local[3], local[2]]
+    }
+}
+
+/// The three tetrahedra of a prism from its corners' edge orientations (acyclic), in
+/// prism-local indices.
+fn prism_tets(forward: [bool; 3]) -> [[usize; 4]; 3] {
+    // Out-degree of each corner: edge k runs k -> k+1 when forward, else k+1 -> k.
+    let mut out = [0usize; 3];
+    for (k, f) in forward.iter().enumerate() {
+        out[if *f { k } else { (k + 1) % 3 }] += 1;
+    }
+    let p = (0..3).find(|&i| out[i] == 2).expect("acyclic: a source");
+    let r = (0..3).find(|&i| out[i] == 0).expect("acyclic: a sink");
+    let q = 3 - p - r;
+    [
+        oriented([p, q, r, r + 3]),
+        oriented([p, q, q + 3, r + 3]),
+        oriented([p, p + 3, q + 3, r + 3]),
+    ]
+}
+
+/// The eight tetrahedra joining a prism's centre (local index 6) to its boundary, with each
+/// quad split by its edge's orientation.
+fn centre_tets(forward: [bool; 3]) -> Vec<[usize; 4]> {
+    let mut tets = vec![oriented([0, 1, 2, 6]), oriented([3, 4, 5, 6])];
+    for (k, f) in forward.iter().enumerate() {
+        let (i, j) = (k, (k + 1) % 3);
+        // Diagonal from the bottom of the edge's tail to the top of its head.
+        let (tail, head) = if *f { (i, j) } else { (j, i) };
+        tets.push(oriented([tail, head, head + 3, 6]));
+        tets.push(oriented([tail, tail + 3, head + 3, 6]));
+    }
+    tets
+}
+
+/// Six times the volume of a tetrahedron, positive when `robust::orient3d` is (the fourth
+/// vertex below the plane in which the first three turn counter-clockwise).
+fn signed_volume(p: [DVec3; 4]) -> f64 {
+    -(p[1] - p[0]).cross(p[2] - p[0]).dot(p[3] - p[0])
+}
+
+/// The smallest dihedral angle of a tetrahedron, in radians; 0 when it is flat or inverted.
+fn min_dihedral(p: [DVec3; 4]) -> f64 {
+    if signed_volume(p) == 0.0 || !signed_volume(p).is_finite() {
+        return 0.0;
+    }
+    // Outward normals of the faces opposite each vertex.
+    let normal = |i: usize| {
+        let [a, b, c] = [0, 1, 2, 3]
+            .into_iter()
+            .filter(|&k| k != i)
+            .map(|k| p[k])
+            .collect::<Vec<_>>()[..]
+        else {
+            unreachable!()
+        };
+        let n = (b - a).cross(c - a).normalize_or_zero();
+        if n.dot(p[i] - a) > 0.0 { -n } else { n }
+    };
+    let n = [normal(0), normal(1), normal(2), normal(3)];
+    let mut min = std::f64::consts::PI;
+    for i in 0..4 {
+        for j in i + 1..4 {
+            let angle = std::f64::consts::PI - n[i].dot(n[j]).clamp(-1.0, 1.0).acos();
+            min = min.min(angle);
+        }
+    }
+    min
+}
+
+/// The tetrahedra of one prism over triangle `tri` of a surface of `n` vertices, given the
+/// orientation of its three edges (`forward[k]`: the quad over edge k is split from the
+/// bottom of corner k to the top of corner k + 1): three tetrahedra, or, for the two cyclic
+/// patterns, eight joined to the inserted vertex `centre`.
+pub fn prism(tri: [u32; 3], n: u32, forward: [bool; 3], centre: u32) -> Vec<[u32; 4]> {
+    let global = |i: usize| match i {
+        0..=2 => tri[i],
+        3..=5 => n + tri[i - 3],
+        _ => centre,
+    };
+    if cyclic(forward) {
+        centre_tets(forward).iter().map(|t| t.map(global)).collect()
+    } else {
+        prism_tets(forward).iter().map(|t| t.map(global)).collect()
+    }
+}
+
+/// Splits the prisms of `triangles` (over `n` surface vertices) of a halo whose vertices are
+/// `positions` (negative offsets, then positive ones).
+pub fn tetrahedralize(
+    triangles: &[[u32; 3]],
+    positions: &[DVec3],
+    n: usize,
+    split: Split,
+) -> Tetrahedra {
+    let edges = Edges::new(triangles);
+    let mut stats = SplitStats::default();
+    // Per triangle, the orientation of its three edges.
+    let mut forward: Vec<[bool; 3]> = match split {
+        Split::Paper => vec![[true, true, false]; triangles.len()],
+        Split::GlobalOrder | Split::Quality => triangles
+            .iter()
+            .map(|&tri| [0, 1, 2].map(|k| forward_of(tri, k, true)))
+            .collect(),
+    };
+    let up = |forward: &[[bool; 3]], t: u32, k: u8| {
+        let tri = triangles[t as usize];
+        let k = k as usize;
+        (tri[k] < tri[(k + 1) % 3]) == forward[t as usize][k]
+    };
+    let mismatched = |forward: &[[bool; 3]], uses: &[(u32, u8)]| {
+        uses.iter()
+            .any(|&(t, k)| up(forward, t, k) != up(forward, uses[0].0, uses[0].1))
+    };
+    stats.mismatches_initial = edges.iter().filter(|u| mismatched(&forward, u)).count();
+
+    match split {
+        Split::GlobalOrder => {}
+        Split::Paper => {
+            // Fig. 4b: flip a prism's diagonal on the shared quad when it stays splittable.
+            let mut changed = true;
+            while changed {
+                changed = false;
+                for uses in edges.iter() {
+                    let (t0, k0) = uses[0];
+                    for &(t, k) in &uses[1..] {
+                        if up(&forward, t, k) == up(&forward, t0, k0) {
+                            continue;
+                        }
+                        let mut f = forward[t as usize];
+                        f[k as usize] = !f[k as usize];
+                        if !cyclic(f) {
+                            forward[t as usize] = f;
+                            stats.flips += 1;
+                            changed = true;
+                            continue;
+                        }
+                        // The first prism flips instead, if that leaves it and every other
+                        // user of the edge consistent.
+                        let mut f0 = forward[t0 as usize];
+                        f0[k0 as usize] = !f0[k0 as usize];
+                        if uses.len() == 2 && !cyclic(f0) {
+                            forward[t0 as usize] = f0;
+                            stats.flips += 1;
+                            changed = true;
+                        }
+                    }
+                }
+            }
+            // Fig. 4d: where neither prism can flip, the second takes the first's diagonal and
+            // becomes cyclic; it gets an inserted vertex below.
+            for uses in edges.iter() {
+                let (t0, k0) = uses[0];
+                for &(t, k) in &uses[1..] {
+                    if up(&forward, t, k) != up(&forward, t0, k0) {
+                        forward[t as usize][k as usize] = !forward[t as usize][k as usize];
+                    }
+                }
+            }
+        }
+        Split::Quality => {
+            let prism_quality = |t: usize, f: [bool; 3]| -> f64 {
+                let tri = triangles[t];
+                let local = |i: usize| {
+                    if i < 3 {
+                        positions[tri[i] as usize]
+                    } else {
+                        positions[n + tri[i - 3] as usize]
+                    }
+                };
+                prism_tets(f)
+                    .iter()
+                    .map(|tet| {
+                        let p = tet.map(local);
+                        // Inverted is worst.
+                        if signed_volume(p) <= 0.0 {
+                            -1.0
+                        } else {
+                            min_dihedral(p)
+                        }
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            };
+            for _pass in 0..2 {
+                for uses in edges.iter() {
+                    let flipped: Vec<(usize, [bool; 3])> = uses
+                        .iter()
+                        .map(|&(t, k)| {
+                            let mut f = forward[t as usize];
+                            f[k as usize] = !f[k as usize];
+                            (t as usize, f)
+                        })
+                        .collect();
+                    if flipped.iter().any(|(_, f)| cyclic(*f)) {
+                        continue;
+                    }
+                    let before = uses
+                        .iter()
+                        .map(|&(t, _)| prism_quality(t as usize, forward[t as usize]))
+                        .fold(f64::INFINITY, f64::min);
+                    let after = flipped
+                        .iter()
+                        .map(|&(t, f)| prism_quality(t, f))
+                        .fold(f64::INFINITY, f64::min);
+                    if after > before + 1e-12 {
+                        for (t, f) in flipped {
+                            forward[t] = f;
+                        }
+                        stats.flips += 1;
+                    }
+                }
+            }
+        }
+    }
+    stats.mismatches_final = edges.iter().filter(|u| mismatched(&forward, u)).count();
+
+    let mut out = Tetrahedra::default();
+    for (t, tri) in triangles.iter().enumerate() {
+        let centre = (positions.len() + out.inserted.len()) as u32;
+        out.tets.extend(prism(*tri, n as u32, forward[t], centre));
+        if cyclic(forward[t]) {
+            let corners =
+                [0, 1, 2].map(|i| positions[tri[i] as usize] + positions[n + tri[i] as usize]);
+            out.inserted
+                .push(corners.iter().copied().sum::<DVec3>() / 6.0);
+            out.inserted_in.push(t as u32);
+            stats.inserted_vertices += 1;
+        }
+    }
+    out.stats = stats;
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn acyclic_patterns_give_three_positive_tetrahedra_of_the_prism_volume() {
+        let at = |i: usize| DVec3::from_array(REFERENCE[i]);
+        for bits in 0..8u8 {
+            let f = [bits & 1 != 0, bits & 2 != 0, bits & 4 != 0];
+            let tets: Vec<[usize; 4]> = if cyclic(f) {
+                centre_tets(f)
+            } else {
+                prism_tets(f).to_vec()
+            };
+            let mut volume = 0.0;
+            for tet in &tets {
+                let p = tet.map(at);
+                let v = signed_volume(p) / 6.0;
+                let o = robust::orient3d(
+                    coord(REFERENCE[tet[0]]),
+                    coord(REFERENCE[tet[1]]),
+                    coord(REFERENCE[tet[2]]),
+                    coord(REFERENCE[tet[3]]),
+                );
+                assert!(o > 0.0 && v > 0.0, "{f:?} {tet:?}");
+                volume += v;
+            }
+            assert!((volume - 0.5).abs() < 1e-15, "{f:?}: {volume}");
+            assert_eq!(tets.len(), if cyclic(f) { 8 } else { 3 });
+        }
+    }
+}
