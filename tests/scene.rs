@@ -103,6 +103,10 @@ const BROKEN: &[(&str, &[&str])] = &[
         &["sampling", "unknown variant `voronoi`"],
     ),
     (
+        "unknown-split.json",
+        &["halo.split", "unknown variant `random`", "global_order"],
+    ),
+    (
         "both-tolerances.json",
         &["sampling.absolute_tolerance", "not both"],
     ),
