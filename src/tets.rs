@@ -32,10 +32,13 @@ use serde::{Deserialize, Serialize};
 pub enum Split {
     /// Per-triangle start, then flips and inserted vertices (paper 000).
     Paper,
-    /// Each quad split through its lowest-index vertex (Dompierre et al. 1999).
+    /// Each quad split through its lowest-index vertex (Dompierre et al. 1999). The default:
+    /// conforming with no inserted vertex and the fastest; on the default scene `quality`
+    /// takes 6 times as long and does not raise the smallest dihedral angle, which the
+    /// prisms around cross-caps decide.
+    #[default]
     GlobalOrder,
     /// The global order, improved by flips towards larger dihedral angles.
-    #[default]
     Quality,
 }
 
