@@ -9,14 +9,17 @@
 //!
 //! The normal n̂ is the view's: the normalized cross product of the projected tangents
 //! (eq. 1); where they are (nearly) parallel, at cross-caps of the projection and at the
-//! poles of spun spheres, it is the normalized sum of the area-weighted normals of the
-//! triangles around the vertex, which depends on the mesh and not on the parametrization.
-//! It is never NaN.
+//! poles of spun spheres, and where a triangle around the vertex faces away from it, it is
+//! the normalized sum of the area-weighted normals of the triangles around the vertex,
+//! which depends on the mesh and not on the parametrization ([`offset_directions`]). It is
+//! never NaN.
 //!
 //! Where rho exceeds what the local geometry allows, the offsets fold and prisms invert.
 //! With `fold: shrink` (the default) rho is halved at the corners of every inverted prism
-//! until none is left (at most 30 times); the report counts the vertices shrunk. With
-//! `fold: report` the inverted tetrahedra are only counted.
+//! for as long as that leaves fewer of them (at most 30 times); the report counts the
+//! vertices shrunk. Prisms that no rho mends (around cross-caps, and across the seam of a
+//! non-orientable surface) stay inverted and are counted. With `fold: report` the inverted
+//! tetrahedra are only counted.
 
 use crate::check::{CheckStats, TetMesh, check};
 use crate::tets::{Split, SplitStats, Tetrahedra, tetrahedralize};
