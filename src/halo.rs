@@ -114,6 +114,8 @@ pub struct Halo {
     pub tets: Vec<[u32; 4]>,
     /// The half-width used at each surface vertex (rho, or less where it was shrunk).
     pub rho: Vec<f64>,
+    /// The surface triangle whose prism each inserted vertex (from 2n on) is in.
+    pub inserted_in: Vec<u32>,
 }
 
 impl Halo {
@@ -279,6 +281,7 @@ pub fn build_halo(
         d_orig,
         tets: tets.tets,
         rho: rho_at,
+        inserted_in: tets.inserted_in,
     };
     let checked = check(&halo.tet_mesh());
     let report = HaloReport {
