@@ -4,19 +4,26 @@
 //!
 //! Layout (the same in memory, in `.glb` and in `.vtk`): for a surface of n vertices, vertex
 //! i < n is the negative offset (t = 0) of surface vertex i, vertex n + i its positive offset
-//! (t = 1), and vertices from 2n on are inserted inside prisms.
+//! (t = 1), and vertices from 2n on are inserted inside prisms. A surface vertex whose two
+//! offsets have identical coordinates is *collapsed*: both indices name one vertex. A prism
+//! may take either offset of each corner as its bottom (twisted prisms, where a
+//! non-orientable surface's offsets turn over).
 //!
+//! The checker reads the surface off the boundary: a boundary face whose three vertices are
+//! offsets of three different surface vertices is an offset face over that surface triangle.
 //! What it checks, each as its own count:
 //! - every tetrahedron positively oriented under exact `robust::orient3d` (`inverted`, `flat`),
 //!   with four distinct vertices (`degenerate`) and no repeat (`duplicate_tets`);
 //! - every face in one or two tetrahedra (`overshared_faces`);
-//! - no quad between two prisms split differently from its two sides (`quad_mismatches`);
-//! - the boundary is exactly the two offset surfaces plus the side walls over the surface's
-//!   open edges (`missing_offset_faces`, `unexpected_boundary_faces`);
+//! - every quad over a surface edge split along one of its diagonals, the same way from both
+//!   sides (`quad_mismatches`);
+//! - every surface triangle has exactly two offset faces on the boundary, each vertex of one
+//!   the other offset of a vertex of the other (`missing_offset_faces`), and every other
+//!   boundary face is a side wall over an open edge of the surface
+//!   (`unexpected_boundary_faces`);
 //! - the tetrahedra's volumes add up to the volume the boundary encloses (`volume_defect`).
 
 use serde::Serialize;
-use std::collections::HashMap;
 
 /// A tetrahedral mesh in the halo layout.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -46,9 +53,9 @@ pub struct CheckStats {
     pub duplicate_tets: usize,
     /// Faces in more than two tetrahedra.
     pub overshared_faces: usize,
-    /// Quads between two prisms whose sides are split differently.
+    /// Quads over surface edges not split along one diagonal, the same way from both sides.
     pub quad_mismatches: usize,
-    /// Offset-surface triangles whose partner on the other offset is not on the boundary.
+    /// Surface triangles whose boundary faces are not exactly two opposite offset faces.
     pub missing_offset_faces: usize,
     /// Boundary faces that are neither offset triangles nor side walls over an open edge.
     pub unexpected_boundary_faces: usize,
@@ -56,6 +63,8 @@ pub struct CheckStats {
     pub boundary_faces: usize,
     /// Faces in exactly two tetrahedra.
     pub interior_faces: usize,
+    /// Collapsed surface vertices (both offsets at one point).
+    pub collapsed_vertices: usize,
     /// Sum of the tetrahedra's absolute volumes.
     pub volume: f64,
     /// Volume enclosed by the boundary faces.
@@ -151,33 +160,41 @@ fn key(mut f: [u32; 3]) -> [u32; 3] {
     f
 }
 
-/// Checks a tetrahedral halo (see the module documentation).
-pub fn check(mesh: &TetMesh) -> CheckStats {
-    let n = mesh.surface_vertices as u32;
-    let nv = mesh.positions.len();
-    let mut s = CheckStats {
-        vertices: nv,
-        tets: mesh.tets.len(),
-        min_volume: f64::INFINITY,
-        max_volume: f64::NEG_INFINITY,
-        min_dihedral_deg: 180.0,
-        ..CheckStats::default()
+/// The faces of a tetrahedron (a, b, c, d), each ordered so that the opposite vertex lies
+/// below it when the tetrahedron is positive: outward and clockwise seen from outside.
+fn faces_of([a, b, c, d]: [u32; 4]) -> [[u32; 3]; 4] {
+    [[b, c, d], [a, d, c], [a, b, d], [a, c, b]]
+}
+
+/// What one pass over a share of the tetrahedra finds.
+#[derive(Default)]
+struct Partial {
+    stats: CheckStats,
+    /// (face, 4 × tetrahedron + face slot) for every face of every non-degenerate tetrahedron.
+    faces: Vec<([u32; 3], u32)>,
+}
+
+/// Orientation, volume, angle and faces of `tets[range]` (indices already canonical).
+fn examine(tets: &[[u32; 4]], first: usize, positions: &[[f64; 3]]) -> Partial {
+    let mut out = Partial {
+        stats: CheckStats {
+            min_volume: f64::INFINITY,
+            max_volume: f64::NEG_INFINITY,
+            min_dihedral_deg: 180.0,
+            ..CheckStats::default()
+        },
+        faces: Vec::with_capacity(4 * tets.len()),
     };
-    // Faces with their uses: (count, one outward orientation).
-    let mut faces: HashMap<[u32; 3], (u32, [u32; 3])> = HashMap::new();
-    let mut seen = std::collections::HashSet::new();
-    for tet in &mesh.tets {
+    let s = &mut out.stats;
+    let nv = positions.len();
+    for (i, tet) in tets.iter().enumerate() {
         let mut sorted = *tet;
         sorted.sort_unstable();
-        let distinct = sorted.windows(2).all(|w| w[0] != w[1]);
-        if !distinct || tet.iter().any(|&i| i as usize >= nv) {
+        if sorted.windows(2).any(|w| w[0] == w[1]) || sorted[3] as usize >= nv {
             s.degenerate += 1;
             continue;
         }
-        if !seen.insert(sorted) {
-            s.duplicate_tets += 1;
-        }
-        let p = tet.map(|i| mesh.positions[i as usize]);
+        let p = tet.map(|i| positions[i as usize]);
         let o = robust::orient3d(c3(p[0]), c3(p[1]), c3(p[2]), c3(p[3]));
         if o < 0.0 {
             s.inverted += 1;
@@ -189,100 +206,229 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
         s.min_volume = s.min_volume.min(v);
         s.max_volume = s.max_volume.max(v);
         s.min_dihedral_deg = s.min_dihedral_deg.min(min_dihedral_deg(p));
-        // Outward faces of a positive tetrahedron (a, b, c, d): the face opposite each
-        // vertex, ordered so that the opposite vertex lies below it.
-        let [a, b, c, d] = *tet;
-        for f in [[b, c, d], [a, d, c], [a, b, d], [a, c, b]] {
-            let f = if o < 0.0 { [f[0], f[2], f[1]] } else { f };
-            let e = faces.entry(key(f)).or_insert((0, f));
-            e.0 += 1;
+        let code = 4 * (first + i) as u32;
+        for (slot, f) in faces_of(*tet).into_iter().enumerate() {
+            out.faces.push((key(f), code + slot as u32));
         }
     }
-    if mesh.tets.is_empty() {
-        s.min_volume = 0.0;
-        s.max_volume = 0.0;
-        s.min_dihedral_deg = 0.0;
-    }
+    out
+}
 
-    let is_boundary = |f: &[u32; 3]| faces.get(&key(*f)).is_some_and(|e| e.0 == 1);
-    let layer = |i: u32| {
-        if i < n {
-            Some(0)
-        } else if i < 2 * n {
-            Some(1)
-        } else {
-            None
-        }
-    };
-    // The surface's triangles: bottom faces of prisms, i.e. faces with every vertex on the
-    // negative offset. Their edges tell the open boundary of the surface.
-    let bottoms: Vec<[u32; 3]> = faces
-        .keys()
-        .filter(|f| f.iter().all(|&i| layer(i) == Some(0)))
-        .copied()
+/// Sorts (key, payload) pairs by key: a counting sort on the first vertex, then each
+/// (small) bucket by the other two.
+fn sort_faces(faces: Vec<([u32; 3], u32)>, vertices: usize) -> Vec<([u32; 3], u32)> {
+    let mut starts = vec![0usize; vertices + 1];
+    for (k, _) in &faces {
+        starts[k[0] as usize + 1] += 1;
+    }
+    for i in 0..vertices {
+        starts[i + 1] += starts[i];
+    }
+    let mut fill = starts.clone();
+    let mut out = vec![([0; 3], 0); faces.len()];
+    for f in faces {
+        out[fill[f.0[0] as usize]] = f;
+        fill[f.0[0] as usize] += 1;
+    }
+    for w in starts.windows(2) {
+        out[w[0]..w[1]].sort_unstable();
+    }
+    out
+}
+
+/// Checks a tetrahedral halo (see the module documentation).
+pub fn check(mesh: &TetMesh) -> CheckStats {
+    let n = mesh.surface_vertices;
+    let nv = mesh.positions.len();
+    let positions = &mesh.positions;
+    let collapsed: Vec<bool> = (0..n)
+        .map(|v| n + v < nv && positions[v] == positions[n + v])
         .collect();
-    let mut edge_uses: HashMap<[u32; 2], u32> = HashMap::new();
-    for f in &bottoms {
-        for (x, y) in [(f[0], f[1]), (f[1], f[2]), (f[0], f[2])] {
-            *edge_uses.entry([x.min(y), x.max(y)]).or_default() += 1;
-        }
-    }
-    for f in &bottoms {
-        let top = f.map(|i| i + n);
-        if !is_boundary(f) || !is_boundary(&top) {
-            s.missing_offset_faces += 1;
-        }
-    }
-    // Quads over surface edges: their two triangles, for each diagonal.
-    let quad_faces = |[x, y]: [u32; 2]| {
-        [
-            [[x, y, y + n], [x, y + n, x + n]],
-            [[x, y, x + n], [y, y + n, x + n]],
-        ]
-    };
-    let mut side_walls = std::collections::HashSet::new();
-    for (&edge, &uses) in &edge_uses {
-        let [d1, d2] = quad_faces(edge);
-        let count = |f: &[u32; 3]| faces.get(&key(*f)).map_or(0, |e| e.0);
-        if uses == 1 {
-            // An open edge: its quad is a side wall, on the boundary, split one way.
-            let one = d1.iter().all(|f| count(f) == 1) && d2.iter().all(|f| count(f) == 0);
-            let other = d2.iter().all(|f| count(f) == 1) && d1.iter().all(|f| count(f) == 0);
-            if !(one || other) {
-                s.quad_mismatches += 1;
-            }
-            for f in d1.iter().chain(&d2) {
-                side_walls.insert(key(*f));
-            }
+    // Collapsed vertices under one index; the offset of the same surface vertex on the other
+    // side (itself when collapsed); the surface vertex of an offset.
+    let canon = |i: u32| {
+        let i = i as usize;
+        if (n..2 * n).contains(&i) && collapsed[i - n] {
+            (i - n) as u32
         } else {
-            // Between prisms: one diagonal, each of its triangles shared by two tetrahedra.
-            let one = d1.iter().all(|f| count(f) == 2) && d2.iter().all(|f| count(f) == 0);
-            let other = d2.iter().all(|f| count(f) == 2) && d1.iter().all(|f| count(f) == 0);
-            if !(one || other) {
-                s.quad_mismatches += 1;
+            i as u32
+        }
+    };
+    let partner = |i: u32| {
+        let i = i as usize;
+        match i {
+            _ if i < n && collapsed[i] => i as u32,
+            _ if i < n => (i + n) as u32,
+            _ => (i - n) as u32,
+        }
+    };
+    let surface_vertex = |i: u32| ((i as usize) < 2 * n).then(|| (i as usize % n.max(1)) as u32);
+
+    let tets: Vec<[u32; 4]> = mesh.tets.iter().map(|t| t.map(canon)).collect();
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |t| t.get())
+        .min(8);
+    let chunk = tets.len().div_ceil(threads).max(1);
+    let partials: Vec<Partial> = std::thread::scope(|scope| {
+        let handles: Vec<_> = tets
+            .chunks(chunk)
+            .enumerate()
+            .map(|(k, part)| scope.spawn(move || examine(part, k * chunk, positions)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("checker thread"))
+            .collect()
+    });
+    let mut s = CheckStats {
+        vertices: nv,
+        tets: mesh.tets.len(),
+        collapsed_vertices: collapsed.iter().filter(|&&c| c).count(),
+        min_volume: f64::INFINITY,
+        max_volume: f64::NEG_INFINITY,
+        min_dihedral_deg: 180.0,
+        ..CheckStats::default()
+    };
+    let mut faces = Vec::with_capacity(partials.iter().map(|p| p.faces.len()).sum());
+    for p in partials {
+        let q = p.stats;
+        s.degenerate += q.degenerate;
+        s.inverted += q.inverted;
+        s.flat += q.flat;
+        s.volume += q.volume;
+        s.min_volume = s.min_volume.min(q.min_volume);
+        s.max_volume = s.max_volume.max(q.max_volume);
+        s.min_dihedral_deg = s.min_dihedral_deg.min(q.min_dihedral_deg);
+        faces.extend(p.faces);
+    }
+    if s.tets == s.degenerate {
+        (s.min_volume, s.max_volume, s.min_dihedral_deg) = (0.0, 0.0, 0.0);
+    }
+    let faces = sort_faces(faces, nv);
+
+    // Distinct faces with their use counts; boundary faces with their tetrahedron.
+    let mut keys: Vec<[u32; 3]> = Vec::with_capacity(faces.len() / 2 + 1);
+    let mut counts: Vec<u32> = Vec::with_capacity(faces.len() / 2 + 1);
+    let mut boundary: Vec<([u32; 3], u32)> = Vec::new();
+    for group in faces.chunk_by(|a, b| a.0 == b.0) {
+        let k = group[0].0;
+        // A repeated tetrahedron repeats every face with the same opposite vertex; count it
+        // once, at the face opposite its largest vertex.
+        let opposite = |code: u32| tets[code as usize / 4][code as usize % 4];
+        for (i, &(_, code)) in group.iter().enumerate() {
+            let o = opposite(code);
+            if o > k[2] && group[..i].iter().any(|&(_, c)| opposite(c) == o) {
+                s.duplicate_tets += 1;
             }
         }
-    }
-    let mut boundary_volume = 0.0;
-    for (k, (count, f)) in &faces {
-        match count {
-            1 => {
-                s.boundary_faces += 1;
-                let offset = k.iter().all(|&i| layer(i) == Some(0))
-                    || k.iter().all(|&i| layer(i) == Some(1));
-                if !offset && !side_walls.contains(k) {
-                    s.unexpected_boundary_faces += 1;
-                }
-                let [a, b, c] = f.map(|i| mesh.positions[i as usize]);
-                // Outward faces whose vertices turn clockwise seen from outside (the
-                // orientation convention above): the divergence theorem with a sign.
-                boundary_volume -= dot(a, cross(b, c)) / 6.0;
-            }
+        match group.len() {
+            1 => boundary.push(group[0]),
             2 => s.interior_faces += 1,
             _ => s.overshared_faces += 1,
         }
+        keys.push(k);
+        counts.push(group.len() as u32);
+    }
+    s.boundary_faces = boundary.len();
+    let count = |f: [u32; 3]| {
+        let f = key(f);
+        keys.binary_search(&f).map_or(0, |i| counts[i])
+    };
+
+    // Offset faces (three offsets of three surface vertices) by surface triangle; the
+    // horizontal edges they bound; the other boundary faces to classify after the edges.
+    let mut offset_faces: Vec<([u32; 3], [u32; 3])> = Vec::new();
+    let mut horizontal: Vec<[u32; 2]> = Vec::new();
+    let mut others: Vec<[u32; 3]> = Vec::new();
+    let mut boundary_volume = 0.0;
+    for &(k, code) in &boundary {
+        let tet = tets[code as usize / 4];
+        let mut f = faces_of(tet)[code as usize % 4];
+        let p = tet.map(|i| c3(positions[i as usize]));
+        if robust::orient3d(p[0], p[1], p[2], p[3]) < 0.0 {
+            f.swap(1, 2);
+        }
+        let [a, b, c] = f.map(|i| positions[i as usize]);
+        // Outward faces turn clockwise seen from outside: the divergence theorem, signed.
+        boundary_volume -= dot(a, cross(b, c)) / 6.0;
+        match k.map(surface_vertex) {
+            [Some(x), Some(y), Some(z)] if x != y && y != z && x != z => {
+                offset_faces.push((key([x, y, z]), k));
+                horizontal.extend([[k[0], k[1]], [k[0], k[2]], [k[1], k[2]]]);
+            }
+            _ => others.push(k),
+        }
     }
     s.boundary_volume = boundary_volume;
+    offset_faces.sort_unstable();
+    horizontal.sort_unstable();
+    let mut edges: Vec<[u32; 2]> = Vec::new();
+    for group in offset_faces.chunk_by(|a, b| a.0 == b.0) {
+        let opposite = group.len() == 2 && key(group[0].1.map(partner)) == group[1].1;
+        if !opposite {
+            s.missing_offset_faces += 1;
+        }
+        let [x, y, z] = group[0].0;
+        edges.extend([[x, y], [x, z], [y, z]]);
+    }
+    edges.sort_unstable();
+
+    // Quads over surface edges; the edges used by one surface triangle are open.
+    let mut open: Vec<[u32; 2]> = Vec::new();
+    for group in edges.chunk_by(|a, b| a == b) {
+        let [x, y] = group[0];
+        let expected = if group.len() >= 2 { 2 } else { 1 };
+        if group.len() == 1 {
+            open.push([x, y]);
+        }
+        let (x1, y1) = (partner(x), partner(y));
+        let quad = match (x1 == x, y1 == y) {
+            (true, true) => continue,
+            (true, false) => count([x, y, y1]) == expected,
+            (false, true) => count([x, x1, y]) == expected,
+            (false, false) => {
+                let candidates = [[x, y, y1], [x, y, x1], [x, x1, y1], [y, y1, x1]];
+                let present: Vec<[u32; 3]> = candidates
+                    .into_iter()
+                    .filter(|&f| count(f) > 0)
+                    .map(key)
+                    .collect();
+                present.len() == 2 && present.iter().all(|&f| count(f) == expected) && {
+                    // The diagonal they share: not a vertical edge of the prisms, not an
+                    // edge of an offset face.
+                    let shared: Vec<u32> = present[0]
+                        .iter()
+                        .filter(|v| present[1].contains(v))
+                        .copied()
+                        .collect();
+                    let d = [shared[0], shared[1]];
+                    surface_vertex(d[0]) != surface_vertex(d[1])
+                        && horizontal.binary_search(&d).is_err()
+                }
+            }
+        };
+        if !quad {
+            s.quad_mismatches += 1;
+        }
+    }
+    for k in others {
+        let wall = match k.map(surface_vertex) {
+            [Some(a), Some(b), Some(c)] => {
+                let mut e = [a, b, c];
+                e.sort_unstable();
+                let pair = if e[0] == e[1] {
+                    [e[0], e[2]]
+                } else {
+                    [e[0], e[1]]
+                };
+                pair[0] != pair[1] && open.binary_search(&pair).is_ok()
+            }
+            _ => false,
+        };
+        if !wall {
+            s.unexpected_boundary_faces += 1;
+        }
+    }
     s.volume_defect = if boundary_volume.abs() > 0.0 {
         (s.volume - boundary_volume).abs() / boundary_volume.abs()
     } else if s.volume == 0.0 {

@@ -22,7 +22,7 @@
 //! tetrahedra are only counted.
 
 use crate::check::{CheckStats, TetMesh, check};
-use crate::tets::{Split, SplitStats, Tetrahedra, tetrahedralize};
+use crate::tets::{self, Corners, Split, SplitStats};
 use crate::view::Projected;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -145,8 +145,16 @@ pub struct HaloReport {
     pub split_stats: SplitStats,
     /// Inverted or flat tetrahedra, as the checker counts them.
     pub inverted: usize,
-    /// Surface vertices whose rho was shrunk.
+    /// Surface vertices whose rho was shrunk (collapsed ones included).
     pub shrunk_vertices: usize,
+    /// Surface vertices whose rho shrank to zero: both offsets at the surface point.
+    pub collapsed_vertices: usize,
+    /// Surface vertices no offset direction fits: the normals of the triangles around them
+    /// lie in no open hemisphere (a cross-cap of the projection, a fold of the mesh).
+    pub singular_vertices: usize,
+    /// Prisms whose corners' offsets lie on different sides of the surface's winding (where
+    /// a non-orientable surface's offset directions turn over).
+    pub twisted_prisms: usize,
     /// Smallest dihedral angle, degrees (checker).
     pub min_dihedral_deg: f64,
     /// The checker's full statistics.
@@ -155,46 +163,237 @@ pub struct HaloReport {
     pub ms: f64,
 }
 
-/// The direction each vertex is offset along: the view's normal (eq. 1), unless some
-/// triangle around the vertex faces away from it (near a cross-cap of the projection the
-/// projected triangles turn over), in which case the normalized sum of the area-weighted
-/// normals of the triangles around it, so that the prisms there keep their orientation.
-pub fn offset_directions(p: &Projected, triangles: &[[u32; 3]]) -> Vec<DVec3> {
-    let mut sum = vec![DVec3::ZERO; p.positions.len()];
-    let mut against = vec![false; p.positions.len()];
-    for t in triangles {
-        let [a, b, c] = t.map(|i| p.positions[i as usize]);
-        let face = (b - a).cross(c - a);
-        for &i in t {
-            sum[i as usize] += face;
-            against[i as usize] |= p.normals[i as usize].dot(face) <= 0.0;
+/// The triangles around each vertex, as (triangle, corner); flat, vertex after vertex.
+struct Stars {
+    uses: Vec<(u32, u8)>,
+    starts: Vec<usize>,
+}
+
+impl Stars {
+    fn new(n: usize, triangles: &[[u32; 3]]) -> Stars {
+        let mut starts = vec![0usize; n + 1];
+        for &i in triangles.iter().flatten() {
+            starts[i as usize + 1] += 1;
+        }
+        for i in 0..n {
+            starts[i + 1] += starts[i];
+        }
+        let mut fill = starts.clone();
+        let mut uses = vec![(0, 0); 3 * triangles.len()];
+        for (t, tri) in triangles.iter().enumerate() {
+            for (k, &i) in tri.iter().enumerate() {
+                uses[fill[i as usize]] = (t as u32, k as u8);
+                fill[i as usize] += 1;
+            }
+        }
+        Stars { uses, starts }
+    }
+
+    fn of(&self, v: usize) -> &[(u32, u8)] {
+        &self.uses[self.starts[v]..self.starts[v + 1]]
+    }
+}
+
+/// For the triangles around a vertex (`star`), whether each is wound against the vertex's
+/// reference orientation: found by walking across the edges they share (two triangles
+/// sharing an edge agree when they run along it in opposite directions), the reference being
+/// the winding of the majority.
+fn reversed_in_star(star: &[(u32, u8)], triangles: &[[u32; 3]]) -> Vec<bool> {
+    // The corners after and before the vertex in each triangle's winding.
+    let ring: Vec<(u32, u32)> = star
+        .iter()
+        .map(|&(t, k)| {
+            let tri = triangles[t as usize];
+            (tri[(k as usize + 1) % 3], tri[(k as usize + 2) % 3])
+        })
+        .collect();
+    let mut reversed: Vec<Option<bool>> = vec![None; star.len()];
+    let mut stack = Vec::new();
+    for seed in 0..star.len() {
+        if reversed[seed].is_some() {
+            continue;
+        }
+        reversed[seed] = Some(false);
+        stack.push(seed);
+        while let Some(i) = stack.pop() {
+            let (next, prev) = ring[i];
+            let ri = reversed[i] == Some(true);
+            for j in 0..star.len() {
+                if reversed[j].is_some() {
+                    continue;
+                }
+                let (nj, pj) = ring[j];
+                // Sharing the edge to `next` as j's `prev` (or `prev` as `next`): agree.
+                let agree = nj == prev || pj == next;
+                let disagree = nj == next || pj == prev;
+                if agree || disagree {
+                    reversed[j] = Some(ri ^ disagree);
+                    stack.push(j);
+                }
+            }
         }
     }
-    (0..p.positions.len())
-        .map(|i| {
-            if against[i] {
-                sum[i].try_normalize().unwrap_or(p.normals[i])
-            } else {
-                p.normals[i]
+    let mut out: Vec<bool> = reversed.into_iter().map(|r| r == Some(true)).collect();
+    if 2 * out.iter().filter(|r| **r).count() > out.len() {
+        out.iter_mut().for_each(|r| *r = !*r);
+    }
+    out
+}
+
+/// The unit direction d maximising min_i d·g_i, and that minimum: the directions from the
+/// origin to the nearest point of the convex hull of the g_i, found among the candidates
+/// each g_i, the bisector of each pair and the direction equidistant from each triple. The
+/// minimum is at most 0 when no open hemisphere holds every g_i.
+pub fn widest_direction(g: &[DVec3]) -> (DVec3, f64) {
+    let score = |d: DVec3| g.iter().map(|x| x.dot(d)).fold(f64::INFINITY, f64::min);
+    let mut best = (DVec3::ZERO, f64::NEG_INFINITY);
+    let mut consider = |d: DVec3| {
+        if let Some(d) = d.try_normalize() {
+            let s = score(d);
+            if s > best.1 {
+                best = (d, s);
             }
-        })
-        .collect()
+        }
+    };
+    for i in 0..g.len() {
+        consider(g[i]);
+        for j in i + 1..g.len() {
+            consider(g[i] + g[j]);
+            for k in j + 1..g.len() {
+                let d = (g[j] - g[i]).cross(g[k] - g[i]);
+                consider(if d.dot(g[i]) >= 0.0 { d } else { -d });
+            }
+        }
+    }
+    best
 }
 
-/// Offsets every vertex by ∓`rho[i]` along `dir[i]`: negative side first, then positive.
-fn offsets(p: &Projected, dir: &[DVec3], rho: &[f64]) -> Vec<DVec3> {
-    let below = (0..p.positions.len()).map(|i| p.positions[i] - dir[i] * rho[i]);
-    let above = (0..p.positions.len()).map(|i| p.positions[i] + dir[i] * rho[i]);
-    below.chain(above).collect()
+/// Where the view's normal is at least this close to every triangle around a vertex
+/// (cosine), it is the offset direction; elsewhere the widest direction is, if wider.
+const NORMAL_MARGIN: f64 = 0.25;
+
+/// Offset directions and how each prism's corners sit.
+struct Frame {
+    dir: Vec<DVec3>,
+    /// Per triangle, the corners whose offset direction disagrees with its winding.
+    flip: Vec<[bool; 3]>,
+    /// Vertices no direction fits.
+    singular: Vec<bool>,
 }
 
-/// The surface vertices of prisms with an inverted or flat tetrahedron.
-fn folded_vertices(positions: &[DVec3], tets: &Tetrahedra) -> Vec<u32> {
-    let c = |i: u32| {
-        let p = if (i as usize) < positions.len() {
-            positions[i as usize]
+/// The offset direction of every vertex: the view's normal n̂ (eq. 1) where every triangle
+/// around the vertex faces its way by a margin, otherwise the direction that faces the
+/// triangles around it best ([`widest_direction`] of their unit normals, each turned to the
+/// vertex's reference winding); both depend on the mesh and the view, not on the
+/// parametrization. n̂'s sign follows the triangles' winding (eq. 3 depends on |2t - 1|
+/// only). Where no direction faces every triangle, the vertex is singular.
+fn frame(p: &Projected, triangles: &[[u32; 3]], stars: &Stars) -> Frame {
+    let n = p.positions.len();
+    let unit_normal = |t: u32| {
+        let [a, b, c] = triangles[t as usize].map(|i| p.positions[i as usize]);
+        (b - a).cross(c - a).normalize_or_zero()
+    };
+    let mut frame = Frame {
+        dir: vec![DVec3::ZERO; n],
+        flip: vec![[false; 3]; triangles.len()],
+        singular: vec![false; n],
+    };
+    let mut g = Vec::new();
+    for v in 0..n {
+        let star = stars.of(v);
+        if star.is_empty() {
+            frame.dir[v] = p.normals[v];
+            continue;
+        }
+        let reversed = reversed_in_star(star, triangles);
+        g.clear();
+        g.extend(
+            star.iter()
+                .zip(&reversed)
+                .map(|(&(t, _), &r)| if r { -unit_normal(t) } else { unit_normal(t) }),
+        );
+        for (&(t, k), &r) in star.iter().zip(&reversed) {
+            frame.flip[t as usize][k as usize] = r;
+        }
+        let normal = if g.iter().map(|x| x.dot(p.normals[v])).sum::<f64>() >= 0.0 {
+            p.normals[v]
         } else {
-            tets.inserted[i as usize - positions.len()]
+            -p.normals[v]
+        };
+        let margin = g
+            .iter()
+            .map(|x| x.dot(normal))
+            .fold(f64::INFINITY, f64::min);
+        frame.dir[v] = normal;
+        if margin < NORMAL_MARGIN {
+            let (wide, wide_margin) = widest_direction(&g);
+            if wide_margin > margin {
+                frame.dir[v] = wide;
+            }
+            frame.singular[v] = wide_margin.max(margin) <= 0.0;
+        }
+    }
+    frame
+}
+
+/// Halvings of rho at a vertex before it collapses to zero.
+const HALVINGS: u32 = 10;
+
+/// Rounds of shrinking at most; each round halves rho around every inverted prism.
+const MAX_ROUNDS: usize = 4 * HALVINGS as usize;
+
+/// Rounds to f32, the precision of the exported files, so that the checked halo is the
+/// exported one.
+fn f32_exact(p: DVec3) -> DVec3 {
+    p.as_vec3().as_dvec3()
+}
+
+/// The halo's offset vertices as rho changes, and which corners collapsed.
+struct Offsets<'a> {
+    projected: &'a Projected,
+    dir: Vec<DVec3>,
+    rho: Vec<f64>,
+    positions: Vec<DVec3>,
+    collapsed: Vec<bool>,
+}
+
+impl Offsets<'_> {
+    /// Places vertex v's two offsets at ∓rho[v] along its direction; where they round to one
+    /// point, the vertex collapses.
+    fn place(&mut self, v: usize) {
+        let n = self.rho.len();
+        let (p, d) = (self.projected.positions[v], self.dir[v]);
+        let (below, above) = (
+            f32_exact(p - d * self.rho[v]),
+            f32_exact(p + d * self.rho[v]),
+        );
+        self.collapsed[v] = below == above;
+        if self.collapsed[v] {
+            self.rho[v] = 0.0;
+        }
+        (self.positions[v], self.positions[n + v]) = (below, above);
+    }
+
+    fn corners(&self, tri: [u32; 3], flip: [bool; 3]) -> Corners {
+        Corners {
+            tri,
+            flip,
+            collapsed: tri.map(|i| self.collapsed[i as usize]),
+        }
+    }
+}
+
+/// The surface vertices of prism `c`'s inverted or flat tetrahedra (exact orientation).
+fn inverted_corners(c: &Corners, forward: [bool; 3], positions: &[DVec3], out: &mut Vec<u32>) {
+    let n = (positions.len() / 2) as u32;
+    let v = c.vertices(n);
+    let forward = c.effective(forward);
+    let centre = tets::cyclic(forward).then(|| tets::centre(v, positions));
+    let at = |i: u32| {
+        let p = if i == u32::MAX {
+            centre.unwrap_or_default()
+        } else {
+            positions[i as usize]
         };
         robust::Coord3D {
             x: p.x,
@@ -202,20 +401,11 @@ fn folded_vertices(positions: &[DVec3], tets: &Tetrahedra) -> Vec<u32> {
             z: p.z,
         }
     };
-    let n = positions.len() / 2;
-    let mut out = Vec::new();
-    for tet in &tets.tets {
-        if robust::orient3d(c(tet[0]), c(tet[1]), c(tet[2]), c(tet[3])) <= 0.0 {
-            out.extend(
-                tet.iter()
-                    .filter(|&&i| (i as usize) < 2 * n)
-                    .map(|&i| i % n as u32),
-            );
+    for tet in tets::prism_tets(v, forward, u32::MAX) {
+        if robust::orient3d(at(tet[0]), at(tet[1]), at(tet[2]), at(tet[3])) <= 0.0 {
+            out.extend(tet.iter().filter(|&&i| i < 2 * n).map(|&i| i % n));
         }
     }
-    out.sort_unstable();
-    out.dedup();
-    out
 }
 
 /// Thickens a projected surface by `rho` (absolute) and splits it into tetrahedra, then
@@ -228,38 +418,78 @@ pub fn build_halo(
 ) -> (Halo, HaloReport) {
     let start = Instant::now();
     let n = projected.positions.len();
-    let mut rho_at = vec![rho; n];
-    let mut shrunk = vec![false; n];
-    let dir = offset_directions(projected, triangles);
-    let mut positions = offsets(projected, &dir, &rho_at);
-    let mut tets = tetrahedralize(triangles, &positions, n, params.split);
-    if params.fold == Fold::Shrink {
-        // Halve rho around inverted prisms while that removes inverted tetrahedra; where it
-        // does not (the triangles around a cross-cap face every way), keep the last rho that
-        // helped and let the checker count what is left.
-        let mut folded = folded_vertices(&positions, &tets);
-        for _ in 0..30 {
-            if folded.is_empty() {
+    let stars = Stars::new(n, triangles);
+    let frame = frame(projected, triangles, &stars);
+    let shrink = params.fold == Fold::Shrink;
+    let mut offsets = Offsets {
+        projected,
+        rho: (0..n)
+            .map(|v| {
+                if shrink && frame.singular[v] {
+                    0.0
+                } else {
+                    rho
+                }
+            })
+            .collect(),
+        dir: frame.dir,
+        positions: vec![DVec3::ZERO; 2 * n],
+        collapsed: vec![false; n],
+    };
+    for v in 0..n {
+        offsets.place(v);
+    }
+    let mut corners: Vec<Corners> = triangles
+        .iter()
+        .zip(&frame.flip)
+        .map(|(&tri, &flip)| offsets.corners(tri, flip))
+        .collect();
+    let (forward, stats) = tets::plan(&corners, &offsets.positions, n, params.split);
+
+    if shrink {
+        // Halve rho at the corners of inverted tetrahedra, re-examining only the prisms
+        // around them, until none is left; a vertex halved HALVINGS times collapses.
+        let floor = rho * 0.5f64.powi(HALVINGS as i32);
+        let mut bad = Vec::new();
+        for (c, f) in corners.iter().zip(&forward) {
+            inverted_corners(c, *f, &offsets.positions, &mut bad);
+        }
+        let mut stamp = vec![usize::MAX; triangles.len()];
+        for round in 0..MAX_ROUNDS {
+            bad.sort_unstable();
+            bad.dedup();
+            if bad.is_empty() {
                 break;
             }
-            let mut trial = rho_at.clone();
-            for &v in &folded {
-                trial[v as usize] *= 0.5;
+            for &v in &bad {
+                let v = v as usize;
+                offsets.rho[v] = if offsets.rho[v] > floor {
+                    0.5 * offsets.rho[v]
+                } else {
+                    0.0
+                };
+                offsets.place(v);
             }
-            let p = offsets(projected, &dir, &trial);
-            let t = tetrahedralize(triangles, &p, n, params.split);
-            let f = folded_vertices(&p, &t);
-            if f.len() >= folded.len() {
-                break;
+            let touched = std::mem::take(&mut bad);
+            for &v in &touched {
+                for &(t, _) in stars.of(v as usize) {
+                    let t = t as usize;
+                    if stamp[t] != round {
+                        stamp[t] = round;
+                        corners[t] = offsets.corners(triangles[t], frame.flip[t]);
+                        inverted_corners(&corners[t], forward[t], &offsets.positions, &mut bad);
+                    }
+                }
             }
-            for &v in &folded {
-                shrunk[v as usize] = true;
-            }
-            (rho_at, positions, tets, folded) = (trial, p, t, f);
         }
     }
+    let tets = tets::emit(&corners, &forward, &offsets.positions, n, stats);
+
     let mut t = vec![0.0; n];
     t.extend(std::iter::repeat_n(1.0, n));
+    for v in (0..n).filter(|&v| offsets.collapsed[v]) {
+        (t[v], t[n + v]) = (0.5, 0.5);
+    }
     let mut d_orig = projected.w.clone();
     d_orig.extend_from_slice(&projected.w);
     for &tri in &tets.inserted_in {
@@ -273,6 +503,7 @@ pub fn build_halo(
                 / 3.0,
         );
     }
+    let mut positions = offsets.positions;
     positions.extend_from_slice(&tets.inserted);
     let halo = Halo {
         surface_vertices: n,
@@ -280,7 +511,7 @@ pub fn build_halo(
         t,
         d_orig,
         tets: tets.tets,
-        rho: rho_at,
+        rho: offsets.rho,
         inserted_in: tets.inserted_in,
     };
     let checked = check(&halo.tet_mesh());
@@ -291,7 +522,14 @@ pub fn build_halo(
         rho,
         split_stats: tets.stats,
         inverted: checked.inverted + checked.flat,
-        shrunk_vertices: shrunk.iter().filter(|s| **s).count(),
+        shrunk_vertices: halo.rho.iter().filter(|&&r| r < rho).count(),
+        collapsed_vertices: offsets.collapsed.iter().filter(|&&c| c).count(),
+        singular_vertices: frame.singular.iter().filter(|&&s| s).count(),
+        twisted_prisms: frame
+            .flip
+            .iter()
+            .filter(|f| !(f[0] == f[1] && f[1] == f[2]))
+            .count(),
         min_dihedral_deg: checked.min_dihedral_deg,
         check: checked,
         ms: start.elapsed().as_secs_f64() * 1e3,

@@ -2,19 +2,27 @@
 //! offsets, split into three tetrahedra so that neighbouring prisms agree on the diagonal of
 //! the quad they share.
 //!
-//! Takes: the surface's triangles and the halo's vertices (offset vertex i of the negative
-//! side at index i, of the positive side at n + i). Gives: tetrahedra, oriented so that
-//! `robust::orient3d` is positive when the prism is not inverted, and vertices inserted inside
-//! prisms that no consistent split fits.
+//! Takes: the surface's triangles as [`Corners`] and the halo's vertices (offset vertex i of
+//! the negative side at index i, of the positive side at n + i). Gives: tetrahedra, oriented
+//! so that `robust::orient3d` is positive when the prism is not inverted, and vertices
+//! inserted inside prisms that no consistent split fits.
 //!
-//! A quad's diagonal runs from the bottom (negative side) of one end of its surface edge to
-//! the top of the other: an orientation of the edge. A prism splits into three tetrahedra
+//! A prism's bottom is the side its triangle's winding turns away from. At each corner that
+//! is the negative offset, unless the corner is *flipped* (its offset direction disagrees
+//! with the winding: on a non-orientable surface some prisms must be twisted this way), and a
+//! *collapsed* corner (rho shrunk to zero) is one vertex at the bottom and the top.
+//!
+//! A quad's diagonal runs from the bottom of one end of its surface edge to the top of the
+//! other: an orientation of the edge within the prism. A prism splits into three tetrahedra
 //! exactly when the orientations of its three edges are acyclic (a source p, a middle q and
 //! a sink r: tetrahedra {p0 q0 r0 r1}, {p0 q0 q1 r1}, {p0 p1 q1 r1}); the two cyclic patterns
 //! need a new vertex, here one at the prism's centre joined to its eight boundary triangles.
-//! Three ways to choose the orientations ([`Split`]):
-//! - `global_order`: every edge from its lower to its higher vertex index. Acyclic
-//!   everywhere, conforming, blind to geometry.
+//! Tetrahedra that repeat a collapsed corner are left out. Neighbours agree on a quad when
+//! both split it through the same global vertex; "up" means through the negative offset of
+//! the edge's lower-index end. Three ways to choose ([`Split`]):
+//! - `global_order`: every quad up, i.e. through its lowest-index vertex. Acyclic
+//!   everywhere (the prism's lowest vertex is a source or a sink), conforming, blind to
+//!   geometry.
 //! - `paper` (paper 000, 5.1): each triangle first orients its edges by its own corner order,
 //!   as a per-triangle GPU program does; the shared quads where two prisms disagree are then
 //!   fixed by flipping one prism's diagonal where that keeps it splittable (fig. 4b), and
@@ -25,6 +33,7 @@
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
+use std::sync::OnceLock;
 
 /// How prisms are split into tetrahedra.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -66,6 +75,74 @@ pub struct SplitStats {
     pub mismatches_final: usize,
 }
 
+/// One prism: its triangle and how each corner's offsets sit (see the module documentation).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Corners {
+    /// The surface triangle.
+    pub tri: [u32; 3],
+    /// Corners whose bottom is the positive offset.
+    pub flip: [bool; 3],
+    /// Corners whose two offsets are one vertex, the negative offset's index.
+    pub collapsed: [bool; 3],
+}
+
+impl Corners {
+    /// A prism with every bottom on the negative offset and no collapsed corner.
+    pub fn plain(tri: [u32; 3]) -> Corners {
+        Corners {
+            tri,
+            ..Corners::default()
+        }
+    }
+
+    /// Global indices of the bottom corners, then of the top corners, for a surface of `n`
+    /// vertices.
+    pub fn vertices(&self, n: u32) -> [u32; 6] {
+        let mut out = [0; 6];
+        for i in 0..3 {
+            let v = self.tri[i];
+            let (bottom, top) = match (self.collapsed[i], self.flip[i]) {
+                (true, _) => (v, v),
+                (false, false) => (v, v + n),
+                (false, true) => (v + n, v),
+            };
+            (out[i], out[i + 3]) = (bottom, top);
+        }
+        out
+    }
+
+    /// Whether the quad over edge k, oriented `forward` in this prism, is split through the
+    /// negative offset of the edge's lower-index end. Its own inverse: the orientation that
+    /// splits the quad `up` is `self.up(k, up)`.
+    fn up(&self, k: usize, forward: bool) -> bool {
+        let (i, j) = (k, (k + 1) % 3);
+        let lower_is_j = self.tri[j] < self.tri[i];
+        forward ^ self.flip[if lower_is_j { j } else { i }] ^ lower_is_j
+    }
+
+    /// Whether the quad over edge k degenerates to a triangle (or a segment): an end of the
+    /// edge collapsed, so either diagonal gives the same faces.
+    fn degenerate(&self, k: usize) -> bool {
+        self.collapsed[k] || self.collapsed[(k + 1) % 3]
+    }
+
+    /// The pattern in effect: a cyclic pattern with a collapsed corner is made acyclic by
+    /// turning an edge at that corner, which changes no face.
+    pub fn effective(&self, mut forward: [bool; 3]) -> [bool; 3] {
+        if cyclic(forward)
+            && let Some(k) = (0..3).find(|&k| self.degenerate(k))
+        {
+            forward[k] = !forward[k];
+        }
+        forward
+    }
+
+    /// Whether the prism splits into tetrahedra with no inserted vertex.
+    fn splittable(&self, forward: [bool; 3]) -> bool {
+        !cyclic(self.effective(forward))
+    }
+}
+
 /// Tetrahedra of a halo, with the vertices inserted for them.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Tetrahedra {
@@ -88,11 +165,11 @@ struct Edges {
 }
 
 impl Edges {
-    fn new(triangles: &[[u32; 3]]) -> Edges {
-        let mut keyed: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(3 * triangles.len());
-        for (t, tri) in triangles.iter().enumerate() {
+    fn new(corners: &[Corners]) -> Edges {
+        let mut keyed: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(3 * corners.len());
+        for (t, c) in corners.iter().enumerate() {
             for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                let (a, b) = (c.tri[k], c.tri[(k + 1) % 3]);
                 keyed.push((a.min(b), a.max(b), t as u32, k as u8));
             }
         }
@@ -119,14 +196,8 @@ impl Edges {
 }
 
 /// Whether a triangle's edge orientations (true: from corner k to corner k + 1) are cyclic.
-fn cyclic(forward: [bool; 3]) -> bool {
+pub fn cyclic(forward: [bool; 3]) -> bool {
     forward[0] == forward[1] && forward[1] == forward[2]
-}
-
-/// The triangle-local orientation of edge k given the edge's global one (`up`: from its lower
-/// to its higher vertex).
-fn forward_of(tri: [u32; 3], k: usize, up: bool) -> bool {
-    (tri[k] < tri[(k + 1) % 3]) == up
 }
 
 /// Reference coordinates of a prism's six vertices (corners 0, 1, 2 of the triangle at the
@@ -162,7 +233,7 @@ fn oriented(local: [usize; 4]) -> [usize; 4] {
 
 /// The three tetrahedra of a prism from its corners' edge orientations (acyclic), in
 /// prism-local indices.
-fn prism_tets(forward: [bool; 3]) -> [[usize; 4]; 3] {
+fn acyclic_tets(forward: [bool; 3]) -> Vec<[usize; 4]> {
     // Out-degree of each corner: edge k runs k -> k+1 when forward, else k+1 -> k.
     let mut out = [0usize; 3];
     for (k, f) in forward.iter().enumerate() {
@@ -171,7 +242,7 @@ fn prism_tets(forward: [bool; 3]) -> [[usize; 4]; 3] {
     let p = (0..3).find(|&i| out[i] == 2).expect("acyclic: a source");
     let r = (0..3).find(|&i| out[i] == 0).expect("acyclic: a sink");
     let q = 3 - p - r;
-    [
+    vec![
         oriented([p, q, r, r + 3]),
         oriented([p, q, q + 3, r + 3]),
         oriented([p, p + 3, q + 3, r + 3]),
@@ -190,6 +261,58 @@ fn centre_tets(forward: [bool; 3]) -> Vec<[usize; 4]> {
         tets.push(oriented([tail, tail + 3, head + 3, 6]));
     }
     tets
+}
+
+/// The prism-local tetrahedra of each of the 8 patterns (bit k: edge k forward).
+fn pattern(forward: [bool; 3]) -> &'static [[usize; 4]] {
+    static TABLE: OnceLock<Vec<Vec<[usize; 4]>>> = OnceLock::new();
+    let table = TABLE.get_or_init(|| {
+        (0..8u8)
+            .map(|bits| {
+                let f = [bits & 1 != 0, bits & 2 != 0, bits & 4 != 0];
+                if cyclic(f) {
+                    centre_tets(f)
+                } else {
+                    acyclic_tets(f)
+                }
+            })
+            .collect()
+    });
+    &table[forward.iter().rev().fold(0, |b, &f| 2 * b + usize::from(f))]
+}
+
+/// The tetrahedra of a prism whose bottom and top corners are the vertices `v` (from
+/// [`Corners::vertices`]), with edge orientations `forward` (in effect, see
+/// [`Corners::effective`]) and, for a cyclic pattern, the inserted vertex `centre`.
+/// Tetrahedra repeating a vertex (at collapsed corners) are left out.
+pub fn prism_tets(v: [u32; 6], forward: [bool; 3], centre: u32) -> impl Iterator<Item = [u32; 4]> {
+    let global = move |i: usize| if i < 6 { v[i] } else { centre };
+    pattern(forward)
+        .iter()
+        .map(move |t| t.map(global))
+        .filter(|t| {
+            t[0] != t[1]
+                && t[0] != t[2]
+                && t[0] != t[3]
+                && t[1] != t[2]
+                && t[1] != t[3]
+                && t[2] != t[3]
+        })
+}
+
+/// The tetrahedra of one plain prism over triangle `tri` of a surface of `n` vertices, given
+/// the orientation of its three edges (`forward[k]`: the quad over edge k is split from the
+/// bottom of corner k to the top of corner k + 1): three tetrahedra, or, for the two cyclic
+/// patterns, eight joined to the inserted vertex `centre`.
+pub fn prism(tri: [u32; 3], n: u32, forward: [bool; 3], centre: u32) -> Vec<[u32; 4]> {
+    prism_tets(Corners::plain(tri).vertices(n), forward, centre).collect()
+}
+
+/// The centre of a prism with corners `v` (the inserted vertex of a cyclic pattern), rounded
+/// to f32 like every halo vertex.
+pub fn centre(v: [u32; 6], positions: &[DVec3]) -> DVec3 {
+    let sum: DVec3 = v.iter().map(|&i| positions[i as usize]).sum();
+    (sum / 6.0).as_vec3().as_dvec3()
 }
 
 /// Six times the volume of a tetrahedron, positive when `robust::orient3d` is (the fourth
@@ -227,49 +350,33 @@ fn min_dihedral(p: [DVec3; 4]) -> f64 {
     min
 }
 
-/// The tetrahedra of one prism over triangle `tri` of a surface of `n` vertices, given the
-/// orientation of its three edges (`forward[k]`: the quad over edge k is split from the
-/// bottom of corner k to the top of corner k + 1): three tetrahedra, or, for the two cyclic
-/// patterns, eight joined to the inserted vertex `centre`.
-pub fn prism(tri: [u32; 3], n: u32, forward: [bool; 3], centre: u32) -> Vec<[u32; 4]> {
-    let global = |i: usize| match i {
-        0..=2 => tri[i],
-        3..=5 => n + tri[i - 3],
-        _ => centre,
-    };
-    if cyclic(forward) {
-        centre_tets(forward).iter().map(|t| t.map(global)).collect()
-    } else {
-        prism_tets(forward).iter().map(|t| t.map(global)).collect()
-    }
-}
-
-/// Splits the prisms of `triangles` (over `n` surface vertices) of a halo whose vertices are
-/// `positions` (negative offsets, then positive ones).
-pub fn tetrahedralize(
-    triangles: &[[u32; 3]],
+/// Chooses the orientation of every prism's edges by `split`, for a surface of `n` vertices
+/// whose halo vertices (offsets) are `positions` (the geometry only matters to `quality`).
+pub fn plan(
+    corners: &[Corners],
     positions: &[DVec3],
     n: usize,
     split: Split,
-) -> Tetrahedra {
-    let edges = Edges::new(triangles);
+) -> (Vec<[bool; 3]>, SplitStats) {
+    let edges = Edges::new(corners);
     let mut stats = SplitStats::default();
-    // Per triangle, the orientation of its three edges.
+    // Per prism, the orientation of its three edges.
     let mut forward: Vec<[bool; 3]> = match split {
-        Split::Paper => vec![[true, true, false]; triangles.len()],
-        Split::GlobalOrder | Split::Quality => triangles
+        Split::Paper => vec![[true, true, false]; corners.len()],
+        Split::GlobalOrder | Split::Quality => corners
             .iter()
-            .map(|&tri| [0, 1, 2].map(|k| forward_of(tri, k, true)))
+            .map(|c| [0, 1, 2].map(|k| c.up(k, true)))
             .collect(),
     };
     let up = |forward: &[[bool; 3]], t: u32, k: u8| {
-        let tri = triangles[t as usize];
-        let k = k as usize;
-        (tri[k] < tri[(k + 1) % 3]) == forward[t as usize][k]
+        corners[t as usize].up(k as usize, forward[t as usize][k as usize])
     };
     let mismatched = |forward: &[[bool; 3]], uses: &[(u32, u8)]| {
-        uses.iter()
-            .any(|&(t, k)| up(forward, t, k) != up(forward, uses[0].0, uses[0].1))
+        let (t0, k0) = uses[0];
+        !corners[t0 as usize].degenerate(k0 as usize)
+            && uses
+                .iter()
+                .any(|&(t, k)| up(forward, t, k) != up(forward, t0, k0))
     };
     stats.mismatches_initial = edges.iter().filter(|u| mismatched(&forward, u)).count();
 
@@ -281,6 +388,9 @@ pub fn tetrahedralize(
             while changed {
                 changed = false;
                 for uses in edges.iter() {
+                    if !mismatched(&forward, uses) {
+                        continue;
+                    }
                     let (t0, k0) = uses[0];
                     for &(t, k) in &uses[1..] {
                         if up(&forward, t, k) == up(&forward, t0, k0) {
@@ -288,7 +398,7 @@ pub fn tetrahedralize(
                         }
                         let mut f = forward[t as usize];
                         f[k as usize] = !f[k as usize];
-                        if !cyclic(f) {
+                        if corners[t as usize].splittable(f) {
                             forward[t as usize] = f;
                             stats.flips += 1;
                             changed = true;
@@ -298,7 +408,7 @@ pub fn tetrahedralize(
                         // user of the edge consistent.
                         let mut f0 = forward[t0 as usize];
                         f0[k0 as usize] = !f0[k0 as usize];
-                        if uses.len() == 2 && !cyclic(f0) {
+                        if uses.len() == 2 && corners[t0 as usize].splittable(f0) {
                             forward[t0 as usize] = f0;
                             stats.flips += 1;
                             changed = true;
@@ -307,8 +417,11 @@ pub fn tetrahedralize(
                 }
             }
             // Fig. 4d: where neither prism can flip, the second takes the first's diagonal and
-            // becomes cyclic; it gets an inserted vertex below.
+            // becomes cyclic; it gets an inserted vertex.
             for uses in edges.iter() {
+                if !mismatched(&forward, uses) {
+                    continue;
+                }
                 let (t0, k0) = uses[0];
                 for &(t, k) in &uses[1..] {
                     if up(&forward, t, k) != up(&forward, t0, k0) {
@@ -319,18 +432,10 @@ pub fn tetrahedralize(
         }
         Split::Quality => {
             let prism_quality = |t: usize, f: [bool; 3]| -> f64 {
-                let tri = triangles[t];
-                let local = |i: usize| {
-                    if i < 3 {
-                        positions[tri[i] as usize]
-                    } else {
-                        positions[n + tri[i - 3] as usize]
-                    }
-                };
-                prism_tets(f)
-                    .iter()
+                let v = corners[t].vertices(n as u32);
+                prism_tets(v, corners[t].effective(f), u32::MAX)
                     .map(|tet| {
-                        let p = tet.map(local);
+                        let p = tet.map(|i| positions[i as usize]);
                         // Inverted is worst.
                         if signed_volume(p) <= 0.0 {
                             -1.0
@@ -341,11 +446,14 @@ pub fn tetrahedralize(
                     .fold(f64::INFINITY, f64::min)
             };
             // Each prism's worst tetrahedron, kept up to date as diagonals flip.
-            let mut quality: Vec<f64> = (0..triangles.len())
+            let mut quality: Vec<f64> = (0..corners.len())
                 .map(|t| prism_quality(t, forward[t]))
                 .collect();
             for _pass in 0..2 {
                 for uses in edges.iter() {
+                    if corners[uses[0].0 as usize].degenerate(uses[0].1 as usize) {
+                        continue;
+                    }
                     let flipped: Vec<(usize, [bool; 3])> = uses
                         .iter()
                         .map(|&(t, k)| {
@@ -354,7 +462,7 @@ pub fn tetrahedralize(
                             (t as usize, f)
                         })
                         .collect();
-                    if flipped.iter().any(|(_, f)| cyclic(*f)) {
+                    if flipped.iter().any(|&(t, f)| !corners[t].splittable(f)) {
                         continue;
                     }
                     let before = flipped
@@ -375,21 +483,34 @@ pub fn tetrahedralize(
         }
     }
     stats.mismatches_final = edges.iter().filter(|u| mismatched(&forward, u)).count();
+    (forward, stats)
+}
 
-    let mut out = Tetrahedra::default();
-    for (t, tri) in triangles.iter().enumerate() {
-        let centre = (positions.len() + out.inserted.len()) as u32;
-        out.tets.extend(prism(*tri, n as u32, forward[t], centre));
-        if cyclic(forward[t]) {
-            let corners =
-                [0, 1, 2].map(|i| positions[tri[i] as usize] + positions[n + tri[i] as usize]);
-            out.inserted
-                .push(corners.iter().copied().sum::<DVec3>() / 6.0);
+/// The tetrahedra of every prism, with a vertex inserted at the centre of each prism whose
+/// pattern (in effect) is cyclic. `positions` are the halo's offset vertices.
+pub fn emit(
+    corners: &[Corners],
+    forward: &[[bool; 3]],
+    positions: &[DVec3],
+    n: usize,
+    stats: SplitStats,
+) -> Tetrahedra {
+    let mut out = Tetrahedra {
+        stats,
+        ..Tetrahedra::default()
+    };
+    out.tets.reserve(3 * corners.len());
+    for (t, c) in corners.iter().enumerate() {
+        let v = c.vertices(n as u32);
+        let f = c.effective(forward[t]);
+        let centre_index = (positions.len() + out.inserted.len()) as u32;
+        out.tets.extend(prism_tets(v, f, centre_index));
+        if cyclic(f) {
+            out.inserted.push(centre(v, positions));
             out.inserted_in.push(t as u32);
-            stats.inserted_vertices += 1;
         }
     }
-    out.stats = stats;
+    out.stats.inserted_vertices = out.inserted.len();
     out
 }
 
@@ -405,7 +526,7 @@ mod tests {
             let tets: Vec<[usize; 4]> = if cyclic(f) {
                 centre_tets(f)
             } else {
-                prism_tets(f).to_vec()
+                acyclic_tets(f)
             };
             let mut volume = 0.0;
             for tet in &tets {

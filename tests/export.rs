@@ -24,14 +24,28 @@ fn every_fixture_builds_and_reads_back() {
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let name = &scene.name;
 
-        // Every halo conforms, as the independent checker sees it. (Inverted tetrahedra
-        // remain where the projection has cross-caps and on non-orientable surfaces.)
+        // Every halo is valid, as the independent checker sees it: conforming, no inverted
+        // or flat tetrahedron, the volumes adding up.
         for p in &products {
             let c = p.halo_report.check;
             let what = format!("{name}/{}: {c:?}", p.name);
-            assert!(c.conforms(), "{what}");
+            assert!(c.valid(), "{what}");
+            assert_eq!(p.halo_report.inverted, 0, "{what}");
             assert_eq!(p.halo_report.split_stats.mismatches_final, 0, "{what}");
-            assert_eq!(c.tets, 3 * p.mesh.triangles.len(), "{what}");
+            // Three per prism, one fewer for each collapsed corner (rho 0), five more for
+            // each inserted vertex.
+            let collapsed_corners = p
+                .mesh
+                .triangles
+                .iter()
+                .flatten()
+                .filter(|&&v| p.halo.rho[v as usize] == 0.0)
+                .count();
+            assert_eq!(
+                c.tets + collapsed_corners,
+                3 * p.mesh.triangles.len() + 5 * p.halo_report.split_stats.inserted_vertices,
+                "{what}"
+            );
         }
 
         // glTF: one mesh per surface, named after it, with the custom attributes.
