@@ -126,32 +126,32 @@ fn volume(p: [[f64; 3]; 4]) -> f64 {
     -dot(cross(sub(p[1], p[0]), sub(p[2], p[0])), sub(p[3], p[0])) / 6.0
 }
 
-/// Smallest dihedral angle in degrees (0 for a flat tetrahedron).
-fn min_dihedral_deg(p: [[f64; 3]; 4]) -> f64 {
+/// The cosine of a tetrahedron's smallest dihedral angle (1 for a flat one).
+fn smallest_dihedral_cosine(p: [[f64; 3]; 4]) -> f64 {
     let mut normals = [[0.0; 3]; 4];
     for (i, n) in normals.iter_mut().enumerate() {
-        let f: Vec<[f64; 3]> = (0..4).filter(|&k| k != i).map(|k| p[k]).collect();
-        let m = cross(sub(f[1], f[0]), sub(f[2], f[0]));
+        let [a, b, c] = [(i + 1) % 4, (i + 2) % 4, (i + 3) % 4].map(|k| p[k]);
+        let m = cross(sub(b, a), sub(c, a));
         let len = dot(m, m).sqrt();
         if len == 0.0 || !len.is_finite() {
-            return 0.0;
+            return 1.0;
         }
-        let m = m.map(|x| x / len);
         // Outward: away from the vertex opposite the face.
-        *n = if dot(m, sub(p[i], f[0])) > 0.0 {
-            m.map(|x| -x)
+        let sign = if dot(m, sub(p[i], a)) > 0.0 {
+            -1.0
         } else {
-            m
+            1.0
         };
+        *n = m.map(|x| sign * x / len);
     }
-    let mut min = 180.0f64;
+    // The dihedral angle between faces i and j is pi minus the angle of their normals.
+    let mut largest = -1.0f64;
     for i in 0..4 {
         for j in i + 1..4 {
-            let c = dot(normals[i], normals[j]).clamp(-1.0, 1.0);
-            min = min.min(180.0 - c.acos().to_degrees());
+            largest = largest.max(-dot(normals[i], normals[j]));
         }
     }
-    min
+    largest.min(1.0)
 }
 
 /// A face as its sorted vertex triple.
@@ -187,6 +187,7 @@ fn examine(tets: &[[u32; 4]], first: usize, positions: &[[f64; 3]]) -> Partial {
     };
     let s = &mut out.stats;
     let nv = positions.len();
+    let mut dihedral_cosine = -1.0f64;
     for (i, tet) in tets.iter().enumerate() {
         let mut sorted = *tet;
         sorted.sort_unstable();
@@ -205,34 +206,66 @@ fn examine(tets: &[[u32; 4]], first: usize, positions: &[[f64; 3]]) -> Partial {
         s.volume += v.abs();
         s.min_volume = s.min_volume.min(v);
         s.max_volume = s.max_volume.max(v);
-        s.min_dihedral_deg = s.min_dihedral_deg.min(min_dihedral_deg(p));
+        dihedral_cosine = dihedral_cosine.max(smallest_dihedral_cosine(p));
         let code = 4 * (first + i) as u32;
         for (slot, f) in faces_of(*tet).into_iter().enumerate() {
             out.faces.push((key(f), code + slot as u32));
         }
     }
+    s.min_dihedral_deg = dihedral_cosine.clamp(-1.0, 1.0).acos().to_degrees();
     out
 }
 
-/// Sorts (key, payload) pairs by key: a counting sort on the first vertex, then each
-/// (small) bucket by the other two.
-fn sort_faces(faces: Vec<([u32; 3], u32)>, vertices: usize) -> Vec<([u32; 3], u32)> {
+/// Sorts `items` whose first sort field is a vertex index below `vertices`: a counting sort
+/// on that vertex, then each (small) bucket by the rest, the buckets shared among threads.
+fn bucket_sort<T: Ord + Copy + Default + Send>(
+    items: Vec<T>,
+    vertices: usize,
+    first: impl Fn(&T) -> u32,
+) -> Vec<T> {
     let mut starts = vec![0usize; vertices + 1];
-    for (k, _) in &faces {
-        starts[k[0] as usize + 1] += 1;
+    for item in &items {
+        starts[first(item) as usize + 1] += 1;
     }
     for i in 0..vertices {
         starts[i + 1] += starts[i];
     }
     let mut fill = starts.clone();
-    let mut out = vec![([0; 3], 0); faces.len()];
-    for f in faces {
-        out[fill[f.0[0] as usize]] = f;
-        fill[f.0[0] as usize] += 1;
+    let mut out = vec![T::default(); items.len()];
+    for item in items {
+        let slot = &mut fill[first(&item) as usize];
+        out[*slot] = item;
+        *slot += 1;
     }
-    for w in starts.windows(2) {
-        out[w[0]..w[1]].sort_unstable();
-    }
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |t| t.get())
+        .min(8);
+    let share = out.len().div_ceil(threads).max(1);
+    std::thread::scope(|scope| {
+        let mut rest: &mut [T] = &mut out;
+        let mut offset = 0;
+        let mut bucket = 0;
+        while !rest.is_empty() {
+            // Cut at the first bucket boundary past an even share.
+            while bucket < vertices && starts[bucket] < offset + share {
+                bucket += 1;
+            }
+            let end = starts[bucket].max(offset + 1).min(offset + rest.len());
+            let (part, tail) = std::mem::take(&mut rest).split_at_mut(end - offset);
+            let bounds: Vec<usize> = starts
+                .iter()
+                .map(|&x| x.clamp(offset, end) - offset)
+                .collect();
+            scope.spawn(move || {
+                for w in bounds.windows(2) {
+                    if w[1] > w[0] + 1 {
+                        part[w[0]..w[1]].sort_unstable();
+                    }
+                }
+            });
+            (rest, offset) = (tail, end);
+        }
+    });
     out
 }
 
@@ -304,7 +337,7 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     if s.tets == s.degenerate {
         (s.min_volume, s.max_volume, s.min_dihedral_deg) = (0.0, 0.0, 0.0);
     }
-    let faces = sort_faces(faces, nv);
+    let faces = bucket_sort(faces, nv, |f| f.0[0]);
 
     // Distinct faces with their use counts; boundary faces with their tetrahedron.
     let mut keys: Vec<[u32; 3]> = Vec::with_capacity(faces.len() / 2 + 1);
@@ -330,15 +363,28 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
         counts.push(group.len() as u32);
     }
     s.boundary_faces = boundary.len();
+    // Where each first vertex's distinct faces start in `keys`.
+    let mut key_starts = vec![0usize; nv + 1];
+    for k in &keys {
+        key_starts[k[0] as usize + 1] += 1;
+    }
+    for i in 0..nv {
+        key_starts[i + 1] += key_starts[i];
+    }
     let count = |f: [u32; 3]| {
         let f = key(f);
-        keys.binary_search(&f).map_or(0, |i| counts[i])
+        let bucket = &keys[key_starts[f[0] as usize]..key_starts[f[0] as usize + 1]];
+        bucket
+            .iter()
+            .position(|&k| k == f)
+            .map_or(0, |i| counts[key_starts[f[0] as usize] + i])
     };
+    // Whether two offsets lie on the same side (both negative or both positive).
+    let same_side = |a: u32, b: u32| (a < n as u32) == (b < n as u32);
 
-    // Offset faces (three offsets of three surface vertices) by surface triangle; the
-    // horizontal edges they bound; the other boundary faces to classify after the edges.
+    // Offset faces (three offsets of three surface vertices) by surface triangle; the other
+    // boundary faces to classify once the open edges are known.
     let mut offset_faces: Vec<([u32; 3], [u32; 3])> = Vec::new();
-    let mut horizontal: Vec<[u32; 2]> = Vec::new();
     let mut others: Vec<[u32; 3]> = Vec::new();
     let mut boundary_volume = 0.0;
     for &(k, code) in &boundary {
@@ -354,29 +400,38 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
         match k.map(surface_vertex) {
             [Some(x), Some(y), Some(z)] if x != y && y != z && x != z => {
                 offset_faces.push((key([x, y, z]), k));
-                horizontal.extend([[k[0], k[1]], [k[0], k[2]], [k[1], k[2]]]);
             }
             _ => others.push(k),
         }
     }
     s.boundary_volume = boundary_volume;
-    offset_faces.sort_unstable();
-    horizontal.sort_unstable();
-    let mut edges: Vec<[u32; 2]> = Vec::new();
+    let offset_faces = bucket_sort(offset_faces, n, |f| f.0[0]);
+    // Surface edges, each with the side pairing of the offset face's edge over it: `true`
+    // when that edge joins two offsets on the same side (its quad's perimeter runs
+    // straight, so the diagonals cross sides), `None` at a collapsed end.
+    let mut edges: Vec<([u32; 2], Option<bool>)> = Vec::new();
     for group in offset_faces.chunk_by(|a, b| a.0 == b.0) {
         let opposite = group.len() == 2 && key(group[0].1.map(partner)) == group[1].1;
         if !opposite {
             s.missing_offset_faces += 1;
         }
-        let [x, y, z] = group[0].0;
-        edges.extend([[x, y], [x, z], [y, z]]);
+        let face = group[0].1;
+        for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+            let (a, b) = (face[i], face[j]);
+            let (x, y) = (
+                surface_vertex(a).unwrap_or(0),
+                surface_vertex(b).unwrap_or(0),
+            );
+            let straight = (partner(a) != a && partner(b) != b).then(|| same_side(a, b));
+            edges.push(([x.min(y), x.max(y)], straight));
+        }
     }
-    edges.sort_unstable();
+    let edges = bucket_sort(edges, n, |e| e.0[0]);
 
     // Quads over surface edges; the edges used by one surface triangle are open.
     let mut open: Vec<[u32; 2]> = Vec::new();
-    for group in edges.chunk_by(|a, b| a == b) {
-        let [x, y] = group[0];
+    for group in edges.chunk_by(|a, b| a.0 == b.0) {
+        let [x, y] = group[0].0;
         let expected = if group.len() >= 2 { 2 } else { 1 };
         if group.len() == 1 {
             open.push([x, y]);
@@ -387,24 +442,24 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
             (true, false) => count([x, y, y1]) == expected,
             (false, true) => count([x, x1, y]) == expected,
             (false, false) => {
-                let candidates = [[x, y, y1], [x, y, x1], [x, x1, y1], [y, y1, x1]];
-                let present: Vec<[u32; 3]> = candidates
-                    .into_iter()
-                    .filter(|&f| count(f) > 0)
-                    .map(key)
-                    .collect();
-                present.len() == 2 && present.iter().all(|&f| count(f) == expected) && {
-                    // The diagonal they share: not a vertical edge of the prisms, not an
-                    // edge of an offset face.
-                    let shared: Vec<u32> = present[0]
-                        .iter()
-                        .filter(|v| present[1].contains(v))
-                        .copied()
-                        .collect();
-                    let d = [shared[0], shared[1]];
-                    surface_vertex(d[0]) != surface_vertex(d[1])
-                        && horizontal.binary_search(&d).is_err()
-                }
+                // Split along a diagonal: the two faces on one of them, each used `expected`
+                // times, the other two unused. The diagonals cross sides where the perimeter
+                // runs straight; every prism over the edge must see the same perimeter.
+                let straight = group[0].1;
+                let agree = group.iter().all(|e| e.1 == straight);
+                let split = |a: u32, b: u32, c: u32, d: u32| {
+                    // Diagonal (a, b); the other diagonal (c, d).
+                    count([a, b, c]) == expected
+                        && count([a, b, d]) == expected
+                        && count([c, d, a]) == 0
+                        && count([c, d, b]) == 0
+                };
+                agree
+                    && if straight == Some(true) {
+                        split(x, y1, x1, y) || split(x1, y, x, y1)
+                    } else {
+                        split(x, y, x1, y1) || split(x1, y1, x, y)
+                    }
             }
         };
         if !quad {

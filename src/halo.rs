@@ -195,49 +195,51 @@ impl Stars {
 }
 
 /// For the triangles around a vertex (`star`), whether each is wound against the vertex's
-/// reference orientation: found by walking across the edges they share (two triangles
-/// sharing an edge agree when they run along it in opposite directions), the reference being
-/// the winding of the majority.
-fn reversed_in_star(star: &[(u32, u8)], triangles: &[[u32; 3]]) -> Vec<bool> {
-    // The corners after and before the vertex in each triangle's winding.
-    let ring: Vec<(u32, u32)> = star
-        .iter()
-        .map(|&(t, k)| {
-            let tri = triangles[t as usize];
-            (tri[(k as usize + 1) % 3], tri[(k as usize + 2) % 3])
-        })
-        .collect();
-    let mut reversed: Vec<Option<bool>> = vec![None; star.len()];
-    let mut stack = Vec::new();
+/// reference orientation (into `reversed`): found by walking across the edges they share
+/// (two triangles sharing an edge agree when they run along it in opposite directions), the
+/// reference being the winding of the majority.
+fn reversed_in_star(
+    star: &[(u32, u8)],
+    triangles: &[[u32; 3]],
+    reversed: &mut Vec<bool>,
+    stack: &mut Vec<usize>,
+) {
+    // The corners after and before the vertex in triangle i's winding.
+    let ring = |i: usize| {
+        let (t, k) = star[i];
+        let tri = triangles[t as usize];
+        (tri[(k as usize + 1) % 3], tri[(k as usize + 2) % 3])
+    };
+    let mut seen = vec![false; star.len()];
+    reversed.clear();
+    reversed.resize(star.len(), false);
     for seed in 0..star.len() {
-        if reversed[seed].is_some() {
+        if seen[seed] {
             continue;
         }
-        reversed[seed] = Some(false);
+        seen[seed] = true;
         stack.push(seed);
         while let Some(i) = stack.pop() {
-            let (next, prev) = ring[i];
-            let ri = reversed[i] == Some(true);
+            let (next, prev) = ring(i);
             for j in 0..star.len() {
-                if reversed[j].is_some() {
+                if seen[j] {
                     continue;
                 }
-                let (nj, pj) = ring[j];
+                let (nj, pj) = ring(j);
                 // Sharing the edge to `next` as j's `prev` (or `prev` as `next`): agree.
                 let agree = nj == prev || pj == next;
                 let disagree = nj == next || pj == prev;
                 if agree || disagree {
-                    reversed[j] = Some(ri ^ disagree);
+                    seen[j] = true;
+                    reversed[j] = reversed[i] ^ disagree;
                     stack.push(j);
                 }
             }
         }
     }
-    let mut out: Vec<bool> = reversed.into_iter().map(|r| r == Some(true)).collect();
-    if 2 * out.iter().filter(|r| **r).count() > out.len() {
-        out.iter_mut().for_each(|r| *r = !*r);
+    if 2 * reversed.iter().filter(|r| **r).count() > reversed.len() {
+        reversed.iter_mut().for_each(|r| *r = !*r);
     }
-    out
 }
 
 /// The unit direction d maximising min_i d·g_i, and that minimum: the directions from the
@@ -289,29 +291,31 @@ struct Frame {
 /// only). Where no direction faces every triangle, the vertex is singular.
 fn frame(p: &Projected, triangles: &[[u32; 3]], stars: &Stars) -> Frame {
     let n = p.positions.len();
-    let unit_normal = |t: u32| {
-        let [a, b, c] = triangles[t as usize].map(|i| p.positions[i as usize]);
-        (b - a).cross(c - a).normalize_or_zero()
-    };
+    let unit_normals: Vec<DVec3> = triangles
+        .iter()
+        .map(|tri| {
+            let [a, b, c] = tri.map(|i| p.positions[i as usize]);
+            (b - a).cross(c - a).normalize_or_zero()
+        })
+        .collect();
     let mut frame = Frame {
         dir: vec![DVec3::ZERO; n],
         flip: vec![[false; 3]; triangles.len()],
         singular: vec![false; n],
     };
-    let mut g = Vec::new();
+    let (mut g, mut reversed, mut stack) = (Vec::new(), Vec::new(), Vec::new());
     for v in 0..n {
         let star = stars.of(v);
         if star.is_empty() {
             frame.dir[v] = p.normals[v];
             continue;
         }
-        let reversed = reversed_in_star(star, triangles);
+        reversed_in_star(star, triangles, &mut reversed, &mut stack);
         g.clear();
-        g.extend(
-            star.iter()
-                .zip(&reversed)
-                .map(|(&(t, _), &r)| if r { -unit_normal(t) } else { unit_normal(t) }),
-        );
+        g.extend(star.iter().zip(&reversed).map(|(&(t, _), &r)| {
+            let f = unit_normals[t as usize];
+            if r { -f } else { f }
+        }));
         for (&(t, k), &r) in star.iter().zip(&reversed) {
             frame.flip[t as usize][k as usize] = r;
         }

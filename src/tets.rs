@@ -166,26 +166,49 @@ struct Edges {
 
 impl Edges {
     fn new(corners: &[Corners]) -> Edges {
-        let mut keyed: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(3 * corners.len());
+        // A counting sort on the lower end, then each (small) bucket by the higher end.
+        let vertices = corners
+            .iter()
+            .flat_map(|c| c.tri)
+            .max()
+            .map_or(0, |v| v as usize + 1);
+        let ends = |c: &Corners, k: usize| {
+            let (a, b) = (c.tri[k], c.tri[(k + 1) % 3]);
+            (a.min(b), a.max(b))
+        };
+        let mut bucket = vec![0usize; vertices + 1];
+        for c in corners {
+            for k in 0..3 {
+                bucket[ends(c, k).0 as usize + 1] += 1;
+            }
+        }
+        for i in 0..vertices {
+            bucket[i + 1] += bucket[i];
+        }
+        let mut fill = bucket.clone();
+        let mut keyed = vec![(0u32, 0u32, 0u8); 3 * corners.len()];
         for (t, c) in corners.iter().enumerate() {
             for k in 0..3 {
-                let (a, b) = (c.tri[k], c.tri[(k + 1) % 3]);
-                keyed.push((a.min(b), a.max(b), t as u32, k as u8));
+                let (lo, hi) = ends(c, k);
+                keyed[fill[lo as usize]] = (hi, t as u32, k as u8);
+                fill[lo as usize] += 1;
             }
         }
-        keyed.sort_unstable();
         let mut starts = vec![0];
-        for (i, w) in keyed.windows(2).enumerate() {
-            if (w[0].0, w[0].1) != (w[1].0, w[1].1) {
-                starts.push(i + 1);
+        for w in bucket.windows(2) {
+            let run = &mut keyed[w[0]..w[1]];
+            run.sort_unstable();
+            for i in 1..run.len() {
+                if run[i].0 != run[i - 1].0 {
+                    starts.push(w[0] + i);
+                }
             }
-        }
-        starts.push(keyed.len());
-        if keyed.is_empty() {
-            starts = vec![0];
+            if !run.is_empty() {
+                starts.push(w[1]);
+            }
         }
         Edges {
-            uses: keyed.iter().map(|k| (k.2, k.3)).collect(),
+            uses: keyed.iter().map(|k| (k.1, k.2)).collect(),
             starts,
         }
     }

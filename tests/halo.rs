@@ -1,11 +1,13 @@
 //! Halos: the three splits conform on random meshes, and the independent checker catches
 //! every planted fault as its own kind.
 
-use crate::common::Rng;
+use crate::common::{Rng, fixture, fixture_scenes};
 use glam::DVec3;
+use halo4d::Scene;
 use halo4d::check::{CheckStats, TetMesh, check};
-use halo4d::halo::{HaloParams, build_halo};
-use halo4d::tets::{Split, prism};
+use halo4d::halo::{Fold, HaloParams, build_halo};
+use halo4d::sample::Sampling;
+use halo4d::tets::{self, Corners, Split, prism};
 use halo4d::view::Projected;
 
 /// A bumpy height field over a jittered grid, its cells cut along random diagonals, its
@@ -239,4 +241,262 @@ fn a_single_prism_splits_every_way_into_its_volume() {
         assert_valid(&s, &format!("{f:?}"));
         assert!((s.volume - 0.1).abs() < 1e-15, "{f:?}: {s:?}");
     }
+}
+
+/// A Möbius band: a strip around a circle whose ends are glued with a half turn, so no
+/// winding of its triangles is consistent. Each triangle gets a random winding and random
+/// corner order, each vertex a random unit "view normal", and the vertices random numbers.
+fn random_moebius(rng: &mut Rng, nu: usize, nv: usize) -> (Projected, Vec<[u32; 3]>) {
+    let n = nu * (nv + 1);
+    let mut label: Vec<u32> = (0..n as u32).collect();
+    for i in (1..n).rev() {
+        label.swap(i, rng.below(i + 1));
+    }
+    // Column i, row j; column nu is column 0 turned over (row j -> nv - j).
+    let index = |i: usize, j: usize| {
+        let (i, j) = if i == nu { (0, nv - j) } else { (i, j) };
+        label[i * (nv + 1) + j]
+    };
+    let mut positions = vec![DVec3::ZERO; n];
+    for i in 0..nu {
+        for j in 0..=nv {
+            let u = std::f64::consts::TAU * i as f64 / nu as f64;
+            let v = 0.4 * (2.0 * j as f64 / nv as f64 - 1.0);
+            positions[index(i, j) as usize] = DVec3::new(
+                (1.0 + v * (u / 2.0).cos()) * u.cos(),
+                (1.0 + v * (u / 2.0).cos()) * u.sin(),
+                v * (u / 2.0).sin(),
+            );
+        }
+    }
+    let mut triangles = Vec::new();
+    for i in 0..nu {
+        for j in 0..nv {
+            let (a, b, c, d) = (
+                index(i, j),
+                index(i + 1, j),
+                index(i + 1, j + 1),
+                index(i, j + 1),
+            );
+            for t in [[a, b, c], [a, c, d]] {
+                let t = if rng.below(2) == 0 {
+                    t
+                } else {
+                    [t[0], t[2], t[1]]
+                };
+                let r = rng.below(3);
+                triangles.push([t[r], t[(r + 1) % 3], t[(r + 2) % 3]]);
+            }
+        }
+    }
+    let normals: Vec<DVec3> = (0..n)
+        .map(|_| {
+            DVec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5)
+                .try_normalize()
+                .unwrap_or(DVec3::Z)
+        })
+        .collect();
+    let projected = Projected {
+        w: positions.iter().map(|p| p.z).collect(),
+        tangent_u: normals.clone(),
+        tangent_v: normals.clone(),
+        positions,
+        normals,
+    };
+    (projected, triangles)
+}
+
+#[test]
+fn a_moebius_band_with_random_windings_gets_twisted_prisms_and_stays_valid() {
+    let mut rng = Rng(31);
+    for round in 0..6 {
+        let (nu, nv) = (12 + rng.below(20), 1 + rng.below(4));
+        let (projected, triangles) = random_moebius(&mut rng, nu, nv);
+        for split in [Split::Paper, Split::GlobalOrder, Split::Quality] {
+            let what = format!("round {round}, {nu}x{nv}, {split:?}");
+            let params = HaloParams {
+                split,
+                ..HaloParams::default()
+            };
+            let (halo, report) = build_halo(&projected, &triangles, 0.05, &params);
+            let stats = check(&halo.tet_mesh());
+            assert_valid(&stats, &what);
+            assert_eq!(report.split_stats.mismatches_final, 0, "{what}");
+            assert_eq!(report.inverted, 0, "{what}");
+            // The band cannot be oriented: somewhere the offsets turn over.
+            assert!(report.twisted_prisms > 0, "{what}");
+            // One boundary circle of 2 nu edges: a side wall of two faces over each.
+            assert_eq!(
+                stats.boundary_faces,
+                2 * triangles.len() + 2 * 2 * nu,
+                "{what}"
+            );
+        }
+    }
+}
+
+#[test]
+fn every_split_conforms_with_holes_and_bowtie_boundary_vertices() {
+    // Punching random triangles out leaves boundary vertices whose triangles form several
+    // fans (a non-manifold boundary).
+    let mut rng = Rng(5);
+    for round in 0..10 {
+        let (projected, mut triangles) = random_surface(&mut rng, 6, 6);
+        let keep = triangles.len() * 2 / 3;
+        while triangles.len() > keep {
+            let i = rng.below(triangles.len());
+            triangles.swap_remove(i);
+        }
+        for split in [Split::Paper, Split::GlobalOrder, Split::Quality] {
+            let what = format!("round {round}, {split:?}");
+            let params = HaloParams {
+                split,
+                ..HaloParams::default()
+            };
+            let (halo, report) = build_halo(&projected, &triangles, 0.05, &params);
+            assert_valid(&check(&halo.tet_mesh()), &what);
+            assert_eq!(report.split_stats.mismatches_final, 0, "{what}");
+        }
+    }
+}
+
+/// The products of a fixture scene with `edit` applied.
+fn run_fixture(name: &str, edit: impl FnOnce(&mut Scene)) -> Vec<halo4d::pipeline::SurfaceProduct> {
+    let mut scene = Scene::load(&fixture(&format!("scenes/{name}.json"))).unwrap();
+    edit(&mut scene);
+    halo4d::run(&scene, true).unwrap().0
+}
+
+#[test]
+fn the_flat_torus_cross_caps_are_exactly_its_singular_vertices() {
+    // (cos s, sin s, cos t, sin t) turned in the yw plane and projected: the tangents of
+    // the projection are parallel where sin s = sin t = 0, four points that the 96 x 96 grid
+    // has as vertices. There no direction faces every triangle around; rho collapses there
+    // and only there, and nothing inverts.
+    let products = run_fixture("flat-torus", |_| {});
+    let p = &products[0];
+    let r = &p.halo_report;
+    assert_eq!(r.singular_vertices, 4, "{r:?}");
+    assert_eq!(r.collapsed_vertices, 4, "{r:?}");
+    assert_eq!(r.inverted, 0, "{r:?}");
+    for (v, &rho) in p.halo.rho.iter().enumerate() {
+        let [s, t] = p.mesh.uv[v];
+        let cross_cap = s.sin().abs() < 1e-9 && t.sin().abs() < 1e-9;
+        assert_eq!(rho == 0.0, cross_cap, "vertex {v} at ({s}, {t}), rho {rho}");
+    }
+    assert!(r.check.valid(), "{r:?}");
+}
+
+#[test]
+fn cross_caps_between_vertices_and_rho_beyond_the_curvature_stay_valid() {
+    // An odd grid puts the cross-caps inside triangles; a rho of 0.3 of the diagonal is
+    // more than the torus's curvature allows almost everywhere.
+    for (u, rho) in [(95, 0.01), (31, 0.01), (48, 0.3), (95, 0.3)] {
+        let products = run_fixture("flat-torus", |scene| {
+            scene.sampling = Sampling::Uniform { u, v: u };
+            scene.halo.rho = rho;
+        });
+        let r = &products[0].halo_report;
+        let what = format!("{u}x{u}, rho {rho}: {r:?}");
+        assert!(r.check.valid(), "{what}");
+        assert_eq!(r.inverted, 0, "{what}");
+        if rho > 0.1 {
+            assert!(
+                r.shrunk_vertices > products[0].mesh.vertex_count() / 2,
+                "{what}"
+            );
+        }
+        assert!(
+            products[0].halo.positions.iter().all(|p| p.is_finite()),
+            "{what}"
+        );
+    }
+    // Without shrinking, the same halo is reported with its inverted tetrahedra.
+    let products = run_fixture("flat-torus", |scene| {
+        scene.halo.rho = 0.3;
+        scene.halo.fold = Fold::Report;
+    });
+    let r = &products[0].halo_report;
+    assert!(r.inverted > 0 && r.shrunk_vertices == 0, "{r:?}");
+    assert_eq!(r.inverted, r.check.inverted + r.check.flat);
+}
+
+#[test]
+fn the_poles_of_a_spun_knot_sampled_on_a_grid_get_a_valid_halo() {
+    // A uniform grid puts a whole row of parameters on each pole.
+    let products = run_fixture("default", |scene| {
+        scene.sampling = Sampling::Uniform { u: 64, v: 48 };
+    });
+    let r = &products[0].halo_report;
+    assert!(r.check.valid(), "{r:?}");
+    assert!(products[0].halo.positions.iter().all(|p| p.is_finite()));
+}
+
+#[test]
+fn the_paper_split_fixes_every_fixture() {
+    // The per-triangle start disagrees on many shared quads; flips and inserted vertices
+    // leave none, and the halo is valid.
+    for path in fixture_scenes() {
+        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        for p in run_fixture(&name, |scene| scene.halo.split = Split::Paper) {
+            let r = &p.halo_report;
+            let s = r.split_stats;
+            let what = format!("{name}/{}: {r:?}", p.name);
+            assert!(s.mismatches_initial > 0, "{what}");
+            assert!(s.flips > 0, "{what}");
+            assert_eq!(s.mismatches_final, 0, "{what}");
+            assert!(r.check.valid() && r.inverted == 0, "{what}");
+        }
+    }
+}
+
+#[test]
+fn the_checker_catches_faults_at_twisted_and_collapsed_prisms() {
+    // A twisted prism rebuilt untwisted: its quads no longer match its neighbours'.
+    let mut rng = Rng(77);
+    let (projected, triangles) = random_moebius(&mut rng, 16, 2);
+    let (halo, report) = build_halo(&projected, &triangles, 0.05, &HaloParams::default());
+    assert!(check(&halo.tet_mesh()).valid() && report.collapsed_vertices == 0);
+    let n = halo.surface_vertices as u32;
+    // Twisted prisms: their offset faces on the boundary mix the two sides.
+    let mut uses = std::collections::HashMap::new();
+    for tet in &halo.tets {
+        for skip in 0..4 {
+            let mut f: Vec<u32> = (0..4).filter(|&i| i != skip).map(|i| tet[i]).collect();
+            f.sort_unstable();
+            *uses.entry(f).or_insert(0) += 1;
+        }
+    }
+    let twisted = |t: usize| {
+        halo.tets[3 * t..3 * t + 3].iter().any(|tet| {
+            (0..4).any(|skip| {
+                let mut f: Vec<u32> = (0..4).filter(|&i| i != skip).map(|i| tet[i]).collect();
+                f.sort_unstable();
+                let surface: std::collections::HashSet<u32> = f.iter().map(|v| v % n).collect();
+                let sides: std::collections::HashSet<bool> = f.iter().map(|&v| v < n).collect();
+                uses[&f] == 1 && surface.len() == 3 && sides.len() == 2
+            })
+        })
+    };
+    let mut caught = 0;
+    for (t, &tri) in triangles.iter().enumerate().filter(|&(t, _)| twisted(t)) {
+        let mut bad = halo.tet_mesh();
+        let plain = tets::prism_tets(Corners::plain(tri).vertices(n), [true, true, false], 0);
+        bad.tets.splice(3 * t..3 * t + 3, plain);
+        let s = check(&bad);
+        assert!(!s.conforms(), "prism {t}: {s:?}");
+        caught += 1;
+    }
+    assert_eq!(caught, report.twisted_prisms);
+
+    // A collapsed vertex whose two offsets are told apart: the prisms around it use one of
+    // them, so the other offset surface has a hole there.
+    let products = run_fixture("flat-torus", |_| {});
+    let halo = &products[0].halo;
+    let v = halo.rho.iter().position(|&r| r == 0.0).unwrap();
+    let mut bad = halo.tet_mesh();
+    bad.positions[halo.surface_vertices + v][2] += 1e-3;
+    let s = check(&bad);
+    assert_eq!(s.collapsed_vertices, 3, "{s:?}");
+    assert!(s.missing_offset_faces > 0 && s.quad_mismatches > 0, "{s:?}");
 }
