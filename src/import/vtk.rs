@@ -39,15 +39,16 @@ pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
     let title = c
         .line()
         .ok_or_else(|| err("truncated after the first line".into()))?;
-    let ascii = match c.line().map(|l| l.trim().to_ascii_uppercase()).as_deref() {
-        Some("ASCII") => true,
-        Some("BINARY") => false,
-        other => {
+    let ascii = match c.line().map(|l| l.trim().to_ascii_uppercase()) {
+        Some(l) if l == "ASCII" => true,
+        Some(l) if l == "BINARY" => false,
+        Some(l) => {
             return Err(err(format!(
                 "the third line must be ASCII or BINARY, found {:?}",
-                truncate(other.unwrap_or("end of file"))
+                truncate(&l)
             )));
         }
+        None => return Err(err("truncated: the file ends before ASCII or BINARY".into())),
     };
     let mut r = Reader {
         c,
