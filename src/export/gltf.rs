@@ -424,3 +424,64 @@ fn glb_container(mut text: Vec<u8>, mut bin: Vec<u8>) -> Vec<u8> {
     out.extend_from_slice(&bin);
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::boundary_faces;
+    use glam::DVec3;
+
+    /// Signed volume enclosed by faces turned counter-clockwise seen from outside.
+    fn enclosed(p: &[DVec3], faces: &[[u32; 3]]) -> f64 {
+        faces
+            .iter()
+            .map(|f| {
+                let [a, b, c] = f.map(|i| p[i as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    }
+
+    #[test]
+    fn boundary_faces_skip_shared_faces_and_turn_outward_whatever_the_tets_orientation() {
+        let p = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(0.0, 0.0, 1.0),
+            DVec3::new(0.0, 0.0, -1.0),
+        ];
+        let up = [0, 1, 2, 3];
+        let positive = |t: [u32; 4]| {
+            let c = |i: u32| robust::Coord3D {
+                x: p[i as usize].x,
+                y: p[i as usize].y,
+                z: p[i as usize].z,
+            };
+            robust::orient3d(c(t[0]), c(t[1]), c(t[2]), c(t[3])) > 0.0
+        };
+        let (up, flipped_up) = if positive(up) {
+            (up, [1, 0, 2, 3])
+        } else {
+            ([1, 0, 2, 3], up)
+        };
+        let down = if positive([0, 1, 2, 4]) {
+            [0, 1, 2, 4]
+        } else {
+            [1, 0, 2, 4]
+        };
+        let one = boundary_faces(&p, &[up]);
+        assert_eq!(one.len(), 4);
+        assert!((enclosed(&p, &one) - 1.0 / 6.0).abs() < 1e-15);
+        // A tetrahedron listed the wrong way round still gets outward faces.
+        let one = boundary_faces(&p, &[flipped_up]);
+        assert!((enclosed(&p, &one) - 1.0 / 6.0).abs() < 1e-15);
+        // Two sharing the face (0, 1, 2): it is inside, six faces remain.
+        let two = boundary_faces(&p, &[up, down]);
+        assert_eq!(two.len(), 6);
+        assert!(
+            two.iter()
+                .all(|f| !(f.contains(&0) && f.contains(&1) && f.contains(&2)))
+        );
+        assert!((enclosed(&p, &two) - 2.0 / 6.0).abs() < 1e-15);
+    }
+}
