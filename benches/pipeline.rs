@@ -1,8 +1,9 @@
-//! Stage costs of the build: uniform sampling, projection and export, on a sweep of grid
-//! sizes, for the default scene's spun trefoil and the quartic Fermat.
+//! Stage costs of the build: uniform sampling, projection and export (with the halo), on a
+//! sweep of grid sizes, for the default scene's spun trefoil and the quartic Fermat.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use halo4d::export::{SurfaceData, to_glb, to_ply};
+use halo4d::export::{SurfaceData, to_glb, to_ply, to_vtk};
+use halo4d::halo::{HaloParams, build_halo};
 use halo4d::surfaces::{Fermat, SpunTrefoil};
 use halo4d::{Surface, View, sample_uniform};
 use std::hint::black_box;
@@ -31,18 +32,27 @@ fn stages(c: &mut Criterion) {
         });
 
         let projected = View::project(&view, &mesh).unwrap();
+        let params = HaloParams::default();
+        let rho = 0.01;
+        let (halo, _) = build_halo(&projected, &mesh.triangles, rho, &params);
         let data = [SurfaceData {
             name,
             surface_type: surface.type_name(),
             patches: surface.patch_count(),
             mesh: &mesh,
             projected: &projected,
+            halo: &halo,
+            halo_params: &params,
+            rho,
         }];
         c.bench_function(&format!("export_glb/{name}/128"), |b| {
             b.iter(|| to_glb(black_box(&data), &serde_json::Value::Null).unwrap())
         });
         c.bench_function(&format!("export_ply/{name}/128"), |b| {
             b.iter(|| to_ply(black_box(&data), name))
+        });
+        c.bench_function(&format!("export_vtk/{name}/128"), |b| {
+            b.iter(|| to_vtk(black_box(&data[0]), name))
         });
     }
 }

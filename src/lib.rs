@@ -2,15 +2,18 @@
 //!
 //! The pipeline, one module per stage (see the README's architecture section):
 //! [`scene`] (what to build) -> [`surfaces`] (4D parametric surfaces with exact derivatives)
-//! -> [`sample`] (meshes to a tolerance, welded by domain rules, audited) -> [`view`] (4D
-//! rotation and projection) -> [`export`] (glTF, PLY, OBJ, report). [`pipeline`] runs them
-//! in order; [`sweep`] measures what each tolerance costs.
+//! -> [`sample`](mod@sample) (meshes to a tolerance, welded by domain rules, audited) ->
+//! [`view`] (4D rotation and projection) -> [`halo`] (offsets, tetrahedra from [`tets`],
+//! checked by [`check`]) -> [`export`] (glTF, PLY, OBJ, VTK, report). [`pipeline`] runs them
+//! in order; [`sweep`] measures what each tolerance costs; [`import`] reads halos back for
+//! checking.
 #![warn(missing_docs)]
 
 pub mod check;
 pub mod error;
 pub mod export;
 pub mod halo;
+pub mod import;
 pub mod pipeline;
 pub mod sample;
 pub mod scene;

@@ -1,6 +1,7 @@
 //! The `halo4d` command line.
 
 use clap::{Parser, Subcommand};
+use halo4d::check::{CheckStats, check};
 use halo4d::{Scene, Surface};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -48,6 +49,15 @@ enum Command {
     },
     /// List the surface catalogue with each surface's parameters and defaults.
     List,
+    /// Check the halos of a .glb or .vtk file with the independent checker. Prints the
+    /// checker's statistics, one column per halo. Exit status 0 when every halo conforms and
+    /// has no inverted or flat tetrahedron, 1 when one does not, 2 when the file cannot be
+    /// read as halos.
+    Check {
+        /// A .glb (every mesh with `halo` extras) or legacy .vtk (with `surface_vertices`
+        /// field data) file, as `halo4d build` writes them.
+        file: PathBuf,
+    },
 }
 
 fn load(scene: Option<PathBuf>) -> Result<Scene, halo4d::SceneError> {
@@ -150,7 +160,148 @@ fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
+        Command::Check { file } => check_file(&file),
     }
+}
+
+/// `halo4d check FILE`.
+fn check_file(file: &std::path::Path) -> ExitCode {
+    let halos = match halo4d::import::read(file) {
+        Ok(h) => h,
+        Err(e) => {
+            eprintln!("error: {}: {e}", file.display());
+            return ExitCode::from(2);
+        }
+    };
+    let stats: Vec<CheckStats> = halos.iter().map(|h| check(&h.mesh)).collect();
+    let names: Vec<&str> = halos.iter().map(|h| h.name.as_str()).collect();
+    print!("{}", table(&names, &stats));
+    let mut failed = false;
+    for (name, s) in names.iter().zip(&stats) {
+        if s.conforms() && s.inverted == 0 && s.flat == 0 {
+            continue;
+        }
+        failed = true;
+        let counts = [
+            ("inverted", s.inverted),
+            ("flat", s.flat),
+            ("degenerate", s.degenerate),
+            ("duplicate_tets", s.duplicate_tets),
+            ("overshared_faces", s.overshared_faces),
+            ("quad_mismatches", s.quad_mismatches),
+            ("missing_offset_faces", s.missing_offset_faces),
+            ("unexpected_boundary_faces", s.unexpected_boundary_faces),
+        ];
+        let mut what: Vec<String> = counts
+            .iter()
+            .filter(|(_, c)| *c > 0)
+            .map(|(k, c)| format!("{c} {k}"))
+            .collect();
+        if !s.conforms()
+            && what
+                .iter()
+                .all(|w| w.ends_with("inverted") || w.ends_with("flat"))
+        {
+            what.push("does not conform".into());
+        }
+        println!("FAILED {name}: {}", what.join(", "));
+    }
+    if failed {
+        return ExitCode::FAILURE;
+    }
+    println!(
+        "ok: {} halo{} conform{}, no inverted or flat tetrahedron",
+        halos.len(),
+        if halos.len() == 1 { "" } else { "s" },
+        if halos.len() == 1 { "s" } else { "" },
+    );
+    ExitCode::SUCCESS
+}
+
+/// The checker's statistics as a table: a row per statistic, in the struct's order, and a
+/// column per halo.
+fn table(names: &[&str], stats: &[CheckStats]) -> String {
+    let columns: Vec<Vec<(String, String)>> = stats.iter().map(stat_rows).collect();
+    let labels: Vec<&str> = columns
+        .first()
+        .map(|c| c.iter().map(|(k, _)| k.as_str()).collect())
+        .unwrap_or_default();
+    let label_width = labels.iter().map(|l| l.len()).max().unwrap_or(0).max(4);
+    let widths: Vec<usize> = names
+        .iter()
+        .zip(&columns)
+        .map(|(n, c)| {
+            c.iter()
+                .map(|(_, v)| v.len())
+                .max()
+                .unwrap_or(0)
+                .max(n.len())
+        })
+        .collect();
+    let mut out = format!("{:<label_width$}", "halo");
+    for (n, w) in names.iter().zip(&widths) {
+        out += &format!("  {n:>w$}");
+    }
+    out.push('\n');
+    for (row, label) in labels.iter().enumerate() {
+        out += &format!("{label:<label_width$}");
+        for (c, w) in columns.iter().zip(&widths) {
+            out += &format!("  {:>w$}", c[row].1);
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// The fields of `stats` in declaration order, formatted. (Through serde, so that a
+/// statistic added to the checker shows up here too.)
+fn stat_rows(stats: &CheckStats) -> Vec<(String, String)> {
+    struct Rows(Vec<(String, serde_json::Value)>);
+    impl<'de> serde::Deserialize<'de> for Rows {
+        fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            struct Visit;
+            impl<'de> serde::de::Visitor<'de> for Visit {
+                type Value = Rows;
+                fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                    f.write_str("a map")
+                }
+                fn visit_map<A: serde::de::MapAccess<'de>>(
+                    self,
+                    mut map: A,
+                ) -> Result<Rows, A::Error> {
+                    let mut rows = Vec::new();
+                    while let Some(entry) = map.next_entry()? {
+                        rows.push(entry);
+                    }
+                    Ok(Rows(rows))
+                }
+            }
+            d.deserialize_map(Visit)
+        }
+    }
+    let rows = serde_json::to_string(stats)
+        .and_then(|text| serde_json::from_str::<Rows>(&text))
+        .map(|r| r.0)
+        .unwrap_or_default();
+    rows.into_iter()
+        .map(|(k, v)| {
+            let text = match v {
+                serde_json::Value::Number(n) if n.is_u64() || n.is_i64() => n.to_string(),
+                serde_json::Value::Number(n) => {
+                    let x = n.as_f64().unwrap_or(f64::NAN);
+                    if x == 0.0 || (1e-2..1e6).contains(&x.abs()) {
+                        format!("{x:.4}")
+                    } else {
+                        format!("{x:.3e}")
+                    }
+                }
+                // serde_json writes a non-finite number as null.
+                serde_json::Value::Null => "not finite".into(),
+                other => other.to_string(),
+            };
+            (k, text)
+        })
+        .collect()
 }
 
 fn fail(e: &dyn std::error::Error) -> ExitCode {

@@ -5,7 +5,7 @@
 
 use crate::error::Error;
 use crate::export::{self, SurfaceData};
-use crate::halo::{Halo, HaloReport, build_halo};
+use crate::halo::{Halo, HaloParams, HaloReport, build_halo};
 use crate::sample::{self, Audit, Mesh4, MeshStats, Sampling, audit};
 use crate::scene::Scene;
 use crate::surfaces::{Surface, Topology};
@@ -121,14 +121,17 @@ impl SamplingReport {
 }
 
 impl SurfaceProduct {
-    /// The view the writers take.
-    pub fn data(&self) -> SurfaceData<'_> {
+    /// The view the writers take; `halo_params` are the scene's.
+    pub fn data<'a>(&'a self, halo_params: &'a HaloParams) -> SurfaceData<'a> {
         SurfaceData {
             name: &self.name,
             surface_type: self.surface.type_name(),
             patches: self.surface.patch_count(),
             mesh: &self.mesh,
             projected: &self.projected,
+            halo: &self.halo,
+            halo_params,
+            rho: self.halo_report.rho,
         }
     }
 }
@@ -317,7 +320,7 @@ pub fn write(
         path: out_dir.to_path_buf(),
         source,
     })?;
-    let data: Vec<SurfaceData> = products.iter().map(SurfaceProduct::data).collect();
+    let data: Vec<SurfaceData> = products.iter().map(|p| p.data(&scene.halo)).collect();
     let write = |file: String, bytes: &[u8]| -> Result<String, Error> {
         let path: PathBuf = out_dir.join(&file);
         export::write_atomic(&path, bytes).map_err(|source| Error::Write { path, source })?;
@@ -344,6 +347,16 @@ pub fn write(
             format!("{name}.obj"),
             export::to_obj(&data, name).as_bytes(),
         )?);
+    }
+    if scene.outputs.vtk {
+        for d in &data {
+            let file = if data.len() == 1 {
+                format!("{name}-halo.vtk")
+            } else {
+                format!("{name}-{}-halo.vtk", d.name)
+            };
+            files.push(write(file, &export::to_vtk(d, name))?);
+        }
     }
     timings.export = ms(export_start);
     if scene.outputs.report {

@@ -68,6 +68,9 @@ pub struct Outputs {
     pub ply: bool,
     /// `<name>.obj`: the surfaces as Wavefront OBJ.
     pub obj: bool,
+    /// `<name>-halo.vtk` (one surface) or `<name>-<surface>-halo.vtk` (several): each halo's
+    /// tetrahedra as legacy VTK, for ParaView and meshio.
+    pub vtk: bool,
     /// `report.json`: counts, bounds, timings and the parsed scene.
     pub report: bool,
 }
@@ -78,6 +81,7 @@ impl Default for Outputs {
             glb: true,
             ply: true,
             obj: false,
+            vtk: true,
             report: true,
         }
     }

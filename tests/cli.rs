@@ -20,7 +20,12 @@ fn build_without_a_scene_writes_the_default_into_exports() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    for f in ["spun-trefoil.glb", "spun-trefoil.ply", "report.json"] {
+    for f in [
+        "spun-trefoil.glb",
+        "spun-trefoil.ply",
+        "spun-trefoil-halo.vtk",
+        "report.json",
+    ] {
         assert!(
             dir.path().join("exports/spun-trefoil").join(f).is_file(),
             "{f} missing"

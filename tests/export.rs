@@ -48,11 +48,12 @@ fn every_fixture_builds_and_reads_back() {
             );
         }
 
-        // glTF: one mesh per surface, named after it, with the custom attributes.
+        // glTF: one mesh per surface, named after it, with the custom attributes, and one per
+        // halo (tests/halo_export.rs reads those).
         let glb = std::fs::read(out.join(format!("{name}.glb"))).unwrap();
         let gltf = gltf::Gltf::from_slice(&glb).unwrap_or_else(|e| panic!("{name}.glb: {e}"));
         let blob = gltf.blob.as_deref().expect("binary chunk");
-        assert_eq!(gltf.meshes().count(), products.len());
+        assert_eq!(gltf.meshes().count(), 2 * products.len());
         let extras = gltf
             .document
             .as_json()
@@ -65,8 +66,11 @@ fn every_fixture_builds_and_reads_back() {
             recorded["halo4d"]["scene"],
             serde_json::to_value(&scene).unwrap()
         );
-        for (mesh, p) in gltf.meshes().zip(&products) {
-            assert_eq!(mesh.name(), Some(p.name.as_str()));
+        for p in &products {
+            let mesh = gltf
+                .meshes()
+                .find(|m| m.name() == Some(p.name.as_str()))
+                .unwrap_or_else(|| panic!("{name}.glb: no mesh `{}`", p.name));
             let prim = mesh.primitives().next().unwrap();
             assert_eq!(prim.mode(), gltf::mesh::Mode::Triangles);
             let reader = prim.reader(|_| Some(blob));
@@ -157,7 +161,7 @@ fn every_fixture_builds_and_reads_back() {
             json["surfaces"][0]["triangles"],
             products[0].mesh.triangles.len()
         );
-        assert_eq!(report.files.len(), 4);
+        assert_eq!(report.files.len(), 4 + products.len());
         assert!(
             !text.contains("NaN") && !text.contains("null,"),
             "report has a non-number"

@@ -5,6 +5,7 @@ mod cli;
 mod common;
 mod export;
 mod halo;
+mod halo_export;
 mod sample;
 mod scene;
 mod surfaces;

@@ -1,12 +1,24 @@
 //! glTF 2.0 binary (`.glb`) export with gltf-json.
 //!
-//! One mesh per surface, named after it, as TRIANGLES with POSITION (min/max computed from the
-//! f32 values actually stored), unit NORMAL, and float SCALAR custom attributes `_W`
-//! (w-depth), `_U`, `_V` (surface parameters) and `_PATCH` (patch index). Floats, because
-//! Blender 3.5+ imports float attributes and drops integer ones. Each attribute has its own
-//! tightly packed, 4-byte aligned buffer view. The asset's extras record the scene as parsed.
+//! Per surface, two meshes, each with its own node:
+//! - the surface, named after it, as TRIANGLES with POSITION (min/max computed from the f32
+//!   values actually stored), unit NORMAL, and float SCALAR custom attributes `_W` (w-depth),
+//!   `_U`, `_V` (surface parameters) and `_PATCH` (patch index);
+//! - its halo, `<surface>-halo`: every halo vertex in the layout of [`crate::check`] with
+//!   POSITION and float SCALAR attributes `_T`, `_D` (d_orig) and `_PATCH`, and as TRIANGLES
+//!   only the halo's boundary faces (those of exactly one tetrahedron, turned outward), which is
+//!   all a renderer shows. glTF has no tetrahedron primitive: the tetrahedra are an UNSIGNED_INT
+//!   SCALAR accessor of 4 indices each, in a buffer view without a target, named by the halo
+//!   mesh's extras `{"halo": {"tetrahedra": accessor, "surface_vertices": n, "rho", "delta_d",
+//!   "delta_t", "split", "surface_mesh": mesh}}` ([`crate::import`] reads them back).
+//!
+//! Floats, because Blender 3.5+ imports float attributes and drops integer ones. Each
+//! attribute has its own tightly packed, 4-byte aligned buffer view. The asset's extras
+//! record the scene as parsed.
 
 use super::SurfaceData;
+use crate::halo::Halo;
+use glam::DVec3;
 use gltf_json as json;
 use json::validation::Checked::Valid;
 use json::validation::USize64;
@@ -29,11 +41,12 @@ struct Builder {
 }
 
 impl Builder {
-    /// Appends a buffer view with `bytes`, aligned to 4 bytes.
+    /// Appends a buffer view with `bytes`, aligned to 4 bytes; `target` is `None` for data
+    /// that no primitive reads (the tetrahedra).
     fn view(
         &mut self,
         bytes: &[u8],
-        target: json::buffer::Target,
+        target: Option<json::buffer::Target>,
     ) -> json::Index<json::buffer::View> {
         debug_assert_eq!(self.bin.len() % 4, 0);
         let offset = self.bin.len();
@@ -45,7 +58,7 @@ impl Builder {
             byte_offset: Some(USize64::from(offset)),
             byte_stride: None,
             name: None,
-            target: Some(Valid(target)),
+            target: target.map(Valid),
             extensions: None,
             extras: None,
         })
@@ -64,7 +77,7 @@ impl Builder {
             1
         };
         let bytes: Vec<u8> = values.iter().flat_map(|x| x.to_le_bytes()).collect();
-        let view = self.view(&bytes, json::buffer::Target::ArrayBuffer);
+        let view = self.view(&bytes, Some(json::buffer::Target::ArrayBuffer));
         let (min, max) = match minmax {
             Some((lo, hi)) => (Some(serde_json::json!(lo)), Some(serde_json::json!(hi))),
             None => (None, None),
@@ -86,9 +99,121 @@ impl Builder {
             sparse: None,
         })
     }
+
+    /// Appends a tightly packed f32 VEC3 POSITION accessor with min/max of the stored values.
+    fn positions(&mut self, points: &[DVec3]) -> json::Index<json::Accessor> {
+        let positions: Vec<f32> = points.iter().flat_map(|v| v.as_vec3().to_array()).collect();
+        let mut lo = [f32::INFINITY; 3];
+        let mut hi = [f32::NEG_INFINITY; 3];
+        for c in positions.chunks_exact(3) {
+            for i in 0..3 {
+                lo[i] = lo[i].min(c[i]);
+                hi[i] = hi[i].max(c[i]);
+            }
+        }
+        self.floats(
+            &positions,
+            json::accessor::Type::Vec3,
+            Some((lo.to_vec(), hi.to_vec())),
+        )
+    }
+
+    /// Appends an UNSIGNED_INT SCALAR accessor over `indices`, with `target` as in [`Self::view`].
+    fn indices(
+        &mut self,
+        indices: &[u32],
+        target: Option<json::buffer::Target>,
+        name: Option<String>,
+    ) -> json::Index<json::Accessor> {
+        let bytes: Vec<u8> = indices.iter().flat_map(|i| i.to_le_bytes()).collect();
+        let view = self.view(&bytes, target);
+        self.root.push(json::Accessor {
+            buffer_view: Some(view),
+            byte_offset: None,
+            count: USize64::from(indices.len()),
+            component_type: Valid(json::accessor::GenericComponentType(
+                json::accessor::ComponentType::U32,
+            )),
+            extensions: None,
+            extras: None,
+            type_: Valid(json::accessor::Type::Scalar),
+            min: None,
+            max: None,
+            name,
+            normalized: false,
+            sparse: None,
+        })
+    }
 }
 
-/// Builds the `.glb` bytes for the surfaces; `scene_json` goes into the asset's extras.
+/// The faces of exactly one tetrahedron, each turned outward (counter-clockwise seen from
+/// outside, glTF's front face) by the exact orientation of its tetrahedron, in a
+/// deterministic order.
+fn boundary_faces(positions: &[DVec3], tets: &[[u32; 4]]) -> Vec<[u32; 3]> {
+    // Outward faces of a positive tetrahedron (a, b, c, d), opposite a, b, c and d:
+    // each ordering with the opposite vertex appended is an even permutation of (a, b, c, d).
+    const FACES: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
+    // One u128 per face use: the sorted vertex triple above, the use (tetrahedron, face) below,
+    // so that sorting groups the uses of each face.
+    let mut uses: Vec<u128> = Vec::with_capacity(tets.len() * 4);
+    for (k, tet) in tets.iter().enumerate() {
+        for (f, face) in FACES.iter().enumerate() {
+            let mut key = face.map(|i| tet[i]);
+            key.sort_unstable();
+            let high = (u128::from(key[0]) << 64) | (u128::from(key[1]) << 32) | u128::from(key[2]);
+            uses.push((high << 32) | (k as u128 * 4 + f as u128));
+        }
+    }
+    uses.sort_unstable();
+    let c = |i: u32| {
+        let p = positions[i as usize];
+        robust::Coord3D {
+            x: p.x,
+            y: p.y,
+            z: p.z,
+        }
+    };
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < uses.len() {
+        let mut j = i + 1;
+        while j < uses.len() && uses[j] >> 32 == uses[i] >> 32 {
+            j += 1;
+        }
+        if j == i + 1 {
+            let use_ = (uses[i] & 0xffff_ffff) as usize;
+            let tet = tets[use_ / 4];
+            let face = FACES[use_ % 4].map(|v| tet[v]);
+            let o = robust::orient3d(c(tet[0]), c(tet[1]), c(tet[2]), c(tet[3]));
+            out.push(if o < 0.0 {
+                [face[0], face[2], face[1]]
+            } else {
+                face
+            });
+        }
+        i = j;
+    }
+    out
+}
+
+/// The patch of each halo vertex: that of its surface vertex for the offsets, that of the
+/// triangle whose prism it is in for an inserted vertex.
+fn halo_patches(s: &SurfaceData) -> Vec<f32> {
+    let halo: &Halo = s.halo;
+    let n = halo.surface_vertices;
+    (0..halo.positions.len())
+        .map(|i| {
+            if i < 2 * n {
+                s.mesh.patch[i % n] as f32
+            } else {
+                s.mesh.triangle_patch[halo.inserted_in[i - 2 * n] as usize] as f32
+            }
+        })
+        .collect()
+}
+
+/// Builds the `.glb` bytes for the surfaces and their halos; `scene_json` goes into the
+/// asset's extras. A halo without tetrahedra gets no mesh (glTF accessors cannot be empty).
 pub fn to_glb(surfaces: &[SurfaceData], scene_json: &serde_json::Value) -> Result<Vec<u8>, String> {
     let extras = |v: serde_json::Value| to_raw_value(&v).map(Some).map_err(|e| e.to_string());
     let mut b = Builder {
@@ -105,19 +230,6 @@ pub fn to_glb(surfaces: &[SurfaceData], scene_json: &serde_json::Value) -> Resul
     let mut nodes = Vec::new();
     for (k, s) in surfaces.iter().enumerate() {
         let p = s.projected;
-        let positions: Vec<f32> = p
-            .positions
-            .iter()
-            .flat_map(|v| v.as_vec3().to_array())
-            .collect();
-        let mut lo = [f32::INFINITY; 3];
-        let mut hi = [f32::NEG_INFINITY; 3];
-        for c in positions.chunks_exact(3) {
-            for i in 0..3 {
-                lo[i] = lo[i].min(c[i]);
-                hi[i] = hi[i].max(c[i]);
-            }
-        }
         let normals: Vec<f32> = p
             .normals
             .iter()
@@ -131,10 +243,7 @@ pub fn to_glb(surfaces: &[SurfaceData], scene_json: &serde_json::Value) -> Resul
         use json::accessor::Type::{Scalar, Vec3};
         use json::mesh::Semantic;
         let attributes = [
-            (
-                Semantic::Positions,
-                b.floats(&positions, Vec3, Some((lo.to_vec(), hi.to_vec()))),
-            ),
+            (Semantic::Positions, b.positions(&p.positions)),
             (Semantic::Normals, b.floats(&normals, Vec3, None)),
             (
                 Semantic::Extras("W".into()),
@@ -153,30 +262,12 @@ pub fn to_glb(surfaces: &[SurfaceData], scene_json: &serde_json::Value) -> Resul
                 b.floats(&scalar(&|i| f64::from(s.mesh.patch[i])), Scalar, None),
             ),
         ];
-        let indices: Vec<u8> = s
-            .mesh
-            .triangles
-            .iter()
-            .flatten()
-            .flat_map(|i| i.to_le_bytes())
-            .collect();
-        let index_view = b.view(&indices, json::buffer::Target::ElementArrayBuffer);
-        let index_accessor = b.root.push(json::Accessor {
-            buffer_view: Some(index_view),
-            byte_offset: None,
-            count: USize64::from(s.mesh.triangles.len() * 3),
-            component_type: Valid(json::accessor::GenericComponentType(
-                json::accessor::ComponentType::U32,
-            )),
-            extensions: None,
-            extras: None,
-            type_: Valid(Scalar),
-            min: None,
-            max: None,
-            name: None,
-            normalized: false,
-            sparse: None,
-        });
+        let triangles: Vec<u32> = s.mesh.triangles.iter().flatten().copied().collect();
+        let index_accessor = b.indices(
+            &triangles,
+            Some(json::buffer::Target::ElementArrayBuffer),
+            None,
+        );
         let material = b.root.push(json::Material {
             name: Some(s.name.to_string()),
             double_sided: true,
@@ -212,6 +303,14 @@ pub fn to_glb(surfaces: &[SurfaceData], scene_json: &serde_json::Value) -> Resul
             name: Some(s.name.to_string()),
             ..Default::default()
         }));
+        if !s.halo.tets.is_empty() {
+            let halo_mesh = halo_mesh(&mut b, s, mesh, PALETTE[k % PALETTE.len()])?;
+            nodes.push(b.root.push(json::Node {
+                mesh: Some(halo_mesh),
+                name: Some(format!("{}-halo", s.name)),
+                ..Default::default()
+            }));
+        }
     }
     let scene = b.root.push(json::Scene {
         extensions: None,
@@ -231,6 +330,82 @@ pub fn to_glb(surfaces: &[SurfaceData], scene_json: &serde_json::Value) -> Resul
     Ok(glb_container(text, b.bin))
 }
 
+/// Appends the halo mesh of `s` (see the module documentation); `surface_mesh` is the
+/// surface's own mesh and `colour` its base colour.
+fn halo_mesh(
+    b: &mut Builder,
+    s: &SurfaceData,
+    surface_mesh: json::Index<json::Mesh>,
+    colour: [f32; 4],
+) -> Result<json::Index<json::Mesh>, String> {
+    use json::accessor::Type::Scalar;
+    use json::mesh::Semantic;
+    let halo = s.halo;
+    let name = format!("{}-halo", s.name);
+    let scalar = |values: &[f64]| values.iter().map(|&x| x as f32).collect::<Vec<f32>>();
+    let attributes = [
+        (Semantic::Positions, b.positions(&halo.positions)),
+        (
+            Semantic::Extras("T".into()),
+            b.floats(&scalar(&halo.t), Scalar, None),
+        ),
+        (
+            Semantic::Extras("D".into()),
+            b.floats(&scalar(&halo.d_orig), Scalar, None),
+        ),
+        (
+            Semantic::Extras("PATCH".into()),
+            b.floats(&halo_patches(s), Scalar, None),
+        ),
+    ];
+    let faces: Vec<u32> = boundary_faces(&halo.positions, &halo.tets)
+        .into_iter()
+        .flatten()
+        .collect();
+    let indices = b.indices(&faces, Some(json::buffer::Target::ElementArrayBuffer), None);
+    let tet_indices: Vec<u32> = halo.tets.iter().flatten().copied().collect();
+    let tetrahedra = b.indices(&tet_indices, None, Some(format!("{name} tetrahedra")));
+    let [r, g, bl, _] = colour;
+    let material = b.root.push(json::Material {
+        name: Some(name.clone()),
+        alpha_mode: Valid(json::material::AlphaMode::Blend),
+        double_sided: true,
+        pbr_metallic_roughness: json::material::PbrMetallicRoughness {
+            base_color_factor: json::material::PbrBaseColorFactor([r, g, bl, 0.35]),
+            metallic_factor: json::material::StrengthFactor(0.0),
+            roughness_factor: json::material::StrengthFactor(0.6),
+            ..Default::default()
+        },
+        ..Default::default()
+    });
+    let extras = serde_json::json!({
+        "halo": {
+            "tetrahedra": tetrahedra.value(),
+            "surface_vertices": halo.surface_vertices,
+            "rho": s.rho,
+            "delta_d": s.halo_params.delta_d,
+            "delta_t": s.halo_params.delta_t,
+            "split": s.halo_params.split.name(),
+            "surface_mesh": surface_mesh.value(),
+        }
+    });
+    Ok(b.root.push(json::Mesh {
+        name: Some(name),
+        extras: Some(to_raw_value(&extras).map_err(|e| e.to_string())?),
+        extensions: None,
+        primitives: vec![json::mesh::Primitive {
+            attributes: attributes.into_iter().map(|(k, v)| (Valid(k), v)).collect(),
+            extensions: None,
+            extras: None,
+            indices: Some(indices),
+            material: Some(material),
+            mode: Valid(json::mesh::Mode::Triangles),
+            targets: None,
+        }],
+        weights: None,
+    }))
+}
+
 /// Wraps JSON and binary chunks in the GLB container (header, JSON chunk padded with spaces,
 /// BIN chunk padded with zeros).
 fn glb_container(mut text: Vec<u8>, mut bin: Vec<u8>) -> Vec<u8> {
@@ -248,4 +423,65 @@ fn glb_container(mut text: Vec<u8>, mut bin: Vec<u8>) -> Vec<u8> {
     out.extend_from_slice(b"BIN\0");
     out.extend_from_slice(&bin);
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::boundary_faces;
+    use glam::DVec3;
+
+    /// Signed volume enclosed by faces turned counter-clockwise seen from outside.
+    fn enclosed(p: &[DVec3], faces: &[[u32; 3]]) -> f64 {
+        faces
+            .iter()
+            .map(|f| {
+                let [a, b, c] = f.map(|i| p[i as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    }
+
+    #[test]
+    fn boundary_faces_skip_shared_faces_and_turn_outward_whatever_the_tets_orientation() {
+        let p = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(0.0, 0.0, 1.0),
+            DVec3::new(0.0, 0.0, -1.0),
+        ];
+        let up = [0, 1, 2, 3];
+        let positive = |t: [u32; 4]| {
+            let c = |i: u32| robust::Coord3D {
+                x: p[i as usize].x,
+                y: p[i as usize].y,
+                z: p[i as usize].z,
+            };
+            robust::orient3d(c(t[0]), c(t[1]), c(t[2]), c(t[3])) > 0.0
+        };
+        let (up, flipped_up) = if positive(up) {
+            (up, [1, 0, 2, 3])
+        } else {
+            ([1, 0, 2, 3], up)
+        };
+        let down = if positive([0, 1, 2, 4]) {
+            [0, 1, 2, 4]
+        } else {
+            [1, 0, 2, 4]
+        };
+        let one = boundary_faces(&p, &[up]);
+        assert_eq!(one.len(), 4);
+        assert!((enclosed(&p, &one) - 1.0 / 6.0).abs() < 1e-15);
+        // A tetrahedron listed the wrong way round still gets outward faces.
+        let one = boundary_faces(&p, &[flipped_up]);
+        assert!((enclosed(&p, &one) - 1.0 / 6.0).abs() < 1e-15);
+        // Two sharing the face (0, 1, 2): it is inside, six faces remain.
+        let two = boundary_faces(&p, &[up, down]);
+        assert_eq!(two.len(), 6);
+        assert!(
+            two.iter()
+                .all(|f| !(f.contains(&0) && f.contains(&1) && f.contains(&2)))
+        );
+        assert!((enclosed(&p, &two) - 2.0 / 6.0).abs() < 1e-15);
+    }
 }

@@ -1,20 +1,25 @@
 //! Export: the products of a build as files.
 //!
-//! Takes: the sampled and projected surfaces. Gives: `.glb` (glTF 2.0 binary, for Blender),
-//! `.ply` (binary PLY with w as vertex `quality`, for MeshLab), `.obj` (Wavefront, positions
-//! and normals only) and `report.json`. Guarantees: every file is written to a temporary
-//! name and renamed into place, so a failure never leaves a half-written file.
+//! Takes: the sampled and projected surfaces and their halos. Gives: `.glb` (glTF 2.0
+//! binary, for Blender: surfaces and halos), `.ply` (binary PLY with w as vertex `quality`,
+//! for MeshLab), `.obj` (Wavefront, positions and normals only), `.vtk` (legacy VTK
+//! unstructured grids of the halos' tetrahedra, for ParaView and meshio) and `report.json`.
+//! Guarantees: every file is written to a temporary name and renamed into place, so a
+//! failure never leaves a half-written file. [`crate::import`] reads the halos back.
 
 mod gltf;
 mod obj;
 mod plot;
 mod ply;
+mod vtk;
 
 pub use gltf::to_glb;
 pub use obj::to_obj;
 pub use plot::{encode_png, speed_vs_error_png};
 pub use ply::to_ply;
+pub use vtk::to_vtk;
 
+use crate::halo::{Halo, HaloParams};
 use crate::sample::Mesh4;
 use crate::view::Projected;
 use std::io::Write;
@@ -33,6 +38,12 @@ pub struct SurfaceData<'a> {
     pub mesh: &'a Mesh4,
     /// Its projection (3D positions, w-depth, normals).
     pub projected: &'a Projected,
+    /// Its halo, in the layout of [`crate::check`].
+    pub halo: &'a Halo,
+    /// The scene's halo parameters (`rho` among them is relative).
+    pub halo_params: &'a HaloParams,
+    /// The halo's half-width, absolute (before any local shrinking).
+    pub rho: f64,
 }
 
 /// Writes `bytes` to `path` through a temporary file in the same folder and a rename.

@@ -1,0 +1,72 @@
+//! Legacy VTK (`.vtk`, version 3.0, binary) of a halo's tetrahedra, for ParaView and meshio.
+//!
+//! One `UNSTRUCTURED_GRID` per halo: every halo vertex in the layout of [`crate::check`]
+//! (negative offsets, positive offsets, inserted vertices) as `double` POINTS, every
+//! tetrahedron as a cell of 4 ids and type 10 (`VTK_TETRA`), the dataset's field data
+//! `surface_vertices` (int), `rho` (absolute), `delta_d` and `delta_t` (double), and the point
+//! scalars `t` and `d_orig` (double). Binary legacy VTK is big-endian; each binary block ends
+//! with a newline, as VTK's own writer does and meshio requires.
+//!
+//! The field data comes after `CELL_TYPES` rather than right after `DATASET`: VTK's reader
+//! takes it anywhere at the dataset level, but meshio files it as field data only there.
+
+use super::SurfaceData;
+
+/// Builds the `.vtk` bytes of one surface's halo. The title line is
+/// `<surface>-halo: halo4d <version>, scene <scene_name>`.
+pub fn to_vtk(surface: &SurfaceData, scene_name: &str) -> Vec<u8> {
+    let halo = surface.halo;
+    let points = halo.positions.len();
+    let tets = halo.tets.len();
+    let mut out = Vec::with_capacity(256 + points * 40 + tets * 24);
+    let text = |out: &mut Vec<u8>, s: &str| out.extend_from_slice(s.as_bytes());
+    text(
+        &mut out,
+        &format!(
+            "# vtk DataFile Version 3.0\n{}-halo: halo4d {}, scene {scene_name}\nBINARY\n\
+             DATASET UNSTRUCTURED_GRID\nPOINTS {points} double\n",
+            surface.name,
+            env!("CARGO_PKG_VERSION"),
+        ),
+    );
+    for p in &halo.positions {
+        for x in p.to_array() {
+            out.extend_from_slice(&x.to_be_bytes());
+        }
+    }
+    // Ids are 32-bit ints in legacy VTK; a scene's triangle limit keeps them far below 2^31.
+    text(&mut out, &format!("\nCELLS {tets} {}\n", 5 * tets));
+    for tet in &halo.tets {
+        out.extend_from_slice(&4i32.to_be_bytes());
+        for &i in tet {
+            out.extend_from_slice(&(i as i32).to_be_bytes());
+        }
+    }
+    text(&mut out, &format!("\nCELL_TYPES {tets}\n"));
+    for _ in 0..tets {
+        out.extend_from_slice(&10i32.to_be_bytes());
+    }
+    text(&mut out, "\nFIELD FieldData 4\nsurface_vertices 1 1 int\n");
+    out.extend_from_slice(&(halo.surface_vertices as i32).to_be_bytes());
+    let params = surface.halo_params;
+    for (name, value) in [
+        ("rho", surface.rho),
+        ("delta_d", params.delta_d),
+        ("delta_t", params.delta_t),
+    ] {
+        text(&mut out, &format!("\n{name} 1 1 double\n"));
+        out.extend_from_slice(&value.to_be_bytes());
+    }
+    text(&mut out, &format!("\nPOINT_DATA {points}\n"));
+    for (name, values) in [("t", &halo.t), ("d_orig", &halo.d_orig)] {
+        text(
+            &mut out,
+            &format!("SCALARS {name} double 1\nLOOKUP_TABLE default\n"),
+        );
+        for x in values.iter() {
+            out.extend_from_slice(&x.to_be_bytes());
+        }
+        out.push(b'\n');
+    }
+    out
+}

@@ -1,0 +1,350 @@
+//! Halos from `.glb`: the container, the JSON chunk (serde_json) and the accessors the halo
+//! meshes name, each bounds-checked against the BIN chunk before it is read.
+
+use super::{FileParams, ImportError, ImportedHalo};
+use crate::check::TetMesh;
+use serde_json::Value;
+
+type Result<T> = std::result::Result<T, ImportError>;
+
+fn glb_err(message: String) -> ImportError {
+    ImportError::Glb(message)
+}
+
+/// Reads every mesh whose extras carry `halo` (see [`crate::export::to_glb`]).
+pub fn read_glb(bytes: &[u8]) -> Result<Vec<ImportedHalo>> {
+    let (json, bin) = chunks(bytes)?;
+    let json: Value = serde_json::from_slice(json)
+        .map_err(|e| glb_err(format!("the JSON chunk is not valid JSON: {e}")))?;
+    let doc = Doc { json: &json, bin };
+    let meshes = match json.get("meshes") {
+        None => &[][..],
+        Some(Value::Array(m)) => &m[..],
+        Some(_) => return Err(glb_err("`meshes` is not an array".into())),
+    };
+    let mut halos = Vec::new();
+    for (i, mesh) in meshes.iter().enumerate() {
+        let Some(halo) = mesh.get("extras").and_then(|e| e.get("halo")) else {
+            continue;
+        };
+        let name = match mesh.get("name") {
+            Some(Value::String(s)) => s.clone(),
+            _ => format!("mesh {i}"),
+        };
+        halos.push(doc.halo(i, mesh, halo, name)?.validate()?);
+    }
+    if halos.is_empty() {
+        return Err(ImportError::NoHalo(format!(
+            "no halo: none of the file's {} meshes has `halo` in its extras (halo4d build writes one `<surface>-halo` mesh per surface)",
+            meshes.len()
+        )));
+    }
+    Ok(halos)
+}
+
+fn u32_at(bytes: &[u8], at: usize) -> u32 {
+    u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]])
+}
+
+/// The JSON chunk and the BIN chunk, if any, of a GLB container.
+fn chunks(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>)> {
+    if bytes.len() < 12 {
+        return Err(glb_err(format!(
+            "truncated: the 12-byte header is incomplete, the file has {} bytes",
+            bytes.len()
+        )));
+    }
+    if &bytes[..4] != b"glTF" {
+        return Err(glb_err(format!(
+            "wrong magic {:?}: a .glb starts with `glTF`",
+            String::from_utf8_lossy(&bytes[..4])
+        )));
+    }
+    let version = u32_at(bytes, 4);
+    if version != 2 {
+        return Err(glb_err(format!(
+            "container version {version}; only glTF 2 is read"
+        )));
+    }
+    let length = u32_at(bytes, 8) as usize;
+    if length > bytes.len() {
+        return Err(glb_err(format!(
+            "truncated: the header says {length} bytes, the file has {}",
+            bytes.len()
+        )));
+    }
+    if length < bytes.len() {
+        return Err(glb_err(format!(
+            "the header says {length} bytes, but the file has {} (trailing data)",
+            bytes.len()
+        )));
+    }
+    let mut at = 12;
+    let mut json = None;
+    let mut bin = None;
+    while at < length {
+        if length - at < 8 {
+            return Err(glb_err(format!(
+                "truncated: a chunk header at byte {at} is incomplete"
+            )));
+        }
+        let len = u32_at(bytes, at) as usize;
+        let kind = &bytes[at + 4..at + 8];
+        let start = at + 8;
+        if len > length - start {
+            return Err(glb_err(format!(
+                "truncated: the chunk at byte {at} claims {len} bytes, {} remain",
+                length - start
+            )));
+        }
+        let data = &bytes[start..start + len];
+        match (kind, json.is_some()) {
+            (b"JSON", false) => json = Some(data),
+            (b"JSON", true) => return Err(glb_err("a second JSON chunk".into())),
+            (_, false) => return Err(glb_err("the first chunk is not the JSON chunk".into())),
+            (b"BIN\0", true) if bin.is_none() => bin = Some(data),
+            (b"BIN\0", true) => return Err(glb_err("a second BIN chunk".into())),
+            // Chunks of unknown types are to be ignored (glTF 2.0, 4.4.3).
+            _ => {}
+        }
+        at = start + len.next_multiple_of(4).min(length - start);
+    }
+    let json = json.ok_or_else(|| glb_err("no JSON chunk".into()))?;
+    Ok((json, bin))
+}
+
+/// A parsed glTF document and its binary chunk.
+struct Doc<'a> {
+    json: &'a Value,
+    bin: Option<&'a [u8]>,
+}
+
+/// A non-negative integer field of a JSON object, or `default` when absent.
+fn index(obj: &Value, key: &str, what: &str, default: Option<u64>) -> Result<u64> {
+    match obj.get(key) {
+        Some(v) => v
+            .as_u64()
+            .ok_or_else(|| glb_err(format!("{what}.{key} is not a non-negative integer: {v}"))),
+        None => default.ok_or_else(|| glb_err(format!("{what} has no `{key}`"))),
+    }
+}
+
+fn to_usize(x: u64, what: &str) -> Result<usize> {
+    usize::try_from(x).map_err(|_| glb_err(format!("{what} is too large: {x}")))
+}
+
+impl<'a> Doc<'a> {
+    /// Element `i` of the top-level array `key`.
+    fn item(&self, key: &str, i: u64) -> Result<&'a Value> {
+        let all = self.json.get(key).and_then(Value::as_array);
+        let len = all.map_or(0, Vec::len);
+        usize::try_from(i)
+            .ok()
+            .and_then(|i| all.and_then(|a| a.get(i)))
+            .ok_or_else(|| {
+                glb_err(format!(
+                    "{key}[{i}] does not exist (the file has {len} {key})"
+                ))
+            })
+    }
+
+    /// The bytes of accessor `i` in the BIN chunk: `count` elements of `element` bytes,
+    /// `stride` apart, from the returned offset, all checked to lie inside its buffer view.
+    fn accessor_bytes(
+        &self,
+        i: u64,
+        accessor: &Value,
+        element: usize,
+    ) -> Result<(&'a [u8], usize, usize)> {
+        let what = format!("accessors[{i}]");
+        if accessor.get("sparse").is_some() {
+            return Err(glb_err(format!("{what} is sparse, which halos never are")));
+        }
+        let count = to_usize(index(accessor, "count", &what, None)?, "count")?;
+        let view_index = index(accessor, "bufferView", &what, None)?;
+        let view = self.item("bufferViews", view_index)?;
+        let view_what = format!("bufferViews[{view_index}]");
+        let buffer = index(view, "buffer", &view_what, None)?;
+        let buffer_json = self.item("buffers", buffer)?;
+        if buffer != 0 || buffer_json.get("uri").is_some() {
+            return Err(glb_err(format!(
+                "{view_what} is in buffer {buffer}, not in the .glb's own binary chunk"
+            )));
+        }
+        let bin = self
+            .bin
+            .ok_or_else(|| glb_err(format!("{what} needs a BIN chunk, and there is none")))?;
+        let view_offset = to_usize(index(view, "byteOffset", &view_what, Some(0))?, "offset")?;
+        let view_len = to_usize(index(view, "byteLength", &view_what, None)?, "length")?;
+        if view_offset
+            .checked_add(view_len)
+            .is_none_or(|end| end > bin.len())
+        {
+            return Err(glb_err(format!(
+                "{view_what} (bytes {view_offset} + {view_len}) runs past the {}-byte BIN chunk",
+                bin.len()
+            )));
+        }
+        let stride = to_usize(
+            index(view, "byteStride", &view_what, Some(element as u64))?,
+            "stride",
+        )?;
+        if stride < element {
+            return Err(glb_err(format!(
+                "{view_what}.byteStride {stride} is less than the {element}-byte elements of {what}"
+            )));
+        }
+        let offset = to_usize(index(accessor, "byteOffset", &what, Some(0))?, "offset")?;
+        let needed = match count {
+            0 => Some(offset),
+            _ => (count - 1)
+                .checked_mul(stride)
+                .and_then(|x| x.checked_add(element))
+                .and_then(|x| x.checked_add(offset)),
+        };
+        if needed.is_none_or(|n| n > view_len) {
+            return Err(glb_err(format!(
+                "{what} claims {count} elements of {element} bytes, more than its {view_len}-byte buffer view holds"
+            )));
+        }
+        Ok((
+            &bin[view_offset + offset..view_offset + view_len],
+            count,
+            stride,
+        ))
+    }
+
+    /// Accessor `i` as floats: FLOAT components of `type_` (`SCALAR` or `VEC3`).
+    fn floats(&self, i: u64, type_: &str, components: usize) -> Result<Vec<f32>> {
+        let accessor = self.item("accessors", i)?;
+        let what = format!("accessors[{i}]");
+        let component_type = index(accessor, "componentType", &what, None)?;
+        let found = accessor.get("type").and_then(Value::as_str).unwrap_or("?");
+        if component_type != 5126 || found != type_ {
+            return Err(glb_err(format!(
+                "{what} is {found} of component type {component_type}, expected {type_} of FLOAT (5126)"
+            )));
+        }
+        let (bytes, count, stride) = self.accessor_bytes(i, accessor, 4 * components)?;
+        let mut out = Vec::with_capacity(count * components);
+        for k in 0..count {
+            for c in 0..components {
+                out.push(f32::from_le_bytes(
+                    bytes[k * stride + 4 * c..][..4]
+                        .try_into()
+                        .expect("4 bytes"),
+                ));
+            }
+        }
+        Ok(out)
+    }
+
+    /// Accessor `i` as unsigned integer SCALARs (UNSIGNED_BYTE, _SHORT or _INT).
+    fn unsigned(&self, i: u64) -> Result<Vec<u32>> {
+        let accessor = self.item("accessors", i)?;
+        let what = format!("accessors[{i}]");
+        let component_type = index(accessor, "componentType", &what, None)?;
+        let found = accessor.get("type").and_then(Value::as_str).unwrap_or("?");
+        let size = match component_type {
+            5121 => 1,
+            5123 => 2,
+            5125 => 4,
+            _ => 0,
+        };
+        if size == 0 || found != "SCALAR" {
+            return Err(glb_err(format!(
+                "{what} is {found} of component type {component_type}, expected SCALAR of an unsigned integer type"
+            )));
+        }
+        let (bytes, count, stride) = self.accessor_bytes(i, accessor, size)?;
+        Ok((0..count)
+            .map(|k| {
+                let b = &bytes[k * stride..];
+                match size {
+                    1 => u32::from(b[0]),
+                    2 => u32::from(u16::from_le_bytes([b[0], b[1]])),
+                    _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+                }
+            })
+            .collect())
+    }
+
+    /// The halo of mesh `i`, whose extras' `halo` is `halo`.
+    fn halo(&self, i: usize, mesh: &Value, halo: &Value, name: String) -> Result<ImportedHalo> {
+        let what = format!("meshes[{i}] (`{name}`)");
+        let extras = format!("{what}.extras.halo");
+        if !halo.is_object() {
+            return Err(glb_err(format!("{extras} is not an object")));
+        }
+        let attributes = mesh
+            .get("primitives")
+            .and_then(|p| p.get(0))
+            .and_then(|p| p.get("attributes"))
+            .ok_or_else(|| glb_err(format!("{what} has no primitive with attributes")))?;
+        let attribute = |key: &str| -> Result<Option<u64>> {
+            match attributes.get(key) {
+                None => Ok(None),
+                Some(_) => index(attributes, key, &format!("{what} attributes"), None).map(Some),
+            }
+        };
+        let position = attribute("POSITION")?
+            .ok_or_else(|| glb_err(format!("{what} has no POSITION attribute")))?;
+        let positions: Vec<[f64; 3]> = self
+            .floats(position, "VEC3", 3)?
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]].map(f64::from))
+            .collect();
+        let scalar = |key: &str| -> Result<Option<Vec<f64>>> {
+            let Some(a) = attribute(key)? else {
+                return Ok(None);
+            };
+            let values = self.floats(a, "SCALAR", 1)?;
+            if values.len() != positions.len() {
+                return Err(glb_err(format!(
+                    "{what}: {key} has {} values for {} positions",
+                    values.len(),
+                    positions.len()
+                )));
+            }
+            Ok(Some(values.into_iter().map(f64::from).collect()))
+        };
+        let t = scalar("_T")?;
+        let d_orig = scalar("_D")?;
+        let tetrahedra = index(halo, "tetrahedra", &extras, None)?;
+        let indices = self.unsigned(tetrahedra)?;
+        if indices.len() % 4 != 0 {
+            return Err(glb_err(format!(
+                "the tetrahedra of {what} (accessors[{tetrahedra}]) have {} indices, not a multiple of 4",
+                indices.len()
+            )));
+        }
+        let surface_vertices = to_usize(
+            index(halo, "surface_vertices", &extras, None)?,
+            "surface_vertices",
+        )?;
+        let number = |key: &str| halo.get(key).and_then(Value::as_f64);
+        Ok(ImportedHalo {
+            name,
+            mesh: TetMesh {
+                positions,
+                surface_vertices,
+                tets: indices
+                    .chunks_exact(4)
+                    .map(|c| [c[0], c[1], c[2], c[3]])
+                    .collect(),
+            },
+            t,
+            d_orig,
+            params: FileParams {
+                rho: number("rho"),
+                delta_d: number("delta_d"),
+                delta_t: number("delta_t"),
+                split: halo.get("split").and_then(Value::as_str).map(String::from),
+                surface_mesh: halo
+                    .get("surface_mesh")
+                    .and_then(Value::as_u64)
+                    .and_then(|m| usize::try_from(m).ok()),
+            },
+        })
+    }
+}

@@ -1,0 +1,613 @@
+//! Halos from legacy VTK: an `UNSTRUCTURED_GRID` of tetrahedra (cell type 10), ASCII or
+//! binary (big-endian), with the CELLS layout of file versions up to 4.2 (a count before each
+//! cell's ids) and of 5.1 (OFFSETS and CONNECTIVITY arrays). `surface_vertices`, `rho`,
+//! `delta_d` and `delta_t` come from the dataset's FIELD data, `t` and `d_orig` from the
+//! point data (SCALARS or FIELD arrays). Sections a halo does not need (other point or cell
+//! attributes, lookup tables, METADATA) are read past.
+
+use super::{FileParams, ImportError, ImportedHalo};
+use crate::check::TetMesh;
+use std::collections::HashMap;
+
+type Result<T> = std::result::Result<T, ImportError>;
+
+fn err(message: String) -> ImportError {
+    ImportError::Vtk(message)
+}
+
+/// The tetrahedron's VTK cell type.
+const VTK_TETRA: f64 = 10.0;
+
+/// Reads the halo of a legacy VTK file (see [`crate::export::to_vtk`]).
+pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
+    let mut c = Cursor { bytes, pos: 0 };
+    let magic = c.line().unwrap_or_default();
+    let version = magic
+        .strip_prefix("# vtk DataFile Version ")
+        .ok_or_else(|| {
+            err(format!(
+                "wrong magic: the first line must be `# vtk DataFile Version x.x`, found {:?}",
+                truncate(&magic)
+            ))
+        })?;
+    let major: u32 = version
+        .trim()
+        .split('.')
+        .next()
+        .and_then(|m| m.parse().ok())
+        .ok_or_else(|| err(format!("unreadable file version {:?}", truncate(version))))?;
+    let title = c
+        .line()
+        .ok_or_else(|| err("truncated after the first line".into()))?;
+    let ascii = match c.line().map(|l| l.trim().to_ascii_uppercase()) {
+        Some(l) if l == "ASCII" => true,
+        Some(l) if l == "BINARY" => false,
+        Some(l) => {
+            return Err(err(format!(
+                "the third line must be ASCII or BINARY, found {:?}",
+                truncate(&l)
+            )));
+        }
+        None => return Err(err("truncated: the file ends before ASCII or BINARY".into())),
+    };
+    let mut r = Reader {
+        c,
+        ascii,
+        new_cells: major >= 5,
+    };
+    match r.keyword_line()?.as_deref() {
+        Some([dataset, kind]) if dataset.eq_ignore_ascii_case("DATASET") => {
+            if !kind.eq_ignore_ascii_case("UNSTRUCTURED_GRID") {
+                return Err(err(format!(
+                    "the dataset is {kind}; halos are UNSTRUCTURED_GRID"
+                )));
+            }
+        }
+        other => {
+            return Err(err(format!(
+                "expected `DATASET UNSTRUCTURED_GRID`, found {:?}",
+                other.map(|w| w.join(" ")).unwrap_or("end of file".into())
+            )));
+        }
+    }
+    let grid = r.grid()?;
+    let name = title
+        .split_once(": ")
+        .map_or(title.as_str(), |(head, _)| head)
+        .trim();
+    let name = if name.is_empty() { "halo" } else { name }.to_string();
+    let field = |key: &str| grid.field.get(key).and_then(|v| v.first().copied());
+    let n = field("surface_vertices").ok_or_else(|| {
+        ImportError::NoHalo(format!(
+            "the file lacks the halo layout: its FIELD data has no `surface_vertices` (halo4d build writes it), so the two offset surfaces cannot be told apart; fields present: {}",
+            if grid.field.is_empty() {
+                "none".to_string()
+            } else {
+                let mut keys: Vec<&str> = grid.field.keys().map(String::as_str).collect();
+                keys.sort_unstable();
+                keys.join(", ")
+            }
+        ))
+    })?;
+    if !(n >= 0.0 && n.fract() == 0.0 && n <= u32::MAX as f64) {
+        return Err(err(format!(
+            "surface_vertices must be a non-negative integer, found {n}"
+        )));
+    }
+    ImportedHalo {
+        name,
+        mesh: TetMesh {
+            positions: grid.points,
+            surface_vertices: n as usize,
+            tets: grid.tets,
+        },
+        t: grid.t,
+        d_orig: grid.d_orig,
+        params: FileParams {
+            rho: field("rho"),
+            delta_d: field("delta_d"),
+            delta_t: field("delta_t"),
+            split: None,
+            surface_mesh: None,
+        },
+    }
+    .validate()
+}
+
+/// At most 60 characters of `s`, for error messages.
+fn truncate(s: &str) -> String {
+    s.chars().take(60).collect()
+}
+
+/// A position in the file's bytes.
+struct Cursor<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+}
+
+impl Cursor<'_> {
+    /// The rest of the current line (without `\r\n`), moving past it; `None` at the end.
+    fn line(&mut self) -> Option<String> {
+        if self.pos >= self.bytes.len() {
+            return None;
+        }
+        let rest = &self.bytes[self.pos..];
+        let end = rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
+        self.pos += (end + 1).min(rest.len());
+        let line = &rest[..end];
+        let line = line.strip_suffix(b"\r").unwrap_or(line);
+        Some(String::from_utf8_lossy(line).into_owned())
+    }
+
+    /// The next whitespace-separated token, moving past it.
+    fn token(&mut self) -> Option<&[u8]> {
+        while self.pos < self.bytes.len() && self.bytes[self.pos].is_ascii_whitespace() {
+            self.pos += 1;
+        }
+        let start = self.pos;
+        while self.pos < self.bytes.len() && !self.bytes[self.pos].is_ascii_whitespace() {
+            self.pos += 1;
+        }
+        (self.pos > start).then(|| &self.bytes[start..self.pos])
+    }
+
+    fn remaining(&self) -> usize {
+        self.bytes.len() - self.pos
+    }
+}
+
+/// A numeric data type of legacy VTK and its size in binary files.
+#[derive(Clone, Copy, PartialEq)]
+enum Type {
+    Int(usize, bool),
+    Float(usize),
+}
+
+impl Type {
+    fn parse(name: &str) -> Result<Type> {
+        Ok(match name.to_ascii_lowercase().as_str() {
+            "unsigned_char" => Type::Int(1, false),
+            "char" => Type::Int(1, true),
+            "unsigned_short" => Type::Int(2, false),
+            "short" => Type::Int(2, true),
+            "unsigned_int" | "vtktypeuint32" => Type::Int(4, false),
+            "int" | "vtktypeint32" => Type::Int(4, true),
+            "unsigned_long" | "vtktypeuint64" => Type::Int(8, false),
+            "long" | "vtktypeint64" | "vtkidtype" => Type::Int(8, true),
+            "float" => Type::Float(4),
+            "double" => Type::Float(8),
+            other => {
+                return Err(err(format!(
+                    "data type `{}` is not a number type this reader knows",
+                    truncate(other)
+                )));
+            }
+        })
+    }
+
+    fn size(self) -> usize {
+        match self {
+            Type::Int(s, _) | Type::Float(s) => s,
+        }
+    }
+
+    /// A big-endian binary value.
+    fn decode(self, b: &[u8]) -> f64 {
+        let mut x = [0u8; 8];
+        match self {
+            Type::Float(4) => f64::from(f32::from_be_bytes(b[..4].try_into().expect("4 bytes"))),
+            Type::Float(_) => f64::from_be_bytes(b[..8].try_into().expect("8 bytes")),
+            Type::Int(size, signed) => {
+                x[8 - size..].copy_from_slice(&b[..size]);
+                let u = u64::from_be_bytes(x);
+                if signed && size < 8 && (u >> (8 * size - 1)) & 1 == 1 {
+                    (u as i64 - (1i64 << (8 * size))) as f64
+                } else if signed {
+                    u as i64 as f64
+                } else {
+                    u as f64
+                }
+            }
+        }
+    }
+}
+
+/// What the reader keeps of the file.
+#[derive(Default)]
+struct Grid {
+    points: Vec<[f64; 3]>,
+    tets: Vec<[u32; 4]>,
+    field: HashMap<String, Vec<f64>>,
+    t: Option<Vec<f64>>,
+    d_orig: Option<Vec<f64>>,
+}
+
+/// Where attribute sections belong.
+#[derive(Clone, Copy, PartialEq)]
+enum Attach {
+    Dataset,
+    Points(usize),
+    Cells(usize),
+}
+
+struct Reader<'a> {
+    c: Cursor<'a>,
+    ascii: bool,
+    /// Version 5 CELLS: OFFSETS and CONNECTIVITY arrays.
+    new_cells: bool,
+}
+
+/// A count from a header line, as usize.
+fn count(word: Option<&String>, what: &str) -> Result<usize> {
+    let word = word.ok_or_else(|| err(format!("{what}: a count is missing")))?;
+    word.parse()
+        .map_err(|_| err(format!("{what}: {:?} is not a count", truncate(word))))
+}
+
+impl Reader<'_> {
+    /// The words of the next line that is not blank; `None` at the end of the file.
+    fn keyword_line(&mut self) -> Result<Option<Vec<String>>> {
+        while let Some(line) = self.c.line() {
+            let words: Vec<String> = line.split_whitespace().map(String::from).collect();
+            if !words.is_empty() {
+                return Ok(Some(words));
+            }
+        }
+        Ok(None)
+    }
+
+    /// `count` numbers of type `ty`; `what` names them in errors. The claimed count is
+    /// checked against the bytes left before anything is allocated.
+    fn numbers(&mut self, count: usize, ty: Type, what: &str) -> Result<Vec<f64>> {
+        let left = self.c.remaining();
+        if self.ascii {
+            // Every ASCII number takes a character and a separator (the last one may lack it).
+            if count > left.div_ceil(2) {
+                return Err(err(format!(
+                    "{what}: {count} values claimed, but only {left} bytes are left"
+                )));
+            }
+            let mut out = Vec::with_capacity(count);
+            for k in 0..count {
+                let word = self.c.token().ok_or_else(|| {
+                    err(format!("{what}: the file ends after {k} of {count} values"))
+                })?;
+                let text = String::from_utf8_lossy(word);
+                let value = match ty {
+                    Type::Float(_) => text.parse::<f64>().ok(),
+                    Type::Int(..) => text.parse::<i64>().ok().map(|i| i as f64),
+                };
+                out.push(value.ok_or_else(|| {
+                    err(format!(
+                        "{what}: value {k} is {:?}, not a number of the declared type",
+                        truncate(&text)
+                    ))
+                })?);
+            }
+            Ok(out)
+        } else {
+            let size = ty.size();
+            if count.checked_mul(size).is_none_or(|b| b > left) {
+                return Err(err(format!(
+                    "{what}: {count} values of {size} bytes claimed, but only {left} bytes are left (truncated?)"
+                )));
+            }
+            let bytes = &self.c.bytes[self.c.pos..self.c.pos + count * size];
+            self.c.pos += count * size;
+            // Binary blocks end with a newline.
+            if self.c.bytes.get(self.c.pos) == Some(&b'\n') {
+                self.c.pos += 1;
+            }
+            Ok(bytes.chunks_exact(size).map(|b| ty.decode(b)).collect())
+        }
+    }
+
+    /// Reads sections up to the end of the file.
+    fn grid(&mut self) -> Result<Grid> {
+        let mut g = Grid::default();
+        let mut points: Option<usize> = None;
+        let mut cells: Option<Vec<[f64; 4]>> = None;
+        let mut types: Option<Vec<f64>> = None;
+        let mut attach = Attach::Dataset;
+        while let Some(words) = self.keyword_line()? {
+            let key = words[0].to_ascii_uppercase();
+            match key.as_str() {
+                "POINTS" => {
+                    let n = count(words.get(1), "POINTS")?;
+                    let ty = Type::parse(words.get(2).map_or("", String::as_str))?;
+                    let xyz = self.numbers(
+                        n.checked_mul(3)
+                            .ok_or_else(|| err("POINTS: count too large".into()))?,
+                        ty,
+                        "POINTS",
+                    )?;
+                    g.points = xyz.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+                    points = Some(n);
+                }
+                "CELLS" => cells = Some(self.cells(&words)?),
+                "CELL_TYPES" => {
+                    let n = count(words.get(1), "CELL_TYPES")?;
+                    types = Some(self.numbers(n, Type::Int(4, true), "CELL_TYPES")?);
+                }
+                "POINT_DATA" => {
+                    let n = count(words.get(1), "POINT_DATA")?;
+                    if Some(n) != points {
+                        return Err(err(format!(
+                            "POINT_DATA is for {n} points, POINTS lists {}",
+                            points.map_or("none".into(), |p| p.to_string())
+                        )));
+                    }
+                    attach = Attach::Points(n);
+                }
+                "CELL_DATA" => {
+                    let n = count(words.get(1), "CELL_DATA")?;
+                    let have = cells.as_ref().map(Vec::len);
+                    if Some(n) != have {
+                        return Err(err(format!(
+                            "CELL_DATA is for {n} cells, CELLS lists {}",
+                            have.map_or("none".into(), |c| c.to_string())
+                        )));
+                    }
+                    attach = Attach::Cells(n);
+                }
+                "FIELD" => {
+                    let arrays = self.field(&words, attach)?;
+                    for (name, values) in arrays {
+                        match attach {
+                            Attach::Dataset => {
+                                g.field.insert(name, values);
+                            }
+                            Attach::Points(_) => g.point_array(&name, values),
+                            Attach::Cells(_) => {}
+                        }
+                    }
+                }
+                "METADATA" => self.skip_metadata(),
+                _ => self.attribute(&words, attach, &mut g)?,
+            }
+        }
+        let points = points.ok_or_else(|| err("no POINTS section".into()))?;
+        let cells = cells.ok_or_else(|| err("no CELLS section".into()))?;
+        let types = types.ok_or_else(|| err("no CELL_TYPES section".into()))?;
+        if types.len() != cells.len() {
+            return Err(err(format!(
+                "CELL_TYPES lists {} cells, CELLS {}",
+                types.len(),
+                cells.len()
+            )));
+        }
+        if let Some(k) = types.iter().position(|&t| t != VTK_TETRA) {
+            return Err(err(format!(
+                "cell {k} has type {}, not 10 (tetrahedron): halos are made of tetrahedra only",
+                types[k]
+            )));
+        }
+        g.tets = Vec::with_capacity(cells.len());
+        for (k, ids) in cells.iter().enumerate() {
+            let mut tet = [0u32; 4];
+            for (slot, &id) in tet.iter_mut().zip(ids) {
+                if !(id >= 0.0 && id.fract() == 0.0 && id < points as f64) {
+                    return Err(err(format!(
+                        "cell {k} names point {id}, but there are {points} points"
+                    )));
+                }
+                *slot = id as u32;
+            }
+            g.tets.push(tet);
+        }
+        Ok(g)
+    }
+
+    /// The cells of a CELLS section, each of which must have 4 point ids.
+    fn cells(&mut self, words: &[String]) -> Result<Vec<[f64; 4]>> {
+        let first = count(words.get(1), "CELLS")?;
+        let size = count(words.get(2), "CELLS")?;
+        let four = |k: usize, ids: &[f64]| -> Result<[f64; 4]> {
+            <[f64; 4]>::try_from(ids).map_err(|_| {
+                err(format!(
+                    "cell {k} has {} points, but halos are made of tetrahedra (4 points) only",
+                    ids.len()
+                ))
+            })
+        };
+        if !self.new_cells {
+            let data = self.numbers(size, Type::Int(4, true), "CELLS")?;
+            let mut out = Vec::with_capacity(first.min(data.len() / 5));
+            let mut at = 0;
+            for k in 0..first {
+                let len = data.get(at).copied().ok_or_else(|| {
+                    err(format!(
+                        "CELLS: its {size} values end at cell {k} of {first}"
+                    ))
+                })?;
+                if !(len >= 0.0 && len.fract() == 0.0 && (len as usize) < data.len() - at) {
+                    return Err(err(format!(
+                        "CELLS: cell {k} claims {len} points, more than its {size} values hold"
+                    )));
+                }
+                let end = at + 1 + len as usize;
+                out.push(four(k, &data[at + 1..end])?);
+                at = end;
+            }
+            if at != data.len() {
+                return Err(err(format!(
+                    "CELLS: {first} cells use {at} of its {size} values"
+                )));
+            }
+            return Ok(out);
+        }
+        // Version 5: `CELLS offsets connectivity`, then the two arrays.
+        let mut array = |name: &str, n: usize| -> Result<Vec<f64>> {
+            match self.keyword_line()?.as_deref() {
+                Some([word, ty]) if word.eq_ignore_ascii_case(name) => {
+                    self.numbers(n, Type::parse(ty)?, name)
+                }
+                other => Err(err(format!(
+                    "CELLS: expected `{name} <type>`, found {:?}",
+                    other.map(|w| w.join(" ")).unwrap_or("end of file".into())
+                ))),
+            }
+        };
+        let offsets = array("OFFSETS", first)?;
+        let connectivity = array("CONNECTIVITY", size)?;
+        if offsets.first().is_some_and(|&o| o != 0.0)
+            || offsets.last().is_some_and(|&o| o != size as f64)
+        {
+            return Err(err(format!(
+                "CELLS: OFFSETS must run from 0 to the {size} CONNECTIVITY values"
+            )));
+        }
+        let mut out = Vec::with_capacity(offsets.len().saturating_sub(1));
+        for (k, w) in offsets.windows(2).enumerate() {
+            let (a, b) = (w[0], w[1]);
+            if !(a.fract() == 0.0 && b.fract() == 0.0 && 0.0 <= a && a <= b && b <= size as f64) {
+                return Err(err(format!(
+                    "CELLS: the OFFSETS of cell {k} ({a}, {b}) are out of order"
+                )));
+            }
+            out.push(four(k, &connectivity[a as usize..b as usize])?);
+        }
+        Ok(out)
+    }
+
+    /// A FIELD section: `FIELD name arrays`, then per array `name components tuples type`
+    /// and its values.
+    fn field(&mut self, words: &[String], attach: Attach) -> Result<Vec<(String, Vec<f64>)>> {
+        let arrays = count(words.get(2), "FIELD")?;
+        let mut out = Vec::new();
+        let mut k = 0;
+        while k < arrays {
+            let line = self
+                .keyword_line()?
+                .ok_or_else(|| err(format!("FIELD: the file ends after {k} of {arrays} arrays")))?;
+            if line[0].eq_ignore_ascii_case("METADATA") {
+                self.skip_metadata();
+                continue;
+            }
+            let [name, components, tuples, ty] = &line[..] else {
+                return Err(err(format!(
+                    "FIELD: expected `name components tuples type`, found {:?}",
+                    truncate(&line.join(" "))
+                )));
+            };
+            let what = format!("FIELD array {name}");
+            let components = count(Some(components), &what)?;
+            let tuples = count(Some(tuples), &what)?;
+            if let Attach::Points(n) | Attach::Cells(n) = attach
+                && tuples != n
+            {
+                return Err(err(format!("{what}: {tuples} tuples for {n} elements")));
+            }
+            let total = components
+                .checked_mul(tuples)
+                .ok_or_else(|| err(format!("{what}: size too large")))?;
+            let values = self.numbers(total, Type::parse(ty)?, &what)?;
+            // Only single-component arrays matter to a halo.
+            if components == 1 {
+                out.push((name.clone(), values));
+            }
+            k += 1;
+        }
+        Ok(out)
+    }
+
+    /// A point or cell attribute section (SCALARS, VECTORS, ...): read, and kept when it
+    /// is `t` or `d_orig` of the points.
+    fn attribute(&mut self, words: &[String], attach: Attach, g: &mut Grid) -> Result<()> {
+        let key = words[0].to_ascii_uppercase();
+        let n = match attach {
+            Attach::Points(n) | Attach::Cells(n) => n,
+            Attach::Dataset => {
+                return Err(err(format!(
+                    "unknown section `{}` (expected POINTS, CELLS, CELL_TYPES, FIELD, POINT_DATA or CELL_DATA)",
+                    truncate(&words[0])
+                )));
+            }
+        };
+        let word = |i: usize| words.get(i).map_or("", String::as_str);
+        match key.as_str() {
+            "SCALARS" => {
+                let components = match words.get(3) {
+                    Some(c) => count(Some(c), "SCALARS")?,
+                    None => 1,
+                };
+                if !(1..=4).contains(&components) {
+                    return Err(err(format!(
+                        "SCALARS {}: {components} components (1 to 4 allowed)",
+                        word(1)
+                    )));
+                }
+                let ty = Type::parse(word(2))?;
+                match self.keyword_line()?.as_deref() {
+                    Some([lt, _]) if lt.eq_ignore_ascii_case("LOOKUP_TABLE") => {}
+                    _ => {
+                        return Err(err(format!(
+                            "SCALARS {}: a `LOOKUP_TABLE name` line must follow",
+                            word(1)
+                        )));
+                    }
+                }
+                let values = self.numbers(components * n, ty, &format!("SCALARS {}", word(1)))?;
+                if components == 1 && matches!(attach, Attach::Points(_)) {
+                    g.point_array(word(1), values);
+                }
+            }
+            "VECTORS" | "NORMALS" | "TENSORS" => {
+                let size = if key == "TENSORS" { 9 } else { 3 };
+                self.numbers(size * n, Type::parse(word(2))?, &key)?;
+            }
+            "TEXTURE_COORDINATES" => {
+                let dim = count(words.get(2), &key)?.min(3);
+                self.numbers(dim * n, Type::parse(word(3))?, &key)?;
+            }
+            "COLOR_SCALARS" => {
+                let m = count(words.get(2), &key)?.min(4);
+                let ty = if self.ascii {
+                    Type::Float(4)
+                } else {
+                    Type::Int(1, false)
+                };
+                self.numbers(m * n, ty, &key)?;
+            }
+            "LOOKUP_TABLE" => {
+                let m = count(words.get(2), &key)?;
+                let ty = if self.ascii {
+                    Type::Float(4)
+                } else {
+                    Type::Int(1, false)
+                };
+                let values = m
+                    .checked_mul(4)
+                    .ok_or_else(|| err("LOOKUP_TABLE: size too large".into()))?;
+                self.numbers(values, ty, &key)?;
+            }
+            _ => {
+                return Err(err(format!(
+                    "unknown section `{}` in the point or cell data",
+                    truncate(&words[0])
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// METADATA blocks end with a blank line.
+    fn skip_metadata(&mut self) {
+        while let Some(line) = self.c.line() {
+            if line.trim().is_empty() {
+                break;
+            }
+        }
+    }
+}
+
+impl Grid {
+    /// Keeps a single-component point array when it is `t` or `d_orig`.
+    fn point_array(&mut self, name: &str, values: Vec<f64>) {
+        match name {
+            "t" => self.t = Some(values),
+            "d_orig" => self.d_orig = Some(values),
+            _ => {}
+        }
+    }
+}

@@ -1,0 +1,759 @@
+//! Halos through their files: every fixture's halo written to .glb and .vtk and read back
+//! (by halo4d's readers and by the gltf crate) unchanged; faults planted in the files caught
+//! by `halo4d check`; malformed files rejected with errors, never panics.
+
+use crate::common::{Rng, fixture, fixture_scenes};
+use halo4d::Scene;
+use halo4d::check::{CheckStats, TetMesh, check};
+use halo4d::import::{ImportError, ImportedHalo, read, read_glb, read_vtk};
+use halo4d::pipeline::SurfaceProduct;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Builds a scene into `dir`, returning its products.
+fn build(scene: &Scene, dir: &Path) -> Vec<SurfaceProduct> {
+    let (products, timings) = halo4d::run(scene, true).unwrap();
+    halo4d::write(scene, &products, timings, dir).unwrap();
+    products
+}
+
+/// The patches fixture (whose halo is valid) built into `dir`: its .glb and .vtk.
+fn patches(dir: &Path) -> (PathBuf, PathBuf, Vec<SurfaceProduct>) {
+    let scene = Scene::load(&fixture("scenes/patches.json")).unwrap();
+    let products = build(&scene, dir);
+    (
+        dir.join("patches.glb"),
+        dir.join("patches-halo.vtk"),
+        products,
+    )
+}
+
+/// The halo with positions rounded to f32, as the .glb stores them.
+fn rounded(mut mesh: TetMesh) -> TetMesh {
+    for p in &mut mesh.positions {
+        *p = p.map(|x| f64::from(x as f32));
+    }
+    mesh
+}
+
+fn bits(values: &[f64]) -> Vec<u64> {
+    values.iter().map(|x| x.to_bits()).collect()
+}
+
+fn bits3(values: &[[f64; 3]]) -> Vec<u64> {
+    values.iter().flatten().map(|x| x.to_bits()).collect()
+}
+
+fn f32_bits(values: &[f64]) -> Vec<u64> {
+    values
+        .iter()
+        .map(|&x| f64::from(x as f32).to_bits())
+        .collect()
+}
+
+/// Whether two runs of the checker agree: every count exactly, and every measure exactly but
+/// the sums over boundary faces, which the checker adds in hash-map order (so in an order
+/// that changes from run to run) and which therefore agree to rounding only.
+fn same_stats(a: &CheckStats, b: &CheckStats) -> bool {
+    let (Value::Object(a), Value::Object(b)) = (
+        serde_json::to_value(a).unwrap(),
+        serde_json::to_value(b).unwrap(),
+    ) else {
+        unreachable!("statistics serialize as a map")
+    };
+    a.len() == b.len()
+        && a.iter()
+            .all(|(k, x)| match (k.as_str(), x.as_f64(), b[k].as_f64()) {
+                ("boundary_volume", Some(x), Some(y)) => {
+                    (x - y).abs() <= 1e-12 * x.abs().max(y.abs())
+                }
+                // A relative difference of nearly equal volumes: its rounding is absolute.
+                ("volume_defect", Some(x), Some(y)) => (x - y).abs() <= 1e-12,
+                _ => *x == b[k],
+            })
+}
+
+fn halo4d(args: &[&str], dir: &Path) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_halo4d"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+/// An ASCII legacy VTK of `h`, field data right after DATASET (where VTK's own writer puts
+/// it, not where halo4d does), `extra_field` lines appended to it.
+fn ascii_vtk(h: &ImportedHalo, with_layout: bool) -> String {
+    let m = &h.mesh;
+    let mut s = format!(
+        "# vtk DataFile Version 3.0\n{}: ascii copy\nASCII\nDATASET UNSTRUCTURED_GRID\n",
+        h.name
+    );
+    if with_layout {
+        s += &format!(
+            "FIELD FieldData 2\nsurface_vertices 1 1 int\n{}\nrho 1 1 double\n{}\n",
+            m.surface_vertices,
+            h.params.rho.unwrap()
+        );
+    }
+    s += &format!("POINTS {} double\n", m.positions.len());
+    for p in &m.positions {
+        s += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    s += &format!("CELLS {} {}\n", m.tets.len(), 5 * m.tets.len());
+    for t in &m.tets {
+        s += &format!("4 {} {} {} {}\n", t[0], t[1], t[2], t[3]);
+    }
+    s += &format!("CELL_TYPES {}\n", m.tets.len());
+    s += &"10\n".repeat(m.tets.len());
+    s += &format!("POINT_DATA {}\n", m.positions.len());
+    for (name, values) in [("t", &h.t), ("d_orig", &h.d_orig)] {
+        s += &format!("SCALARS {name} double\nLOOKUP_TABLE default\n");
+        for x in values.as_ref().unwrap() {
+            s += &format!("{x}\n");
+        }
+    }
+    s
+}
+
+/// Where the BIN chunk's data starts in a .glb.
+fn bin_start(glb: &[u8]) -> usize {
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    20 + json_len + 8
+}
+
+/// The .glb with its JSON chunk edited.
+fn with_json(glb: &[u8], edit: impl FnOnce(&mut Value)) -> Vec<u8> {
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let mut json: Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    edit(&mut json);
+    let mut text = serde_json::to_vec(&json).unwrap();
+    text.resize(text.len().next_multiple_of(4), b' ');
+    let bin_chunk = &glb[20 + json_len..];
+    let total = 20 + text.len() + bin_chunk.len();
+    let mut out = b"glTF".to_vec();
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(text.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&text);
+    out.extend_from_slice(bin_chunk);
+    out
+}
+
+/// The JSON of the first halo mesh and its index.
+fn halo_mesh(json: &mut Value) -> &mut Value {
+    json["meshes"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .find(|m| m["extras"].get("halo").is_some())
+        .unwrap()
+}
+
+/// Where in the .glb the first halo's tetrahedra and positions lie.
+fn halo_offsets(glb: &[u8]) -> (usize, usize) {
+    let gltf = gltf::Gltf::from_slice(glb).unwrap();
+    let mesh = gltf
+        .meshes()
+        .find(|m| m.name().is_some_and(|n| n.ends_with("-halo")))
+        .unwrap();
+    let extras: Value = serde_json::from_str(mesh.extras().as_ref().unwrap().get()).unwrap();
+    let at = |a: gltf::Accessor| bin_start(glb) + a.view().unwrap().offset() + a.offset();
+    let tets = gltf
+        .accessors()
+        .nth(extras["halo"]["tetrahedra"].as_u64().unwrap() as usize)
+        .unwrap();
+    let positions = mesh
+        .primitives()
+        .next()
+        .unwrap()
+        .get(&gltf::Semantic::Positions)
+        .unwrap();
+    (at(tets), at(positions))
+}
+
+#[test]
+fn every_fixture_halo_reads_back_unchanged_from_glb_and_vtk() {
+    let dir = tempfile::tempdir().unwrap();
+    for path in fixture_scenes() {
+        let scene = Scene::load(&path).unwrap();
+        let out = dir.path().join(&scene.name);
+        let products = build(&scene, &out);
+        let name = &scene.name;
+        let from_glb = read(&out.join(format!("{name}.glb"))).unwrap();
+        assert_eq!(from_glb.len(), products.len(), "{name}");
+        for (p, g) in products.iter().zip(&from_glb) {
+            let halo = &p.halo;
+            let what = format!("{name}/{}", p.name);
+            let mesh = halo.tet_mesh();
+            let vtk_file = if products.len() == 1 {
+                format!("{name}-halo.vtk")
+            } else {
+                format!("{name}-{}-halo.vtk", p.name)
+            };
+            let v = read_vtk(&std::fs::read(out.join(vtk_file)).unwrap()).unwrap();
+            let expected = check(&mesh);
+            for h in [g, &v] {
+                assert_eq!(h.name, format!("{}-halo", p.name), "{what}");
+                assert_eq!(h.mesh.surface_vertices, halo.surface_vertices, "{what}");
+                assert_eq!(h.mesh.tets, halo.tets, "{what}");
+                assert_eq!(h.params.rho, Some(p.halo_report.rho), "{what}");
+                assert_eq!(h.params.delta_d, Some(scene.halo.delta_d), "{what}");
+                assert_eq!(h.params.delta_t, Some(scene.halo.delta_t), "{what}");
+            }
+            // The .glb: f32, exactly the values written.
+            assert_eq!(
+                bits3(&g.mesh.positions),
+                bits3(&rounded(mesh.clone()).positions)
+            );
+            assert_eq!(bits(g.t.as_ref().unwrap()), f32_bits(&halo.t), "{what}");
+            assert_eq!(bits(g.d_orig.as_ref().unwrap()), f32_bits(&halo.d_orig));
+            assert_eq!(g.params.split.as_deref(), Some(scene.halo.split.name()));
+            // The checker sees in the file what it saw in memory (where the halo's positions
+            // are exact in f32, as the layout has them, the rounding changes nothing).
+            let glb_stats = check(&g.mesh);
+            let same = |a: &CheckStats, b: &CheckStats| {
+                assert!(same_stats(a, b), "{what}:\n{a:?}\n{b:?}");
+            };
+            same(&glb_stats, &check(&rounded(mesh.clone())));
+            if rounded(mesh.clone()) == mesh {
+                same(&glb_stats, &expected);
+            }
+            // The .vtk: f64, bit for bit.
+            assert_eq!(bits3(&v.mesh.positions), bits3(&mesh.positions), "{what}");
+            assert_eq!(bits(v.t.as_ref().unwrap()), bits(&halo.t), "{what}");
+            assert_eq!(
+                bits(v.d_orig.as_ref().unwrap()),
+                bits(&halo.d_orig),
+                "{what}"
+            );
+            same(&check(&v.mesh), &expected);
+            // An ASCII copy reads back bit for bit too (Rust prints f64 so that it parses
+            // back exactly).
+            let a = read_vtk(ascii_vtk(&v, true).as_bytes()).unwrap();
+            assert_eq!(bits3(&a.mesh.positions), bits3(&mesh.positions), "{what}");
+            assert_eq!(a.mesh, v.mesh, "{what}");
+            assert_eq!((&a.t, &a.d_orig), (&v.t, &v.d_orig), "{what}");
+        }
+    }
+}
+
+#[test]
+fn the_glb_halo_is_plain_gltf_to_the_gltf_crate() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Scene::default_scene();
+    let products = build(&scene, dir.path());
+    let glb = std::fs::read(dir.path().join(format!("{}.glb", scene.name))).unwrap();
+    let gltf = gltf::Gltf::from_slice(&glb).unwrap();
+    let blob = gltf.blob.as_deref().unwrap();
+    for p in &products {
+        let halo = &p.halo;
+        let n = halo.surface_vertices;
+        let mesh = gltf
+            .meshes()
+            .find(|m| m.name() == Some(format!("{}-halo", p.name).as_str()))
+            .expect("a halo mesh per surface");
+        assert!(
+            gltf.nodes()
+                .any(|node| node.mesh().map(|m| m.index()) == Some(mesh.index())),
+            "the halo mesh has its own node"
+        );
+        let prim = mesh.primitives().next().unwrap();
+        assert_eq!(prim.mode(), gltf::mesh::Mode::Triangles);
+        let reader = prim.reader(|_| Some(blob));
+        let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
+        assert_eq!(positions.len(), halo.positions.len());
+        let patch: Vec<f64> = (0..halo.positions.len())
+            .map(|i| {
+                f64::from(if i < 2 * n {
+                    p.mesh.patch[i % n]
+                } else {
+                    p.mesh.triangle_patch[halo.inserted_in[i - 2 * n] as usize]
+                })
+            })
+            .collect();
+        for (attr, expect) in [("_T", &halo.t), ("_D", &halo.d_orig), ("_PATCH", &patch)] {
+            let acc = prim
+                .attributes()
+                .find(|(s, _)| s.to_string() == attr)
+                .unwrap_or_else(|| panic!("no {attr}"))
+                .1;
+            assert_eq!(acc.data_type(), gltf::accessor::DataType::F32);
+            assert_eq!(acc.dimensions(), gltf::accessor::Dimensions::Scalar);
+            let bytes = &blob[acc.view().unwrap().offset() + acc.offset()..][..acc.count() * 4];
+            let got: Vec<f64> = bytes
+                .chunks_exact(4)
+                .map(|c| f64::from(f32::from_le_bytes(c.try_into().unwrap())))
+                .collect();
+            assert_eq!(bits(&got), f32_bits(expect), "{attr}");
+        }
+
+        // The triangles are the boundary faces, turned outward: as many as the checker
+        // counts, enclosing the volume it measures (with the opposite sign, as the checker
+        // turns its faces the other way).
+        let faces: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
+        let stats = check(&halo.tet_mesh());
+        assert_eq!(faces.len(), 3 * stats.boundary_faces);
+        let mut enclosed = 0.0;
+        for f in faces.chunks_exact(3) {
+            let [a, b, c] = [f[0], f[1], f[2]].map(|i| halo.positions[i as usize]);
+            enclosed += a.dot(b.cross(c)) / 6.0;
+        }
+        assert!(
+            (enclosed - stats.boundary_volume).abs() <= 1e-9 * stats.boundary_volume.abs(),
+            "{enclosed} against {}",
+            stats.boundary_volume
+        );
+
+        // The extras name the tetrahedra's accessor: 4 indices per tetrahedron, in a view
+        // without a target.
+        let extras: Value = serde_json::from_str(mesh.extras().as_ref().unwrap().get()).unwrap();
+        let h = &extras["halo"];
+        assert_eq!(h["surface_vertices"], n);
+        assert_eq!(h["rho"], p.halo_report.rho);
+        assert_eq!(h["split"], scene.halo.split.name());
+        let surface_mesh = gltf
+            .meshes()
+            .nth(h["surface_mesh"].as_u64().unwrap() as usize)
+            .unwrap();
+        assert_eq!(surface_mesh.name(), Some(p.name.as_str()));
+        let tets = gltf
+            .accessors()
+            .nth(h["tetrahedra"].as_u64().unwrap() as usize)
+            .unwrap();
+        assert_eq!(tets.count(), 4 * halo.tets.len());
+        assert_eq!(tets.data_type(), gltf::accessor::DataType::U32);
+        assert_eq!(tets.dimensions(), gltf::accessor::Dimensions::Scalar);
+        let view = tets.view().unwrap();
+        assert_eq!(view.target(), None);
+        let indices: Vec<u32> = blob[view.offset() + tets.offset()..][..tets.count() * 4]
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        assert_eq!(indices, halo.tets.concat());
+    }
+}
+
+#[test]
+fn a_scene_of_several_surfaces_writes_a_vtk_per_halo_and_checks_each() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Scene::parse(
+        r#"{ "name": "pair", "surfaces": [
+             { "name": "flat", "surface": { "type": "patches", "count": 2 } },
+             { "name": "torus", "surface": { "type": "flat_torus" } } ],
+             "sampling": { "method": "uniform", "u": 8, "v": 8 },
+             "outputs": { "ply": false, "report": false } }"#,
+        "pair",
+    )
+    .unwrap();
+    let products = build(&scene, dir.path());
+    let mut files: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    assert_eq!(
+        files,
+        ["pair-flat-halo.vtk", "pair-torus-halo.vtk", "pair.glb"]
+    );
+    let from_glb = read(&dir.path().join("pair.glb")).unwrap();
+    let names: Vec<&str> = from_glb.iter().map(|h| h.name.as_str()).collect();
+    assert_eq!(names, ["flat-halo", "torus-halo"]);
+    for (p, g) in products.iter().zip(&from_glb) {
+        let v = read(&dir.path().join(format!("pair-{}-halo.vtk", p.name))).unwrap();
+        assert_eq!(v[0].mesh, p.halo.tet_mesh());
+        assert_eq!(g.mesh.tets, p.halo.tets);
+    }
+    let out = halo4d(&["check", "pair.glb"], dir.path());
+    let table = String::from_utf8_lossy(&out.stdout);
+    let header = table.lines().next().unwrap();
+    assert!(
+        header.contains("flat-halo") && header.contains("torus-halo"),
+        "{table}"
+    );
+}
+
+#[test]
+fn check_passes_a_valid_halo_and_catches_faults_planted_in_its_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let (glb, vtk, _) = patches(dir.path());
+    for file in [&glb, &vtk] {
+        let out = halo4d(&["check", file.to_str().unwrap()], dir.path());
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{}: {text}", file.display());
+        assert!(text.contains("inverted") && text.contains("quad_mismatches"));
+        assert!(
+            text.contains("patches-halo") && text.contains("ok:"),
+            "{text}"
+        );
+    }
+
+    let halo = read_vtk(&std::fs::read(&vtk).unwrap()).unwrap();
+    let planted = |name: &str, edit: &dyn Fn(&mut ImportedHalo), expect: &[&str]| {
+        let mut h = halo.clone();
+        edit(&mut h);
+        let file = dir.path().join(name);
+        std::fs::write(&file, ascii_vtk(&h, true)).unwrap();
+        let out = halo4d(&["check", name], dir.path());
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(out.status.code(), Some(1), "{name}: {text}");
+        let verdict = text.lines().last().unwrap();
+        assert!(verdict.starts_with("FAILED patches-halo"), "{name}: {text}");
+        for e in expect {
+            assert!(verdict.contains(e), "{name}: `{e}` not in {verdict}");
+        }
+    };
+    planted(
+        "flipped.vtk",
+        &|h| h.mesh.tets[7].swap(0, 1),
+        &["1 inverted"],
+    );
+    planted(
+        "duplicated.vtk",
+        &|h| h.mesh.tets.push(h.mesh.tets[3]),
+        &["1 duplicate_tets"],
+    );
+    planted(
+        "missing.vtk",
+        &|h| {
+            h.mesh.tets.remove(10);
+        },
+        &["unexpected_boundary_faces"],
+    );
+    planted(
+        "flat.vtk",
+        &|h| {
+            // d onto a: exactly flat, whatever the rounding.
+            let [a, _, _, d] = h.mesh.tets[0];
+            h.mesh.positions[d as usize] = h.mesh.positions[a as usize];
+        },
+        &["flat"],
+    );
+
+    // In the .glb: one tetrahedron's orientation flipped in the binary chunk.
+    let mut bytes = std::fs::read(&glb).unwrap();
+    let (tets, _) = halo_offsets(&bytes);
+    let (first, second) = bytes.split_at_mut(tets + 4);
+    first[tets..].swap_with_slice(&mut second[..4]);
+    std::fs::write(dir.path().join("flipped.glb"), &bytes).unwrap();
+    let out = halo4d(&["check", "flipped.glb"], dir.path());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{text}");
+    assert!(text.contains("FAILED patches-halo: 1 inverted"), "{text}");
+}
+
+#[test]
+fn unreadable_files_are_errors_of_the_cli_with_the_file_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let (glb, vtk, _) = patches(dir.path());
+    let bytes = std::fs::read(&glb).unwrap();
+    std::fs::write(dir.path().join("cut.glb"), &bytes[..bytes.len() / 2]).unwrap();
+    let halo = read_vtk(&std::fs::read(&vtk).unwrap()).unwrap();
+    std::fs::write(dir.path().join("bare.vtk"), ascii_vtk(&halo, false)).unwrap();
+    std::fs::write(dir.path().join("notes.txt"), "hello").unwrap();
+    for (file, words) in [
+        ("cut.glb", &["cut.glb", "truncated"][..]),
+        (
+            "bare.vtk",
+            &["bare.vtk", "lacks the halo layout", "surface_vertices"],
+        ),
+        ("notes.txt", &["notes.txt", ".glb or a .vtk"]),
+        ("absent.vtk", &["absent.vtk", "cannot read"]),
+    ] {
+        let out = halo4d(&["check", file], dir.path());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{file}: {err}");
+        assert!(err.starts_with("error: "), "{err}");
+        for w in words {
+            assert!(err.contains(w), "{file}: `{w}` not in {err}");
+        }
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+/// `read_glb` fails with an error containing `words`.
+fn glb_fails(bytes: &[u8], words: &[&str]) {
+    let e = read_glb(bytes)
+        .expect_err("accepted a broken .glb")
+        .to_string();
+    for w in words {
+        assert!(e.contains(w), "`{w}` not in: {e}");
+    }
+}
+
+/// `read_vtk` fails with an error containing `words`.
+fn vtk_fails(bytes: &[u8], words: &[&str]) {
+    let e = read_vtk(bytes)
+        .expect_err("accepted a broken .vtk")
+        .to_string();
+    for w in words {
+        assert!(e.contains(w), "`{w}` not in: {e}");
+    }
+}
+
+#[test]
+fn malformed_glb_files_are_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let (glb, _, products) = patches(dir.path());
+    let good = std::fs::read(&glb).unwrap();
+    let tets = products[0].halo.tets.len();
+    assert_eq!(read_glb(&good).unwrap().len(), 1);
+
+    glb_fails(b"", &["truncated", "header"]);
+    glb_fails(&good[..11], &["truncated"]);
+    glb_fails(&good[..100], &["truncated", "header says"]);
+    glb_fails(&good[..good.len() - 4], &["truncated"]);
+    let mut magic = good.clone();
+    magic[..4].copy_from_slice(b"PLY\n");
+    glb_fails(&magic, &["wrong magic"]);
+    let mut version = good.clone();
+    version[4] = 3;
+    glb_fails(&version, &["version 3"]);
+    let mut garbled = good.clone();
+    garbled[20..30].copy_from_slice(b"{not json!");
+    glb_fails(&garbled, &["not valid JSON"]);
+    // A chunk that claims more than the file holds.
+    let mut chunk = good.clone();
+    chunk[12..16].copy_from_slice(&u32::MAX.to_le_bytes());
+    glb_fails(&chunk, &["truncated", "claims"]);
+
+    let edited = |edit: &dyn Fn(&mut Value)| with_json(&good, |j| edit(j));
+    glb_fails(
+        &edited(&|j| halo_mesh(j)["extras"]["halo"]["tetrahedra"] = 999.into()),
+        &["accessors[999] does not exist"],
+    );
+    glb_fails(
+        &edited(&|j| halo_mesh(j)["extras"]["halo"]["tetrahedra"] = (-1).into()),
+        &["tetrahedra", "not a non-negative integer"],
+    );
+    glb_fails(
+        &edited(&|j| {
+            halo_mesh(j)["extras"]["halo"]
+                .as_object_mut()
+                .unwrap()
+                .remove("surface_vertices");
+        }),
+        &["no `surface_vertices`"],
+    );
+    glb_fails(
+        &edited(&|j| halo_mesh(j)["extras"]["halo"]["surface_vertices"] = 100_000.into()),
+        &["surface_vertices = 100000", "offset vertices"],
+    );
+    // Ten million tetrahedra claimed by a file of a hundred kilobytes.
+    glb_fails(
+        &edited(&|j| {
+            let a = halo_mesh(j)["extras"]["halo"]["tetrahedra"]
+                .as_u64()
+                .unwrap() as usize;
+            j["accessors"][a]["count"] = 40_000_000.into();
+        }),
+        &["claims 40000000 elements", "buffer view"],
+    );
+    glb_fails(
+        &edited(&|j| {
+            let a = halo_mesh(j)["extras"]["halo"]["tetrahedra"]
+                .as_u64()
+                .unwrap() as usize;
+            j["accessors"][a]["count"] = (4 * tets - 2).into();
+        }),
+        &["not a multiple of 4"],
+    );
+    glb_fails(
+        &edited(&|j| {
+            let a = halo_mesh(j)["primitives"][0]["attributes"]["_T"]
+                .as_u64()
+                .unwrap() as usize;
+            j["accessors"][a]["count"] = 3.into();
+        }),
+        &["_T has 3 values"],
+    );
+    glb_fails(
+        &edited(&|j| {
+            let a = halo_mesh(j)["primitives"][0]["attributes"]["POSITION"]
+                .as_u64()
+                .unwrap() as usize;
+            let v = j["accessors"][a]["bufferView"].as_u64().unwrap() as usize;
+            j["bufferViews"][v]["byteLength"] = u32::MAX.into();
+        }),
+        &["runs past"],
+    );
+    glb_fails(
+        &edited(&|j| {
+            for m in j["meshes"].as_array_mut().unwrap() {
+                m.as_object_mut().unwrap().remove("extras");
+            }
+        }),
+        &["no halo", "2 meshes"],
+    );
+
+    // Values in the binary chunk: an index out of range, a NaN coordinate.
+    let (tets_at, positions_at) = halo_offsets(&good);
+    let mut index = good.clone();
+    index[tets_at + 8..tets_at + 12].copy_from_slice(&7_000_000u32.to_le_bytes());
+    glb_fails(
+        &index,
+        &["patches-halo", "tetrahedron 0 names vertex 7000000"],
+    );
+    let mut nan = good.clone();
+    nan[positions_at + 16..positions_at + 20].copy_from_slice(&f32::NAN.to_le_bytes());
+    glb_fails(
+        &nan,
+        &["patches-halo", "vertex 1 has a non-finite coordinate"],
+    );
+}
+
+#[test]
+fn malformed_vtk_files_are_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, vtk, _) = patches(dir.path());
+    let good = std::fs::read(&vtk).unwrap();
+    let halo = read_vtk(&good).unwrap();
+    let text = ascii_vtk(&halo, true);
+    assert_eq!(read_vtk(text.as_bytes()).unwrap().mesh, halo.mesh);
+    let (np, nt, n) = (
+        halo.mesh.positions.len(),
+        halo.mesh.tets.len(),
+        halo.mesh.surface_vertices,
+    );
+    let cells = format!("CELLS {nt} {}", 5 * nt);
+    let points = format!("POINTS {np} double\n");
+
+    vtk_fails(b"", &["wrong magic"]);
+    vtk_fails(b"ply\nformat ascii 1.0\n", &["wrong magic"]);
+    vtk_fails(&good[..40], &["truncated"]);
+    vtk_fails(&good[..good.len() / 2], &["claimed", "left"]);
+    vtk_fails(&good[..good.len() - 9], &["SCALARS d_orig", "claimed"]);
+    let replace = |from: &str, to: &str| {
+        assert!(text.contains(from), "{from}");
+        text.replacen(from, to, 1)
+    };
+    vtk_fails(replace("ASCII", "TEXT").as_bytes(), &["ASCII or BINARY"]);
+    vtk_fails(
+        replace("UNSTRUCTURED_GRID", "POLYDATA").as_bytes(),
+        &["POLYDATA", "UNSTRUCTURED_GRID"],
+    );
+    vtk_fails(
+        replace(
+            &format!("CELL_TYPES {nt}\n10\n"),
+            &format!("CELL_TYPES {nt}\n12\n"),
+        )
+        .as_bytes(),
+        &["cell 0 has type 12", "tetrahedron"],
+    );
+    vtk_fails(
+        replace(
+            &format!("CELL_TYPES {nt}\n10\n"),
+            &format!("CELL_TYPES {}\n", nt - 1),
+        )
+        .as_bytes(),
+        &[&format!("CELL_TYPES lists {} cells, CELLS {nt}", nt - 1)],
+    );
+    vtk_fails(
+        replace(&format!("{cells}\n4 "), &format!("{cells}\n3 ")).as_bytes(),
+        &["cell 0 has 3 points"],
+    );
+    vtk_fails(
+        replace(
+            &format!("POINT_DATA {np}"),
+            &format!("POINT_DATA {}", np - 1),
+        )
+        .as_bytes(),
+        &[&format!(
+            "POINT_DATA is for {} points, POINTS lists {np}",
+            np - 1
+        )],
+    );
+    // Ten million tetrahedra, or a billion points, claimed in a small file.
+    vtk_fails(
+        replace(&cells, "CELLS 10000000 50000000").as_bytes(),
+        &["CELLS", "50000000 values claimed"],
+    );
+    vtk_fails(
+        replace(&points, "POINTS 1000000000 double\n").as_bytes(),
+        &["POINTS", "3000000000 values claimed"],
+    );
+    // An extra first cell that names a point beyond the last.
+    let index = replace(
+        &format!("{cells}\n"),
+        &format!("CELLS {} {}\n4 0 1 2 {}\n", nt + 1, 5 * nt + 5, 5 * np),
+    );
+    vtk_fails(
+        index
+            .replacen(
+                &format!("CELL_TYPES {nt}\n"),
+                &format!("CELL_TYPES {}\n10\n", nt + 1),
+                1,
+            )
+            .as_bytes(),
+        &[&format!(
+            "cell 0 names point {}, but there are {np} points",
+            5 * np
+        )],
+    );
+    let points_at = text.find(&points).unwrap() + points.len();
+    let mut nan = text.clone();
+    let line_end = points_at + text[points_at..].find('\n').unwrap();
+    nan.replace_range(points_at..line_end, "0 NaN 0");
+    vtk_fails(nan.as_bytes(), &["vertex 0 has a non-finite coordinate"]);
+    let layout = format!("surface_vertices 1 1 int\n{n}\n");
+    vtk_fails(
+        replace(&layout, &format!("surface_vertices 1 1 int\n{np}\n")).as_bytes(),
+        &[
+            &format!("surface_vertices = {np}"),
+            &format!("{np} vertices"),
+        ],
+    );
+    vtk_fails(
+        replace(&layout, "surface_vertices 1 1 double\n4.5\n").as_bytes(),
+        &["surface_vertices must be a non-negative integer"],
+    );
+    vtk_fails(
+        ascii_vtk(&halo, false).as_bytes(),
+        &["lacks the halo layout", "surface_vertices"],
+    );
+    vtk_fails(
+        replace("SCALARS t double", "SPLINES t double").as_bytes(),
+        &["SPLINES"],
+    );
+    assert!(matches!(
+        read_vtk(ascii_vtk(&halo, false).as_bytes()),
+        Err(ImportError::NoHalo(_))
+    ));
+}
+
+#[test]
+fn no_cut_or_corrupted_file_panics_the_readers() {
+    let dir = tempfile::tempdir().unwrap();
+    let (glb, vtk, _) = patches(dir.path());
+    let halo = read_vtk(&std::fs::read(&vtk).unwrap()).unwrap();
+    let files = [
+        std::fs::read(&glb).unwrap(),
+        std::fs::read(&vtk).unwrap(),
+        ascii_vtk(&halo, true).into_bytes(),
+    ];
+    let mut rng = Rng(0x4a10);
+    for (k, good) in files.iter().enumerate() {
+        let parse = |bytes: &[u8]| {
+            if k == 0 {
+                read_glb(bytes).map(|_| ())
+            } else {
+                read_vtk(bytes).map(|_| ())
+            }
+        };
+        for cut in (0..good.len()).step_by(good.len() / 200) {
+            let result = parse(&good[..cut]);
+            // An ASCII file cut inside its last number can still be a valid file.
+            assert!(k == 2 || result.is_err(), "file {k} cut at {cut}");
+        }
+        for _ in 0..300 {
+            let mut bytes = good.clone();
+            for _ in 0..1 + rng.below(4) {
+                let at = rng.below(bytes.len());
+                bytes[at] = rng.bits() as u8;
+            }
+            let _ = parse(&bytes);
+        }
+    }
+}
