@@ -160,22 +160,16 @@ fn key(mut f: [u32; 3]) -> [u32; 3] {
     f
 }
 
-/// The faces of a tetrahedron (a, b, c, d), each ordered so that the opposite vertex lies
-/// below it when the tetrahedron is positive: outward and clockwise seen from outside.
-fn faces_of([a, b, c, d]: [u32; 4]) -> [[u32; 3]; 4] {
-    [[b, c, d], [a, d, c], [a, b, d], [a, c, b]]
-}
-
 /// What one pass over a share of the tetrahedra finds.
 #[derive(Default)]
 struct Partial {
     stats: CheckStats,
-    /// (face, 4 × tetrahedron + face slot) for every face of every non-degenerate tetrahedron.
+    /// (face, the vertex opposite it) for every face of every non-degenerate tetrahedron.
     faces: Vec<([u32; 3], u32)>,
 }
 
 /// Orientation, volume, angle and faces of `tets[range]` (indices already canonical).
-fn examine(tets: &[[u32; 4]], first: usize, positions: &[[f64; 3]]) -> Partial {
+fn examine(tets: &[[u32; 4]], positions: &[[f64; 3]]) -> Partial {
     let mut out = Partial {
         stats: CheckStats {
             min_volume: f64::INFINITY,
@@ -188,7 +182,7 @@ fn examine(tets: &[[u32; 4]], first: usize, positions: &[[f64; 3]]) -> Partial {
     let s = &mut out.stats;
     let nv = positions.len();
     let mut dihedral_cosine = -1.0f64;
-    for (i, tet) in tets.iter().enumerate() {
+    for tet in tets {
         let mut sorted = *tet;
         sorted.sort_unstable();
         if sorted.windows(2).any(|w| w[0] == w[1]) || sorted[3] as usize >= nv {
@@ -207,10 +201,13 @@ fn examine(tets: &[[u32; 4]], first: usize, positions: &[[f64; 3]]) -> Partial {
         s.min_volume = s.min_volume.min(v);
         s.max_volume = s.max_volume.max(v);
         dihedral_cosine = dihedral_cosine.max(smallest_dihedral_cosine(p));
-        let code = 4 * (first + i) as u32;
-        for (slot, f) in faces_of(*tet).into_iter().enumerate() {
-            out.faces.push((key(f), code + slot as u32));
-        }
+        let [a, b, c, d] = sorted;
+        out.faces.extend([
+            ([b, c, d], a),
+            ([a, c, d], b),
+            ([a, b, d], c),
+            ([a, b, c], d),
+        ]);
     }
     s.min_dihedral_deg = dihedral_cosine.clamp(-1.0, 1.0).acos().to_degrees();
     out
@@ -305,8 +302,7 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     let partials: Vec<Partial> = std::thread::scope(|scope| {
         let handles: Vec<_> = tets
             .chunks(chunk)
-            .enumerate()
-            .map(|(k, part)| scope.spawn(move || examine(part, k * chunk, positions)))
+            .map(|part| scope.spawn(move || examine(part, positions)))
             .collect();
         handles
             .into_iter()
@@ -347,10 +343,8 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
         let k = group[0].0;
         // A repeated tetrahedron repeats every face with the same opposite vertex; count it
         // once, at the face opposite its largest vertex.
-        let opposite = |code: u32| tets[code as usize / 4][code as usize % 4];
-        for (i, &(_, code)) in group.iter().enumerate() {
-            let o = opposite(code);
-            if o > k[2] && group[..i].iter().any(|&(_, c)| opposite(c) == o) {
+        for (i, &(_, o)) in group.iter().enumerate() {
+            if o > k[2] && group[..i].iter().any(|&(_, other)| other == o) {
                 s.duplicate_tets += 1;
             }
         }
@@ -387,15 +381,16 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     let mut offset_faces: Vec<([u32; 3], [u32; 3])> = Vec::new();
     let mut others: Vec<[u32; 3]> = Vec::new();
     let mut boundary_volume = 0.0;
-    for &(k, code) in &boundary {
-        let tet = tets[code as usize / 4];
-        let mut f = faces_of(tet)[code as usize % 4];
-        let p = tet.map(|i| c3(positions[i as usize]));
-        if robust::orient3d(p[0], p[1], p[2], p[3]) < 0.0 {
+    for &(k, o) in &boundary {
+        // Turned so that the opposite vertex lies above it: outward, clockwise seen from
+        // outside.
+        let mut f = k;
+        let [pa, pb, pc, po] = [k[0], k[1], k[2], o].map(|i| c3(positions[i as usize]));
+        if robust::orient3d(pa, pb, pc, po) > 0.0 {
             f.swap(1, 2);
         }
         let [a, b, c] = f.map(|i| positions[i as usize]);
-        // Outward faces turn clockwise seen from outside: the divergence theorem, signed.
+        // The divergence theorem, signed for that orientation.
         boundary_volume -= dot(a, cross(b, c)) / 6.0;
         match k.map(surface_vertex) {
             [Some(x), Some(y), Some(z)] if x != y && y != z && x != z => {

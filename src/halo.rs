@@ -195,22 +195,25 @@ impl Stars {
 }
 
 /// For the triangles around a vertex (`star`), whether each is wound against the vertex's
-/// reference orientation (into `reversed`): found by walking across the edges they share
+/// reference orientation (into `scratch.reversed`): found by walking across the edges they share
 /// (two triangles sharing an edge agree when they run along it in opposite directions), the
 /// reference being the winding of the majority.
-fn reversed_in_star(
-    star: &[(u32, u8)],
-    triangles: &[[u32; 3]],
-    reversed: &mut Vec<bool>,
-    stack: &mut Vec<usize>,
-) {
-    // The corners after and before the vertex in triangle i's winding.
-    let ring = |i: usize| {
-        let (t, k) = star[i];
+fn reversed_in_star(star: &[(u32, u8)], triangles: &[[u32; 3]], scratch: &mut Scratch) {
+    let Scratch {
+        ring,
+        seen,
+        reversed,
+        stack,
+        ..
+    } = scratch;
+    // The corners after and before the vertex in each triangle's winding.
+    ring.clear();
+    ring.extend(star.iter().map(|&(t, k)| {
         let tri = triangles[t as usize];
         (tri[(k as usize + 1) % 3], tri[(k as usize + 2) % 3])
-    };
-    let mut seen = vec![false; star.len()];
+    }));
+    seen.clear();
+    seen.resize(star.len(), false);
     reversed.clear();
     reversed.resize(star.len(), false);
     for seed in 0..star.len() {
@@ -220,12 +223,12 @@ fn reversed_in_star(
         seen[seed] = true;
         stack.push(seed);
         while let Some(i) = stack.pop() {
-            let (next, prev) = ring(i);
+            let (next, prev) = ring[i];
             for j in 0..star.len() {
                 if seen[j] {
                     continue;
                 }
-                let (nj, pj) = ring(j);
+                let (nj, pj) = ring[j];
                 // Sharing the edge to `next` as j's `prev` (or `prev` as `next`): agree.
                 let agree = nj == prev || pj == next;
                 let disagree = nj == next || pj == prev;
@@ -240,6 +243,25 @@ fn reversed_in_star(
     if 2 * reversed.iter().filter(|r| **r).count() > reversed.len() {
         reversed.iter_mut().for_each(|r| *r = !*r);
     }
+}
+
+/// A run of vertices' share of a [`Frame`]: directions, singular flags and, along their
+/// stars, which triangles are reversed.
+#[derive(Default)]
+struct FramePart {
+    dir: Vec<DVec3>,
+    singular: Vec<bool>,
+    reversed: Vec<bool>,
+}
+
+/// Buffers reused from vertex to vertex.
+#[derive(Default)]
+struct Scratch {
+    ring: Vec<(u32, u32)>,
+    seen: Vec<bool>,
+    reversed: Vec<bool>,
+    stack: Vec<usize>,
+    g: Vec<DVec3>,
 }
 
 /// The unit direction d maximising min_i d·g_i, and that minimum: the directions from the
@@ -298,27 +320,17 @@ fn frame(p: &Projected, triangles: &[[u32; 3]], stars: &Stars) -> Frame {
             (b - a).cross(c - a).normalize_or_zero()
         })
         .collect();
-    let mut frame = Frame {
-        dir: vec![DVec3::ZERO; n],
-        flip: vec![[false; 3]; triangles.len()],
-        singular: vec![false; n],
-    };
-    let (mut g, mut reversed, mut stack) = (Vec::new(), Vec::new(), Vec::new());
-    for v in 0..n {
+    // Per vertex: its direction, whether it is singular, and (flat, along the stars)
+    // whether each triangle around it is reversed; vertices shared among threads.
+    let vertex = |v: usize, scratch: &mut Scratch| {
         let star = stars.of(v);
-        if star.is_empty() {
-            frame.dir[v] = p.normals[v];
-            continue;
-        }
-        reversed_in_star(star, triangles, &mut reversed, &mut stack);
+        reversed_in_star(star, triangles, scratch);
+        let g = &mut scratch.g;
         g.clear();
-        g.extend(star.iter().zip(&reversed).map(|(&(t, _), &r)| {
+        g.extend(star.iter().zip(&scratch.reversed).map(|(&(t, _), &r)| {
             let f = unit_normals[t as usize];
             if r { -f } else { f }
         }));
-        for (&(t, k), &r) in star.iter().zip(&reversed) {
-            frame.flip[t as usize][k as usize] = r;
-        }
         let normal = if g.iter().map(|x| x.dot(p.normals[v])).sum::<f64>() >= 0.0 {
             p.normals[v]
         } else {
@@ -328,14 +340,54 @@ fn frame(p: &Projected, triangles: &[[u32; 3]], stars: &Stars) -> Frame {
             .iter()
             .map(|x| x.dot(normal))
             .fold(f64::INFINITY, f64::min);
-        frame.dir[v] = normal;
-        if margin < NORMAL_MARGIN {
-            let (wide, wide_margin) = widest_direction(&g);
-            if wide_margin > margin {
-                frame.dir[v] = wide;
-            }
-            frame.singular[v] = wide_margin.max(margin) <= 0.0;
+        if star.is_empty() || margin >= NORMAL_MARGIN {
+            return (normal, false);
         }
+        let (wide, wide_margin) = widest_direction(g);
+        let dir = if wide_margin > margin { wide } else { normal };
+        (dir, wide_margin.max(margin) <= 0.0)
+    };
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |t| t.get())
+        .min(8);
+    let share = n.div_ceil(threads).max(1);
+    // Each thread's vertices, joined in vertex order.
+    let parts: Vec<FramePart> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..n)
+            .step_by(share)
+            .map(|first| {
+                let vertex = &vertex;
+                scope.spawn(move || {
+                    let mut scratch = Scratch::default();
+                    let mut part = FramePart::default();
+                    for v in first..(first + share).min(n) {
+                        let (dir, singular) = vertex(v, &mut scratch);
+                        part.dir.push(dir);
+                        part.singular.push(singular);
+                        part.reversed.extend_from_slice(&scratch.reversed);
+                    }
+                    part
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("frame thread"))
+            .collect()
+    });
+    let mut frame = Frame {
+        dir: Vec::with_capacity(n),
+        flip: vec![[false; 3]; triangles.len()],
+        singular: Vec::with_capacity(n),
+    };
+    let mut reversed = Vec::with_capacity(stars.uses.len());
+    for part in parts {
+        frame.dir.extend(part.dir);
+        frame.singular.extend(part.singular);
+        reversed.extend(part.reversed);
+    }
+    for (&(t, k), r) in stars.uses.iter().zip(reversed) {
+        frame.flip[t as usize][k as usize] = r;
     }
     frame
 }

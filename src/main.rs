@@ -86,8 +86,8 @@ fn main() -> ExitCode {
                     }
                     let t = report.timings_ms;
                     eprintln!(
-                        "sample {:.1} ms, audit {:.1} ms, view {:.1} ms, export {:.1} ms, total {:.1} ms",
-                        t.sample, t.audit, t.view, t.export, t.total
+                        "sample {:.1} ms, audit {:.1} ms, view {:.1} ms, halo {:.1} ms, export {:.1} ms, total {:.1} ms",
+                        t.sample, t.audit, t.view, t.halo, t.export, t.total
                     );
                     for f in &report.files {
                         println!("{}", out.join(f).display());

@@ -351,13 +351,11 @@ fn min_dihedral(p: [DVec3; 4]) -> f64 {
     }
     // Outward normals of the faces opposite each vertex.
     let normal = |i: usize| {
-        let [a, b, c] = [0, 1, 2, 3]
-            .into_iter()
-            .filter(|&k| k != i)
-            .map(|k| p[k])
-            .collect::<Vec<_>>()[..]
-        else {
-            unreachable!()
+        let (a, b, c) = match i {
+            0 => (p[1], p[2], p[3]),
+            1 => (p[0], p[2], p[3]),
+            2 => (p[0], p[1], p[3]),
+            _ => (p[0], p[1], p[2]),
         };
         let n = (b - a).cross(c - a).normalize_or_zero();
         if n.dot(p[i] - a) > 0.0 { -n } else { n }
