@@ -7,19 +7,24 @@
 //! as d_new = d_orig + max(0, |2t - 1| - delta_t) delta_d, evaluated after interpolating t
 //! and d_orig, so the halo carries those two and not d_new.
 //!
-//! The normal n̂ is the view's: the normalized cross product of the projected tangents
-//! (eq. 1); where they are (nearly) parallel, at cross-caps of the projection and at the
-//! poles of spun spheres, and where a triangle around the vertex faces away from it, it is
-//! the normalized sum of the area-weighted normals of the triangles around the vertex,
-//! which depends on the mesh and not on the parametrization ([`offset_directions`]). It is
-//! never NaN.
+//! The offset direction d of a vertex is the view's normal n̂ (eq. 1: the normalized cross
+//! product of the projected tangents) where every triangle around the vertex faces it by a
+//! margin; elsewhere (at cross-caps of the projection and the poles of spun spheres, where
+//! the tangents are parallel, and where the mesh folds) it is the widest direction of the
+//! triangles around the vertex ([`widest_direction`]), which depends on the mesh and the
+//! view, not on the parametrization. Never NaN. Each vertex orients the triangles around it
+//! by walking across their shared edges; where a non-orientable surface turns over, a prism's
+//! corners disagree and the prism is twisted (see [`crate::tets`]).
 //!
-//! Where rho exceeds what the local geometry allows, the offsets fold and prisms invert.
-//! With `fold: shrink` (the default) rho is halved at the corners of every inverted prism
-//! for as long as that leaves fewer of them (at most 30 times); the report counts the
-//! vertices shrunk. Prisms that no rho mends (around cross-caps, and across the seam of a
-//! non-orientable surface) stay inverted and are counted. With `fold: report` the inverted
-//! tetrahedra are only counted.
+//! Where no direction faces every triangle around a vertex (a cross-cap: the normals turn
+//! through a full circle around it), no rho keeps its prisms valid: the vertex is singular
+//! and its rho is 0. Where rho exceeds what the local geometry allows, the offsets fold and
+//! prisms invert: with `fold: shrink` (the default) rho is halved at the corners of every
+//! inverted tetrahedron, re-examining only the prisms around them, until none is inverted;
+//! a vertex halved [`HALVINGS`] times collapses to 0. A collapsed vertex has both offsets at
+//! the surface point, with t = 0.5, and only the negative one's index is used. With
+//! `fold: report` rho stays as asked and the inverted tetrahedra are counted. Vertices are
+//! rounded to f32, what the files store, before they are checked.
 
 use crate::check::{CheckStats, TetMesh, check};
 use crate::tets::{self, Corners, Split, SplitStats};
@@ -393,7 +398,7 @@ fn frame(p: &Projected, triangles: &[[u32; 3]], stars: &Stars) -> Frame {
 }
 
 /// Halvings of rho at a vertex before it collapses to zero.
-const HALVINGS: u32 = 10;
+pub const HALVINGS: u32 = 10;
 
 /// Rounds of shrinking at most; each round halves rho around every inverted prism.
 const MAX_ROUNDS: usize = 4 * HALVINGS as usize;
