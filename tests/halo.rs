@@ -5,7 +5,7 @@ use crate::common::{Rng, fixture, fixture_scenes};
 use glam::DVec3;
 use halo4d::Scene;
 use halo4d::check::{CheckStats, TetMesh, check};
-use halo4d::halo::{Fold, HaloParams, build_halo};
+use halo4d::halo::{Fold, Halo, HaloParams, HaloReport, build_halo};
 use halo4d::sample::Sampling;
 use halo4d::tets::{self, Corners, Split, prism};
 use halo4d::view::Projected;
@@ -78,22 +78,40 @@ fn assert_valid(stats: &CheckStats, what: &str) {
     assert_eq!(stats.quad_mismatches, 0, "{what}");
 }
 
+/// The halo of a mesh with each split (rho 0.05), each checked valid by the checker, with
+/// no mismatched quad left by the builder: (split, halo, report, checker's statistics).
+fn with_each_split(
+    projected: &Projected,
+    triangles: &[[u32; 3]],
+    what: &str,
+) -> Vec<(Split, Halo, HaloReport, CheckStats)> {
+    [Split::Paper, Split::GlobalOrder, Split::Quality]
+        .into_iter()
+        .map(|split| {
+            let what = format!("{what}, {split:?}");
+            let params = HaloParams {
+                split,
+                ..HaloParams::default()
+            };
+            let (halo, report) = build_halo(projected, triangles, 0.05, &params);
+            let stats = check(&halo.tet_mesh());
+            assert_valid(&stats, &what);
+            assert_eq!(report.split_stats.mismatches_final, 0, "{what}");
+            assert_eq!(report.inverted, 0, "{what}");
+            (split, halo, report, stats)
+        })
+        .collect()
+}
+
 #[test]
 fn every_split_conforms_on_random_meshes_with_a_boundary() {
     let mut rng = Rng(2024);
     for round in 0..12 {
         let (nx, ny) = (2 + rng.below(9), 2 + rng.below(9));
         let (projected, triangles) = random_surface(&mut rng, nx, ny);
-        for split in [Split::Paper, Split::GlobalOrder, Split::Quality] {
-            let what = format!("round {round}, {nx}x{ny}, {split:?}");
-            let params = HaloParams {
-                split,
-                ..HaloParams::default()
-            };
-            let (halo, report) = build_halo(&projected, &triangles, 0.05, &params);
-            let stats = check(&halo.tet_mesh());
-            assert_valid(&stats, &what);
-            assert_eq!(report.split_stats.mismatches_final, 0, "{what}");
+        let what = format!("round {round}, {nx}x{ny}");
+        for (split, halo, report, stats) in with_each_split(&projected, &triangles, &what) {
+            let what = format!("{what}, {split:?}");
             assert_eq!(
                 stats.boundary_faces,
                 2 * triangles.len() + 2 * 2 * (nx + ny),
@@ -312,17 +330,9 @@ fn a_moebius_band_with_random_windings_gets_twisted_prisms_and_stays_valid() {
     for round in 0..6 {
         let (nu, nv) = (12 + rng.below(20), 1 + rng.below(4));
         let (projected, triangles) = random_moebius(&mut rng, nu, nv);
-        for split in [Split::Paper, Split::GlobalOrder, Split::Quality] {
-            let what = format!("round {round}, {nu}x{nv}, {split:?}");
-            let params = HaloParams {
-                split,
-                ..HaloParams::default()
-            };
-            let (halo, report) = build_halo(&projected, &triangles, 0.05, &params);
-            let stats = check(&halo.tet_mesh());
-            assert_valid(&stats, &what);
-            assert_eq!(report.split_stats.mismatches_final, 0, "{what}");
-            assert_eq!(report.inverted, 0, "{what}");
+        let what = format!("round {round}, {nu}x{nv}");
+        for (split, _, report, stats) in with_each_split(&projected, &triangles, &what) {
+            let what = format!("{what}, {split:?}");
             // The band cannot be oriented: somewhere the offsets turn over.
             assert!(report.twisted_prisms > 0, "{what}");
             // One boundary circle of 2 nu edges: a side wall of two faces over each.
@@ -347,16 +357,7 @@ fn every_split_conforms_with_holes_and_bowtie_boundary_vertices() {
             let i = rng.below(triangles.len());
             triangles.swap_remove(i);
         }
-        for split in [Split::Paper, Split::GlobalOrder, Split::Quality] {
-            let what = format!("round {round}, {split:?}");
-            let params = HaloParams {
-                split,
-                ..HaloParams::default()
-            };
-            let (halo, report) = build_halo(&projected, &triangles, 0.05, &params);
-            assert_valid(&check(&halo.tet_mesh()), &what);
-            assert_eq!(report.split_stats.mismatches_final, 0, "{what}");
-        }
+        with_each_split(&projected, &triangles, &format!("round {round}"));
     }
 }
 
