@@ -4,7 +4,7 @@
 
 use crate::common::{Rng, fixture, fixture_scenes};
 use halo4d::Scene;
-use halo4d::check::{CheckStats, TetMesh, check};
+use halo4d::check::check;
 use halo4d::import::{ImportError, ImportedHalo, read, read_glb, read_vtk};
 use halo4d::pipeline::SurfaceProduct;
 use serde_json::Value;
@@ -29,14 +29,6 @@ fn patches(dir: &Path) -> (PathBuf, PathBuf, Vec<SurfaceProduct>) {
     )
 }
 
-/// The halo with positions rounded to f32, as the .glb stores them.
-fn rounded(mut mesh: TetMesh) -> TetMesh {
-    for p in &mut mesh.positions {
-        *p = p.map(|x| f64::from(x as f32));
-    }
-    mesh
-}
-
 fn bits(values: &[f64]) -> Vec<u64> {
     values.iter().map(|x| x.to_bits()).collect()
 }
@@ -50,28 +42,6 @@ fn f32_bits(values: &[f64]) -> Vec<u64> {
         .iter()
         .map(|&x| f64::from(x as f32).to_bits())
         .collect()
-}
-
-/// Whether two runs of the checker agree: every count exactly, and every measure exactly but
-/// the sums over boundary faces, which the checker adds in hash-map order (so in an order
-/// that changes from run to run) and which therefore agree to rounding only.
-fn same_stats(a: &CheckStats, b: &CheckStats) -> bool {
-    let (Value::Object(a), Value::Object(b)) = (
-        serde_json::to_value(a).unwrap(),
-        serde_json::to_value(b).unwrap(),
-    ) else {
-        unreachable!("statistics serialize as a map")
-    };
-    a.len() == b.len()
-        && a.iter()
-            .all(|(k, x)| match (k.as_str(), x.as_f64(), b[k].as_f64()) {
-                ("boundary_volume", Some(x), Some(y)) => {
-                    (x - y).abs() <= 1e-12 * x.abs().max(y.abs())
-                }
-                // A relative difference of nearly equal volumes: its rounding is absolute.
-                ("volume_defect", Some(x), Some(y)) => (x - y).abs() <= 1e-12,
-                _ => *x == b[k],
-            })
 }
 
 fn halo4d(args: &[&str], dir: &Path) -> std::process::Output {
@@ -203,24 +173,13 @@ fn every_fixture_halo_reads_back_unchanged_from_glb_and_vtk() {
                 assert_eq!(h.params.delta_d, Some(scene.halo.delta_d), "{what}");
                 assert_eq!(h.params.delta_t, Some(scene.halo.delta_t), "{what}");
             }
-            // The .glb: f32, exactly the values written.
-            assert_eq!(
-                bits3(&g.mesh.positions),
-                bits3(&rounded(mesh.clone()).positions)
-            );
+            // The .glb: f32, and the halo's positions are exact in f32, so bit for bit.
+            assert_eq!(bits3(&g.mesh.positions), bits3(&mesh.positions), "{what}");
             assert_eq!(bits(g.t.as_ref().unwrap()), f32_bits(&halo.t), "{what}");
             assert_eq!(bits(g.d_orig.as_ref().unwrap()), f32_bits(&halo.d_orig));
             assert_eq!(g.params.split.as_deref(), Some(scene.halo.split.name()));
-            // The checker sees in the file what it saw in memory (where the halo's positions
-            // are exact in f32, as the layout has them, the rounding changes nothing).
-            let glb_stats = check(&g.mesh);
-            let same = |a: &CheckStats, b: &CheckStats| {
-                assert!(same_stats(a, b), "{what}:\n{a:?}\n{b:?}");
-            };
-            same(&glb_stats, &check(&rounded(mesh.clone())));
-            if rounded(mesh.clone()) == mesh {
-                same(&glb_stats, &expected);
-            }
+            // The checker sees in the files exactly what it saw in memory.
+            assert_eq!(check(&g.mesh), expected, "{what}");
             // The .vtk: f64, bit for bit.
             assert_eq!(bits3(&v.mesh.positions), bits3(&mesh.positions), "{what}");
             assert_eq!(bits(v.t.as_ref().unwrap()), bits(&halo.t), "{what}");
@@ -229,7 +188,7 @@ fn every_fixture_halo_reads_back_unchanged_from_glb_and_vtk() {
                 bits(&halo.d_orig),
                 "{what}"
             );
-            same(&check(&v.mesh), &expected);
+            assert_eq!(check(&v.mesh), expected, "{what}");
             // An ASCII copy reads back bit for bit too (Rust prints f64 so that it parses
             // back exactly).
             let a = read_vtk(ascii_vtk(&v, true).as_bytes()).unwrap();
