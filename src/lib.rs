@@ -14,6 +14,7 @@ pub mod error;
 pub mod export;
 pub mod halo;
 pub mod import;
+pub mod intersect;
 pub mod pipeline;
 pub mod sample;
 pub mod scene;

@@ -1,0 +1,443 @@
+//! The exact self-intersection curves of projected surfaces, with over and under.
+//!
+//! Takes: sheets (projected surfaces: 3D positions, w-depth, triangles), all of a scene
+//! together, so curves between surfaces are found as well as self-intersections. Gives:
+//! [`Curves`], polylines whose vertices are *events*, "edge e crosses triangle f", each
+//! carrying the w-depth of both sheets there.
+//!
+//! - Broad phase: an obvhs BVH over the triangles' boxes, traversed against itself
+//!   ([`broad`]).
+//! - Narrow phase: exact `robust::orient3d` under Simulation of Simplicity ([`sos`]), so
+//!   coplanar overlaps, vertices exactly on triangles and edges through edges are decided
+//!   consistently rather than skipped ([`exact`]). Triangles sharing an edge never cross;
+//!   triangles sharing a vertex cross only along a segment that ends at that vertex, which
+//!   is how a curve ends at a cross-cap (a branch point of the projection).
+//! - Chaining by shared events, without a distance tolerance ([`chain`]): closed curves
+//!   close, open ones end at a mesh boundary or a branch point.
+//!
+//! Only the coordinates of the points are rounded; every decision is exact. What the
+//! perturbation decided is counted (`perturbed`, `coplanar` in [`CurvesReport`]), as is
+//! anything that could not be resolved.
+
+pub mod broad;
+mod chain;
+pub mod exact;
+pub mod sos;
+
+pub use exact::Node;
+use exact::{Pair, Segment, Soup};
+use glam::DVec3;
+use obvhs::aabb::Aabb;
+use serde::Serialize;
+use std::time::Instant;
+
+/// One projected surface.
+#[derive(Clone, Copy, Debug)]
+pub struct Sheet<'a> {
+    /// Vertex positions in 3D.
+    pub positions: &'a [DVec3],
+    /// w-depth of each vertex (smaller is nearer).
+    pub w: &'a [f64],
+    /// Triangles.
+    pub triangles: &'a [[u32; 3]],
+}
+
+/// A triangle of one of the sheets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+pub struct Face {
+    /// Index of the sheet (surface) in the input.
+    pub surface: u32,
+    /// Triangle index in that sheet.
+    pub triangle: u32,
+}
+
+/// A vertex of a curve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CurvePoint {
+    /// Where it is.
+    pub position: DVec3,
+    /// w-depth of the curve's two sheets here, labelled consistently along the curve.
+    pub w: [f64; 2],
+    /// A triangle of each sheet that contains the point.
+    pub faces: [Face; 2],
+    /// The event, in global indices (vertices and triangles of all sheets in order).
+    pub node: Node,
+    /// The event's edge lies in its face's plane (a coplanar overlap decided by the
+    /// perturbation; the point is placed in the middle of the overlap).
+    pub coplanar: bool,
+}
+
+impl CurvePoint {
+    /// Which sheet (0 or 1) is nearer in w here (0 on a tie).
+    pub fn near(&self) -> usize {
+        usize::from(self.w[1] < self.w[0])
+    }
+
+    /// w of the far sheet minus w of the near sheet (>= 0).
+    pub fn dw(&self) -> f64 {
+        (self.w[0] - self.w[1]).abs()
+    }
+}
+
+/// How an open curve ends.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum End {
+    /// The curve is closed.
+    Closed,
+    /// At a boundary edge of a mesh.
+    Boundary,
+    /// At a mesh vertex where the projection folds (a cross-cap).
+    BranchPoint,
+    /// At a node where more than two segments meet; counted as unresolved.
+    Branch,
+}
+
+/// A self-intersection curve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Curve {
+    /// Its vertices in order; a closed curve returns from the last to the first.
+    pub points: Vec<CurvePoint>,
+    /// Whether it closes.
+    pub closed: bool,
+    /// How it ends at its first and last point.
+    pub ends: [End; 2],
+}
+
+/// Which pairs of triangles reach the exact tests.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BroadPhase {
+    /// Pairs whose boxes touch, from the BVH.
+    #[default]
+    Bvh,
+    /// Every pair (for testing the BVH; quadratic).
+    AllPairs,
+}
+
+/// `report.json`'s `curves`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct CurvesReport {
+    /// Curves.
+    pub count: usize,
+    /// Closed curves.
+    pub closed: usize,
+    /// Open curves.
+    pub open: usize,
+    /// Curve vertices (events).
+    pub points: usize,
+    /// Open-curve ends at a mesh boundary.
+    pub boundary_ends: usize,
+    /// Open-curve ends at a branch point (cross-cap).
+    pub branch_point_ends: usize,
+    /// Points where three sheets cross.
+    pub triple_points: usize,
+    /// Events whose edge lies in the plane of its face (coplanar overlaps).
+    pub coplanar: usize,
+    /// Events with a vertex exactly on the other triangle's plane, decided by the
+    /// perturbation.
+    pub perturbed: usize,
+    /// What could not be resolved: nodes where more than two segments meet, curves ending
+    /// at an edge that is not a boundary, triangle pairs whose predicates disagreed, and
+    /// triple points whose constructed points lie exactly on a plane.
+    pub unresolved: usize,
+    /// Triangles, all sheets.
+    pub triangles: usize,
+    /// Triangle pairs the broad phase passed on.
+    pub candidate_pairs: usize,
+    /// Crossing triangle pairs (curve segments).
+    pub segments: usize,
+    /// Milliseconds in all.
+    pub ms: f64,
+    /// Of which building the BVH (with the boxes).
+    pub bvh_ms: f64,
+    /// Traversing it.
+    pub traverse_ms: f64,
+    /// The exact tests.
+    pub exact_ms: f64,
+    /// Placing, chaining and counting.
+    pub chain_ms: f64,
+}
+
+/// The curves and what they cost.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Curves {
+    /// The curves.
+    pub curves: Vec<Curve>,
+    /// Counts and timings.
+    pub report: CurvesReport,
+}
+
+/// The intersection curves of `sheets`, with the BVH broad phase.
+pub fn curves(sheets: &[Sheet]) -> Curves {
+    curves_with(sheets, BroadPhase::Bvh)
+}
+
+/// The intersection curves of `sheets`, with the given broad phase.
+pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
+    let start = Instant::now();
+    let mut report = CurvesReport::default();
+    let (soup, tri_start) = merge(sheets);
+    report.triangles = soup.tris.len();
+
+    let mut pairs: Vec<(u32, u32)> = Vec::new();
+    match broad_phase {
+        BroadPhase::Bvh => {
+            let boxes: Vec<_> = soup
+                .tris
+                .iter()
+                .map(|t| {
+                    let p = t.map(|v| soup.positions[v as usize]);
+                    broad::outward(p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
+                })
+                .collect();
+            let groups = groups(&soup.tris);
+            let group_boxes: Vec<_> = groups
+                .windows(2)
+                .map(|g| {
+                    boxes[g[0] as usize..g[1] as usize]
+                        .iter()
+                        .fold(Aabb::INVALID, |u, b| u.union(b))
+                })
+                .collect();
+            let bvh = broad::build(&group_boxes, 2);
+            report.bvh_ms = ms(start);
+            let t = Instant::now();
+            let mut test = |a: u32, b: u32| {
+                if boxes[a as usize].intersect_aabb(&boxes[b as usize]) {
+                    pairs.push((a.min(b), a.max(b)));
+                }
+            };
+            for g in groups.windows(2) {
+                for a in g[0]..g[1] {
+                    for b in a + 1..g[1] {
+                        test(a, b);
+                    }
+                }
+            }
+            broad::self_pairs(&bvh, &group_boxes, |ga, gb| {
+                for a in groups[ga as usize]..groups[ga as usize + 1] {
+                    for b in groups[gb as usize]..groups[gb as usize + 1] {
+                        test(a, b);
+                    }
+                }
+            });
+            report.traverse_ms = ms(t);
+        }
+        BroadPhase::AllPairs => {
+            let n = soup.tris.len() as u32;
+            pairs = (0..n)
+                .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
+                .collect();
+        }
+    }
+    report.candidate_pairs = pairs.len();
+
+    let t = Instant::now();
+    let mut segments: Vec<Segment> = Vec::new();
+    for &(a, b) in &pairs {
+        match soup.pair(a, b) {
+            Pair::Apart => {}
+            Pair::Cross(s) => segments.push(s),
+            Pair::Inconsistent(..) => report.unresolved += 1,
+        }
+    }
+    drop(pairs);
+    report.exact_ms = ms(t);
+    report.segments = segments.len();
+
+    let t = Instant::now();
+    let face = |g: u32| {
+        let surface = tri_start.partition_point(|&s| s <= g) - 1;
+        Face {
+            surface: surface as u32,
+            triangle: g - tri_start[surface],
+        }
+    };
+    let (curves, branches) = chain::chain(&soup, &segments, face);
+    report.unresolved += branches;
+    let boundary = curves
+        .iter()
+        .any(|c| c.ends.contains(&End::Boundary))
+        .then(|| BoundaryEdges::new(&soup));
+    for c in &curves {
+        report.points += c.points.len();
+        for p in &c.points {
+            report.coplanar += usize::from(p.coplanar);
+            report.perturbed += usize::from(on_plane(&soup, p.node));
+        }
+        if c.closed {
+            report.closed += 1;
+            continue;
+        }
+        report.open += 1;
+        for (end, point) in c
+            .ends
+            .iter()
+            .zip([&c.points[0], &c.points[c.points.len() - 1]])
+        {
+            match *end {
+                End::Boundary => {
+                    if let Node::Crossing { edge, .. } = point.node
+                        && boundary.as_ref().is_some_and(|b| b.contains(edge))
+                    {
+                        report.boundary_ends += 1;
+                    } else {
+                        report.unresolved += 1;
+                    }
+                }
+                End::BranchPoint => report.branch_point_ends += 1,
+                End::Branch | End::Closed => {}
+            }
+        }
+    }
+    report.count = curves.len();
+    let (triples, undecided) = triple_points(&soup, &segments);
+    report.triple_points = triples;
+    report.unresolved += undecided;
+    report.chain_ms = ms(t);
+    report.ms = ms(start);
+    Curves { curves, report }
+}
+
+/// Runs of up to four consecutive triangles that share a vertex with the run's first (as
+/// samplers emit them, a quad's two triangles together), as the starts of the runs and the
+/// end. The BVH is built over runs: a quarter of the primitives, and neighbours inside a
+/// run need no traversal.
+fn groups(tris: &[[u32; 3]]) -> Vec<u32> {
+    let mut starts = Vec::with_capacity(tris.len() / 2 + 1);
+    let mut i = 0;
+    while i < tris.len() {
+        starts.push(i as u32);
+        let (start, first) = (i, tris[i]);
+        i += 1;
+        while i < tris.len() && i - start < 4 && tris[i].iter().any(|v| first.contains(v)) {
+            i += 1;
+        }
+    }
+    starts.push(tris.len() as u32);
+    starts
+}
+
+/// All sheets in one soup with global indices, and the first global triangle of each sheet.
+fn merge(sheets: &[Sheet]) -> (Soup, Vec<u32>) {
+    let mut soup = Soup::default();
+    let mut tri_start = Vec::with_capacity(sheets.len());
+    for s in sheets {
+        let base = soup.positions.len() as u32;
+        tri_start.push(soup.tris.len() as u32);
+        soup.positions.extend_from_slice(s.positions);
+        soup.w.extend_from_slice(s.w);
+        soup.tris
+            .extend(s.triangles.iter().map(|t| t.map(|v| v + base)));
+    }
+    (soup, tri_start)
+}
+
+/// Whether an event had one of its edge's vertices exactly in its face's plane.
+fn on_plane(soup: &Soup, node: Node) -> bool {
+    match node {
+        Node::Vertex(_) => false,
+        Node::Crossing { edge, face } => {
+            let f = soup.tris[face as usize].map(|v| soup.positions[v as usize]);
+            edge.iter()
+                .any(|&v| sos::orient3d(f[0], f[1], f[2], soup.positions[v as usize]) == 0.0)
+        }
+    }
+}
+
+/// The edges with one triangle.
+struct BoundaryEdges(Vec<[u32; 2]>);
+
+impl BoundaryEdges {
+    fn new(soup: &Soup) -> Self {
+        let mut edges: Vec<[u32; 2]> = soup
+            .tris
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| [t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])]))
+            .collect();
+        edges.sort_unstable();
+        let mut single = Vec::new();
+        let mut i = 0;
+        while i < edges.len() {
+            let mut j = i + 1;
+            while j < edges.len() && edges[j] == edges[i] {
+                j += 1;
+            }
+            if j - i == 1 {
+                single.push(edges[i]);
+            }
+            i = j;
+        }
+        BoundaryEdges(single)
+    }
+
+    fn contains(&self, edge: [u32; 2]) -> bool {
+        self.0.binary_search(&edge).is_ok()
+    }
+}
+
+/// Triple points: in a triangle A crossed by B and by C, the segments A∩B and A∩C cross
+/// where the ends of each lie on opposite sides of the other's plane. Counted once, in the
+/// triple's smallest triangle. The ends are constructed points, so a side that is exactly
+/// zero is not decided: it is returned as the second count. Triangles of a triple that
+/// share a vertex are one sheet, and no triple point.
+fn triple_points(soup: &Soup, segments: &[Segment]) -> (usize, usize) {
+    let places: Vec<[DVec3; 2]> = segments
+        .iter()
+        .map(|s| s.ends.map(|n| soup.place(n).0))
+        .collect();
+    let mut by_tri: Vec<(u32, u32, u32)> = segments
+        .iter()
+        .enumerate()
+        .flat_map(|(i, s)| {
+            [
+                (s.tris[0], s.tris[1], i as u32),
+                (s.tris[1], s.tris[0], i as u32),
+            ]
+        })
+        .collect();
+    by_tri.sort_unstable();
+    let side = |tri: u32, p: DVec3| {
+        let f = soup.tris[tri as usize].map(|v| soup.positions[v as usize]);
+        sos::orient3d(f[0], f[1], f[2], p)
+    };
+    let separated = |tri: u32, ends: [DVec3; 2]| -> Option<bool> {
+        let (a, b) = (side(tri, ends[0]), side(tri, ends[1]));
+        (a != 0.0 && b != 0.0).then_some((a > 0.0) != (b > 0.0))
+    };
+    // Triangles that share a vertex are one sheet there, not two.
+    let touch = |x: u32, y: u32| {
+        let (tx, ty) = (soup.tris[x as usize], soup.tris[y as usize]);
+        tx.iter().any(|v| ty.contains(v))
+    };
+    let (mut triples, mut undecided) = (0, 0);
+    let mut i = 0;
+    while i < by_tri.len() {
+        let mut j = i;
+        while j < by_tri.len() && by_tri[j].0 == by_tri[i].0 {
+            j += 1;
+        }
+        let a = by_tri[i].0;
+        for x in i..j {
+            for y in x + 1..j {
+                let ((_, b, sb), (_, c, sc)) = (by_tri[x], by_tri[y]);
+                if b == c || a > b || a > c || touch(b, c) || touch(a, b) || touch(a, c) {
+                    continue;
+                }
+                match (
+                    separated(c, places[sb as usize]),
+                    separated(b, places[sc as usize]),
+                ) {
+                    (Some(true), Some(true)) => triples += 1,
+                    (Some(false), _) | (_, Some(false)) => {}
+                    _ => undecided += 1,
+                }
+            }
+        }
+        i = j;
+    }
+    (triples, undecided)
+}
+
+fn ms(since: Instant) -> f64 {
+    since.elapsed().as_secs_f64() * 1e3
+}
