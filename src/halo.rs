@@ -403,6 +403,53 @@ pub const HALVINGS: u32 = 10;
 /// Rounds of shrinking at most; each round halves rho around every inverted prism.
 const MAX_ROUNDS: usize = 4 * HALVINGS as usize;
 
+/// How many times rho is graded (each followed by shrinking what grading inverted).
+const MAX_GRADINGS: usize = 8;
+
+/// The largest ratio of neighbouring half-widths. Inside a prism whose corners' rho differ
+/// by a ratio r, the surface triangle leaves the prism's mid-section: along a side quad
+/// split through a diagonal, the surface edge reaches |2t - 1| = (r - 1) / (r + 1). Keeping
+/// that within the dead zone delta_t of eq. 3 keeps the halo depth on the surface equal to
+/// d_orig, so a sheet crossing it is hidden however close it is in w.
+pub fn grade(delta_t: f64) -> f64 {
+    ((1.0 + delta_t) / (1.0 - delta_t)).clamp(1.05, 2.0)
+}
+
+/// Lowers rho where a neighbour's is more than `grade` times smaller (a Dijkstra sweep from
+/// the smallest, on the mesh's edges), leaving collapsed vertices (rho 0) out. Returns the
+/// vertices lowered.
+fn graded(rho: &mut [f64], stars: &Stars, triangles: &[[u32; 3]], grade: f64) -> Vec<u32> {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+    // Positive f64s order as their bits.
+    let mut heap: BinaryHeap<Reverse<(u64, u32)>> = rho
+        .iter()
+        .enumerate()
+        .filter(|&(_, &r)| r > 0.0)
+        .map(|(v, &r)| Reverse((r.to_bits(), v as u32)))
+        .collect();
+    let mut changed = Vec::new();
+    while let Some(Reverse((bits, v))) = heap.pop() {
+        if bits != rho[v as usize].to_bits() {
+            continue;
+        }
+        let limit = f64::from_bits(bits) * grade;
+        for &(t, _) in stars.of(v as usize) {
+            for &u in &triangles[t as usize] {
+                let r = &mut rho[u as usize];
+                if *r > limit {
+                    *r = limit;
+                    changed.push(u);
+                    heap.push(Reverse((limit.to_bits(), u)));
+                }
+            }
+        }
+    }
+    changed.sort_unstable();
+    changed.dedup();
+    changed
+}
+
 /// Rounds to f32, the precision of the exported files, so that the checked halo is the
 /// exported one.
 fn f32_exact(p: DVec3) -> DVec3 {
@@ -509,39 +556,57 @@ pub fn build_halo(
 
     if shrink {
         // Halve rho at the corners of inverted tetrahedra, re-examining only the prisms
-        // around them, until none is left; a vertex halved HALVINGS times collapses.
+        // around them, until none is left; a vertex halved HALVINGS times collapses. Then
+        // grade rho so neighbours differ by at most `grade`, and go on while grading
+        // inverts anything.
         let floor = rho * 0.5f64.powi(HALVINGS as i32);
+        let grade = grade(params.delta_t);
         let mut bad = Vec::new();
         for (c, f) in corners.iter().zip(&forward) {
             inverted_corners(c, *f, &offsets.positions, &mut bad);
         }
         let mut stamp = vec![usize::MAX; triangles.len()];
-        for round in 0..MAX_ROUNDS {
-            bad.sort_unstable();
-            bad.dedup();
-            if bad.is_empty() {
-                break;
-            }
-            for &v in &bad {
-                let v = v as usize;
-                offsets.rho[v] = if offsets.rho[v] > floor {
-                    0.5 * offsets.rho[v]
-                } else {
-                    0.0
-                };
-                offsets.place(v);
-            }
-            let touched = std::mem::take(&mut bad);
-            for &v in &touched {
+        let mut round = 0;
+        let mut reexamine = |touched: &[u32], offsets: &Offsets, bad: &mut Vec<u32>| {
+            round += 1;
+            for &v in touched {
                 for &(t, _) in stars.of(v as usize) {
                     let t = t as usize;
                     if stamp[t] != round {
                         stamp[t] = round;
                         corners[t] = offsets.corners(triangles[t], frame.flip[t]);
-                        inverted_corners(&corners[t], forward[t], &offsets.positions, &mut bad);
+                        inverted_corners(&corners[t], forward[t], &offsets.positions, bad);
                     }
                 }
             }
+        };
+        for _ in 0..MAX_GRADINGS {
+            for _ in 0..MAX_ROUNDS {
+                bad.sort_unstable();
+                bad.dedup();
+                if bad.is_empty() {
+                    break;
+                }
+                for &v in &bad {
+                    let v = v as usize;
+                    offsets.rho[v] = if offsets.rho[v] > floor {
+                        0.5 * offsets.rho[v]
+                    } else {
+                        0.0
+                    };
+                    offsets.place(v);
+                }
+                let touched = std::mem::take(&mut bad);
+                reexamine(&touched, &offsets, &mut bad);
+            }
+            let changed = graded(&mut offsets.rho, &stars, triangles, grade);
+            if changed.is_empty() {
+                break;
+            }
+            for &v in &changed {
+                offsets.place(v as usize);
+            }
+            reexamine(&changed, &offsets, &mut bad);
         }
     }
     let tets = tets::emit(&corners, &forward, &offsets.positions, n, stats);

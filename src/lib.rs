@@ -21,10 +21,11 @@ pub mod scene;
 pub mod surfaces;
 pub mod sweep;
 pub mod tets;
+pub mod verify;
 pub mod view;
 
 pub use error::Error;
-pub use pipeline::{Report, build, run, write};
+pub use pipeline::{Built, Report, build, run, write};
 pub use sample::{Mesh4, MeshStats, Sampling, sample, sample_adaptive, sample_uniform};
 pub use scene::{Scene, SceneError};
 pub use surfaces::{Domain, Eval4, Surface, Topology};

@@ -84,10 +84,26 @@ fn main() -> ExitCode {
                             s.name, s.vertices, s.triangles, s.mesh.euler_characteristic
                         );
                     }
+                    let (c, v) = (&report.curves, &report.halo_verification);
+                    eprintln!(
+                        "curves: {} ({} closed, {} open), {} points, {} triple points, {} unresolved",
+                        c.count, c.closed, c.open, c.points, c.triple_points, c.unresolved
+                    );
+                    eprintln!(
+                        "halo verification: {} curve samples: {} correct, {} wrong, {} ambiguous, {} third sheet; {} surface samples: {} hidden, {} spurious",
+                        v.curve_samples,
+                        v.correct,
+                        v.wrong,
+                        v.ambiguous,
+                        v.third_sheet,
+                        v.surface_samples,
+                        v.hidden_samples,
+                        v.spurious_hidden_samples
+                    );
                     let t = report.timings_ms;
                     eprintln!(
-                        "sample {:.1} ms, audit {:.1} ms, view {:.1} ms, halo {:.1} ms, export {:.1} ms, total {:.1} ms",
-                        t.sample, t.audit, t.view, t.halo, t.export, t.total
+                        "sample {:.1} ms, audit {:.1} ms, view {:.1} ms, halo {:.1} ms, curves {:.1} ms, verify {:.1} ms, export {:.1} ms, total {:.1} ms",
+                        t.sample, t.audit, t.view, t.halo, t.curves, t.verify, t.export, t.total
                     );
                     for f in &report.files {
                         println!("{}", out.join(f).display());

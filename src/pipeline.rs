@@ -6,9 +6,11 @@
 use crate::error::Error;
 use crate::export::{self, SurfaceData};
 use crate::halo::{Halo, HaloParams, HaloReport, build_halo};
+use crate::intersect::{self, Curves, CurvesReport, Sheet};
 use crate::sample::{self, Audit, Mesh4, MeshStats, Sampling, audit};
 use crate::scene::Scene;
 use crate::surfaces::{Surface, Topology};
+use crate::verify::{self, HaloInput, Verification};
 use crate::view::Projected;
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -35,6 +37,58 @@ pub struct SurfaceProduct {
     pub halo: Halo,
     /// The halo's report.
     pub halo_report: HaloReport,
+}
+
+/// Everything a build computes before writing.
+#[derive(Clone, Debug)]
+pub struct Built {
+    /// Per surface.
+    pub surfaces: Vec<SurfaceProduct>,
+    /// The intersection curves of all surfaces together.
+    pub curves: Curves,
+    /// The halos checked against the curves.
+    pub verification: Verification,
+    /// Milliseconds per stage so far.
+    pub timings: Timings,
+}
+
+impl Built {
+    /// The surfaces as the intersection stage reads them.
+    pub fn sheets(&self) -> Vec<Sheet<'_>> {
+        sheets(&self.surfaces)
+    }
+}
+
+fn sheets(surfaces: &[SurfaceProduct]) -> Vec<Sheet<'_>> {
+    surfaces
+        .iter()
+        .map(|p| Sheet {
+            positions: &p.projected.positions,
+            w: &p.projected.w,
+            triangles: &p.mesh.triangles,
+        })
+        .collect()
+}
+
+/// The halos as the verification reads them.
+pub fn halo_inputs<'a>(
+    surfaces: &'a [SurfaceProduct],
+    params: &HaloParams,
+) -> Vec<Option<HaloInput<'a>>> {
+    surfaces
+        .iter()
+        .map(|p| {
+            (!p.halo.tets.is_empty()).then_some(HaloInput {
+                positions: &p.halo.positions,
+                t: &p.halo.t,
+                d_orig: &p.halo.d_orig,
+                tets: &p.halo.tets,
+                surface_vertices: p.halo.surface_vertices,
+                delta_d: params.delta_d,
+                delta_t: params.delta_t,
+            })
+        })
+        .collect()
 }
 
 /// How a surface was sampled, and the audit of the mesh (`report.json`'s `sampling`).
@@ -147,6 +201,10 @@ pub struct Timings {
     pub view: f64,
     /// Halos: thickening, tetrahedra, checking, all surfaces.
     pub halo: f64,
+    /// Intersection curves, all surfaces together.
+    pub curves: f64,
+    /// Verifying the halos against the curves.
+    pub verify: f64,
     /// Writing the outputs.
     pub export: f64,
     /// Sum of the stages.
@@ -201,6 +259,10 @@ pub struct Report {
     pub scene_name: String,
     /// Per surface.
     pub surfaces: Vec<SurfaceReport>,
+    /// The intersection curves of all surfaces together.
+    pub curves: CurvesReport,
+    /// The halos checked against the curves.
+    pub halo_verification: Verification,
     /// Milliseconds per stage.
     pub timings_ms: Timings,
     /// Warnings, also printed on stderr.
@@ -228,9 +290,10 @@ fn progress(len: usize, quiet: bool) -> ProgressBar {
     bar
 }
 
-/// Samples, projects and thickens every surface of the scene.
-pub fn run(scene: &Scene, quiet: bool) -> Result<(Vec<SurfaceProduct>, Timings), Error> {
-    let bar = progress(scene.surfaces.len() * 3, quiet);
+/// Samples, projects and thickens every surface of the scene, finds the intersection
+/// curves and verifies the halos against them.
+pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
+    let bar = progress(scene.surfaces.len() * 3 + 2, quiet);
     let mut timings = Timings::default();
     let mut products = Vec::with_capacity(scene.surfaces.len());
     let mut projections = Vec::with_capacity(scene.surfaces.len());
@@ -296,25 +359,39 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<(Vec<SurfaceProduct>, Timings),
             halo_report,
         });
     }
+    bar.set_message("intersection curves");
+    let start = Instant::now();
+    let curves = intersect::curves(&sheets(&products));
+    timings.curves = ms(start);
+    bar.inc(1);
+    bar.set_message("verifying halos");
+    let start = Instant::now();
+    let verification = verify::verify(
+        &sheets(&products),
+        &halo_inputs(&products, &scene.halo),
+        &curves,
+    );
+    timings.verify = ms(start);
     bar.finish_and_clear();
-    Ok((products, timings))
+    Ok(Built {
+        surfaces: products,
+        curves,
+        verification,
+        timings,
+    })
 }
 
 /// Builds a scene into `out_dir`: runs the stages and writes the outputs the scene asks for.
 pub fn build(scene: &Scene, out_dir: &Path, quiet: bool) -> Result<Report, Error> {
-    let (products, timings) = run(scene, quiet)?;
-    write(scene, &products, timings, out_dir)
+    write(scene, &run(scene, quiet)?, out_dir)
 }
 
 /// Writes the outputs the scene asks for from the products of [`run`] into `out_dir`, and
-/// returns the report (also written as `report.json` when asked for). `timings` are those
-/// of [`run`]; the export time is added, and the total is the sum of the stages.
-pub fn write(
-    scene: &Scene,
-    products: &[SurfaceProduct],
-    mut timings: Timings,
-    out_dir: &Path,
-) -> Result<Report, Error> {
+/// returns the report (also written as `report.json` when asked for). The export time is
+/// added to the timings of [`run`], and the total is the sum of the stages.
+pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Error> {
+    let products = &built.surfaces;
+    let mut timings = built.timings;
     let export_start = Instant::now();
     std::fs::create_dir_all(out_dir).map_err(|source| Error::Write {
         path: out_dir.to_path_buf(),
@@ -362,11 +439,19 @@ pub fn write(
     if scene.outputs.report {
         files.push("report.json".into());
     }
-    timings.total = timings.sample + timings.audit + timings.view + timings.halo + timings.export;
+    timings.total = timings.sample
+        + timings.audit
+        + timings.view
+        + timings.halo
+        + timings.curves
+        + timings.verify
+        + timings.export;
     let report = Report {
         halo4d: env!("CARGO_PKG_VERSION"),
         scene_name: scene.name.clone(),
         surfaces: products.iter().map(surface_report).collect(),
+        curves: built.curves.report.clone(),
+        halo_verification: built.verification.clone(),
         timings_ms: timings,
         warnings: products
             .iter()

@@ -19,14 +19,15 @@ fn every_fixture_builds_and_reads_back() {
         let mut scene = Scene::load(&path).unwrap();
         scene.outputs.obj = true;
         let out = dir.path().join(&scene.name);
-        let (products, timings) = halo4d::run(&scene, true).unwrap();
-        let report = halo4d::write(&scene, &products, timings, &out)
+        let built = halo4d::run(&scene, true).unwrap();
+        let products = &built.surfaces;
+        let report = halo4d::write(&scene, &built, &out)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let name = &scene.name;
 
         // Every halo is valid, as the independent checker sees it: conforming, no inverted
         // or flat tetrahedron, the volumes adding up.
-        for p in &products {
+        for p in products {
             let c = p.halo_report.check;
             let what = format!("{name}/{}: {c:?}", p.name);
             assert!(c.valid(), "{what}");
@@ -66,7 +67,7 @@ fn every_fixture_builds_and_reads_back() {
             recorded["halo4d"]["scene"],
             serde_json::to_value(&scene).unwrap()
         );
-        for p in &products {
+        for p in products {
             let mesh = gltf
                 .meshes()
                 .find(|m| m.name() == Some(p.name.as_str()))
@@ -147,7 +148,7 @@ fn every_fixture_builds_and_reads_back() {
         let (models, _) =
             tobj::load_obj(out.join(format!("{name}.obj")), &tobj::GPU_LOAD_OPTIONS).unwrap();
         assert_eq!(models.len(), products.len());
-        for (m, p) in models.iter().zip(&products) {
+        for (m, p) in models.iter().zip(products) {
             assert_eq!(m.name, p.name);
             assert_eq!(m.mesh.indices.len(), 3 * p.mesh.triangles.len());
             assert_eq!(m.mesh.positions.len(), 3 * p.mesh.vertex_count());

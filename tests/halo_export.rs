@@ -13,9 +13,9 @@ use std::process::Command;
 
 /// Builds a scene into `dir`, returning its products.
 fn build(scene: &Scene, dir: &Path) -> Vec<SurfaceProduct> {
-    let (products, timings) = halo4d::run(scene, true).unwrap();
-    halo4d::write(scene, &products, timings, dir).unwrap();
-    products
+    let built = halo4d::run(scene, true).unwrap();
+    halo4d::write(scene, &built, dir).unwrap();
+    built.surfaces
 }
 
 /// The patches fixture (whose halo is valid) built into `dir`: its .glb and .vtk.
