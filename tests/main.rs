@@ -6,6 +6,7 @@ mod common;
 mod export;
 mod halo;
 mod halo_export;
+mod intersect;
 mod sample;
 mod scene;
 mod surfaces;

@@ -379,7 +379,7 @@ impl BoundaryEdges {
 /// where the ends of each lie on opposite sides of the other's plane. Counted once, in the
 /// triple's smallest triangle. The ends are constructed points, so a side that is exactly
 /// zero is not decided: it is returned as the second count. Triangles of a triple that
-/// share a vertex are one sheet, and no triple point.
+/// share a vertex, or lie in one plane, are one sheet, and no triple point.
 fn triple_points(soup: &Soup, segments: &[Segment]) -> (usize, usize) {
     let places: Vec<[DVec3; 2]> = segments
         .iter()
@@ -409,6 +409,13 @@ fn triple_points(soup: &Soup, segments: &[Segment]) -> (usize, usize) {
         let (tx, ty) = (soup.tris[x as usize], soup.tris[y as usize]);
         tx.iter().any(|v| ty.contains(v))
     };
+    // Two triangles in one plane (of one flat sheet) are one sheet too.
+    let coplanar = |x: u32, y: u32| {
+        let f = soup.tris[x as usize].map(|v| soup.positions[v as usize]);
+        soup.tris[y as usize]
+            .iter()
+            .all(|&v| sos::orient3d(f[0], f[1], f[2], soup.positions[v as usize]) == 0.0)
+    };
     let (mut triples, mut undecided) = (0, 0);
     let mut i = 0;
     while i < by_tri.len() {
@@ -420,7 +427,14 @@ fn triple_points(soup: &Soup, segments: &[Segment]) -> (usize, usize) {
         for x in i..j {
             for y in x + 1..j {
                 let ((_, b, sb), (_, c, sc)) = (by_tri[x], by_tri[y]);
-                if b == c || a > b || a > c || touch(b, c) || touch(a, b) || touch(a, c) {
+                if b == c
+                    || a > b
+                    || a > c
+                    || touch(b, c)
+                    || touch(a, b)
+                    || touch(a, c)
+                    || coplanar(b, c)
+                {
                     continue;
                 }
                 match (

@@ -1,0 +1,449 @@
+//! Intersection curves: the analytic flat torus, brute force against the BVH, degenerate
+//! configurations, and the halo verification that rests on them.
+
+use crate::common::{Rng, fixture, fixture_scenes};
+use glam::DVec3;
+use halo4d::intersect::{BroadPhase, Curves, End, Node, Sheet, curves, curves_with};
+use halo4d::{Sampling, Scene, sample, sample_uniform};
+
+/// A mesh in the intersection stage's terms.
+struct Soup {
+    positions: Vec<DVec3>,
+    w: Vec<f64>,
+    triangles: Vec<[u32; 3]>,
+}
+
+impl Soup {
+    fn sheet(&self) -> Sheet<'_> {
+        Sheet {
+            positions: &self.positions,
+            w: &self.w,
+            triangles: &self.triangles,
+        }
+    }
+}
+
+/// The flat torus (cos s, sin s, cos t, sin t) on an n x n uniform grid, turned by `alpha`
+/// degrees in the yw plane and projected orthographically, through the real pipeline stages.
+fn flat_torus(n: usize, alpha: f64) -> Soup {
+    let text = format!(
+        r#"{{"name": "t", "surfaces": [{{"surface": {{"type": "flat_torus"}}}}],
+            "view": {{"rotation": {{"yw": {alpha}}}}}}}"#
+    );
+    let scene = Scene::parse(&text, "test").unwrap();
+    let mesh = sample_uniform(&scene.surfaces[0].surface, n, n);
+    let p = scene.view.project(&mesh).unwrap();
+    Soup {
+        positions: p.positions,
+        w: p.w,
+        triangles: mesh.triangles,
+    }
+}
+
+/// Distance from `p` to the analytic double curve of the turned flat torus: the points of
+/// the plane y = 0 with sin t = cot(alpha) sin s, that is 1 - z^2 = cot^2(alpha) (1 - x^2),
+/// to first order in the implicit function (the points are within 1e-3 of it).
+fn analytic_distance(p: DVec3, alpha: f64) -> f64 {
+    let c2 = (1.0 / alpha.to_radians().tan()).powi(2);
+    let f = 1.0 - p.z * p.z - c2 * (1.0 - p.x * p.x);
+    let grad = (2.0 * c2 * p.x).hypot(-2.0 * p.z);
+    p.y.hypot(f / grad)
+}
+
+/// Every curve point and every chaining decision, sorted: the set of crossing events.
+fn events(c: &Curves) -> Vec<Node> {
+    let mut v: Vec<Node> = c
+        .curves
+        .iter()
+        .flat_map(|c| c.points.iter().map(|p| p.node))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn flat_torus_curves_are_two_arcs_between_the_four_cross_caps() {
+    let caps = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)];
+    for alpha in [30.0, 60.0, 75.0] {
+        let mut previous: Option<f64> = None;
+        for n in [24, 48, 96, 192] {
+            let soup = flat_torus(n, alpha);
+            let c = curves(&[soup.sheet()]);
+            let r = &c.report;
+            let what = format!("alpha {alpha}, {n} x {n}: {r:?}");
+            assert_eq!((r.count, r.open, r.closed), (2, 2, 0), "{what}");
+            assert_eq!(r.branch_point_ends, 4, "{what}");
+            assert_eq!((r.unresolved, r.boundary_ends), (0, 0), "{what}");
+            // The grid has the cross-caps (s, t) in {0, pi}^2 as vertices: the arcs end
+            // exactly there, and each arc joins two cross-caps on one side: x = +-1 when
+            // alpha < 45 degrees (the curve runs across z), z = +-1 when alpha > 45.
+            let mut ends = Vec::new();
+            for curve in &c.curves {
+                assert_eq!(curve.ends, [End::BranchPoint; 2], "{what}");
+                let (a, b) = (
+                    curve.points[0].position,
+                    curve.points.last().unwrap().position,
+                );
+                for e in [a, b] {
+                    let cap = caps
+                        .iter()
+                        .position(|&(x, z)| (e - DVec3::new(x, 0.0, z)).length() < 1e-12)
+                        .unwrap_or_else(|| panic!("{what}: end {e} is not a cross-cap"));
+                    ends.push(cap);
+                }
+                if alpha < 45.0 {
+                    assert_eq!(a.x, b.x, "{what}");
+                } else {
+                    assert_eq!(a.z, b.z, "{what}");
+                }
+                // At a cross-cap both sheets have the same w; away from it they differ.
+                assert!(curve.points[0].dw() < 1e-12);
+                assert!(curve.points.iter().any(|p| p.dw() > 0.5), "{what}");
+            }
+            ends.sort_unstable();
+            assert_eq!(ends, [0, 1, 2, 3], "{what}: each cross-cap ends one arc");
+            // Every point lies near the analytic curve, nearer as the mesh refines.
+            let worst = c
+                .curves
+                .iter()
+                .flat_map(|c| &c.points)
+                .map(|p| analytic_distance(p.position, alpha))
+                .fold(0.0, f64::max);
+            let h = std::f64::consts::TAU / n as f64;
+            assert!(
+                worst < 0.5 * h * h,
+                "{what}: {worst} from the curve, h = {h}"
+            );
+            if let Some(coarse) = previous {
+                let order = (coarse / worst).log2();
+                eprintln!(
+                    "alpha {alpha}: {n} x {n}: max distance {worst:.3e}, observed order {order:.2}"
+                );
+                assert!(order > 1.5, "{what}: order {order}");
+            }
+            previous = Some(worst);
+        }
+    }
+}
+
+#[test]
+fn the_bvh_finds_the_events_all_pairs_find() {
+    // Random crumpled grids crossing each other and themselves.
+    let mut rng = Rng(5);
+    for case in 0..12 {
+        let mut soups = Vec::new();
+        for _ in 0..2 {
+            let k = 6 + rng.below(6);
+            let mut positions = Vec::new();
+            let lean = DVec3::new(rng.unit(), rng.unit(), rng.unit()) - 0.5;
+            for j in 0..=k {
+                for i in 0..=k {
+                    let (u, v) = (i as f64 / k as f64, j as f64 / k as f64);
+                    let bump = 0.4 * (rng.unit() - 0.5);
+                    positions.push(DVec3::new(u, v, bump) + lean * (u * 3.0 * v));
+                }
+            }
+            let mut triangles = Vec::new();
+            for j in 0..k as u32 {
+                for i in 0..k as u32 {
+                    let a = j * (k as u32 + 1) + i;
+                    let (b, c, d) = (a + 1, a + k as u32 + 1, a + k as u32 + 2);
+                    triangles.push([a, b, d]);
+                    triangles.push([a, d, c]);
+                }
+            }
+            let w = positions.iter().map(|p| p.x - p.y).collect();
+            soups.push(Soup {
+                positions,
+                w,
+                triangles,
+            });
+        }
+        let sheets: Vec<Sheet> = soups.iter().map(Soup::sheet).collect();
+        let fast = curves_with(&sheets, BroadPhase::Bvh);
+        let slow = curves_with(&sheets, BroadPhase::AllPairs);
+        assert_eq!(events(&fast), events(&slow), "case {case}");
+        assert_eq!(fast.report.segments, slow.report.segments, "case {case}");
+        assert!(fast.report.segments > 0, "case {case} has no crossing");
+        assert_eq!(fast.report.unresolved, 0, "case {case}");
+    }
+}
+
+#[test]
+fn every_fixture_at_low_resolution_agrees_with_all_pairs() {
+    for path in fixture_scenes() {
+        let scene = Scene::load(&path).unwrap();
+        let projected: Vec<_> = scene
+            .surfaces
+            .iter()
+            .map(|s| {
+                let mesh = sample(&s.surface, &Sampling::Uniform { u: 14, v: 14 }).mesh;
+                let p = scene.view.project(&mesh).unwrap();
+                Soup {
+                    positions: p.positions,
+                    w: p.w,
+                    triangles: mesh.triangles,
+                }
+            })
+            .collect();
+        let sheets: Vec<Sheet> = projected.iter().map(Soup::sheet).collect();
+        let fast = curves_with(&sheets, BroadPhase::Bvh);
+        let slow = curves_with(&sheets, BroadPhase::AllPairs);
+        assert_eq!(events(&fast), events(&slow), "{}", path.display());
+        let (f, s) = (&fast.report, &slow.report);
+        assert_eq!(
+            (f.count, f.open, f.closed, f.points, f.triple_points),
+            (s.count, s.open, s.closed, s.points, s.triple_points),
+            "{}",
+            path.display()
+        );
+    }
+}
+
+/// A closed octahedron with corners at `centre` +- `r` along the axes.
+fn octahedron(centre: DVec3, r: f64) -> Soup {
+    let positions: Vec<DVec3> = [
+        DVec3::X,
+        -DVec3::X,
+        DVec3::Y,
+        -DVec3::Y,
+        DVec3::Z,
+        -DVec3::Z,
+    ]
+    .iter()
+    .map(|&d| centre + d * r)
+    .collect();
+    let triangles = vec![
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    let w = positions.iter().map(|p| p.z).collect();
+    Soup {
+        positions,
+        w,
+        triangles,
+    }
+}
+
+/// Curves of two closed surfaces: every curve closes, nothing is unresolved, no point is
+/// NaN.
+fn closed_pair(a: &Soup, b: &Soup) -> Curves {
+    let c = curves(&[a.sheet(), b.sheet()]);
+    let r = &c.report;
+    assert_eq!(r.open, 0, "{r:?}");
+    assert_eq!(r.unresolved, 0, "{r:?}");
+    for p in c.curves.iter().flat_map(|c| &c.points) {
+        assert!(p.position.is_finite() && p.w[0].is_finite() && p.w[1].is_finite());
+    }
+    c
+}
+
+/// A closed tetrahedron.
+fn tetrahedron(corners: [[f64; 3]; 4]) -> Soup {
+    let positions: Vec<DVec3> = corners.iter().map(|&c| DVec3::from(c)).collect();
+    let w = positions.iter().map(|p| -p.y).collect();
+    Soup {
+        positions,
+        w,
+        triangles: vec![[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]],
+    }
+}
+
+#[test]
+fn a_vertex_exactly_on_a_triangle_is_decided_and_the_curve_closes() {
+    // b's first corner lies exactly on a's face (+X, +Y, +Z), in the plane x + y + z = 1;
+    // b has corners on both sides of that plane, so it crosses the face there.
+    let a = octahedron(DVec3::ZERO, 1.0);
+    let b = tetrahedron([
+        [0.5, 0.25, 0.25],
+        [1.2, 0.6, 0.4],
+        [0.1, 0.1, 0.1],
+        [0.3, 0.8, -0.4],
+    ]);
+    let c = closed_pair(&a, &b);
+    assert_eq!(c.report.count, 1, "{:?}", c.report);
+    assert!(c.report.perturbed > 0, "{:?}", c.report);
+}
+
+#[test]
+fn an_edge_exactly_through_an_edge_is_decided_and_the_curve_closes() {
+    // b's edge from (0.5, -0.5, 0.5) to (0.5, 0.5, 0.5) crosses a's edge from +X to +Z at
+    // (0.5, 0, 0.5).
+    let a = octahedron(DVec3::ZERO, 1.0);
+    let b = tetrahedron([
+        [0.5, -0.5, 0.5],
+        [0.5, 0.5, 0.5],
+        [0.2, 0.1, -0.3],
+        [1.1, 0.2, 0.9],
+    ]);
+    let c = closed_pair(&a, &b);
+    assert_eq!(c.report.count, 1, "{:?}", c.report);
+}
+
+#[test]
+fn coplanar_overlapping_faces_are_decided_consistently() {
+    // b is a moved within the plane x + y + z = 1 of a's face (+X, +Y, +Z) (and of the
+    // face (-X, -Y, +Z)): those faces overlap b's, and the solids interpenetrate.
+    let a = octahedron(DVec3::ZERO, 1.0);
+    let b = octahedron(DVec3::new(0.25, -0.25, 0.0), 1.0);
+    let c = closed_pair(&a, &b);
+    assert!(c.report.count >= 1);
+    assert!(c.report.perturbed + c.report.coplanar > 0, "{:?}", c.report);
+
+    // Two overlapping squares in one plane: whatever the perturbation makes of them, every
+    // event lies in a face's plane and every open curve ends at a boundary.
+    let square = |dx: f64, dy: f64| Soup {
+        positions: vec![
+            DVec3::new(dx, dy, 0.0),
+            DVec3::new(dx + 1.0, dy, 0.0),
+            DVec3::new(dx + 1.0, dy + 1.0, 0.0),
+            DVec3::new(dx, dy + 1.0, 0.0),
+        ],
+        w: vec![dx; 4],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+    };
+    let (p, q) = (square(0.0, 0.0), square(0.3, 0.45));
+    let c = curves(&[p.sheet(), q.sheet()]);
+    let r = &c.report;
+    assert_eq!(r.unresolved, 0, "{r:?}");
+    assert_eq!(r.boundary_ends, 2 * r.open, "{r:?}");
+    for pt in c.curves.iter().flat_map(|c| &c.points) {
+        assert!(pt.coplanar && pt.position.is_finite(), "{pt:?}");
+    }
+}
+
+#[test]
+fn surfaces_touching_tangentially_give_no_crossing() {
+    // b touches a's face (+X, +Y, +Z) from outside at one corner, exactly on the face.
+    let a = octahedron(DVec3::ZERO, 1.0);
+    let touch = DVec3::new(0.5, 0.25, 0.25);
+    let b = tetrahedron([
+        touch.to_array(),
+        [1.0, 0.4, 0.35],
+        [0.6, 0.8, 0.3],
+        [0.55, 0.3, 0.9],
+    ]);
+    let c = closed_pair(&a, &b);
+    // The perturbation decides whether the touching corner pokes through; if it does, the
+    // curve is a loop of zero length at the touching point.
+    for p in c.curves.iter().flat_map(|c| &c.points) {
+        assert!((p.position - touch).length() < 1e-12, "{:?}", p.position);
+    }
+}
+
+#[test]
+fn three_planes_cross_at_one_triple_point() {
+    // Three squares in the coordinate planes, split off their diagonals through the origin.
+    let square = |axis: usize| {
+        let corners = [(-1.0, -0.7), (1.3, -0.7), (1.3, 1.0), (-1.0, 1.0)];
+        let positions: Vec<DVec3> = corners
+            .iter()
+            .map(|&(u, v)| {
+                let mut p = [0.0; 3];
+                p[(axis + 1) % 3] = u;
+                p[(axis + 2) % 3] = v;
+                DVec3::from(p)
+            })
+            .collect();
+        let w = positions.iter().map(|_| axis as f64).collect();
+        Soup {
+            positions,
+            w,
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        }
+    };
+    let soups = [square(0), square(1), square(2)];
+    let sheets: Vec<Sheet> = soups.iter().map(Soup::sheet).collect();
+    let c = curves(&sheets);
+    assert_eq!(c.report.triple_points, 1, "{:?}", c.report);
+    assert_eq!(c.report.count, 3, "{:?}", c.report);
+    assert_eq!(c.report.boundary_ends, 6, "{:?}", c.report);
+    assert_eq!(c.report.unresolved, 0, "{:?}", c.report);
+}
+
+#[test]
+fn curves_are_deterministic() {
+    let soup = flat_torus(40, 35.0);
+    assert_eq!(
+        curves(&[soup.sheet()]).curves,
+        curves(&[soup.sheet()]).curves
+    );
+}
+
+#[test]
+fn every_fixture_halo_is_verified_by_its_curves() {
+    let (mut correct, mut ambiguous) = (0, 0);
+    for path in fixture_scenes() {
+        let scene = Scene::load(&path).unwrap();
+        let built = halo4d::run(&scene, true).unwrap();
+        let v = &built.verification;
+        let what = format!("{}: {v:?}", path.display());
+        assert!(built.curves.report.count > 0, "{what}");
+        assert_eq!(
+            built.curves.report.unresolved, 0,
+            "{what}: {:?}",
+            built.curves.report
+        );
+        assert_eq!(v.wrong, 0, "{what}");
+        assert_eq!(v.spurious_hidden_samples, 0, "{what}");
+        assert!(v.correct > 0 && v.hidden_samples > 0, "{what}");
+        correct += v.correct;
+        ambiguous += v.ambiguous;
+    }
+    // Few samples are left undecided (branch points, boundaries, sheets at equal w).
+    assert!(
+        correct > 10 * ambiguous,
+        "{correct} correct, {ambiguous} ambiguous"
+    );
+}
+
+/// The flat torus fixture's build, for planting faults in its halo.
+fn flat_torus_build() -> halo4d::Built {
+    let scene = Scene::load(&fixture("scenes/flat-torus.json")).unwrap();
+    halo4d::run(&scene, true).unwrap()
+}
+
+fn verify(built: &halo4d::Built, scene: &Scene) -> halo4d::verify::Verification {
+    halo4d::verify::verify(
+        &built.sheets(),
+        &halo4d::pipeline::halo_inputs(&built.surfaces, &scene.halo),
+        &built.curves,
+    )
+}
+
+#[test]
+fn a_halo_too_deep_in_w_is_caught_as_wrong() {
+    let scene = Scene::load(&fixture("scenes/flat-torus.json")).unwrap();
+    let mut built = flat_torus_build();
+    assert_eq!(verify(&built, &scene).wrong, 0);
+    // Every halo vertex 10 deeper than its surface point: no sheet hides another.
+    for d in &mut built.surfaces[0].halo.d_orig {
+        *d += 10.0;
+    }
+    let v = verify(&built, &scene);
+    assert!(v.wrong > v.correct, "{v:?}");
+}
+
+#[test]
+fn a_halo_moved_off_its_surface_is_caught_as_spurious() {
+    let scene = Scene::load(&fixture("scenes/flat-torus.json")).unwrap();
+    let mut built = flat_torus_build();
+    // The halo shifted by a tenth of the torus along z and made shallow in w: it hides
+    // points of the surface it no longer surrounds.
+    let halo = &mut built.surfaces[0].halo;
+    for p in &mut halo.positions {
+        p.z += 0.1;
+    }
+    for d in &mut halo.d_orig {
+        *d -= 10.0;
+    }
+    let v = verify(&built, &scene);
+    assert!(v.spurious_hidden_samples > 0, "{v:?}");
+    assert!(!v.spurious_at.is_empty());
+}
