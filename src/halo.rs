@@ -42,6 +42,8 @@ pub struct HaloParams {
     /// Depth increment delta_d at the halo's outer surfaces (eq. 3), in w units.
     pub delta_d: f64,
     /// Dead zone delta_t in [0, 1) of |2t - 1| before the depth starts to grow (eq. 3).
+    /// It also bounds how fast rho may change between neighbours ([`grade`]): 0.3 lets rho
+    /// grow by 1.86 per edge away from where folding shrank it.
     pub delta_t: f64,
     /// How prisms are split into tetrahedra.
     pub split: Split,
@@ -65,7 +67,7 @@ impl Default for HaloParams {
         HaloParams {
             rho: 0.01,
             delta_d: 0.5,
-            delta_t: 0.1,
+            delta_t: 0.3,
             split: Split::default(),
             fold: Fold::default(),
         }

@@ -501,3 +501,34 @@ fn the_checker_catches_faults_at_twisted_and_collapsed_prisms() {
     assert_eq!(s.collapsed_vertices, 3, "{s:?}");
     assert!(s.missing_offset_faces > 0 && s.quad_mismatches > 0, "{s:?}");
 }
+
+#[test]
+fn rho_is_graded_so_neighbours_differ_by_at_most_the_dead_zone_ratio() {
+    // Inside a prism whose corners' rho differ by r, the surface leaves the mid-section of
+    // the prism by up to |2t - 1| = (r - 1) / (r + 1); the grading keeps that within
+    // delta_t, so eq. 3 gives d_orig on the surface itself.
+    for (name, delta_t) in [
+        ("default", 0.1),
+        ("fermat-quartic", 0.1),
+        ("klein-bottle", 0.3),
+    ] {
+        let products = run_fixture(name, |s| s.halo.delta_t = delta_t);
+        let grade = halo4d::halo::grade(delta_t);
+        assert!(((grade - 1.0) / (grade + 1.0) - delta_t).abs() < 1e-12);
+        for p in &products {
+            let rho = &p.halo.rho;
+            assert!(
+                p.halo_report.shrunk_vertices > 0,
+                "{name}: nothing to grade"
+            );
+            for t in &p.mesh.triangles {
+                for k in 0..3 {
+                    let (a, b) = (rho[t[k] as usize], rho[t[(k + 1) % 3] as usize]);
+                    if a > 0.0 && b > 0.0 {
+                        assert!(a <= grade * b * (1.0 + 1e-12), "{name}: {a} next to {b}");
+                    }
+                }
+            }
+        }
+    }
+}

@@ -54,9 +54,22 @@ pub struct Soup {
     pub w: Vec<f64>,
     /// Triangles.
     pub tris: Vec<[u32; 3]>,
+    /// Each triangle's plane for the floating-point filter ([`Soup::prepare`]); computed
+    /// on the fly when empty.
+    planes: Vec<FilteredPlane>,
 }
 
 impl Soup {
+    /// Computes every triangle's filtered plane once, for the many pairs each is in.
+    pub fn prepare(&mut self) {
+        let p = &self.positions;
+        self.planes = self
+            .tris
+            .iter()
+            .map(|t| FilteredPlane::new(t.map(|v| p[v as usize])))
+            .collect();
+    }
+
     /// The perturbed sign of `orient3d`: floating point where its error bound allows,
     /// else exact arithmetic and the perturbation.
     #[inline]
@@ -90,7 +103,7 @@ impl Soup {
                 }
             }
         }
-        if shared < 2 && (self.clearly_aside(tb, ta) || self.clearly_aside(ta, tb)) {
+        if shared < 2 && (self.clearly_aside(b, ta) || self.clearly_aside(a, tb)) {
             return Pair::Apart;
         }
         match shared {
@@ -101,12 +114,16 @@ impl Soup {
     }
 
     /// Whether floating point alone shows every vertex of `t` strictly on one side of the
-    /// plane of `plane` (then the triangles cannot cross, whatever the perturbation).
-    /// Vertices of `plane` itself lie in it and do not count.
+    /// plane of triangle `of` (then the two cannot cross, whatever the perturbation).
+    /// Vertices of `of` itself lie in its plane and do not count.
     #[inline]
-    fn clearly_aside(&self, plane: [u32; 3], t: [u32; 3]) -> bool {
+    fn clearly_aside(&self, of: u32, t: [u32; 3]) -> bool {
         let p = &self.positions;
-        let f = FilteredPlane::new(plane.map(|v| p[v as usize]));
+        let plane = self.tris[of as usize];
+        let f = match self.planes.get(of as usize) {
+            Some(f) => *f,
+            None => FilteredPlane::new(plane.map(|v| p[v as usize])),
+        };
         let mut side = 0;
         for v in t {
             if v == plane[0] || v == plane[1] || v == plane[2] {
@@ -212,6 +229,7 @@ impl Soup {
 /// det[f1 - f0; f2 - f0; p - f0] expanded along its last row, with Shewchuk's error bound
 /// for a determinant of three differences (the same computation as `orient3d`'s first
 /// stage, with the cofactors computed once for every point tested).
+#[derive(Clone, Copy, Debug)]
 struct FilteredPlane {
     base: DVec3,
     normal: DVec3,
@@ -340,6 +358,7 @@ mod tests {
             positions: points.iter().map(|&p| DVec3::from(p)).collect(),
             w: points.iter().map(|p| p[0]).collect(),
             tris: tris.to_vec(),
+            planes: Vec::new(),
         }
     }
 

@@ -175,10 +175,12 @@ pub fn curves(sheets: &[Sheet]) -> Curves {
 pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
     let start = Instant::now();
     let mut report = CurvesReport::default();
-    let (soup, tri_start) = merge(sheets);
+    let (mut soup, tri_start) = merge(sheets);
+    soup.prepare();
     report.triangles = soup.tris.len();
 
-    let mut pairs: Vec<(u32, u32)> = Vec::new();
+    // About eight touching pairs per triangle on a fine mesh: reserved, not grown.
+    let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(8 * soup.tris.len());
     match broad_phase {
         BroadPhase::Bvh => {
             let boxes: Vec<_> = soup

@@ -1,0 +1,52 @@
+//! Intersection curves: all curves of the flat-torus fixture's view, chained, on uniform
+//! grids of 316 x 316 (199,712 triangles) and 708 x 708 (1,002,528 triangles), on one
+//! thread. Before the timed runs, prints how one run splits between building the BVH,
+//! traversing it and the exact tests, and the halo verification's cost on the smaller mesh.
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use halo4d::intersect::{Sheet, curves};
+use halo4d::{Scene, sample_uniform};
+use std::hint::black_box;
+use std::path::Path;
+
+fn curve_costs(c: &mut Criterion) {
+    let scene =
+        Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/scenes/flat-torus.json"))
+            .expect("the flat-torus fixture loads");
+    let mut group = c.benchmark_group("curves/flat_torus");
+    group.sample_size(10);
+    for n in [316, 708] {
+        let mesh = sample_uniform(&scene.surfaces[0].surface, n, n);
+        let projected = scene.view.project(&mesh).expect("the view projects");
+        let sheets = [Sheet {
+            positions: &projected.positions,
+            w: &projected.w,
+            triangles: &mesh.triangles,
+        }];
+        let r = curves(&sheets).report;
+        eprintln!(
+            "{} triangles: {:.1} ms = BVH {:.1} + traversal {:.1} + exact {:.1} + chaining {:.1}; \
+             {} candidate pairs, {} segments, {} curves, {:.2} M triangles/s",
+            r.triangles,
+            r.ms,
+            r.bvh_ms,
+            r.traverse_ms,
+            r.exact_ms,
+            r.chain_ms,
+            r.candidate_pairs,
+            r.segments,
+            r.count,
+            r.triangles as f64 / r.ms / 1e3,
+        );
+        group.throughput(Throughput::Elements(mesh.triangles.len() as u64));
+        group.bench_with_input(
+            BenchmarkId::from_parameter(mesh.triangles.len()),
+            &sheets,
+            |b, s| b.iter(|| curves(black_box(s))),
+        );
+    }
+    group.finish();
+}
+
+criterion_group!(benches, curve_costs);
+criterion_main!(benches);
