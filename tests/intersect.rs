@@ -446,3 +446,31 @@ fn a_halo_moved_off_its_surface_is_caught_as_spurious() {
     assert!(v.spurious_hidden_samples > 0, "{v:?}");
     assert!(!v.spurious_at.is_empty());
 }
+
+#[test]
+fn empty_and_single_triangle_inputs_give_no_curves() {
+    assert_eq!(curves(&[]).report.count, 0);
+    let one = Soup {
+        positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+        w: vec![0.0; 3],
+        triangles: vec![[0, 1, 2]],
+    };
+    let empty = Soup {
+        positions: Vec::new(),
+        w: Vec::new(),
+        triangles: Vec::new(),
+    };
+    for sheets in [
+        vec![one.sheet()],
+        vec![empty.sheet()],
+        vec![one.sheet(), empty.sheet()],
+    ] {
+        let c = curves(&sheets);
+        assert_eq!((c.report.count, c.report.unresolved), (0, 0));
+        let v = halo4d::verify::verify(&sheets, &vec![None; sheets.len()], &c);
+        assert_eq!(
+            (v.wrong, v.spurious_hidden_samples, v.hidden_samples),
+            (0, 0, 0)
+        );
+    }
+}
