@@ -15,7 +15,7 @@
 //! Then, when the scene has any, the intersection curves of all surfaces together in one mesh
 //! `curves` with its own node: a LINES primitive with POSITION (min/max of the stored f32
 //! values) and float SCALAR attributes `_DW` (w of the far sheet minus w of the near sheet,
-//! >= 0), `_CURVE` (the curve's index) and `_W` (w of the near sheet), one per curve point;
+//! never negative), `_CURVE` (the curve's index) and `_W` (w of the near sheet), one per curve point;
 //! its indices join consecutive points, and a closed curve's last point back to its first.
 //! The mesh's extras count them: `{"curves": {"count", "closed", "open", "points"}}`.
 //! Blender imports the lines as loose edges.
