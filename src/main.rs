@@ -348,6 +348,10 @@ fn conform(n: usize) -> String {
 /// Runs the checker on each halo and prints its table and a `FAILED` line per halo that does
 /// not conform or has an inverted or flat tetrahedron; returns whether none failed.
 fn check_halos(halos: &[&ImportedHalo]) -> bool {
+    if halos.is_empty() {
+        println!("no halo in the file");
+        return true;
+    }
     let stats: Vec<CheckStats> = halos.iter().map(|h| check(&h.mesh)).collect();
     let names: Vec<&str> = halos.iter().map(|h| h.name.as_str()).collect();
     print!("{}", table(&names, &stats));

@@ -450,6 +450,19 @@ fn check_dir_passes_a_build_and_catches_faults_planted_in_its_glb() {
         text
     };
 
+    // The halo mesh no longer marked as one: a scene without halos, whose curves nothing
+    // explains.
+    let text = planted(
+        "bare",
+        &with_json(&glb, |j| {
+            for m in j["meshes"].as_array_mut().unwrap() {
+                m["extras"].as_object_mut().unwrap().remove("halo");
+            }
+        }),
+    );
+    assert!(text.contains("no halo in the file"), "{text}");
+    assert_eq!(count(&text, "wrong"), correct + third, "{text}");
+
     // d_orig of every halo vertex raised by more than the whole scene's range of w. A halo
     // depth (eq. 3) is d_orig interpolated plus a non-negative term, and d_orig is at least
     // the smallest w, so every halo depth now exceeds every sheet's w: no halo hides anything.
