@@ -1,5 +1,6 @@
-//! Stage costs of the build: uniform sampling, projection and export (with the halo), on a
-//! sweep of grid sizes, for the default scene's spun trefoil and the quartic Fermat.
+//! Stage costs of the build: uniform sampling, projection and export (with the halo and the
+//! intersection curves), on a sweep of grid sizes, for the default scene's spun trefoil and
+//! the quartic Fermat.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use halo4d::export::{SurfaceData, to_glb, to_ply, to_vtk};
@@ -45,8 +46,13 @@ fn stages(c: &mut Criterion) {
             halo_params: &params,
             rho,
         }];
+        let curves = halo4d::intersect::curves(&[halo4d::intersect::Sheet {
+            positions: &projected.positions,
+            w: &projected.w,
+            triangles: &mesh.triangles,
+        }]);
         c.bench_function(&format!("export_glb/{name}/128"), |b| {
-            b.iter(|| to_glb(black_box(&data), &serde_json::Value::Null).unwrap())
+            b.iter(|| to_glb(black_box(&data), &curves, &serde_json::Value::Null).unwrap())
         });
         c.bench_function(&format!("export_ply/{name}/128"), |b| {
             b.iter(|| to_ply(black_box(&data), name))

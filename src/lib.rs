@@ -5,8 +5,8 @@
 //! -> [`sample`](mod@sample) (meshes to a tolerance, welded by domain rules, audited) ->
 //! [`view`] (4D rotation and projection) -> [`halo`] (offsets, tetrahedra from [`tets`],
 //! checked by [`check`]) -> [`export`] (glTF, PLY, OBJ, VTK, report). [`pipeline`] runs them
-//! in order; [`sweep`] measures what each tolerance costs; [`import`] reads halos back for
-//! checking.
+//! in order; [`sweep`] measures what each tolerance costs; [`import`] reads halos and scenes
+//! back for checking.
 #![warn(missing_docs)]
 
 pub mod check;

@@ -2,8 +2,9 @@
 
 use clap::{Parser, Subcommand};
 use halo4d::check::{CheckStats, check};
+use halo4d::import::{ImportError, ImportedHalo, read_scene_glb};
 use halo4d::{Scene, Surface};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Surfaces in 4D turned into verified 3D geometry: glTF for Blender, PLY for MeshLab.
@@ -49,13 +50,25 @@ enum Command {
     },
     /// List the surface catalogue with each surface's parameters and defaults.
     List,
-    /// Check the halos of a .glb or .vtk file with the independent checker. Prints the
-    /// checker's statistics, one column per halo. Exit status 0 when every halo conforms and
-    /// has no inverted or flat tetrahedron, 1 when one does not, 2 when the file cannot be
-    /// read as halos.
+    /// Check the halos of a .glb or .vtk file with the independent checker, or a build's
+    /// output folder: its halos and their verification against the intersection curves.
+    ///
+    /// With a FILE, prints the checker's statistics, one column per halo. Exit status 0 when
+    /// every halo conforms and has no inverted or flat tetrahedron, 1 when one does not, 2
+    /// when the file cannot be read as halos.
+    ///
+    /// With a folder (what `halo4d build --out DIR` wrote), reads its one .glb, runs the
+    /// checker on each halo, recomputes the intersection curves of the file's surfaces and
+    /// verifies the halos against them (along every curve the far sheet hidden by the near
+    /// sheet's halo and the near sheet visible; nowhere a halo cutting a gap away from its
+    /// sheet), and prints both. Exit status 0 when every halo conforms with no inverted or
+    /// flat tetrahedron and the verification finds no wrong curve sample and no spurious
+    /// hidden sample, 1 when something failed (a `FAILED` line says what), 2 when the folder
+    /// or its .glb cannot be read.
     Check {
         /// A .glb (every mesh with `halo` extras) or legacy .vtk (with `surface_vertices`
-        /// field data) file, as `halo4d build` writes them.
+        /// field data) file, or a folder with one scene .glb, as `halo4d build` writes them.
+        #[arg(value_name = "FILE|DIR")]
         file: PathBuf,
     },
 }
@@ -176,12 +189,13 @@ fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
+        Command::Check { file } if file.is_dir() => check_dir(&file),
         Command::Check { file } => check_file(&file),
     }
 }
 
 /// `halo4d check FILE`.
-fn check_file(file: &std::path::Path) -> ExitCode {
+fn check_file(file: &Path) -> ExitCode {
     let halos = match halo4d::import::read(file) {
         Ok(h) => h,
         Err(e) => {
@@ -189,6 +203,155 @@ fn check_file(file: &std::path::Path) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let halos: Vec<&ImportedHalo> = halos.iter().collect();
+    if !check_halos(&halos) {
+        return ExitCode::FAILURE;
+    }
+    println!(
+        "ok: {}, no inverted or flat tetrahedron",
+        conform(halos.len())
+    );
+    ExitCode::SUCCESS
+}
+
+/// `halo4d check DIR`.
+fn check_dir(dir: &Path) -> ExitCode {
+    let file = match scene_glb(dir) {
+        Ok(f) => f,
+        Err(message) => {
+            eprintln!("error: {}: {message}", dir.display());
+            return ExitCode::from(2);
+        }
+    };
+    let scene = match std::fs::read(&file)
+        .map_err(ImportError::from)
+        .and_then(|bytes| read_scene_glb(&bytes))
+    {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {}: {e}", file.display());
+            return ExitCode::from(2);
+        }
+    };
+    match &scene.name {
+        Some(name) => println!("scene {name}: {}", file.display()),
+        None => println!("{}", file.display()),
+    }
+    let halos: Vec<&ImportedHalo> = scene
+        .surfaces
+        .iter()
+        .filter_map(|s| s.halo.as_ref())
+        .collect();
+    let mut ok = check_halos(&halos);
+    let (curves, v) = scene.verify();
+    let c = &curves.report;
+    println!();
+    println!(
+        "curves: {} ({} closed, {} open), {} points, {} triple points, {} unresolved",
+        c.count, c.closed, c.open, c.points, c.triple_points, c.unresolved
+    );
+    let rows = [
+        ("curve_samples", v.curve_samples),
+        ("correct", v.correct),
+        ("wrong", v.wrong),
+        ("ambiguous", v.ambiguous),
+        ("third_sheet", v.third_sheet),
+        ("surface_samples", v.surface_samples),
+        ("hidden_samples", v.hidden_samples),
+        ("spurious_hidden_samples", v.spurious_hidden_samples),
+    ];
+    let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
+    println!("{:<width$}  {:>9}", "halo verification", "samples");
+    for (k, n) in rows {
+        println!("{k:<width$}  {n:>9}");
+    }
+    let at = |points: &[[f64; 3]]| {
+        points
+            .first()
+            .map(|p| format!(" (the first at ({:.6}, {:.6}, {:.6}))", p[0], p[1], p[2]))
+            .unwrap_or_default()
+    };
+    if v.wrong > 0 {
+        ok = false;
+        println!(
+            "FAILED halo verification: {} of {} curve samples wrong{}",
+            v.wrong,
+            v.curve_samples,
+            at(&v.wrong_at)
+        );
+    }
+    if v.spurious_hidden_samples > 0 {
+        ok = false;
+        println!(
+            "FAILED halo verification: {} of {} surface samples hidden where no sheet is within rho{}",
+            v.spurious_hidden_samples,
+            v.surface_samples,
+            at(&v.spurious_at)
+        );
+    }
+    if !ok {
+        return ExitCode::FAILURE;
+    }
+    println!(
+        "ok: {}, no inverted or flat tetrahedron; {} curve samples correct, {} ambiguous, {} third sheet, none wrong; no spurious hidden sample",
+        conform(halos.len()),
+        v.correct,
+        v.ambiguous,
+        v.third_sheet
+    );
+    ExitCode::SUCCESS
+}
+
+/// The one `.glb` in `dir`, or why there is none.
+fn scene_glb(dir: &Path) -> Result<PathBuf, String> {
+    let entries = std::fs::read_dir(dir).map_err(|e| format!("cannot read the folder: {e}"))?;
+    let mut glbs = Vec::new();
+    for entry in entries {
+        let path = entry
+            .map_err(|e| format!("cannot read the folder: {e}"))?
+            .path();
+        if path.is_file()
+            && path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+        {
+            glbs.push(path);
+        }
+    }
+    glbs.sort();
+    match glbs.len() {
+        1 => Ok(glbs.remove(0)),
+        0 => Err(
+            "no .glb in the folder: give a folder that `halo4d build` wrote with outputs.glb on"
+                .into(),
+        ),
+        n => Err(format!(
+            "{n} .glb files in the folder ({}); expected one, the scene's <name>.glb: check a file instead",
+            glbs.iter()
+                .filter_map(|p| p.file_name())
+                .map(|n| n.to_string_lossy())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )),
+    }
+}
+
+/// "1 halo conforms" or "n halos conform".
+fn conform(n: usize) -> String {
+    if n == 1 {
+        "1 halo conforms".into()
+    } else {
+        format!("{n} halos conform")
+    }
+}
+
+/// Runs the checker on each halo and prints its table and a `FAILED` line per halo that does
+/// not conform or has an inverted or flat tetrahedron; returns whether none failed.
+fn check_halos(halos: &[&ImportedHalo]) -> bool {
+    if halos.is_empty() {
+        println!("no halo in the file");
+        return true;
+    }
     let stats: Vec<CheckStats> = halos.iter().map(|h| check(&h.mesh)).collect();
     let names: Vec<&str> = halos.iter().map(|h| h.name.as_str()).collect();
     print!("{}", table(&names, &stats));
@@ -222,16 +385,7 @@ fn check_file(file: &std::path::Path) -> ExitCode {
         }
         println!("FAILED {name}: {}", what.join(", "));
     }
-    if failed {
-        return ExitCode::FAILURE;
-    }
-    println!(
-        "ok: {} halo{} conform{}, no inverted or flat tetrahedron",
-        halos.len(),
-        if halos.len() == 1 { "" } else { "s" },
-        if halos.len() == 1 { "s" } else { "" },
-    );
-    ExitCode::SUCCESS
+    !failed
 }
 
 /// The checker's statistics as a table: a row per statistic, in the struct's order, and a

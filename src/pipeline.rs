@@ -410,14 +410,20 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
             stage: "export",
             message: e.to_string(),
         })?;
-        let glb = export::to_glb(&data, &scene_json).map_err(|message| Error::Internal {
-            stage: "export",
-            message,
+        let glb = export::to_glb(&data, &built.curves, &scene_json).map_err(|message| {
+            Error::Internal {
+                stage: "export",
+                message,
+            }
         })?;
         files.push(write(format!("{name}.glb"), &glb)?);
     }
     if scene.outputs.ply {
         files.push(write(format!("{name}.ply"), &export::to_ply(&data, name))?);
+        files.push(write(
+            format!("{name}-curves.ply"),
+            &export::to_curves_ply(&built.curves, name),
+        )?);
     }
     if scene.outputs.obj {
         files.push(write(

@@ -49,12 +49,16 @@ fn every_fixture_builds_and_reads_back() {
             );
         }
 
-        // glTF: one mesh per surface, named after it, with the custom attributes, and one per
-        // halo (tests/halo_export.rs reads those).
+        // glTF: one mesh per surface, named after it, with the custom attributes, one per
+        // halo (tests/halo_export.rs reads those) and one of the curves, if any
+        // (tests/curves_export.rs reads that).
         let glb = std::fs::read(out.join(format!("{name}.glb"))).unwrap();
         let gltf = gltf::Gltf::from_slice(&glb).unwrap_or_else(|e| panic!("{name}.glb: {e}"));
         let blob = gltf.blob.as_deref().expect("binary chunk");
-        assert_eq!(gltf.meshes().count(), 2 * products.len());
+        assert_eq!(
+            gltf.meshes().count(),
+            2 * products.len() + usize::from(!built.curves.curves.is_empty())
+        );
         let extras = gltf
             .document
             .as_json()
@@ -162,7 +166,8 @@ fn every_fixture_builds_and_reads_back() {
             json["surfaces"][0]["triangles"],
             products[0].mesh.triangles.len()
         );
-        assert_eq!(report.files.len(), 4 + products.len());
+        // .glb, .ply, -curves.ply, .obj, report.json and a .vtk per halo.
+        assert_eq!(report.files.len(), 5 + products.len());
         assert!(
             !text.contains("NaN") && !text.contains("null,"),
             "report has a non-number"

@@ -544,7 +544,7 @@ fn malformed_glb_files_are_clear_errors() {
                 m.as_object_mut().unwrap().remove("extras");
             }
         }),
-        &["no halo", "2 meshes"],
+        &["no halo", "3 meshes"],
     );
 
     // Values in the binary chunk: an index out of range, a NaN coordinate.

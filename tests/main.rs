@@ -3,6 +3,7 @@
 mod adaptive;
 mod cli;
 mod common;
+mod curves_export;
 mod export;
 mod halo;
 mod halo_export;

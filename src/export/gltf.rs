@@ -12,12 +12,21 @@
 //!   mesh's extras `{"halo": {"tetrahedra": accessor, "surface_vertices": n, "rho", "delta_d",
 //!   "delta_t", "split", "surface_mesh": mesh}}` ([`crate::import`] reads them back).
 //!
+//! Then, when the scene has any, the intersection curves of all surfaces together in one mesh
+//! `curves` with its own node: a LINES primitive with POSITION (min/max of the stored f32
+//! values) and float SCALAR attributes `_DW` (w of the far sheet minus w of the near sheet,
+//! never negative), `_CURVE` (the curve's index) and `_W` (w of the near sheet), one per curve point;
+//! its indices join consecutive points, and a closed curve's last point back to its first.
+//! The mesh's extras count them: `{"curves": {"count", "closed", "open", "points"}}`.
+//! Blender imports the lines as loose edges.
+//!
 //! Floats, because Blender 3.5+ imports float attributes and drops integer ones. Each
 //! attribute has its own tightly packed, 4-byte aligned buffer view. The asset's extras
 //! record the scene as parsed.
 
-use super::SurfaceData;
+use super::{SurfaceData, curve_segments};
 use crate::halo::Halo;
+use crate::intersect::Curves;
 use glam::DVec3;
 use gltf_json as json;
 use json::validation::Checked::Valid;
@@ -33,6 +42,9 @@ const PALETTE: [[f32; 4]; 6] = [
     [0.60, 0.45, 0.80, 1.0],
     [0.85, 0.85, 0.85, 1.0],
 ];
+
+/// Base colour of the curves' lines.
+const CURVE_COLOUR: [f32; 4] = [0.9, 0.1, 0.1, 1.0];
 
 /// Accumulates the binary chunk and the JSON objects that describe it.
 struct Builder {
@@ -212,9 +224,14 @@ fn halo_patches(s: &SurfaceData) -> Vec<f32> {
         .collect()
 }
 
-/// Builds the `.glb` bytes for the surfaces and their halos; `scene_json` goes into the
-/// asset's extras. A halo without tetrahedra gets no mesh (glTF accessors cannot be empty).
-pub fn to_glb(surfaces: &[SurfaceData], scene_json: &serde_json::Value) -> Result<Vec<u8>, String> {
+/// Builds the `.glb` bytes for the surfaces, their halos and the scene's intersection
+/// `curves`; `scene_json` goes into the asset's extras. A halo without tetrahedra, and
+/// curves without a segment, get no mesh (glTF accessors cannot be empty).
+pub fn to_glb(
+    surfaces: &[SurfaceData],
+    curves: &Curves,
+    scene_json: &serde_json::Value,
+) -> Result<Vec<u8>, String> {
     let extras = |v: serde_json::Value| to_raw_value(&v).map(Some).map_err(|e| e.to_string());
     let mut b = Builder {
         root: json::Root {
@@ -312,6 +329,13 @@ pub fn to_glb(surfaces: &[SurfaceData], scene_json: &serde_json::Value) -> Resul
             }));
         }
     }
+    if let Some(mesh) = curves_mesh(&mut b, curves)? {
+        nodes.push(b.root.push(json::Node {
+            mesh: Some(mesh),
+            name: Some("curves".into()),
+            ..Default::default()
+        }));
+    }
     let scene = b.root.push(json::Scene {
         extensions: None,
         extras: None,
@@ -404,6 +428,80 @@ fn halo_mesh(
         }],
         weights: None,
     }))
+}
+
+/// Appends the mesh `curves` (see the module documentation), or nothing when the curves have
+/// no segment.
+fn curves_mesh(
+    b: &mut Builder,
+    curves: &Curves,
+) -> Result<Option<json::Index<json::Mesh>>, String> {
+    use json::accessor::Type::Scalar;
+    use json::mesh::Semantic;
+    let segments: Vec<u32> = curve_segments(curves).into_iter().flatten().collect();
+    if segments.is_empty() {
+        return Ok(None);
+    }
+    let points = || curves.curves.iter().flat_map(|c| c.points.iter());
+    let positions: Vec<DVec3> = points().map(|p| p.position).collect();
+    let dw: Vec<f32> = points().map(|p| p.dw() as f32).collect();
+    let index: Vec<f32> = curves
+        .curves
+        .iter()
+        .enumerate()
+        .flat_map(|(k, c)| std::iter::repeat_n(k as f32, c.points.len()))
+        .collect();
+    let w_near: Vec<f32> = points().map(|p| p.w[p.near()] as f32).collect();
+    let attributes = [
+        (Semantic::Positions, b.positions(&positions)),
+        (Semantic::Extras("DW".into()), b.floats(&dw, Scalar, None)),
+        (
+            Semantic::Extras("CURVE".into()),
+            b.floats(&index, Scalar, None),
+        ),
+        (
+            Semantic::Extras("W".into()),
+            b.floats(&w_near, Scalar, None),
+        ),
+    ];
+    let indices = b.indices(
+        &segments,
+        Some(json::buffer::Target::ElementArrayBuffer),
+        None,
+    );
+    let material = b.root.push(json::Material {
+        name: Some("curves".into()),
+        pbr_metallic_roughness: json::material::PbrMetallicRoughness {
+            base_color_factor: json::material::PbrBaseColorFactor(CURVE_COLOUR),
+            metallic_factor: json::material::StrengthFactor(0.0),
+            roughness_factor: json::material::StrengthFactor(1.0),
+            ..Default::default()
+        },
+        ..Default::default()
+    });
+    let extras = serde_json::json!({
+        "curves": {
+            "count": curves.curves.len(),
+            "closed": curves.curves.iter().filter(|c| c.closed).count(),
+            "open": curves.curves.iter().filter(|c| !c.closed).count(),
+            "points": positions.len(),
+        }
+    });
+    Ok(Some(b.root.push(json::Mesh {
+        name: Some("curves".into()),
+        extras: Some(to_raw_value(&extras).map_err(|e| e.to_string())?),
+        extensions: None,
+        primitives: vec![json::mesh::Primitive {
+            attributes: attributes.into_iter().map(|(k, v)| (Valid(k), v)).collect(),
+            extensions: None,
+            extras: None,
+            indices: Some(indices),
+            material: Some(material),
+            mode: Valid(json::mesh::Mode::Lines),
+            targets: None,
+        }],
+        weights: None,
+    })))
 }
 
 /// Wraps JSON and binary chunks in the GLB container (header, JSON chunk padded with spaces,

@@ -1,11 +1,14 @@
 //! Export: the products of a build as files.
 //!
-//! Takes: the sampled and projected surfaces and their halos. Gives: `.glb` (glTF 2.0
-//! binary, for Blender: surfaces and halos), `.ply` (binary PLY with w as vertex `quality`,
-//! for MeshLab), `.obj` (Wavefront, positions and normals only), `.vtk` (legacy VTK
+//! Takes: the sampled and projected surfaces, their halos and the intersection curves. Gives: `.glb` (glTF 2.0
+//! binary, for Blender: surfaces, halos and intersection curves), `.ply` (binary PLY with w
+//! as vertex `quality`, for MeshLab), `-curves.ply` (the intersection curves as PLY edges,
+//! with the depth gap dw as vertex `quality`, for MeshLab, which reads LINES from a `.glb`
+//! as bogus triangles), `.obj` (Wavefront, positions and normals only), `.vtk` (legacy VTK
 //! unstructured grids of the halos' tetrahedra, for ParaView and meshio) and `report.json`.
 //! Guarantees: every file is written to a temporary name and renamed into place, so a
-//! failure never leaves a half-written file. [`crate::import`] reads the halos back.
+//! failure never leaves a half-written file. [`crate::import`] reads the halos and
+//! surfaces back.
 
 mod gltf;
 mod obj;
@@ -16,10 +19,11 @@ mod vtk;
 pub use gltf::to_glb;
 pub use obj::to_obj;
 pub use plot::{encode_png, speed_vs_error_png};
-pub use ply::to_ply;
+pub use ply::{to_curves_ply, to_ply};
 pub use vtk::to_vtk;
 
 use crate::halo::{Halo, HaloParams};
+use crate::intersect::Curves;
 use crate::sample::Mesh4;
 use crate::view::Projected;
 use std::io::Write;
@@ -44,6 +48,22 @@ pub struct SurfaceData<'a> {
     pub halo_params: &'a HaloParams,
     /// The halo's half-width, absolute (before any local shrinking).
     pub rho: f64,
+}
+
+/// The line segments of `curves` as pairs of indices into their points, numbered curve
+/// after curve: consecutive points, and for a closed curve the last back to the first.
+fn curve_segments(curves: &Curves) -> Vec<[u32; 2]> {
+    let mut out = Vec::new();
+    let mut base = 0u32;
+    for c in &curves.curves {
+        let n = c.points.len() as u32;
+        out.extend((1..n).map(|k| [base + k - 1, base + k]));
+        if c.closed && n > 1 {
+            out.push([base + n - 1, base]);
+        }
+        base += n;
+    }
+    out
 }
 
 /// Writes `bytes` to `path` through a temporary file in the same folder and a rename.

@@ -1,6 +1,7 @@
-//! Binary PLY of the projected surfaces, for MeshLab.
+//! Binary PLY of the projected surfaces and of the intersection curves, for MeshLab.
 
-use super::SurfaceData;
+use super::{SurfaceData, curve_segments};
+use crate::intersect::Curves;
 
 /// Builds a binary little-endian PLY with all surfaces in one mesh: per vertex x, y, z,
 /// nx, ny, nz, `quality` (the w-depth, which MeshLab keeps as its per-vertex scalar), u, v,
@@ -57,6 +58,55 @@ pub fn to_ply(surfaces: &[SurfaceData], scene_name: &str) -> Vec<u8> {
             }
         }
         base += s.projected.positions.len();
+    }
+    out
+}
+
+/// Builds a binary little-endian PLY of the intersection curves (`<name>-curves.ply`): per
+/// curve point x, y, z, `quality` (dw, the far sheet's w minus the near sheet's, which
+/// MeshLab keeps as its per-vertex scalar), `w_near`, `w_far` and `curve` (the curve's index),
+/// all float; per line segment an `edge` of `int vertex1, int vertex2` (consecutive points,
+/// and a closed curve's last back to its first). No curves give a valid file with no vertex
+/// and no edge.
+pub fn to_curves_ply(curves: &Curves, scene_name: &str) -> Vec<u8> {
+    let vertices: usize = curves.curves.iter().map(|c| c.points.len()).sum();
+    let segments = curve_segments(curves);
+    let header = format!(
+        "ply\nformat binary_little_endian 1.0\n\
+         comment halo4d {}: scene {scene_name}; intersection curves, quality is w_far - w_near\n\
+         element vertex {vertices}\n\
+         property float x\nproperty float y\nproperty float z\n\
+         property float quality\nproperty float w_near\nproperty float w_far\n\
+         property float curve\n\
+         element edge {}\n\
+         property int vertex1\nproperty int vertex2\n\
+         end_header\n",
+        env!("CARGO_PKG_VERSION"),
+        segments.len(),
+    );
+    let mut out = header.into_bytes();
+    out.reserve(vertices * 28 + segments.len() * 8);
+    for (k, c) in curves.curves.iter().enumerate() {
+        for p in &c.points {
+            let near = p.near();
+            let floats = [
+                p.position.x,
+                p.position.y,
+                p.position.z,
+                p.dw(),
+                p.w[near],
+                p.w[1 - near],
+                k as f64,
+            ];
+            for f in floats {
+                out.extend_from_slice(&(f as f32).to_le_bytes());
+            }
+        }
+    }
+    for s in segments {
+        for i in s {
+            out.extend_from_slice(&(i as i32).to_le_bytes());
+        }
     }
     out
 }

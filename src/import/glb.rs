@@ -1,8 +1,9 @@
-//! Halos from `.glb`: the container, the JSON chunk (serde_json) and the accessors the halo
-//! meshes name, each bounds-checked against the BIN chunk before it is read.
+//! Halos and surfaces from `.glb`: the container, the JSON chunk (serde_json) and the
+//! accessors the meshes name, each bounds-checked against the BIN chunk before it is read.
 
-use super::{FileParams, ImportError, ImportedHalo};
+use super::{FileParams, ImportError, ImportedHalo, ImportedScene, ImportedSurface};
 use crate::check::TetMesh;
+use glam::DVec3;
 use serde_json::Value;
 
 type Result<T> = std::result::Result<T, ImportError>;
@@ -14,24 +15,15 @@ fn glb_err(message: String) -> ImportError {
 /// Reads every mesh whose extras carry `halo` (see [`crate::export::to_glb`]).
 pub fn read_glb(bytes: &[u8]) -> Result<Vec<ImportedHalo>> {
     let (json, bin) = chunks(bytes)?;
-    let json: Value = serde_json::from_slice(json)
-        .map_err(|e| glb_err(format!("the JSON chunk is not valid JSON: {e}")))?;
+    let json = parse(json)?;
     let doc = Doc { json: &json, bin };
-    let meshes = match json.get("meshes") {
-        None => &[][..],
-        Some(Value::Array(m)) => &m[..],
-        Some(_) => return Err(glb_err("`meshes` is not an array".into())),
-    };
+    let meshes = meshes(&json)?;
     let mut halos = Vec::new();
     for (i, mesh) in meshes.iter().enumerate() {
-        let Some(halo) = mesh.get("extras").and_then(|e| e.get("halo")) else {
+        let Some(halo) = extra(mesh, "halo") else {
             continue;
         };
-        let name = match mesh.get("name") {
-            Some(Value::String(s)) => s.clone(),
-            _ => format!("mesh {i}"),
-        };
-        halos.push(doc.halo(i, mesh, halo, name)?.validate()?);
+        halos.push(doc.halo(i, mesh, halo, mesh_name(mesh, i))?.validate()?);
     }
     if halos.is_empty() {
         return Err(ImportError::NoHalo(format!(
@@ -40,6 +32,118 @@ pub fn read_glb(bytes: &[u8]) -> Result<Vec<ImportedHalo>> {
         )));
     }
     Ok(halos)
+}
+
+/// Reads a scene's `.glb` as `halo4d build` writes it: every surface (a mesh whose extras
+/// carry `surface`: positions, `_W` and triangles) with its halo, if any (the mesh whose
+/// extras' `halo.surface_mesh` names the surface's mesh). Each halo has t, d_orig, delta_d
+/// and delta_t, and as many surface vertices as its surface, so that the scene can be
+/// verified ([`ImportedScene::verify`]).
+pub fn read_scene_glb(bytes: &[u8]) -> Result<ImportedScene> {
+    let (json, bin) = chunks(bytes)?;
+    let json = parse(json)?;
+    let doc = Doc { json: &json, bin };
+    let meshes = meshes(&json)?;
+    let mut surfaces: Vec<ImportedSurface> = Vec::new();
+    // For each mesh, the surface it is.
+    let mut surface_of = vec![None; meshes.len()];
+    for (i, mesh) in meshes.iter().enumerate() {
+        if extra(mesh, "surface").is_some() {
+            surface_of[i] = Some(surfaces.len());
+            surfaces.push(doc.surface(i, mesh, mesh_name(mesh, i))?);
+        }
+    }
+    if surfaces.is_empty() {
+        return Err(ImportError::NoSurface(format!(
+            "no surface: none of the file's {} meshes has `surface` in its extras (halo4d build writes one mesh per surface)",
+            meshes.len()
+        )));
+    }
+    for (i, mesh) in meshes.iter().enumerate() {
+        let Some(extras) = extra(mesh, "halo") else {
+            continue;
+        };
+        let halo = doc.halo(i, mesh, extras, mesh_name(mesh, i))?.validate()?;
+        let bad = |message: String| ImportError::BadHalo {
+            name: halo.name.clone(),
+            message,
+        };
+        let m = index(
+            extras,
+            "surface_mesh",
+            &format!("meshes[{i}].extras.halo"),
+            None,
+        )?;
+        let s = usize::try_from(m)
+            .ok()
+            .and_then(|m| surface_of.get(m).copied().flatten())
+            .ok_or_else(|| {
+                bad(format!(
+                    "surface_mesh = {m} is not one of the file's surface meshes"
+                ))
+            })?;
+        let surface = &surfaces[s];
+        if surface.halo.is_some() {
+            return Err(bad(format!(
+                "surface `{}` (meshes[{m}]) has a halo already",
+                surface.name
+            )));
+        }
+        if halo.mesh.surface_vertices != surface.positions.len() {
+            return Err(bad(format!(
+                "surface_vertices = {}, but its surface `{}` has {} vertices",
+                halo.mesh.surface_vertices,
+                surface.name,
+                surface.positions.len()
+            )));
+        }
+        for (what, present) in [
+            ("the attribute _T (t)", halo.t.is_some()),
+            ("the attribute _D (d_orig)", halo.d_orig.is_some()),
+            ("delta_d in its extras", halo.params.delta_d.is_some()),
+            ("delta_t in its extras", halo.params.delta_t.is_some()),
+        ] {
+            if !present {
+                return Err(bad(format!(
+                    "has no {what}, which the halo depth of paper 000 eq. 3 needs"
+                )));
+            }
+        }
+        surfaces[s].halo = Some(halo);
+    }
+    let name = json
+        .pointer("/asset/extras/halo4d/scene/name")
+        .and_then(Value::as_str)
+        .map(String::from);
+    Ok(ImportedScene { name, surfaces })
+}
+
+/// The JSON chunk parsed.
+fn parse(json: &[u8]) -> Result<Value> {
+    serde_json::from_slice(json)
+        .map_err(|e| glb_err(format!("the JSON chunk is not valid JSON: {e}")))
+}
+
+/// The document's meshes (none when it has no `meshes`).
+fn meshes(json: &Value) -> Result<&[Value]> {
+    match json.get("meshes") {
+        None => Ok(&[]),
+        Some(Value::Array(m)) => Ok(m),
+        Some(_) => Err(glb_err("`meshes` is not an array".into())),
+    }
+}
+
+/// The entry `key` of a mesh's extras.
+fn extra<'v>(mesh: &'v Value, key: &str) -> Option<&'v Value> {
+    mesh.get("extras").and_then(|e| e.get(key))
+}
+
+/// A mesh's name, or `mesh i` when it has none.
+fn mesh_name(mesh: &Value, i: usize) -> String {
+    match mesh.get("name") {
+        Some(Value::String(s)) => s.clone(),
+        _ => format!("mesh {i}"),
+    }
 }
 
 fn u32_at(bytes: &[u8], at: usize) -> u32 {
@@ -267,6 +371,91 @@ impl<'a> Doc<'a> {
                 }
             })
             .collect())
+    }
+
+    /// The surface of mesh `i`: its first primitive's POSITION, `_W` and triangles.
+    fn surface(&self, i: usize, mesh: &Value, name: String) -> Result<ImportedSurface> {
+        let what = format!("meshes[{i}] (`{name}`)");
+        let primitive = mesh
+            .get("primitives")
+            .and_then(|p| p.get(0))
+            .ok_or_else(|| glb_err(format!("{what} has no primitive")))?;
+        let mode = index(primitive, "mode", &format!("{what}.primitives[0]"), Some(4))?;
+        if mode != 4 {
+            return Err(glb_err(format!(
+                "{what} has primitives of mode {mode}, expected TRIANGLES (4)"
+            )));
+        }
+        let attributes = primitive
+            .get("attributes")
+            .ok_or_else(|| glb_err(format!("{what} has no attributes")))?;
+        let attribute = |key: &str| -> Result<u64> {
+            index(attributes, key, &format!("{what} attributes"), None)
+        };
+        let positions: Vec<DVec3> = self
+            .floats(attribute("POSITION")?, "VEC3", 3)?
+            .chunks_exact(3)
+            .map(|c| DVec3::new(c[0].into(), c[1].into(), c[2].into()))
+            .collect();
+        let w: Vec<f64> = self
+            .floats(attribute("_W")?, "SCALAR", 1)?
+            .into_iter()
+            .map(f64::from)
+            .collect();
+        let indices = self.unsigned(index(
+            primitive,
+            "indices",
+            &format!("{what}.primitives[0]"),
+            None,
+        )?)?;
+        let bad = |message: String| ImportError::BadSurface {
+            name: name.clone(),
+            message,
+        };
+        let nv = positions.len();
+        if w.len() != nv {
+            return Err(bad(format!("_W has {} values for {nv} positions", w.len())));
+        }
+        if let Some(k) = positions.iter().position(|p| !p.is_finite()) {
+            let p = positions[k];
+            return Err(bad(format!(
+                "vertex {k} has a non-finite coordinate ({}, {}, {})",
+                p.x, p.y, p.z
+            )));
+        }
+        if let Some(k) = w.iter().position(|x| !x.is_finite()) {
+            return Err(bad(format!("_W of vertex {k} is not finite ({})", w[k])));
+        }
+        if indices.len() % 3 != 0 {
+            return Err(bad(format!(
+                "{} triangle indices, not a multiple of 3",
+                indices.len()
+            )));
+        }
+        let triangles: Vec<[u32; 3]> = indices
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
+        for (k, t) in triangles.iter().enumerate() {
+            if let Some(&v) = t.iter().find(|&&v| v as usize >= nv) {
+                return Err(bad(format!(
+                    "triangle {k} names vertex {v}, but there are only {nv} vertices"
+                )));
+            }
+            if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
+                return Err(bad(format!(
+                    "triangle {k} repeats a vertex: {t:?} (halo4d never writes one)"
+                )));
+            }
+        }
+        Ok(ImportedSurface {
+            name,
+            mesh: i,
+            positions,
+            w,
+            triangles,
+            halo: None,
+        })
     }
 
     /// The halo of mesh `i`, whose extras' `halo` is `halo`.

@@ -1,9 +1,13 @@
-//! Import: halos read back from the files [`crate::export`] writes, for `halo4d check`.
+//! Import: halos and surfaces read back from the files [`crate::export`] writes, for
+//! `halo4d check`.
 //!
 //! Takes: the bytes of a `.glb` (every mesh whose extras carry `halo`) or of a legacy `.vtk`
 //! (an `UNSTRUCTURED_GRID` of tetrahedra whose field data has `surface_vertices`, ASCII or
 //! binary, file version 2.0 to 5.1). Gives: [`ImportedHalo`]s, each a [`TetMesh`] in the
-//! halo layout of [`crate::check`] with its name, per-vertex t and d_orig and parameters.
+//! halo layout of [`crate::check`] with its name, per-vertex t and d_orig and parameters;
+//! from a scene's `.glb` also its surfaces ([`read_scene_glb`]: positions, w-depth and
+//! triangles, each with its halo), from which [`ImportedScene::verify`] recomputes the
+//! intersection curves and verifies the halos against them.
 //! Guarantees: malformed input (truncated, wrong magic, bad JSON, references out of range,
 //! counts that disagree, non-finite coordinates) is an [`ImportError`] that names the
 //! problem, never a panic; a count claimed in a file is checked against the bytes actually
@@ -12,10 +16,13 @@
 mod glb;
 mod vtk;
 
-pub use glb::read_glb;
+pub use glb::{read_glb, read_scene_glb};
 pub use vtk::read_vtk;
 
 use crate::check::TetMesh;
+use crate::intersect::{self, Curves, Sheet};
+use crate::verify::{self, HaloInput, Verification};
+use glam::DVec3;
 use std::path::Path;
 
 /// A halo read from a file.
@@ -31,6 +38,84 @@ pub struct ImportedHalo {
     pub d_orig: Option<Vec<f64>>,
     /// The halo parameters the file records.
     pub params: FileParams,
+}
+
+/// A surface read from a scene's `.glb`, with its halo.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ImportedSurface {
+    /// The glTF mesh name (the surface's name in the scene).
+    pub name: String,
+    /// Index of its glTF mesh.
+    pub mesh: usize,
+    /// Projected positions, as stored (f32 values, widened).
+    pub positions: Vec<DVec3>,
+    /// w-depth of each vertex (`_W`).
+    pub w: Vec<f64>,
+    /// Triangles, none of which repeats a vertex.
+    pub triangles: Vec<[u32; 3]>,
+    /// Its halo, when the file has one: with t, d_orig, delta_d and delta_t, and as many
+    /// surface vertices as the surface has vertices.
+    pub halo: Option<ImportedHalo>,
+}
+
+/// A scene read from its `.glb` ([`read_scene_glb`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ImportedScene {
+    /// The scene's name, from the asset's extras, when recorded.
+    pub name: Option<String>,
+    /// Its surfaces, in the file's order.
+    pub surfaces: Vec<ImportedSurface>,
+}
+
+impl ImportedScene {
+    /// The surfaces as the intersection stage reads them.
+    pub fn sheets(&self) -> Vec<Sheet<'_>> {
+        self.surfaces
+            .iter()
+            .map(|s| Sheet {
+                positions: &s.positions,
+                w: &s.w,
+                triangles: &s.triangles,
+            })
+            .collect()
+    }
+
+    /// Recomputes the intersection curves of the surfaces ([`intersect::curves`]) and
+    /// verifies the halos against them ([`verify::verify`]). Takes the scene as
+    /// [`read_scene_glb`] returns it; a halo without tetrahedra, t, d_orig, delta_d or
+    /// delta_t counts as none.
+    pub fn verify(&self) -> (Curves, Verification) {
+        let sheets = self.sheets();
+        let curves = intersect::curves(&sheets);
+        let positions: Vec<Vec<DVec3>> = self
+            .surfaces
+            .iter()
+            .map(|s| {
+                s.halo.as_ref().map_or_else(Vec::new, |h| {
+                    h.mesh.positions.iter().map(|&p| DVec3::from(p)).collect()
+                })
+            })
+            .collect();
+        let halos: Vec<Option<HaloInput>> = self
+            .surfaces
+            .iter()
+            .zip(&positions)
+            .map(|(s, positions)| {
+                let h = s.halo.as_ref().filter(|h| !h.mesh.tets.is_empty())?;
+                Some(HaloInput {
+                    positions,
+                    t: h.t.as_deref()?,
+                    d_orig: h.d_orig.as_deref()?,
+                    tets: &h.mesh.tets,
+                    surface_vertices: h.mesh.surface_vertices,
+                    delta_d: h.params.delta_d?,
+                    delta_t: h.params.delta_t?,
+                })
+            })
+            .collect();
+        let verification = verify::verify(&sheets, &halos, &curves);
+        (curves, verification)
+    }
 }
 
 /// The halo parameters a file records; absent ones are `None`.
@@ -66,6 +151,17 @@ pub enum ImportError {
     /// The file is well formed but carries no halo in halo4d's layout.
     #[error("{0}")]
     NoHalo(String),
+    /// The file is well formed but carries no surface in halo4d's layout.
+    #[error("{0}")]
+    NoSurface(String),
+    /// A surface's data break the layout: an index out of range, a non-finite coordinate, ...
+    #[error("surface `{name}`: {message}")]
+    BadSurface {
+        /// The surface.
+        name: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A halo's data break the layout: an index out of range, a non-finite coordinate, ...
     #[error("halo `{name}`: {message}")]
     BadHalo {

@@ -1,0 +1,691 @@
+//! Intersection curves through their files: the .glb's `curves` mesh (read by the gltf crate)
+//! and `<name>-curves.ply` (read by ply-rs) hold exactly the curves of the build; a scene's
+//! surfaces and halos read back from its .glb; `halo4d check DIR` passes a build and catches
+//! faults planted in its .glb; unreadable folders are errors.
+
+use crate::common::{Rng, fixture};
+use halo4d::import::{ImportError, ImportedScene, read_scene_glb};
+use halo4d::intersect::Curves;
+use halo4d::{Built, Scene};
+use ply_rs::ply::Property;
+use serde_json::Value;
+use std::path::Path;
+use std::process::Command;
+
+/// Builds a scene into `dir`.
+fn build(scene: &Scene, dir: &Path) -> Built {
+    let built = halo4d::run(scene, true).unwrap();
+    halo4d::write(scene, &built, dir).unwrap();
+    built
+}
+
+fn halo4d(args: &[&str], dir: &Path) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_halo4d"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+/// The default scene (a spun trefoil: closed and open curves) and the patches fixture (open
+/// curves ending at mesh boundaries).
+fn scenes() -> Vec<Scene> {
+    vec![
+        Scene::default_scene(),
+        Scene::load(&fixture("scenes/patches.json")).unwrap(),
+    ]
+}
+
+/// The line segments the files must hold, numbering the points curve after curve: an open
+/// curve of n points has n - 1, a closed one n (the last point joined to the first).
+fn expected_segments(curves: &Curves) -> Vec<[u32; 2]> {
+    let mut out = Vec::new();
+    let mut base = 0;
+    for c in &curves.curves {
+        let n = c.points.len() as u32;
+        assert!(n >= 2, "a curve of {n} points");
+        for k in 0..n - 1 {
+            out.push([base + k, base + k + 1]);
+        }
+        if c.closed {
+            out.push([base + n - 1, base]);
+        }
+        base += n;
+    }
+    out
+}
+
+/// The values of a float SCALAR accessor.
+fn scalars(blob: &[u8], acc: &gltf::Accessor) -> Vec<f32> {
+    assert_eq!(acc.data_type(), gltf::accessor::DataType::F32);
+    assert_eq!(acc.dimensions(), gltf::accessor::Dimensions::Scalar);
+    let view = acc.view().unwrap();
+    assert_eq!(view.stride(), None, "tightly packed");
+    blob[view.offset() + acc.offset()..][..acc.count() * 4]
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect()
+}
+
+#[test]
+fn the_glb_curves_mesh_holds_every_curve_point_and_segment() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut closed, mut open) = (0, 0);
+    for scene in scenes() {
+        let out = dir.path().join(&scene.name);
+        let built = build(&scene, &out);
+        let curves = &built.curves;
+        let name = &scene.name;
+        let points: Vec<_> = curves.curves.iter().flat_map(|c| &c.points).collect();
+        assert!(!points.is_empty(), "{name}: no curves");
+        closed += curves.curves.iter().filter(|c| c.closed).count();
+        open += curves.curves.iter().filter(|c| !c.closed).count();
+
+        let glb = std::fs::read(out.join(format!("{name}.glb"))).unwrap();
+        let gltf = gltf::Gltf::from_slice(&glb).unwrap();
+        let blob = gltf.blob.as_deref().unwrap();
+        let mesh = gltf
+            .meshes()
+            .find(|m| m.name() == Some("curves"))
+            .expect("a mesh `curves`");
+        assert!(
+            gltf.nodes()
+                .any(|node| node.mesh().map(|m| m.index()) == Some(mesh.index())
+                    && node.name() == Some("curves")),
+            "{name}: the curves mesh has its own node"
+        );
+        assert!(
+            gltf.scenes()
+                .next()
+                .unwrap()
+                .nodes()
+                .any(|n| n.mesh().map(|m| m.index()) == Some(mesh.index())),
+            "{name}: the node is in the scene"
+        );
+        assert_eq!(mesh.primitives().count(), 1);
+        let prim = mesh.primitives().next().unwrap();
+        assert_eq!(prim.mode(), gltf::mesh::Mode::Lines);
+        let reader = prim.reader(|_| Some(blob));
+
+        // Positions: the f32 of each curve point, in order, min/max from the stored values.
+        let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
+        let expected: Vec<[f32; 3]> = points
+            .iter()
+            .map(|p| p.position.as_vec3().to_array())
+            .collect();
+        assert_eq!(positions, expected, "{name}");
+        let acc = prim.get(&gltf::Semantic::Positions).unwrap();
+        let min: Vec<f32> = serde_json::from_value(acc.min().unwrap()).unwrap();
+        let max: Vec<f32> = serde_json::from_value(acc.max().unwrap()).unwrap();
+        for k in 0..3 {
+            let lo = positions.iter().map(|q| q[k]).fold(f32::INFINITY, f32::min);
+            let hi = positions
+                .iter()
+                .map(|q| q[k])
+                .fold(f32::NEG_INFINITY, f32::max);
+            assert_eq!((min[k], max[k]), (lo, hi), "{name}");
+        }
+
+        // _DW, _CURVE and _W, one per point.
+        let curve_index: Vec<f32> = curves
+            .curves
+            .iter()
+            .enumerate()
+            .flat_map(|(k, c)| vec![k as f32; c.points.len()])
+            .collect();
+        for (attr, want) in [
+            (
+                "_DW",
+                points.iter().map(|p| p.dw() as f32).collect::<Vec<_>>(),
+            ),
+            ("_CURVE", curve_index),
+            ("_W", points.iter().map(|p| p.w[p.near()] as f32).collect()),
+        ] {
+            let acc = prim
+                .attributes()
+                .find(|(s, _)| s.to_string() == attr)
+                .unwrap_or_else(|| panic!("{name}: no {attr}"))
+                .1;
+            let got = scalars(blob, &acc);
+            assert_eq!(got, want, "{name}: {attr}");
+        }
+        // dw is the far sheet's w minus the near sheet's: never negative.
+        assert!(
+            points
+                .iter()
+                .all(|p| p.dw() >= 0.0 && p.w[1 - p.near()] - p.w[p.near()] == p.dw())
+        );
+
+        // Segments: consecutive points, closed curves closed.
+        let indices: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
+        let segments: Vec<[u32; 2]> = indices.chunks_exact(2).map(|s| [s[0], s[1]]).collect();
+        assert_eq!(indices.len() % 2, 0);
+        assert_eq!(segments, expected_segments(curves), "{name}");
+        let count: usize = curves
+            .curves
+            .iter()
+            .map(|c| c.points.len() - usize::from(!c.closed))
+            .sum();
+        assert_eq!(segments.len(), count, "{name}");
+
+        let extras: Value = serde_json::from_str(mesh.extras().as_ref().unwrap().get()).unwrap();
+        let r = &curves.report;
+        assert_eq!(
+            extras["curves"],
+            serde_json::json!({
+                "count": r.count, "closed": r.closed, "open": r.open, "points": r.points
+            }),
+            "{name}"
+        );
+        assert_eq!(r.points, points.len());
+    }
+    assert!(closed > 0 && open > 0, "{closed} closed, {open} open");
+}
+
+fn float(p: &Property) -> f32 {
+    match p {
+        Property::Float(x) => *x,
+        other => panic!("expected a float, got {other:?}"),
+    }
+}
+
+fn int(p: &Property) -> i32 {
+    match p {
+        Property::Int(x) => *x,
+        other => panic!("expected an int, got {other:?}"),
+    }
+}
+
+#[test]
+fn the_curves_ply_holds_the_same_points_and_edges() {
+    let dir = tempfile::tempdir().unwrap();
+    for scene in scenes() {
+        let out = dir.path().join(&scene.name);
+        let built = build(&scene, &out);
+        let name = &scene.name;
+        let report: Value =
+            serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+        let file = format!("{name}-curves.ply");
+        assert!(
+            report["files"]
+                .as_array()
+                .unwrap()
+                .contains(&Value::from(file.as_str())),
+            "{name}: {file} not in the report's files"
+        );
+        let bytes = std::fs::read(out.join(&file)).unwrap();
+        let parser = ply_rs::parser::Parser::<ply_rs::ply::DefaultElement>::new();
+        let ply = parser.read_ply(&mut bytes.as_slice()).unwrap();
+        assert_eq!(
+            ply.header.encoding,
+            ply_rs::ply::Encoding::BinaryLittleEndian
+        );
+        let vertices = &ply.payload["vertex"];
+        let edges = &ply.payload["edge"];
+        let mut k = 0;
+        for (c, curve) in built.curves.curves.iter().enumerate() {
+            for p in &curve.points {
+                let v = &vertices[k];
+                let near = p.near();
+                let xyz = [&v["x"], &v["y"], &v["z"]].map(float);
+                assert_eq!(xyz, p.position.as_vec3().to_array(), "{name}: vertex {k}");
+                assert_eq!(float(&v["quality"]), p.dw() as f32, "{name}: vertex {k}");
+                assert_eq!(float(&v["w_near"]), p.w[near] as f32);
+                assert_eq!(float(&v["w_far"]), p.w[1 - near] as f32);
+                assert_eq!(float(&v["curve"]), c as f32);
+                k += 1;
+            }
+        }
+        assert_eq!(vertices.len(), k, "{name}");
+        let got: Vec<[u32; 2]> = edges
+            .iter()
+            .map(|e| [int(&e["vertex1"]), int(&e["vertex2"])].map(|i| i as u32))
+            .collect();
+        assert_eq!(got, expected_segments(&built.curves), "{name}");
+    }
+}
+
+#[test]
+fn without_curves_the_glb_has_no_curves_mesh_and_the_ply_is_empty_but_valid() {
+    let scene = Scene::load(&fixture("scenes/patches.json")).unwrap();
+    let built = halo4d::run(&scene, true).unwrap();
+    let data: Vec<_> = built.surfaces.iter().map(|p| p.data(&scene.halo)).collect();
+    let none = Curves::default();
+    let glb = halo4d::export::to_glb(&data, &none, &Value::Null).unwrap();
+    let gltf = gltf::Gltf::from_slice(&glb).unwrap();
+    assert_eq!(gltf.meshes().count(), 2);
+    assert!(gltf.meshes().all(|m| m.name() != Some("curves")));
+    assert!(gltf.nodes().all(|n| n.name() != Some("curves")));
+
+    let bytes = halo4d::export::to_curves_ply(&none, "empty");
+    let parser = ply_rs::parser::Parser::<ply_rs::ply::DefaultElement>::new();
+    let ply = parser.read_ply(&mut bytes.as_slice()).unwrap();
+    for element in ["vertex", "edge"] {
+        assert_eq!(ply.header.elements[element].count, 0, "{element}");
+        assert!(ply.payload.get(element).is_none_or(|e| e.is_empty()));
+    }
+    let text = String::from_utf8(bytes).unwrap();
+    assert!(text.ends_with("end_header\n"), "{text}");
+}
+
+#[test]
+fn a_scene_reads_back_from_its_glb_with_every_surface_and_its_halo() {
+    let dir = tempfile::tempdir().unwrap();
+    // Two surfaces, so that halos are matched to surfaces by `surface_mesh`, not by order.
+    let scene = Scene::parse(
+        r#"{ "name": "pair", "surfaces": [
+             { "name": "flat", "surface": { "type": "patches", "count": 2 } },
+             { "name": "torus", "surface": { "type": "flat_torus" } } ],
+             "sampling": { "method": "uniform", "u": 8, "v": 8 },
+             "view": { "rotation": { "yw": 40 } } }"#,
+        "pair",
+    )
+    .unwrap();
+    let built = build(&scene, dir.path());
+    let bytes = std::fs::read(dir.path().join("pair.glb")).unwrap();
+    let read = read_scene_glb(&bytes).unwrap();
+    assert_eq!(read.name.as_deref(), Some("pair"));
+    assert_eq!(read.surfaces.len(), built.surfaces.len());
+    let gltf = gltf::Gltf::from_slice(&bytes).unwrap();
+    for (p, s) in built.surfaces.iter().zip(&read.surfaces) {
+        assert_eq!(s.name, p.name);
+        assert_eq!(
+            gltf.meshes().nth(s.mesh).unwrap().name(),
+            Some(p.name.as_str())
+        );
+        let f32_of = |x: f64| f64::from(x as f32);
+        let want: Vec<[f64; 3]> = p
+            .projected
+            .positions
+            .iter()
+            .map(|v| v.to_array().map(f32_of))
+            .collect();
+        let got: Vec<[f64; 3]> = s.positions.iter().map(|v| v.to_array()).collect();
+        assert_eq!(got, want, "{}", p.name);
+        let w: Vec<f64> = p.projected.w.iter().map(|&x| f32_of(x)).collect();
+        assert_eq!(s.w, w, "{}", p.name);
+        assert_eq!(s.triangles, p.mesh.triangles, "{}", p.name);
+
+        let h = s.halo.as_ref().expect("a halo per surface");
+        assert_eq!(h.name, format!("{}-halo", p.name));
+        assert_eq!(h.mesh, p.halo.tet_mesh(), "{}", p.name);
+        assert_eq!(h.mesh.surface_vertices, s.positions.len());
+        assert_eq!(h.params.delta_d, Some(scene.halo.delta_d));
+        assert_eq!(h.params.delta_t, Some(scene.halo.delta_t));
+        assert_eq!(h.params.surface_mesh, Some(s.mesh));
+        let d: Vec<f64> = p.halo.d_orig.iter().map(|&x| f32_of(x)).collect();
+        assert_eq!(h.d_orig.as_deref(), Some(&d[..]));
+    }
+    // The curves between the two surfaces are found again, and the halos explain them.
+    let (curves, v) = read.verify();
+    assert!(curves.report.count > 0 && v.curve_samples > 0, "{v:?}");
+    assert!(
+        curves
+            .curves
+            .iter()
+            .flat_map(|c| &c.points)
+            .any(|p| p.faces[0].surface != p.faces[1].surface),
+        "no curve between the two surfaces"
+    );
+    assert_eq!((v.wrong, v.spurious_hidden_samples), (0, 0), "{v:?}");
+    assert!(v.correct > 0, "{v:?}");
+}
+
+/// The JSON chunk and the BIN chunk's data offset of a .glb.
+fn split(glb: &[u8]) -> (Value, usize) {
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let json = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    (json, 20 + json_len + 8)
+}
+
+/// The .glb with its JSON chunk edited.
+fn with_json(glb: &[u8], edit: impl FnOnce(&mut Value)) -> Vec<u8> {
+    let (mut json, bin) = split(glb);
+    edit(&mut json);
+    let mut text = serde_json::to_vec(&json).unwrap();
+    text.resize(text.len().next_multiple_of(4), b' ');
+    let bin_chunk = &glb[bin - 8..];
+    let total = 20 + text.len() + bin_chunk.len();
+    let mut out = b"glTF".to_vec();
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(text.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&text);
+    out.extend_from_slice(bin_chunk);
+    out
+}
+
+/// Where in the .glb the values of attribute `attr` of the first mesh whose extras carry
+/// `kind` lie, and how many there are.
+fn attribute_at(glb: &[u8], kind: &str, attr: &str) -> (usize, usize) {
+    let (json, bin) = split(glb);
+    let mesh = json["meshes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["extras"].get(kind).is_some())
+        .unwrap();
+    let a =
+        &json["accessors"][mesh["primitives"][0]["attributes"][attr].as_u64().unwrap() as usize];
+    let view = &json["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
+    let offset = view["byteOffset"].as_u64().unwrap_or(0) + a["byteOffset"].as_u64().unwrap_or(0);
+    (bin + offset as usize, a["count"].as_u64().unwrap() as usize)
+}
+
+/// Applies `f` to `count` f32 values (of `components` each) at `at`.
+fn edit_f32(bytes: &mut [u8], at: usize, count: usize, f: impl Fn(f32) -> f32) {
+    for k in 0..count {
+        let b = &mut bytes[at + 4 * k..at + 4 * k + 4];
+        let x = f32::from_le_bytes(b.try_into().unwrap());
+        b.copy_from_slice(&f(x).to_le_bytes());
+    }
+}
+
+/// The number on the line of `halo4d check DIR`'s output that starts with `label`.
+fn count(text: &str, label: &str) -> usize {
+    text.lines()
+        .find_map(|l| {
+            let mut words = l.split_whitespace();
+            (words.next() == Some(label)).then(|| words.next().unwrap().parse().unwrap())
+        })
+        .unwrap_or_else(|| panic!("no `{label}` in {text}"))
+}
+
+#[test]
+fn check_dir_passes_a_build_and_catches_faults_planted_in_its_glb() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Scene::load(&fixture("scenes/patches.json")).unwrap();
+    let built = build(&scene, &dir.path().join("patches"));
+    let out = halo4d(&["check", "patches"], dir.path());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    for word in [
+        "patches-halo",
+        "quad_mismatches",
+        "curve_samples",
+        "correct",
+        "ambiguous",
+        "third_sheet",
+        "surface_samples",
+        "hidden_samples",
+        "spurious_hidden_samples",
+    ] {
+        assert!(text.contains(word), "`{word}` not in {text}");
+    }
+    assert!(
+        text.lines()
+            .last()
+            .unwrap()
+            .starts_with("ok: 1 halo conforms")
+    );
+    assert!(!text.contains("FAILED"), "{text}");
+    let (correct, third) = (count(&text, "correct"), count(&text, "third_sheet"));
+    assert!(correct > 0, "{text}");
+    assert_eq!(
+        (
+            count(&text, "wrong"),
+            count(&text, "spurious_hidden_samples")
+        ),
+        (0, 0)
+    );
+    // The build verified the same halo against its own (f64) curves.
+    assert_eq!(built.verification.wrong, 0);
+
+    let glb = std::fs::read(dir.path().join("patches/patches.glb")).unwrap();
+    let imported: ImportedScene = read_scene_glb(&glb).unwrap();
+    let w = imported.surfaces.iter().flat_map(|s| s.w.iter().copied());
+    let (lo, hi) = w.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+        (lo.min(x), hi.max(x))
+    });
+    let planted = |name: &str, bytes: &[u8]| {
+        let d = dir.path().join(name);
+        std::fs::create_dir(&d).unwrap();
+        std::fs::write(d.join("patches.glb"), bytes).unwrap();
+        let out = halo4d(&["check", name], dir.path());
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert_eq!(out.status.code(), Some(1), "{name}: {text}");
+        // The tetrahedra are as good as before: only the verification fails.
+        assert!(!text.contains("FAILED patches-halo"), "{name}: {text}");
+        text
+    };
+
+    // The halo mesh no longer marked as one: a scene without halos, whose curves nothing
+    // explains.
+    let text = planted(
+        "bare",
+        &with_json(&glb, |j| {
+            for m in j["meshes"].as_array_mut().unwrap() {
+                m["extras"].as_object_mut().unwrap().remove("halo");
+            }
+        }),
+    );
+    assert!(text.contains("no halo in the file"), "{text}");
+    assert_eq!(count(&text, "wrong"), correct + third, "{text}");
+
+    // d_orig of every halo vertex raised by more than the whole scene's range of w. A halo
+    // depth (eq. 3) is d_orig interpolated plus a non-negative term, and d_orig is at least
+    // the smallest w, so every halo depth now exceeds every sheet's w: no halo hides anything.
+    // Each curve sample that is not ambiguous (those the build found correct or hidden by a
+    // third sheet) must then be wrong, whatever the geometry: the test cannot pass by accident.
+    let mut raised = glb.clone();
+    let (at, n) = attribute_at(&glb, "halo", "_D");
+    let lift = (2.0 * (hi - lo) + 1.0) as f32;
+    edit_f32(&mut raised, at, n, |d| d + lift);
+    let text = planted("raised", &raised);
+    assert_eq!(count(&text, "wrong"), correct + third, "{text}");
+    assert_eq!(count(&text, "correct"), 0, "{text}");
+    assert!(
+        text.contains("FAILED halo verification") && text.contains("curve samples wrong"),
+        "{text}"
+    );
+
+    // The halo's positions doubled (about the origin: exact in f32, a similarity, so the
+    // checker sees the same valid tetrahedra): the halo now hides the sheets far from the
+    // surface it was built over, which only a spurious gap explains.
+    let mut doubled = glb.clone();
+    let (at, n) = attribute_at(&glb, "halo", "POSITION");
+    edit_f32(&mut doubled, at, 3 * n, |x| 2.0 * x);
+    let text = planted("doubled", &doubled);
+    assert!(count(&text, "spurious_hidden_samples") > 0, "{text}");
+    assert!(
+        text.contains("FAILED halo verification") && text.contains("no sheet is within rho"),
+        "{text}"
+    );
+}
+
+#[test]
+fn check_dir_on_an_unreadable_folder_is_an_error_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Scene::load(&fixture("scenes/patches.json")).unwrap();
+    build(&scene, &dir.path().join("patches"));
+    let glb = std::fs::read(dir.path().join("patches/patches.glb")).unwrap();
+    let folder = |name: &str, files: &[(&str, &[u8])]| {
+        let d = dir.path().join(name);
+        std::fs::create_dir(&d).unwrap();
+        for (f, bytes) in files {
+            std::fs::write(d.join(f), bytes).unwrap();
+        }
+    };
+    folder("cut", &[("patches.glb", &glb[..glb.len() / 2])]);
+    folder("none", &[("notes.txt", b"hello")]);
+    folder("two", &[("a.glb", &glb), ("b.glb", &glb)]);
+    let no_halo_surface = with_json(&glb, |j| {
+        for m in j["meshes"].as_array_mut().unwrap() {
+            m["extras"].as_object_mut().unwrap().remove("surface");
+        }
+    });
+    folder("bare", &[("patches.glb", &no_halo_surface)]);
+    for (name, words) in [
+        ("cut", &["cut", "patches.glb", "truncated"][..]),
+        ("none", &["none", "no .glb"]),
+        ("two", &["two", "2 .glb files", "a.glb, b.glb"]),
+        ("bare", &["patches.glb", "no surface"]),
+    ] {
+        let out = halo4d(&["check", name], dir.path());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        assert!(err.starts_with("error: "), "{err}");
+        for w in words {
+            assert!(err.contains(w), "{name}: `{w}` not in {err}");
+        }
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+/// `read_scene_glb` fails with an error containing `words`.
+fn scene_fails(bytes: &[u8], words: &[&str]) {
+    let e = read_scene_glb(bytes)
+        .expect_err("accepted a broken scene .glb")
+        .to_string();
+    for w in words {
+        assert!(e.contains(w), "`{w}` not in: {e}");
+    }
+}
+
+#[test]
+fn malformed_scene_glb_files_are_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Scene::load(&fixture("scenes/patches.json")).unwrap();
+    let built = build(&scene, dir.path());
+    let good = std::fs::read(dir.path().join("patches.glb")).unwrap();
+    let n = built.surfaces[0].projected.positions.len();
+    assert_eq!(read_scene_glb(&good).unwrap().surfaces.len(), 1);
+
+    scene_fails(&good[..100], &["truncated"]);
+    let halo = |j: &mut Value| -> usize {
+        j["meshes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .position(|m| m["extras"].get("halo").is_some())
+            .unwrap()
+    };
+    let edited = |edit: &dyn Fn(&mut Value)| with_json(&good, |j| edit(j));
+    scene_fails(
+        &edited(&|j| {
+            let h = halo(j);
+            j["meshes"][h]["extras"]["halo"]["surface_mesh"] = (h as u64).into();
+        }),
+        &["patches-halo", "is not one of the file's surface meshes"],
+    );
+    scene_fails(
+        &edited(&|j| {
+            let h = halo(j);
+            j["meshes"][h]["extras"]["halo"]
+                .as_object_mut()
+                .unwrap()
+                .remove("surface_mesh");
+        }),
+        &["no `surface_mesh`"],
+    );
+    scene_fails(
+        &edited(&|j| {
+            let h = halo(j);
+            j["meshes"][h]["extras"]["halo"]["surface_vertices"] = (n - 1).into();
+        }),
+        &[
+            &format!("surface_vertices = {}", n - 1),
+            &format!("{n} vertices"),
+        ],
+    );
+    scene_fails(
+        &edited(&|j| {
+            let h = halo(j);
+            j["meshes"][h]["extras"]["halo"]
+                .as_object_mut()
+                .unwrap()
+                .remove("delta_t");
+        }),
+        &["patches-halo", "delta_t"],
+    );
+    scene_fails(
+        &edited(&|j| {
+            let h = halo(j);
+            let copy = j["meshes"][h].clone();
+            j["meshes"].as_array_mut().unwrap().push(copy);
+        }),
+        &["has a halo already"],
+    );
+    scene_fails(
+        &edited(&|j| {
+            let w = j["meshes"][0]["primitives"][0]["attributes"]["_W"]
+                .as_u64()
+                .unwrap() as usize;
+            j["accessors"][w]["count"] = 5.into();
+        }),
+        &[
+            "surface `patches`",
+            &format!("_W has 5 values for {n} positions"),
+        ],
+    );
+    scene_fails(
+        &edited(&|j| j["meshes"][0]["primitives"][0]["mode"] = 1.into()),
+        &["mode 1", "TRIANGLES"],
+    );
+    scene_fails(
+        &edited(&|j| {
+            j["meshes"][0]["primitives"][0]["attributes"]
+                .as_object_mut()
+                .unwrap()
+                .remove("_W");
+        }),
+        &["no `_W`"],
+    );
+    // Values in the binary chunk: a triangle that repeats a vertex, an index out of range.
+    let (json, bin) = split(&good);
+    let indices = &json["accessors"][json["meshes"][0]["primitives"][0]["indices"]
+        .as_u64()
+        .unwrap() as usize];
+    let view = &json["bufferViews"][indices["bufferView"].as_u64().unwrap() as usize];
+    let at = bin + view["byteOffset"].as_u64().unwrap_or(0) as usize;
+    let mut repeated = good.clone();
+    let first: [u8; 4] = repeated[at..at + 4].try_into().unwrap();
+    repeated[at + 4..at + 8].copy_from_slice(&first);
+    scene_fails(
+        &repeated,
+        &["surface `patches`", "triangle 0 repeats a vertex"],
+    );
+    let mut beyond = good.clone();
+    beyond[at..at + 4].copy_from_slice(&9_000_000u32.to_le_bytes());
+    scene_fails(&beyond, &["triangle 0 names vertex 9000000"]);
+    let (w_at, _) = attribute_at(&good, "surface", "_W");
+    let mut nan = good.clone();
+    nan[w_at + 8..w_at + 12].copy_from_slice(&f32::INFINITY.to_le_bytes());
+    scene_fails(&nan, &["_W of vertex 2 is not finite"]);
+    assert!(matches!(
+        read_scene_glb(&edited(&|j| {
+            j["meshes"][0]["extras"]
+                .as_object_mut()
+                .unwrap()
+                .remove("surface");
+        })),
+        Err(ImportError::NoSurface(_))
+    ));
+}
+
+#[test]
+fn no_cut_or_corrupted_scene_glb_panics_the_reader_or_the_verification() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Scene::load(&fixture("scenes/patches.json")).unwrap();
+    build(&scene, dir.path());
+    let good = std::fs::read(dir.path().join("patches.glb")).unwrap();
+    for cut in (0..good.len()).step_by(good.len() / 200) {
+        assert!(read_scene_glb(&good[..cut]).is_err(), "cut at {cut}");
+    }
+    let mut rng = Rng(0xc0e5);
+    let mut verified = 0;
+    for _ in 0..120 {
+        let mut bytes = good.clone();
+        for _ in 0..1 + rng.below(4) {
+            let at = rng.below(bytes.len());
+            bytes[at] = rng.bits() as u8;
+        }
+        // Whatever a corrupted file still reads as is verified without a panic.
+        if let Ok(s) = read_scene_glb(&bytes) {
+            let _ = s.verify();
+            verified += 1;
+        }
+    }
+    assert!(verified > 0);
+}
