@@ -474,3 +474,28 @@ fn empty_and_single_triangle_inputs_give_no_curves() {
         );
     }
 }
+
+#[test]
+fn triangles_naming_a_vertex_twice_are_left_out() {
+    let mut a = octahedron(DVec3::ZERO, 1.0);
+    let b = octahedron(DVec3::new(0.3, 0.2, 0.1), 1.0);
+    let clean = curves(&[a.sheet(), b.sheet()]);
+    a.triangles.push([0, 0, 2]);
+    a.triangles.push([1, 3, 3]);
+    // Global triangle indices shift; the points do not.
+    let points = |c: &Curves| {
+        let mut v: Vec<_> = c
+            .curves
+            .iter()
+            .flat_map(|c| &c.points)
+            .map(|p| p.position.to_array().map(f64::to_bits))
+            .collect();
+        v.sort();
+        v
+    };
+    for broad in [BroadPhase::Bvh, BroadPhase::AllPairs] {
+        let c = curves_with(&[a.sheet(), b.sheet()], broad);
+        assert_eq!(c.report.degenerate_triangles, 2);
+        assert_eq!(points(&c), points(&clean));
+    }
+}

@@ -90,9 +90,14 @@ impl Soup {
         s0 == self.sign(p, q, t[1], t[2]) && s0 == self.sign(p, q, t[2], t[0])
     }
 
-    /// The intersection of triangles `a` < `b`.
+    /// The intersection of triangles `a` < `b`. A triangle naming one vertex twice has no
+    /// interior and crosses nothing.
     pub fn pair(&self, a: u32, b: u32) -> Pair {
         let (ta, tb) = (self.tris[a as usize], self.tris[b as usize]);
+        let proper = |t: [u32; 3]| t[0] != t[1] && t[1] != t[2] && t[2] != t[0];
+        if !proper(ta) || !proper(tb) {
+            return Pair::Apart;
+        }
         let mut shared = 0;
         let mut at = [0usize; 2];
         for (i, va) in ta.iter().enumerate() {

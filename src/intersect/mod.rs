@@ -141,6 +141,8 @@ pub struct CurvesReport {
     pub unresolved: usize,
     /// Triangles, all sheets.
     pub triangles: usize,
+    /// Triangles naming one vertex twice, left out (they have no interior to cross).
+    pub degenerate_triangles: usize,
     /// Triangle pairs the broad phase passed on.
     pub candidate_pairs: usize,
     /// Crossing triangle pairs (curve segments).
@@ -178,6 +180,8 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
     let (mut soup, tri_start) = merge(sheets);
     soup.prepare();
     report.triangles = soup.tris.len();
+    let proper = |t: &[u32; 3]| t[0] != t[1] && t[1] != t[2] && t[2] != t[0];
+    report.degenerate_triangles = soup.tris.iter().filter(|t| !proper(t)).count();
 
     // About eight touching pairs per triangle on a fine mesh: reserved, not grown.
     let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(8 * soup.tris.len());
@@ -187,6 +191,10 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
                 .tris
                 .iter()
                 .map(|t| {
+                    if !proper(t) {
+                        // Touches nothing.
+                        return Aabb::INVALID;
+                    }
                     let p = t.map(|v| soup.positions[v as usize]);
                     broad::outward(p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
                 })
@@ -225,10 +233,12 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
             report.traverse_ms = ms(t);
         }
         BroadPhase::AllPairs => {
-            let n = soup.tris.len() as u32;
-            pairs = (0..n)
-                .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
+            let ok: Vec<u32> = (0..soup.tris.len() as u32)
+                .filter(|&t| proper(&soup.tris[t as usize]))
                 .collect();
+            for (i, &a) in ok.iter().enumerate() {
+                pairs.extend(ok[i + 1..].iter().map(|&b| (a, b)));
+            }
         }
     }
     report.candidate_pairs = pairs.len();
