@@ -1,15 +1,6 @@
 //! The command line, run as a user runs it.
 
-use crate::common::fixture;
-use std::process::Command;
-
-fn halo4d(args: &[&str], dir: &std::path::Path) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_halo4d"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
-}
+use crate::common::{fixture, halo4d};
 
 #[test]
 fn build_without_a_scene_writes_the_default_into_exports() {

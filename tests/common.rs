@@ -1,6 +1,7 @@
 //! Shared helpers: fixture paths and a seeded generator.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 
 /// A path under `fixtures/`.
 pub fn fixture(rel: &str) -> PathBuf {
@@ -47,4 +48,25 @@ impl Rng {
     pub fn below(&mut self, n: usize) -> usize {
         (self.bits() % n as u64) as usize
     }
+}
+
+/// Runs the `halo4d` binary with `args` in `dir`.
+pub fn halo4d(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_halo4d"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the halo4d binary runs")
+}
+
+/// `out` failed on unreadable input (exit 2) with an `error: ` line containing `words`,
+/// and no panic.
+pub fn assert_unreadable(out: &Output, what: &str, words: &[&str]) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{what}: {err}");
+    assert!(err.starts_with("error: "), "{err}");
+    for w in words {
+        assert!(err.contains(w), "{what}: `{w}` not in {err}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
 }

@@ -3,28 +3,19 @@
 //! surfaces and halos read back from its .glb; `halo4d check DIR` passes a build and catches
 //! faults planted in its .glb; unreadable folders are errors.
 
-use crate::common::{Rng, fixture};
+use crate::common::{Rng, assert_unreadable, fixture, halo4d};
 use halo4d::import::{ImportError, ImportedScene, read_scene_glb};
 use halo4d::intersect::Curves;
 use halo4d::{Built, Scene};
 use ply_rs::ply::Property;
 use serde_json::Value;
 use std::path::Path;
-use std::process::Command;
 
 /// Builds a scene into `dir`.
 fn build(scene: &Scene, dir: &Path) -> Built {
     let built = halo4d::run(scene, true).unwrap();
     halo4d::write(scene, &built, dir).unwrap();
     built
-}
-
-fn halo4d(args: &[&str], dir: &Path) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_halo4d"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
 }
 
 /// The default scene (a spun trefoil: closed and open curves) and the patches fixture (open
@@ -523,13 +514,7 @@ fn check_dir_on_an_unreadable_folder_is_an_error_naming_it() {
         ("bare", &["patches.glb", "no surface"]),
     ] {
         let out = halo4d(&["check", name], dir.path());
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
-        assert!(err.starts_with("error: "), "{err}");
-        for w in words {
-            assert!(err.contains(w), "{name}: `{w}` not in {err}");
-        }
-        assert!(!err.contains("panicked"), "{err}");
+        assert_unreadable(&out, name, words);
     }
 }
 

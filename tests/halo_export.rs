@@ -2,14 +2,13 @@
 //! (by halo4d's readers and by the gltf crate) unchanged; faults planted in the files caught
 //! by `halo4d check`; malformed files rejected with errors, never panics.
 
-use crate::common::{Rng, fixture, fixture_scenes};
+use crate::common::{Rng, assert_unreadable, fixture, fixture_scenes, halo4d};
 use halo4d::Scene;
 use halo4d::check::check;
 use halo4d::import::{ImportError, ImportedHalo, read, read_glb, read_vtk};
 use halo4d::pipeline::SurfaceProduct;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// Builds a scene into `dir`, returning its products.
 fn build(scene: &Scene, dir: &Path) -> Vec<SurfaceProduct> {
@@ -42,14 +41,6 @@ fn f32_bits(values: &[f64]) -> Vec<u64> {
         .iter()
         .map(|&x| f64::from(x as f32).to_bits())
         .collect()
-}
-
-fn halo4d(args: &[&str], dir: &Path) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_halo4d"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
 }
 
 /// An ASCII legacy VTK of `h`, field data right after DATASET (where VTK's own writer puts
@@ -422,13 +413,7 @@ fn unreadable_files_are_errors_of_the_cli_with_the_file_named() {
         ("absent.vtk", &["absent.vtk", "cannot read"]),
     ] {
         let out = halo4d(&["check", file], dir.path());
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{file}: {err}");
-        assert!(err.starts_with("error: "), "{err}");
-        for w in words {
-            assert!(err.contains(w), "{file}: `{w}` not in {err}");
-        }
-        assert!(!err.contains("panicked"), "{err}");
+        assert_unreadable(&out, file, words);
     }
 }
 

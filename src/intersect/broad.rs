@@ -121,13 +121,7 @@ mod tests {
 
     #[test]
     fn self_pairs_equal_all_pairs() {
-        let mut state = 7u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::intersect::lcg(7);
         let boxes: Vec<Aabb> = (0..400)
             .map(|_| {
                 let c = DVec3::new(next(), next(), next());

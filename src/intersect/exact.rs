@@ -405,13 +405,8 @@ mod tests {
 
     #[test]
     fn the_plane_filter_agrees_with_orient3d() {
-        let mut state = 11u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut unit = crate::intersect::lcg(11);
+        let mut next = || unit() - 0.5;
         let mut decided = 0;
         for k in 0..20000 {
             let f = [(); 3].map(|_| DVec3::new(next(), next(), next()));

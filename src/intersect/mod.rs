@@ -467,3 +467,14 @@ fn triple_points(soup: &Soup, segments: &[Segment]) -> (usize, usize) {
 fn ms(since: Instant) -> f64 {
     since.elapsed().as_secs_f64() * 1e3
 }
+
+/// Reproducible numbers in [0, 1) for the unit tests (a 64-bit LCG).
+#[cfg(test)]
+pub(crate) fn lcg(mut state: u64) -> impl FnMut() -> f64 {
+    move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}

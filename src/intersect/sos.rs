@@ -243,13 +243,8 @@ mod tests {
 
     #[test]
     fn the_filter_agrees_with_robust_when_it_decides() {
-        let mut state = 3u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut unit = crate::intersect::lcg(3);
+        let mut next = || unit() - 0.5;
         let mut decided = 0;
         for k in 0..20000 {
             let mut p = [(); 4].map(|_| dv(next(), next(), next()));
