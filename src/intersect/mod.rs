@@ -149,7 +149,7 @@ pub struct CurvesReport {
     pub segments: usize,
     /// Milliseconds in all.
     pub ms: f64,
-    /// Of which building the BVH (with the boxes).
+    /// Of which merging the sheets, computing boxes and planes and building the BVH.
     pub bvh_ms: f64,
     /// Traversing it.
     pub traverse_ms: f64,
