@@ -193,39 +193,41 @@ struct CurveSample {
 }
 
 /// A tetrahedron containing a point whose halo depth there is below the point's w.
+/// A tetrahedron (global index into [`HaloIndex`]) containing a point whose halo depth
+/// there is below the point's w.
 #[derive(Clone, Copy, Debug)]
-struct Hider {
-    surface: u32,
-    tet: u32,
-}
+struct Hider(u32);
 
-/// The halos' tetrahedra in one BVH, and what the classification needs of each surface.
-struct Index<'a> {
-    sheets: &'a [Sheet<'a>],
+/// The halo tetrahedra of several surfaces in one obvhs BVH, for the question the halo
+/// verification and the renderer's exact mode both ask: is this point of a sheet hidden?
+pub struct HaloIndex<'a> {
     halos: &'a [Option<HaloInput<'a>>],
-    /// Per surface: the triangles around each vertex (CSR).
-    vertex_tris: Vec<(Vec<u32>, Vec<u32>)>,
-    /// Per surface: whether each triangle has an edge on the mesh boundary.
-    at_boundary: Vec<Vec<bool>>,
-    /// Per surface: the surface vertices each inserted vertex's tetrahedra are over.
-    inserted: Vec<Vec<Vec<u32>>>,
     /// Global tetrahedron -> (surface, tet).
     tets: Vec<(u32, u32)>,
+    /// Per global tetrahedron, the surface vertices it is built over (an inserted vertex
+    /// stands for those of the tetrahedra around it), sorted, padded with `u32::MAX`.
+    over: Vec<[u32; 6]>,
     bvh: obvhs::bvh2::Bvh2,
 }
 
-impl<'a> Index<'a> {
-    fn new(sheets: &'a [Sheet<'a>], halos: &'a [Option<HaloInput<'a>>]) -> Self {
+impl<'a> HaloIndex<'a> {
+    /// Indexes the tetrahedra of `halos` (one per surface, `None` for none).
+    pub fn new(halos: &'a [Option<HaloInput<'a>>]) -> Self {
         let mut boxes = Vec::new();
         let mut tets = Vec::new();
-        let mut inserted = Vec::new();
+        let mut over = Vec::new();
         for (s, halo) in halos.iter().enumerate() {
-            let Some(h) = halo else {
-                inserted.push(Vec::new());
-                continue;
-            };
+            let Some(h) = halo else { continue };
             let n = h.surface_vertices;
+            // The surface vertices around each inserted vertex.
             let mut sets: Vec<Vec<u32>> = vec![Vec::new(); h.positions.len().saturating_sub(2 * n)];
+            for tet in h.tets {
+                for &k in tet.iter().filter(|&&k| k as usize >= 2 * n) {
+                    for &v in tet.iter().filter(|&&v| (v as usize) < 2 * n) {
+                        sets[k as usize - 2 * n].push(v % n as u32);
+                    }
+                }
+            }
             for (i, tet) in h.tets.iter().enumerate() {
                 let p = tet.map(|v| h.positions[v as usize]);
                 boxes.push(broad::outward(
@@ -233,18 +235,121 @@ impl<'a> Index<'a> {
                     p[0].max(p[1]).max(p[2]).max(p[3]),
                 ));
                 tets.push((s as u32, i as u32));
-                for &k in tet.iter().filter(|&&k| k as usize >= 2 * n) {
-                    for &v in tet.iter().filter(|&&v| (v as usize) < 2 * n) {
-                        sets[k as usize - 2 * n].push(v % n as u32);
+                let mut vs: Vec<u32> = Vec::with_capacity(8);
+                for &k in tet {
+                    if (k as usize) < 2 * n {
+                        vs.push(k % n as u32);
+                    } else {
+                        vs.extend_from_slice(&sets[k as usize - 2 * n]);
                     }
                 }
+                vs.sort_unstable();
+                vs.dedup();
+                let mut padded = [u32::MAX; 6];
+                for (slot, v) in padded.iter_mut().zip(vs) {
+                    *slot = v;
+                }
+                over.push(padded);
             }
-            for set in &mut sets {
-                set.sort_unstable();
-                set.dedup();
-            }
-            inserted.push(sets);
         }
+        HaloIndex {
+            halos,
+            tets,
+            over,
+            bvh: broad::build(&boxes, 4),
+        }
+    }
+
+    /// Whether the point `x` of a triangle (with vertices `own`) of surface `surface`, at
+    /// depth `w`, is hidden: inside a tetrahedron whose halo depth there is below `w`,
+    /// other than those of the prisms of the triangles sharing a vertex with it.
+    pub fn hidden(&self, x: DVec3, w: f64, surface: u32, own: [u32; 3]) -> bool {
+        let mut hidden = false;
+        self.visit(x, |g| {
+            if !self.within(g, surface, &own) && self.depth_at(g, x).is_some_and(|depth| depth < w)
+            {
+                hidden = true;
+            }
+            !hidden
+        });
+        hidden
+    }
+
+    /// Calls `f` with each tetrahedron whose box contains `x`, until it returns false.
+    fn visit(&self, x: DVec3, mut f: impl FnMut(u32) -> bool) {
+        self.bvh.aabb_traverse(broad::outward(x, x), |bvh, node| {
+            let node = &bvh.nodes[node as usize];
+            let first = node.first_index as usize;
+            bvh.primitive_indices[first..first + node.prim_count as usize]
+                .iter()
+                .all(|&g| f(g))
+        });
+    }
+
+    /// The surface vertices tetrahedron `g` is built over.
+    fn over(&self, g: u32) -> impl Iterator<Item = u32> + '_ {
+        self.over[g as usize]
+            .iter()
+            .copied()
+            .take_while(|&v| v != u32::MAX)
+    }
+
+    /// Whether tetrahedron `g` is over a vertex of `ring` on `surface`.
+    fn within(&self, g: u32, surface: u32, ring: &[u32]) -> bool {
+        self.tets[g as usize].0 == surface && self.over(g).any(|v| ring.contains(&v))
+    }
+
+    /// The tetrahedra containing `x` whose halo depth there is below `w`, except those of
+    /// `own` (its surface and ring).
+    fn hiders(&self, x: DVec3, w: f64, own: (u32, &[u32])) -> Vec<Hider> {
+        let mut out = Vec::new();
+        self.visit(x, |g| {
+            if !self.within(g, own.0, own.1) && self.depth_at(g, x).is_some_and(|depth| depth < w) {
+                out.push(Hider(g));
+            }
+            true
+        });
+        out
+    }
+
+    /// Halo depth (eq. 3) at `x` if tetrahedron `g` contains it (boundary included).
+    fn depth_at(&self, g: u32, x: DVec3) -> Option<f64> {
+        let (surface, tet) = self.tets[g as usize];
+        let h = self.halos[surface as usize].as_ref()?;
+        let k = h.tets[tet as usize];
+        let p = k.map(|v| h.positions[v as usize]);
+        let l = [
+            orient3d(x, p[1], p[2], p[3]),
+            orient3d(p[0], x, p[2], p[3]),
+            orient3d(p[0], p[1], x, p[3]),
+            orient3d(p[0], p[1], p[2], x),
+        ];
+        if l.iter().any(|&v| v < 0.0) {
+            return None;
+        }
+        let total: f64 = l.iter().sum();
+        if total <= 0.0 {
+            return None;
+        }
+        let interp = |f: &[f64]| (0..4).map(|i| l[i] * f[k[i] as usize]).sum::<f64>() / total;
+        let t = interp(h.t);
+        let d = interp(h.d_orig);
+        Some(d + ((2.0 * t - 1.0).abs() - h.delta_t).max(0.0) * h.delta_d)
+    }
+}
+
+/// What the classification needs of each surface, with the halos' index.
+struct Index<'a> {
+    sheets: &'a [Sheet<'a>],
+    halos: HaloIndex<'a>,
+    /// Per surface: the triangles around each vertex (CSR).
+    vertex_tris: Vec<(Vec<u32>, Vec<u32>)>,
+    /// Per surface: whether each triangle has an edge on the mesh boundary.
+    at_boundary: Vec<Vec<bool>>,
+}
+
+impl<'a> Index<'a> {
+    fn new(sheets: &'a [Sheet<'a>], halos: &'a [Option<HaloInput<'a>>]) -> Self {
         let vertex_tris: Vec<_> = sheets.iter().map(vertex_triangles).collect();
         let at_boundary = sheets
             .iter()
@@ -267,21 +372,16 @@ impl<'a> Index<'a> {
             .collect();
         Index {
             sheets,
-            halos,
+            halos: HaloIndex::new(halos),
             vertex_tris,
             at_boundary,
-            inserted,
-            tets,
-            bvh: broad::build(&boxes, 4),
         }
     }
 
-    /// The vertices of `face`, sorted: a tetrahedron over one of them belongs to the halo
-    /// of a triangle that shares a vertex with `face`.
+    /// The vertices of `face`: a tetrahedron over one of them belongs to the halo of a
+    /// triangle that shares a vertex with `face`.
     fn ring(&self, face: Face) -> [u32; 3] {
-        let mut v = self.sheets[face.surface as usize].triangles[face.triangle as usize];
-        v.sort_unstable();
-        v
+        self.sheets[face.surface as usize].triangles[face.triangle as usize]
     }
 
     /// Whether `other` has a vertex on a triangle around a vertex of `face` (both on one
@@ -305,81 +405,6 @@ impl<'a> Index<'a> {
         })
     }
 
-    /// The surface vertices a tetrahedron is built over.
-    fn over(&self, surface: u32, tet: u32) -> Vec<u32> {
-        let h = self.halos[surface as usize]
-            .as_ref()
-            .expect("tet of a halo");
-        let n = h.surface_vertices;
-        let mut out = Vec::with_capacity(6);
-        for &k in &h.tets[tet as usize] {
-            if (k as usize) < 2 * n {
-                out.push(k % n as u32);
-            } else {
-                out.extend_from_slice(&self.inserted[surface as usize][k as usize - 2 * n]);
-            }
-        }
-        out.sort_unstable();
-        out.dedup();
-        out
-    }
-
-    /// Whether the tetrahedron is over a vertex of `ring` on `surface`.
-    fn within(&self, hider: Hider, surface: u32, ring: &[u32]) -> bool {
-        hider.surface == surface
-            && self
-                .over(hider.surface, hider.tet)
-                .iter()
-                .any(|v| ring.binary_search(v).is_ok())
-    }
-
-    /// The tetrahedra containing `x` whose halo depth there is below `w`, except those of
-    /// `own` (its surface and ring).
-    fn hiders(&self, x: DVec3, w: f64, own: (u32, &[u32])) -> Vec<Hider> {
-        let mut out = Vec::new();
-        let query = broad::outward(x, x);
-        self.bvh.aabb_traverse(query, |bvh, node| {
-            let node = &bvh.nodes[node as usize];
-            let first = node.first_index as usize;
-            for &g in &bvh.primitive_indices[first..first + node.prim_count as usize] {
-                let (surface, tet) = self.tets[g as usize];
-                let hider = Hider { surface, tet };
-                if let Some(depth) = self.depth_at(surface, tet, x)
-                    && depth < w
-                    && !self.within(hider, own.0, own.1)
-                {
-                    out.push(hider);
-                }
-            }
-            true
-        });
-        out
-    }
-
-    /// Halo depth (eq. 3) at `x` if the tetrahedron contains it.
-    fn depth_at(&self, surface: u32, tet: u32, x: DVec3) -> Option<f64> {
-        let h = self.halos[surface as usize].as_ref()?;
-        let k = h.tets[tet as usize];
-        let p = k.map(|v| h.positions[v as usize]);
-        let l = [
-            orient3d(x, p[1], p[2], p[3]),
-            orient3d(p[0], x, p[2], p[3]),
-            orient3d(p[0], p[1], x, p[3]),
-            orient3d(p[0], p[1], p[2], x),
-        ];
-        if l.iter().any(|&v| v < 0.0) {
-            return None;
-        }
-        let total: f64 = l.iter().sum();
-        if total <= 0.0 {
-            return None;
-        }
-        let interp = |f: &[f64]| (0..4).map(|i| l[i] * f[k[i] as usize]).sum::<f64>() / total;
-        let t = interp(h.t);
-        let d = interp(h.d_orig);
-        Some(d + ((2.0 * t - 1.0).abs() - h.delta_t).max(0.0) * h.delta_d)
-    }
-
     fn classify_curve_sample(&self, s: &CurveSample, v: &mut Verification) {
         v.curve_samples += 1;
         let near = usize::from(s.w[1] < s.w[0]);
@@ -399,14 +424,15 @@ impl<'a> Index<'a> {
             v.ambiguous += 1;
             return;
         }
-        let far_hidden = self
+        let halos = &self.halos;
+        let far_hidden = halos
             .hiders(s.x, s.w[far], (ff.surface, &ring_far))
             .into_iter()
-            .any(|h| self.within(h, fn_.surface, &ring_near));
-        let near_hiders = self.hiders(s.x, s.w[near], (fn_.surface, &ring_near));
+            .any(|h| halos.within(h.0, fn_.surface, &ring_near));
+        let near_hiders = halos.hiders(s.x, s.w[near], (fn_.surface, &ring_near));
         let by_far = near_hiders
             .iter()
-            .any(|&h| self.within(h, ff.surface, &ring_far));
+            .any(|h| halos.within(h.0, ff.surface, &ring_far));
         if !far_hidden || by_far {
             v.wrong += 1;
             if v.wrong_at.len() < EXAMPLES {
@@ -429,24 +455,26 @@ impl<'a> Index<'a> {
     ) {
         v.surface_samples += 1;
         let ring = self.ring(face);
-        let hiders = self.hiders(x, w, (face.surface, &ring));
+        let halos = &self.halos;
+        let hiders = halos.hiders(x, w, (face.surface, &ring));
         if hiders.is_empty() {
             return;
         }
         let near_its_sheet = hiders.iter().all(|h| {
-            let sheet = &self.sheets[h.surface as usize];
-            let halo = self.halos[h.surface as usize]
-                .as_ref()
-                .expect("tet of a halo");
+            let surface = halos.tets[h.0 as usize].0 as usize;
+            let sheet = &self.sheets[surface];
+            let halo = halos.halos[surface].as_ref().expect("tet of a halo");
             let n = halo.surface_vertices;
-            let over = self.over(h.surface, h.tet);
-            let rho = over
-                .iter()
-                .map(|&k| {
+            let rho = halos
+                .over(h.0)
+                .map(|k| {
                     (halo.positions[k as usize + n] - halo.positions[k as usize]).length() * 0.5
                 })
                 .fold(0.0, f64::max);
-            let points: Vec<DVec3> = over.iter().map(|&k| sheet.positions[k as usize]).collect();
+            let points: Vec<DVec3> = halos
+                .over(h.0)
+                .map(|k| sheet.positions[k as usize])
+                .collect();
             distance_to_hull(x, &points) <= rho + tolerance
         });
         if near_its_sheet {
