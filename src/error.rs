@@ -21,6 +21,14 @@ pub enum Error {
         /// The offending vertex.
         source: BehindEye,
     },
+    /// The picture could not be made (a camera inside the scene, a bad setting).
+    #[error("scene `{scene}`: {source}")]
+    Render {
+        /// The scene.
+        scene: String,
+        /// The cause.
+        source: crate::render::RenderError,
+    },
     /// An output could not be written.
     #[error("cannot write {}: {source}; check that the output folder is writable (choose another with --out)", path.display())]
     Write {

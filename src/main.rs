@@ -48,6 +48,33 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Render a scene's picture (its `camera` and `render` settings, with the flags below
+    /// overriding them) to a PNG.
+    Render {
+        /// Scene file (JSON) [default: the built-in default scene].
+        scene: Option<PathBuf>,
+        /// The PNG to write [default: exports/<scene name>/<scene name>.png].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Image width in pixels.
+        #[arg(long)]
+        width: Option<u32>,
+        /// Image height in pixels.
+        #[arg(long)]
+        height: Option<u32>,
+        /// How halos hide sheets: exact (per hit, the reference) or slices (paper 000).
+        #[arg(long, value_enum)]
+        mode: Option<ModeArg>,
+        /// Slices for --mode slices.
+        #[arg(long)]
+        slices: Option<u32>,
+        /// A cross-eyed stereo pair side by side.
+        #[arg(long)]
+        stereo: bool,
+        /// No progress bar.
+        #[arg(long, short)]
+        quiet: bool,
+    },
     /// List the surface catalogue with each surface's parameters and defaults.
     List,
     /// Check the halos of a .glb or .vtk file with the independent checker, or a build's
@@ -71,6 +98,15 @@ enum Command {
         #[arg(value_name = "FILE|DIR")]
         file: PathBuf,
     },
+}
+
+/// `--mode` of `halo4d render`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum ModeArg {
+    /// Each hit asks the tetrahedra whether it is hidden.
+    Exact,
+    /// Halo depth images on planes perpendicular to the view.
+    Slices,
 }
 
 fn load(scene: Option<PathBuf>) -> Result<Scene, halo4d::SceneError> {
@@ -115,8 +151,16 @@ fn main() -> ExitCode {
                     );
                     let t = report.timings_ms;
                     eprintln!(
-                        "sample {:.1} ms, audit {:.1} ms, view {:.1} ms, halo {:.1} ms, curves {:.1} ms, verify {:.1} ms, export {:.1} ms, total {:.1} ms",
-                        t.sample, t.audit, t.view, t.halo, t.curves, t.verify, t.export, t.total
+                        "sample {:.1} ms, audit {:.1} ms, view {:.1} ms, halo {:.1} ms, curves {:.1} ms, verify {:.1} ms, export {:.1} ms, render {:.1} ms, total {:.1} ms",
+                        t.sample,
+                        t.audit,
+                        t.view,
+                        t.halo,
+                        t.curves,
+                        t.verify,
+                        t.export,
+                        t.render,
+                        t.total
                     );
                     for f in &report.files {
                         println!("{}", out.join(f).display());
@@ -125,6 +169,70 @@ fn main() -> ExitCode {
                 }
                 Err(e) => fail(&e),
             }
+        }
+        Command::Render {
+            scene,
+            out,
+            width,
+            height,
+            mode,
+            slices,
+            stereo,
+            quiet,
+        } => {
+            let mut scene = match load(scene) {
+                Ok(s) => s,
+                Err(e) => return fail(&e),
+            };
+            let r = &mut scene.render;
+            r.width = width.unwrap_or(r.width);
+            r.height = height.unwrap_or(r.height);
+            r.slices = slices.unwrap_or(r.slices);
+            r.stereo |= stereo;
+            if let Some(m) = mode {
+                r.mode = match m {
+                    ModeArg::Exact => halo4d::render::RenderMode::Exact,
+                    ModeArg::Slices => halo4d::render::RenderMode::Slices,
+                };
+            }
+            if let Err((field, message)) = scene.render.check() {
+                eprintln!("error: render.{field}: {message}");
+                return ExitCode::from(2);
+            }
+            let out = out.unwrap_or_else(|| {
+                Path::new("exports")
+                    .join(&scene.name)
+                    .join(format!("{}.png", scene.name))
+            });
+            let built = match halo4d::run(&scene, quiet) {
+                Ok(b) => b,
+                Err(e) => return fail(&e),
+            };
+            let start = std::time::Instant::now();
+            let picture = match built.render(&scene.halo, &scene.render, &scene.camera) {
+                Ok(p) => p,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(2);
+                }
+            };
+            let ms = start.elapsed().as_secs_f64() * 1e3;
+            if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty())
+                && let Err(e) = std::fs::create_dir_all(dir)
+            {
+                eprintln!("error: cannot create {}: {e}", dir.display());
+                return ExitCode::FAILURE;
+            }
+            if let Err(e) = halo4d::export::write_atomic(&out, &picture.png()) {
+                eprintln!("error: cannot write {}: {e}", out.display());
+                return ExitCode::FAILURE;
+            }
+            eprintln!(
+                "{} x {} {:?} render in {ms:.0} ms",
+                picture.width, picture.height, scene.render.mode
+            );
+            println!("{}", out.display());
+            ExitCode::SUCCESS
         }
         Command::Sweep {
             scene,

@@ -7,6 +7,9 @@ use crate::error::Error;
 use crate::export::{self, SurfaceData};
 use crate::halo::{Halo, HaloParams, HaloReport, build_halo};
 use crate::intersect::{self, Curves, CurvesReport, Sheet};
+use crate::render::{
+    self, CameraSettings, Picture, RenderError, RenderInput, RenderSettings, RenderSurface,
+};
 use crate::sample::{self, Audit, Mesh4, MeshStats, Sampling, audit};
 use crate::scene::Scene;
 use crate::surfaces::{Surface, Topology};
@@ -56,6 +59,43 @@ impl Built {
     /// The surfaces as the intersection stage reads them.
     pub fn sheets(&self) -> Vec<Sheet<'_>> {
         sheets(&self.surfaces)
+    }
+}
+
+/// The surfaces as the renderer reads them.
+pub fn render_surfaces(surfaces: &[SurfaceProduct]) -> Vec<RenderSurface<'_>> {
+    surfaces
+        .iter()
+        .map(|p| RenderSurface {
+            positions: &p.projected.positions,
+            w: &p.projected.w,
+            normals: &p.projected.normals,
+            uv: &p.mesh.uv,
+            triangles: &p.mesh.triangles,
+        })
+        .collect()
+}
+
+impl Built {
+    /// The picture of the scene's `render` settings through its `camera`, or the given
+    /// ones.
+    pub fn render(
+        &self,
+        halo: &HaloParams,
+        settings: &RenderSettings,
+        camera: &CameraSettings,
+    ) -> Result<Picture, RenderError> {
+        let surfaces = render_surfaces(&self.surfaces);
+        let halos = halo_inputs(&self.surfaces, halo);
+        render::render(
+            &RenderInput {
+                surfaces: &surfaces,
+                halos: &halos,
+                curves: &self.curves,
+            },
+            settings,
+            camera,
+        )
     }
 }
 
@@ -205,6 +245,8 @@ pub struct Timings {
     pub curves: f64,
     /// Verifying the halos against the curves.
     pub verify: f64,
+    /// Rendering the picture.
+    pub render: f64,
     /// Writing the outputs.
     pub export: f64,
     /// Sum of the stages.
@@ -442,6 +484,17 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
         }
     }
     timings.export = ms(export_start);
+    if scene.outputs.png {
+        let start = Instant::now();
+        let picture = built
+            .render(&scene.halo, &scene.render, &scene.camera)
+            .map_err(|source| Error::Render {
+                scene: scene.name.clone(),
+                source,
+            })?;
+        timings.render = ms(start);
+        files.push(write(format!("{name}.png"), &picture.png())?);
+    }
     if scene.outputs.report {
         files.push("report.json".into());
     }
@@ -451,6 +504,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
         + timings.halo
         + timings.curves
         + timings.verify
+        + timings.render
         + timings.export;
     let report = Report {
         halo4d: env!("CARGO_PKG_VERSION"),

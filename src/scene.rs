@@ -6,6 +6,7 @@
 //! is allowed. No input makes the parser panic.
 
 use crate::halo::HaloParams;
+use crate::render::{CameraSettings, RenderSettings};
 use crate::sample::Sampling;
 use crate::surfaces::Surface;
 use crate::view::View;
@@ -38,6 +39,12 @@ pub struct Scene {
     /// Halo parameters.
     #[serde(default)]
     pub halo: HaloParams,
+    /// The 3D camera of the picture.
+    #[serde(default)]
+    pub camera: CameraSettings,
+    /// How the picture is drawn.
+    #[serde(default)]
+    pub render: RenderSettings,
     /// Which files to write.
     #[serde(default)]
     pub outputs: Outputs,
@@ -73,6 +80,8 @@ pub struct Outputs {
     pub vtk: bool,
     /// `report.json`: counts, bounds, timings and the parsed scene.
     pub report: bool,
+    /// `<name>.png`: the picture of the `render` settings through the `camera`.
+    pub png: bool,
 }
 
 impl Default for Outputs {
@@ -83,6 +92,7 @@ impl Default for Outputs {
             obj: false,
             vtk: true,
             report: true,
+            png: true,
         }
     }
 }
@@ -254,6 +264,12 @@ impl Scene {
         self.halo
             .check()
             .map_err(|(f, m)| (format!("halo.{f}"), m))?;
+        self.camera
+            .check()
+            .map_err(|(f, m)| (format!("camera.{f}"), m))?;
+        self.render
+            .check()
+            .map_err(|(f, m)| (format!("render.{f}"), m))?;
         Ok(())
     }
 }

@@ -275,6 +275,32 @@ impl<'a> HaloIndex<'a> {
         hidden
     }
 
+    /// The number of tetrahedra.
+    pub(crate) fn len(&self) -> usize {
+        self.tets.len()
+    }
+
+    /// Tetrahedron `g`'s corners, t and d_orig at them, and its halo's (delta_t, delta_d).
+    pub(crate) fn tet(&self, g: u32) -> ([DVec3; 4], [f64; 4], [f64; 4], (f64, f64)) {
+        let (surface, tet) = self.tets[g as usize];
+        let h = self.halos[surface as usize]
+            .as_ref()
+            .expect("an indexed tetrahedron has a halo");
+        let k = h.tets[tet as usize];
+        (
+            k.map(|v| h.positions[v as usize]),
+            k.map(|v| h.t[v as usize]),
+            k.map(|v| h.d_orig[v as usize]),
+            (h.delta_t, h.delta_d),
+        )
+    }
+
+    /// Whether tetrahedron `g` belongs to the halo of a triangle sharing a vertex with the
+    /// triangle `own` of `surface` (a sheet's own halo, which never hides it).
+    pub(crate) fn is_own(&self, g: u32, surface: u32, own: &[u32; 3]) -> bool {
+        self.within(g, surface, own)
+    }
+
     /// Calls `f` with each tetrahedron whose box contains `x`, until it returns false.
     fn visit(&self, x: DVec3, mut f: impl FnMut(u32) -> bool) {
         self.bvh.aabb_traverse(broad::outward(x, x), |bvh, node| {

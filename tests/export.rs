@@ -18,6 +18,12 @@ fn every_fixture_builds_and_reads_back() {
     for path in fixture_scenes() {
         let mut scene = Scene::load(&path).unwrap();
         scene.outputs.obj = true;
+        // The picture's own tests look at it; here it only has to be written.
+        (
+            scene.render.width,
+            scene.render.height,
+            scene.render.samples,
+        ) = (128, 128, 1);
         let out = dir.path().join(&scene.name);
         let built = halo4d::run(&scene, true).unwrap();
         let products = &built.surfaces;
@@ -166,8 +172,8 @@ fn every_fixture_builds_and_reads_back() {
             json["surfaces"][0]["triangles"],
             products[0].mesh.triangles.len()
         );
-        // .glb, .ply, -curves.ply, .obj, report.json and a .vtk per halo.
-        assert_eq!(report.files.len(), 5 + products.len());
+        // .glb, .ply, -curves.ply, .obj, .png, report.json and a .vtk per halo.
+        assert_eq!(report.files.len(), 6 + products.len());
         assert!(
             !text.contains("NaN") && !text.contains("null,"),
             "report has a non-number"

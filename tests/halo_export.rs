@@ -306,7 +306,12 @@ fn a_scene_of_several_surfaces_writes_a_vtk_per_halo_and_checks_each() {
     files.sort();
     assert_eq!(
         files,
-        ["pair-flat-halo.vtk", "pair-torus-halo.vtk", "pair.glb"]
+        [
+            "pair-flat-halo.vtk",
+            "pair-torus-halo.vtk",
+            "pair.glb",
+            "pair.png"
+        ]
     );
     let from_glb = read(&dir.path().join("pair.glb")).unwrap();
     let names: Vec<&str> = from_glb.iter().map(|h| h.name.as_str()).collect();

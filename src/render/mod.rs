@@ -1,0 +1,725 @@
+//! The CPU reference renderer: pictures of the projected surfaces with their halos.
+//!
+//! Takes: the projected surfaces (positions, w, normals, parameters), their halos and the
+//! intersection curves, a [`CameraSettings`] and [`RenderSettings`]. Gives: an RGB image.
+//! Eye rays are cast through an obvhs BVH over all triangles and every hit along a ray is
+//! kept ([`trace`]), so transparency composites in exact depth order. A hit is hidden where
+//! it lies in a halo of another sheet whose halo depth (paper 000 eq. 3) is below its own
+//! w: decided per hit by a query over the tetrahedra (`exact`, the reference), or by the
+//! paper's multi-slice method (`slices`). Shading is Phong with two lights over a colour by
+//! w-depth, with paper 001's depth cues (opacity by w, silhouette opacity, hither clipping,
+//! ribbons), and the self-intersection curves and silhouettes are drawn as lines of exact
+//! width broadened through the FFT (paper 002, [`lines`]). Renders are deterministic.
+
+pub mod camera;
+pub mod shade;
+pub mod slices;
+pub mod trace;
+
+use crate::intersect::Curves;
+use crate::verify::{HaloIndex, HaloInput};
+use camera::Camera;
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+use trace::{Hit, TraceSurface, Tracer};
+
+/// Perspective or orthographic.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CameraProjection {
+    /// Rays from the eye through the pixels.
+    #[default]
+    Perspective,
+    /// Parallel rays along the view direction.
+    Orthographic,
+}
+
+/// The 3D orbit camera of a scene (`camera` in a scene file).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CameraSettings {
+    /// Degrees about the z axis, from +x.
+    pub azimuth: f64,
+    /// Degrees above the xy plane (z is up), in [-89, 89].
+    pub elevation: f64,
+    /// Distance of the eye from the centre of the projected scene's bounding box, in units
+    /// of half its diagonal.
+    pub distance: f64,
+    /// Vertical field of view in degrees (perspective).
+    pub fov: f64,
+    /// Perspective or orthographic.
+    pub projection: CameraProjection,
+}
+
+impl Default for CameraSettings {
+    fn default() -> Self {
+        CameraSettings {
+            azimuth: 35.0,
+            elevation: 25.0,
+            distance: 3.2,
+            fov: 38.0,
+            projection: CameraProjection::Perspective,
+        }
+    }
+}
+
+/// How halos hide sheets in a picture.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RenderMode {
+    /// Each hit asks the tetrahedra whether it is hidden (the reference).
+    #[default]
+    Exact,
+    /// Paper 000's multi-slice method: halo depth images on `slices` planes perpendicular
+    /// to the view.
+    Slices,
+}
+
+/// The colour scale of w-depth.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Colormap {
+    /// Blue (near) through light grey to orange (far).
+    #[default]
+    Diverging,
+    /// Viridis: dark blue (near) to yellow (far).
+    Viridis,
+    /// Dark (near) to light (far).
+    Gray,
+}
+
+/// Which surface parameter ribbons run along.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RibbonAxis {
+    /// Bands of constant u are cut away.
+    U,
+    /// Bands of constant v are cut away.
+    V,
+}
+
+/// Paper 001's ribbons: the surface cut into `count` bands along a parameter, a `gap` share
+/// of each removed.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Ribbons {
+    /// The parameter the gaps are spaced along.
+    pub along: RibbonAxis,
+    /// Bands per unit of the parameter (patch parameters run over their domains).
+    pub count: f64,
+    /// Share of each band cut away, in (0, 1).
+    pub gap: f64,
+}
+
+/// How a scene is drawn (`render` in a scene file).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RenderSettings {
+    /// Image width in pixels (each half of a stereo pair).
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// `exact` or `slices`.
+    pub mode: RenderMode,
+    /// Slices for `slices` mode.
+    pub slices: u32,
+    /// Samples per pixel on a square grid: 1, 4, 9 or 16.
+    pub samples: u32,
+    /// Whether halos hide anything.
+    pub halos: bool,
+    /// Surface opacity at the near end of w (1 is opaque).
+    pub opacity: f64,
+    /// Surface opacity at the far end of w (paper 001's opacity by w); the near value when
+    /// absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub opacity_far: Option<f64>,
+    /// Paper 001's silhouette opacity 1 - (1 - alpha)^(1/d) for transparent surfaces.
+    pub silhouette_opacity: bool,
+    /// Colour of w-depth.
+    pub colormap: Colormap,
+    /// A colour bar of the w scale along the bottom of the image.
+    pub legend: bool,
+    /// Hither clipping: surfaces nearer the eye than this (in units of half the scene's
+    /// diagonal) are cut away.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hither: Option<f64>,
+    /// Ribbons.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ribbons: Option<Ribbons>,
+    /// Draw the self-intersection curves.
+    pub curves: bool,
+    /// Draw silhouettes (where the eye ray lies in the tangent plane).
+    pub silhouettes: bool,
+    /// Line width in pixels.
+    pub line_width: f64,
+    /// Line width at the far side of the scene, for lines that thin with distance; the
+    /// same width everywhere when absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub line_width_far: Option<f64>,
+    /// A cross-eyed stereo pair side by side (the left image for the right eye).
+    pub stereo: bool,
+    /// Angle between the two eyes of a stereo pair, in degrees.
+    pub eye_separation: f64,
+    /// Background colour, RGB in [0, 1].
+    pub background: [f64; 3],
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            width: 1024,
+            height: 1024,
+            mode: RenderMode::Exact,
+            slices: 256,
+            samples: 4,
+            halos: true,
+            opacity: 1.0,
+            opacity_far: None,
+            silhouette_opacity: true,
+            colormap: Colormap::Diverging,
+            legend: false,
+            hither: None,
+            ribbons: None,
+            curves: true,
+            silhouettes: true,
+            line_width: 2.5,
+            line_width_far: None,
+            stereo: false,
+            eye_separation: 5.0,
+            background: [1.0, 1.0, 1.0],
+        }
+    }
+}
+
+/// The largest image side, so a typo cannot ask for gigabytes.
+pub const MAX_SIDE: u32 = 8192;
+
+impl RenderSettings {
+    /// Checks the numbers: `Err((field, message))` names the first bad one.
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        let side = |v: u32| (1..=MAX_SIDE).contains(&v);
+        if !side(self.width) {
+            return Err((
+                "width",
+                format!("must be 1 to {MAX_SIDE} pixels, got {}", self.width),
+            ));
+        }
+        if !side(self.height) {
+            return Err((
+                "height",
+                format!("must be 1 to {MAX_SIDE} pixels, got {}", self.height),
+            ));
+        }
+        if !(1..=4096).contains(&self.slices) {
+            return Err(("slices", format!("must be 1 to 4096, got {}", self.slices)));
+        }
+        if ![1, 4, 9, 16].contains(&self.samples) {
+            return Err((
+                "samples",
+                format!(
+                    "must be 1, 4, 9 or 16 (a square grid), got {}",
+                    self.samples
+                ),
+            ));
+        }
+        let unit = |v: f64| v.is_finite() && v > 0.0 && v <= 1.0;
+        if !unit(self.opacity) {
+            return Err((
+                "opacity",
+                format!("must be in (0, 1], got {}", self.opacity),
+            ));
+        }
+        if let Some(o) = self.opacity_far
+            && !unit(o)
+        {
+            return Err(("opacity_far", format!("must be in (0, 1], got {o}")));
+        }
+        if let Some(h) = self.hither
+            && !(h.is_finite() && h >= 0.0)
+        {
+            return Err(("hither", format!("must be a distance >= 0, got {h}")));
+        }
+        if let Some(r) = self.ribbons {
+            if !(r.count.is_finite() && r.count > 0.0 && r.count <= 1e4) {
+                return Err((
+                    "ribbons.count",
+                    format!("must be in (0, 10000], got {}", r.count),
+                ));
+            }
+            if !(r.gap.is_finite() && r.gap > 0.0 && r.gap < 1.0) {
+                return Err(("ribbons.gap", format!("must be in (0, 1), got {}", r.gap)));
+            }
+        }
+        let max_width = f64::from(self.width.min(self.height)) / 4.0;
+        for (field, w) in [
+            ("line_width", Some(self.line_width)),
+            ("line_width_far", self.line_width_far),
+        ] {
+            if let Some(w) = w
+                && !(w.is_finite() && w >= 0.5 && w <= max_width.max(0.5))
+            {
+                return Err((
+                    field,
+                    format!(
+                        "must be 0.5 to {max_width:.0} pixels (a quarter of the image), got {w}"
+                    ),
+                ));
+            }
+        }
+        if !(self.eye_separation.is_finite() && (0.0..=30.0).contains(&self.eye_separation)) {
+            return Err((
+                "eye_separation",
+                format!("must be 0 to 30 degrees, got {}", self.eye_separation),
+            ));
+        }
+        if self
+            .background
+            .iter()
+            .any(|c| !(c.is_finite() && (0.0..=1.0).contains(c)))
+        {
+            return Err((
+                "background",
+                format!("must be three numbers in [0, 1], got {:?}", self.background),
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl CameraSettings {
+    /// Checks the numbers: `Err((field, message))` names the first bad one.
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        if !self.azimuth.is_finite() {
+            return Err(("azimuth", format!("must be finite, got {}", self.azimuth)));
+        }
+        if !(self.elevation.is_finite() && (-89.0..=89.0).contains(&self.elevation)) {
+            return Err((
+                "elevation",
+                format!("must be -89 to 89 degrees, got {}", self.elevation),
+            ));
+        }
+        if !(self.distance.is_finite() && self.distance > 0.0 && self.distance <= 1e4) {
+            return Err((
+                "distance",
+                format!(
+                    "must be in (0, 10000] (units of half the scene's diagonal), got {}",
+                    self.distance
+                ),
+            ));
+        }
+        if !(self.fov.is_finite() && self.fov > 1.0 && self.fov < 170.0) {
+            return Err(("fov", format!("must be 1 to 170 degrees, got {}", self.fov)));
+        }
+        Ok(())
+    }
+}
+
+/// Why a picture could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// A setting is out of range.
+    #[error("render.{field}: {message}")]
+    Setting {
+        /// The setting.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// An orthographic eye inside the scene sees nothing sensible.
+    #[error(
+        "camera.distance: the eye at {distance} half-diagonals is inside the scene's bounding box; an orthographic camera must be outside it (raise camera.distance above 1)"
+    )]
+    CameraInside {
+        /// The distance asked for.
+        distance: f64,
+    },
+    /// Nothing to draw.
+    #[error("the scene has no triangles to render")]
+    Empty,
+}
+
+/// One surface as the renderer reads it.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderSurface<'a> {
+    /// Vertex positions.
+    pub positions: &'a [DVec3],
+    /// w-depth of each vertex.
+    pub w: &'a [f64],
+    /// Unit normal of each vertex (for shading).
+    pub normals: &'a [DVec3],
+    /// Surface parameters (u, v) of each vertex (for ribbons).
+    pub uv: &'a [[f64; 2]],
+    /// Triangles.
+    pub triangles: &'a [[u32; 3]],
+}
+
+/// What a picture is made of.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderInput<'a> {
+    /// The surfaces.
+    pub surfaces: &'a [RenderSurface<'a>],
+    /// Their halos (one per surface).
+    pub halos: &'a [Option<HaloInput<'a>>],
+    /// The intersection curves.
+    pub curves: &'a Curves,
+}
+
+/// An RGB picture, 8 bits per channel, row-major from the top.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Picture {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Three bytes per pixel.
+    pub rgb: Vec<u8>,
+}
+
+impl Picture {
+    /// The PNG file's bytes.
+    pub fn png(&self) -> Vec<u8> {
+        use image::ImageEncoder;
+        let mut out = Vec::new();
+        image::codecs::png::PngEncoder::new(&mut out)
+            .write_image(
+                &self.rgb,
+                self.width,
+                self.height,
+                image::ExtendedColorType::Rgb8,
+            )
+            .expect("an in-memory PNG of a valid size encodes");
+        out
+    }
+}
+
+/// The image of one eye: linear RGB per pixel, and per pixel the ray distance of the
+/// first visible surface (infinite where none) for the lines' occlusion.
+#[allow(dead_code)] // `front` is for the lines overlay
+struct View {
+    rgb: Vec<DVec3>,
+    front: Vec<f64>,
+}
+
+/// Renders a picture.
+pub fn render(
+    input: &RenderInput,
+    settings: &RenderSettings,
+    camera: &CameraSettings,
+) -> Result<Picture, RenderError> {
+    settings.check().map_err(|(f, m)| RenderError::Setting {
+        field: f.into(),
+        message: m,
+    })?;
+    camera.check().map_err(|(f, m)| RenderError::Setting {
+        field: format!("camera.{f}"),
+        message: m,
+    })?;
+    let bounds = input
+        .surfaces
+        .iter()
+        .flat_map(|s| {
+            s.triangles
+                .iter()
+                .flatten()
+                .map(|&v| s.positions[v as usize])
+        })
+        .fold(None, |b: Option<(DVec3, DVec3)>, p| {
+            Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
+        })
+        .ok_or(RenderError::Empty)?;
+    let scene = Scene::new(input, settings, bounds);
+    let eyes: Vec<f64> = if settings.stereo {
+        // Cross-eyed: the left image is the right eye's (turned right, +azimuth).
+        vec![
+            settings.eye_separation * 0.5,
+            -settings.eye_separation * 0.5,
+        ]
+    } else {
+        vec![0.0]
+    };
+    let (w, h) = (settings.width, settings.height);
+    let mut rgb = vec![0u8; 3 * (w as usize * eyes.len()) * h as usize];
+    for (e, &offset) in eyes.iter().enumerate() {
+        let cam = Camera::new(camera, bounds, w, h, offset)?;
+        let view = scene.view(&cam);
+        for y in 0..h as usize {
+            for x in 0..w as usize {
+                let c = view.rgb[y * w as usize + x];
+                let at = 3 * (y * w as usize * eyes.len() + e * w as usize + x);
+                for k in 0..3 {
+                    rgb[at + k] = to_srgb8(c[k]);
+                }
+            }
+        }
+    }
+    Ok(Picture {
+        width: w * eyes.len() as u32,
+        height: h,
+        rgb,
+    })
+}
+
+/// Linear [0, 1] to an 8-bit sRGB value.
+fn to_srgb8(c: f64) -> u8 {
+    let c = c.clamp(0.0, 1.0);
+    let s = if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0).round() as u8
+}
+
+/// What every ray of one render shares.
+struct Scene<'a> {
+    input: &'a RenderInput<'a>,
+    settings: &'a RenderSettings,
+    tracer: Tracer<'a>,
+    halos: Option<HaloIndex<'a>>,
+    w_range: (f64, f64),
+    centre: DVec3,
+    radius: f64,
+    background: DVec3,
+}
+
+impl<'a> Scene<'a> {
+    fn new(
+        input: &'a RenderInput<'a>,
+        settings: &'a RenderSettings,
+        (lo, hi): (DVec3, DVec3),
+    ) -> Self {
+        let trace = input
+            .surfaces
+            .iter()
+            .map(|s| TraceSurface {
+                positions: s.positions,
+                triangles: s.triangles,
+            })
+            .collect();
+        let w_range = input
+            .surfaces
+            .iter()
+            .flat_map(|s| s.triangles.iter().flatten().map(|&v| s.w[v as usize]))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), w| {
+                (a.min(w), b.max(w))
+            });
+        Scene {
+            input,
+            settings,
+            tracer: Tracer::new(trace, (hi - lo).length()),
+            halos: settings.halos.then(|| HaloIndex::new(input.halos)),
+            w_range,
+            centre: (lo + hi) * 0.5,
+            radius: (hi - lo).length() * 0.5,
+            background: DVec3::from(settings.background),
+        }
+    }
+
+    /// The sample points of pixel (x, y) in [-1, 1]^2 (y up), and which is its centre's.
+    fn samples(&self, x: usize, y: usize) -> impl Iterator<Item = (f64, f64, bool)> + '_ {
+        let n = (self.settings.samples as f64).sqrt().round() as usize;
+        let (w, h) = (self.settings.width as f64, self.settings.height as f64);
+        (0..n * n).map(move |k| {
+            let (i, j) = (k % n, k / n);
+            let px = x as f64 + (i as f64 + 0.5) / n as f64;
+            let py = y as f64 + (j as f64 + 0.5) / n as f64;
+            (
+                2.0 * px / w - 1.0,
+                1.0 - 2.0 * py / h,
+                i == n / 2 && j == n / 2,
+            )
+        })
+    }
+
+    /// One eye's image.
+    fn view(&self, cam: &Camera) -> View {
+        match (self.settings.mode, &self.halos) {
+            (RenderMode::Slices, Some(index)) => self.view_slices(cam, index),
+            _ => self.view_with(cam, |_, _, hit, x, w| {
+                let tri =
+                    self.input.surfaces[hit.surface as usize].triangles[hit.triangle as usize];
+                self.halos
+                    .as_ref()
+                    .is_some_and(|index| index.hidden(x, w, hit.surface, tri))
+            }),
+        }
+    }
+
+    /// One eye's image with `hidden(pixel, hit number in the pixel, hit, x, w)` deciding
+    /// which hits the halos hide; rows shared between the cores.
+    fn view_with(
+        &self,
+        cam: &Camera,
+        hidden: impl Fn(usize, usize, &Hit, DVec3, f64) -> bool + Sync,
+    ) -> View {
+        let (w, h) = (self.settings.width as usize, self.settings.height as usize);
+        let mut rgb = vec![DVec3::ZERO; w * h];
+        let mut front = vec![f64::INFINITY; w * h];
+        let threads = std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .min(h.max(1));
+        let rows_per = h.div_ceil(threads);
+        let hidden = &hidden;
+        std::thread::scope(|scope| {
+            for (band, (rgb, front)) in rgb
+                .chunks_mut(rows_per * w)
+                .zip(front.chunks_mut(rows_per * w))
+                .enumerate()
+            {
+                scope.spawn(move || {
+                    let mut hits = Vec::new();
+                    for (i, (c, f)) in rgb.iter_mut().zip(front.iter_mut()).enumerate() {
+                        let pixel = band * rows_per * w + i;
+                        let (x, y) = (pixel % w, pixel / w);
+                        let mut sum = DVec3::ZERO;
+                        let mut count = 0;
+                        let mut numbered = 0;
+                        for (sx, sy, centre) in self.samples(x, y) {
+                            let (origin, dir) = cam.ray(sx, sy);
+                            self.trace(origin, dir, &mut hits);
+                            let base = numbered;
+                            numbered += hits.len();
+                            let (colour, first) =
+                                self.shade(cam, origin, dir, &hits, |k, hit, x, wd| {
+                                    hidden(pixel, base + k, hit, x, wd)
+                                });
+                            sum += colour;
+                            count += 1;
+                            if centre {
+                                *f = first;
+                            }
+                        }
+                        *c = sum / count as f64;
+                    }
+                });
+            }
+        });
+        View { rgb, front }
+    }
+
+    /// Every hit of a ray that is not clipped away (hither, ribbons), in order.
+    fn trace(&self, origin: DVec3, dir: DVec3, hits: &mut Vec<Hit>) {
+        let s = self.settings;
+        let t_min = s.hither.map_or(0.0, |h| h * self.radius);
+        self.tracer.hits(origin, dir, t_min, hits);
+        if let Some(r) = s.ribbons {
+            let k = match r.along {
+                RibbonAxis::U => 0,
+                RibbonAxis::V => 1,
+            };
+            hits.retain(|hit| {
+                let surf = &self.input.surfaces[hit.surface as usize];
+                let tri = surf.triangles[hit.triangle as usize];
+                let param: f64 = (0..3)
+                    .map(|i| hit.bary[i] * surf.uv[tri[i] as usize][k])
+                    .sum();
+                (param * r.count).rem_euclid(1.0) >= r.gap
+            });
+        }
+    }
+
+    /// The multi-slice image: every hit of every sample first, then the slices decide which
+    /// are hidden, then the samples are composited.
+    fn view_slices(&self, cam: &Camera, index: &HaloIndex) -> View {
+        let (w, h) = (self.settings.width as usize, self.settings.height as usize);
+        // Per pixel, its hits over all its samples, in sample order.
+        let mut starts = vec![0u32; w * h + 1];
+        let mut probes: Vec<slices::Probe> = Vec::new();
+        let mut hits = Vec::new();
+        for pixel in 0..w * h {
+            for (sx, sy, _) in self.samples(pixel % w, pixel / w) {
+                let (origin, dir) = cam.ray(sx, sy);
+                self.trace(origin, dir, &mut hits);
+                for hit in &hits {
+                    let surf = &self.input.surfaces[hit.surface as usize];
+                    let tri = surf.triangles[hit.triangle as usize];
+                    probes.push(slices::Probe {
+                        pixel: pixel as u32,
+                        x: origin + dir * hit.t,
+                        w: (0..3).map(|i| hit.bary[i] * surf.w[tri[i] as usize]).sum(),
+                        surface: hit.surface,
+                        triangle: tri,
+                    });
+                }
+            }
+            starts[pixel + 1] = probes.len() as u32;
+        }
+        let centre = (cam.eye + cam.forward * self.centre_depth(cam), self.radius);
+        let depth = (centre.0 - cam.eye).dot(cam.forward);
+        let hidden = slices::hidden(
+            index,
+            cam,
+            (self.settings.width, self.settings.height),
+            self.settings.slices,
+            (depth - self.radius, depth + self.radius),
+            &probes,
+        );
+        drop(probes);
+        self.view_with(cam, |pixel, k, _, _, _| hidden[starts[pixel] as usize + k])
+    }
+
+    /// The view depth of the scene's centre.
+    fn centre_depth(&self, cam: &Camera) -> f64 {
+        (self.centre - cam.eye).dot(cam.forward)
+    }
+
+    /// Composites the hits of one ray front to back, leaving out those `hidden(k, hit, x,
+    /// w)` says the halos hide: the colour, and the distance of the first visible hit.
+    fn shade(
+        &self,
+        cam: &Camera,
+        origin: DVec3,
+        dir: DVec3,
+        hits: &[Hit],
+        hidden: impl Fn(usize, &Hit, DVec3, f64) -> bool,
+    ) -> (DVec3, f64) {
+        let s = self.settings;
+        let (w0, w1) = self.w_range;
+        let span = if w1 > w0 { w1 - w0 } else { 1.0 };
+        let mut colour = DVec3::ZERO;
+        let mut alpha = 0.0;
+        let mut first = f64::INFINITY;
+        for (k, hit) in hits.iter().enumerate() {
+            let surf = &self.input.surfaces[hit.surface as usize];
+            let tri = surf.triangles[hit.triangle as usize];
+            let b = hit.bary;
+            let mix = |f: &dyn Fn(usize) -> f64| {
+                b[0] * f(tri[0] as usize) + b[1] * f(tri[1] as usize) + b[2] * f(tri[2] as usize)
+            };
+            let x = origin + dir * hit.t;
+            let w = mix(&|v| surf.w[v]);
+            if hidden(k, hit, x, w) {
+                continue;
+            }
+            if first.is_infinite() {
+                first = hit.t;
+            }
+            let mut n = DVec3::new(
+                mix(&|v| surf.normals[v].x),
+                mix(&|v| surf.normals[v].y),
+                mix(&|v| surf.normals[v].z),
+            );
+            if n.length_squared() <= 1e-24 || !n.is_finite() {
+                let p = tri.map(|v| surf.positions[v as usize]);
+                n = (p[1] - p[0]).cross(p[2] - p[0]);
+            }
+            let n = n.normalize_or_zero();
+            let depth = (w - w0) / span;
+            let base = shade::colormap(s.colormap, depth);
+            let lit = shade::phong(base, n, dir, cam.right, cam.up);
+            let mut a = match s.opacity_far {
+                Some(far) => s.opacity + (far - s.opacity) * depth.clamp(0.0, 1.0),
+                None => s.opacity,
+            };
+            if s.silhouette_opacity {
+                a = shade::silhouette_opacity(a, n.dot(dir));
+            }
+            colour += lit * ((1.0 - alpha) * a);
+            alpha += (1.0 - alpha) * a;
+            if alpha > 0.999 {
+                break;
+            }
+        }
+        (colour + self.background * (1.0 - alpha), first)
+    }
+}

@@ -1,0 +1,177 @@
+//! Every intersection of a ray with the projected triangles, through an obvhs BVH.
+
+use crate::intersect::broad;
+use glam::{DVec3, Vec3A};
+use obvhs::bvh2::Bvh2;
+use obvhs::ray::Ray;
+
+/// One surface's triangles as the tracer reads them.
+#[derive(Clone, Copy, Debug)]
+pub struct TraceSurface<'a> {
+    /// Vertex positions.
+    pub positions: &'a [DVec3],
+    /// Triangles.
+    pub triangles: &'a [[u32; 3]],
+}
+
+/// A ray's hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Distance along the ray.
+    pub t: f64,
+    /// Surface index.
+    pub surface: u32,
+    /// Triangle index in that surface.
+    pub triangle: u32,
+    /// Barycentric coordinates of the hit on the triangle's corners.
+    pub bary: [f64; 3],
+}
+
+/// The triangles of all surfaces in one BVH.
+pub struct Tracer<'a> {
+    surfaces: Vec<TraceSurface<'a>>,
+    /// Global triangle -> (surface, triangle).
+    tris: Vec<(u32, u32)>,
+    bvh: Bvh2,
+    /// Hits closer than this along the ray are one hit on a shared edge or vertex.
+    same: f64,
+}
+
+impl<'a> Tracer<'a> {
+    /// Indexes the triangles of `surfaces`; `scale` is the scene's size, for telling one
+    /// hit on an edge from two.
+    pub fn new(surfaces: Vec<TraceSurface<'a>>, scale: f64) -> Self {
+        let mut boxes = Vec::new();
+        let mut tris = Vec::new();
+        for (s, surf) in surfaces.iter().enumerate() {
+            for (i, t) in surf.triangles.iter().enumerate() {
+                let p = t.map(|v| surf.positions[v as usize]);
+                boxes.push(broad::outward(
+                    p[0].min(p[1]).min(p[2]),
+                    p[0].max(p[1]).max(p[2]),
+                ));
+                tris.push((s as u32, i as u32));
+            }
+        }
+        Tracer {
+            surfaces,
+            tris,
+            bvh: broad::build(&boxes, 4),
+            same: 1e-12 * scale,
+        }
+    }
+
+    /// Every hit along the ray from `origin` in unit direction `dir` with t > `t_min`, in
+    /// order of t, into `hits` (cleared first). A ray through an edge or vertex shared by
+    /// triangles of one surface hits it once.
+    pub fn hits(&self, origin: DVec3, dir: DVec3, t_min: f64, hits: &mut Vec<Hit>) {
+        hits.clear();
+        let ray = Ray::new(
+            Vec3A::new(origin.x as f32, origin.y as f32, origin.z as f32),
+            Vec3A::new(dir.x as f32, dir.y as f32, dir.z as f32),
+            0.0,
+            f32::INFINITY,
+        );
+        self.bvh.ray_traverse_anyhit(ray, |_, slot| {
+            let g = self.bvh.primitive_indices[slot];
+            let (s, i) = self.tris[g as usize];
+            let surf = &self.surfaces[s as usize];
+            let tri = surf.triangles[i as usize];
+            let p = tri.map(|v| surf.positions[v as usize]);
+            if let Some((t, bary)) = intersect(origin, dir, p)
+                && t > t_min
+            {
+                hits.push(Hit {
+                    t,
+                    surface: s,
+                    triangle: i,
+                    bary,
+                });
+            }
+        });
+        hits.sort_by(|a, b| a.t.total_cmp(&b.t));
+        // Drop the second of two hits at one t on neighbouring triangles of one surface.
+        let mut kept = 0;
+        for k in 0..hits.len() {
+            let h = hits[k];
+            let duplicate = hits[..kept]
+                .iter()
+                .rev()
+                .take_while(|o| h.t - o.t <= self.same)
+                .any(|o| {
+                    o.surface == h.surface && {
+                        let surf = &self.surfaces[h.surface as usize];
+                        let (a, b) = (
+                            surf.triangles[o.triangle as usize],
+                            surf.triangles[h.triangle as usize],
+                        );
+                        a.iter().any(|v| b.contains(v))
+                    }
+                });
+            if !duplicate {
+                hits[kept] = h;
+                kept += 1;
+            }
+        }
+        hits.truncate(kept);
+    }
+}
+
+/// Möller-Trumbore in f64, edges included: (t, barycentric coordinates).
+fn intersect(origin: DVec3, dir: DVec3, p: [DVec3; 3]) -> Option<(f64, [f64; 3])> {
+    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+    let q = dir.cross(e2);
+    let det = e1.dot(q);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = origin - p[0];
+    let u = s.dot(q) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let r = s.cross(e1);
+    let v = dir.dot(r) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    let t = e2.dot(r) * inv;
+    Some((t, [1.0 - u - v, u, v]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_ray_through_a_shared_edge_hits_once_and_stacked_sheets_in_order() {
+        let positions = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+        ];
+        let triangles = vec![[0, 1, 2], [0, 2, 3]];
+        let lifted: Vec<DVec3> = positions.iter().map(|p| *p + DVec3::Z).collect();
+        let surfaces = [
+            TraceSurface {
+                positions: &positions,
+                triangles: &triangles,
+            },
+            TraceSurface {
+                positions: &lifted,
+                triangles: &triangles,
+            },
+        ];
+        let tracer = Tracer::new(surfaces.to_vec(), 1.0);
+        let mut hits = Vec::new();
+        // Straight down through the diagonal (0, 0)-(1, 1) of both squares.
+        tracer.hits(DVec3::new(0.5, 0.5, 5.0), -DVec3::Z, 0.0, &mut hits);
+        assert_eq!(hits.len(), 2, "{hits:?}");
+        assert_eq!((hits[0].surface, hits[1].surface), (1, 0));
+        assert!((hits[0].t - 4.0).abs() < 1e-12 && (hits[1].t - 5.0).abs() < 1e-12);
+        tracer.hits(DVec3::new(2.0, 0.5, 5.0), -DVec3::Z, 0.0, &mut hits);
+        assert!(hits.is_empty());
+    }
+}
