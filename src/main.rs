@@ -197,7 +197,7 @@ fn main() -> ExitCode {
             }
             if let Err((field, message)) = scene.render.check() {
                 eprintln!("error: render.{field}: {message}");
-                return ExitCode::from(2);
+                return ExitCode::FAILURE;
             }
             let out = out.unwrap_or_else(|| {
                 Path::new("exports")
@@ -213,7 +213,7 @@ fn main() -> ExitCode {
                 Ok(p) => p,
                 Err(e) => {
                     eprintln!("error: {e}");
-                    return ExitCode::from(2);
+                    return ExitCode::FAILURE;
                 }
             };
             let ms = start.elapsed().as_secs_f64() * 1e3;

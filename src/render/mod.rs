@@ -406,28 +406,7 @@ pub fn render(
     settings: &RenderSettings,
     camera: &CameraSettings,
 ) -> Result<Picture, RenderError> {
-    settings.check().map_err(|(f, m)| RenderError::Setting {
-        field: f.into(),
-        message: m,
-    })?;
-    camera.check().map_err(|(f, m)| RenderError::Setting {
-        field: format!("camera.{f}"),
-        message: m,
-    })?;
-    let bounds = input
-        .surfaces
-        .iter()
-        .flat_map(|s| {
-            s.triangles
-                .iter()
-                .flatten()
-                .map(|&v| s.positions[v as usize])
-        })
-        .fold(None, |b: Option<(DVec3, DVec3)>, p| {
-            Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
-        })
-        .ok_or(RenderError::Empty)?;
-    let scene = Scene::new(input, settings, bounds);
+    let (bounds, scene) = prepare(input, settings, camera)?;
     let eyes: Vec<f64> = if settings.stereo {
         // Cross-eyed: the left image is the right eye's (turned right, +azimuth).
         vec![
@@ -457,6 +436,117 @@ pub fn render(
         height: h,
         rgb,
     })
+}
+
+/// What the centre ray of a pixel sees first, for probing a picture at known places.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Seen {
+    /// Surface index.
+    pub surface: u32,
+    /// Triangle index in that surface.
+    pub triangle: u32,
+    /// Where.
+    pub position: DVec3,
+    /// Its w-depth.
+    pub w: f64,
+}
+
+/// Probes a picture: what the ray through an image point sees first that the halos do not
+/// hide (with the exact test), as [`render`] decides it for the first eye.
+pub struct Prober<'a> {
+    input: &'a RenderInput<'a>,
+    scene: Scene<'a>,
+    cam: Camera,
+}
+
+impl<'a> Prober<'a> {
+    /// Indexes the scene for probing.
+    pub fn new(
+        input: &'a RenderInput<'a>,
+        settings: &'a RenderSettings,
+        camera: &CameraSettings,
+    ) -> Result<Self, RenderError> {
+        let (bounds, scene) = prepare(input, settings, camera)?;
+        let cam = Camera::new(
+            camera,
+            bounds,
+            settings.width,
+            settings.height,
+            first_eye(settings),
+        )?;
+        Ok(Prober { input, scene, cam })
+    }
+
+    /// The camera of the first eye.
+    pub fn camera(&self) -> &Camera {
+        &self.cam
+    }
+
+    /// What the ray through image point `p` (pixel units, y down; a pixel's centre is at
+    /// +0.5) sees first.
+    pub fn seen(&self, p: [f64; 2]) -> Option<Seen> {
+        let s = self.scene.settings;
+        let (w, h) = (f64::from(s.width), f64::from(s.height));
+        let (origin, dir) = self.cam.ray(2.0 * p[0] / w - 1.0, 1.0 - 2.0 * p[1] / h);
+        let mut hits = Vec::new();
+        self.scene.trace(origin, dir, &mut hits);
+        hits.iter().find_map(|hit| {
+            let surf = &self.input.surfaces[hit.surface as usize];
+            let tri = surf.triangles[hit.triangle as usize];
+            let x = origin + dir * hit.t;
+            let wd: f64 = (0..3).map(|i| hit.bary[i] * surf.w[tri[i] as usize]).sum();
+            let hidden = self
+                .scene
+                .halos
+                .as_ref()
+                .is_some_and(|index| index.hidden(x, wd, hit.surface, tri));
+            (!hidden).then_some(Seen {
+                surface: hit.surface,
+                triangle: hit.triangle,
+                position: x,
+                w: wd,
+            })
+        })
+    }
+}
+
+/// The azimuth offset of the first (left) image.
+fn first_eye(settings: &RenderSettings) -> f64 {
+    if settings.stereo {
+        settings.eye_separation * 0.5
+    } else {
+        0.0
+    }
+}
+
+/// Checks the settings and indexes the scene.
+fn prepare<'a>(
+    input: &'a RenderInput<'a>,
+    settings: &'a RenderSettings,
+    camera: &CameraSettings,
+) -> Result<((DVec3, DVec3), Scene<'a>), RenderError> {
+    settings.check().map_err(|(f, m)| RenderError::Setting {
+        field: f.into(),
+        message: m,
+    })?;
+    camera.check().map_err(|(f, m)| RenderError::Setting {
+        field: format!("camera.{f}"),
+        message: m,
+    })?;
+    let bounds = input
+        .surfaces
+        .iter()
+        .flat_map(|s| {
+            s.triangles
+                .iter()
+                .flatten()
+                .map(|&v| s.positions[v as usize])
+        })
+        .fold(None, |b: Option<(DVec3, DVec3)>, p| {
+            Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
+        })
+        .ok_or(RenderError::Empty)?;
+    Ok((bounds, Scene::new(input, settings, bounds)))
 }
 
 /// Linear [0, 1] to an 8-bit sRGB value.

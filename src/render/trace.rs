@@ -117,27 +117,44 @@ impl<'a> Tracer<'a> {
     }
 }
 
-/// Möller-Trumbore in f64, edges included: (t, barycentric coordinates).
+/// Watertight ray-triangle intersection (Woop, Benthin and Wald 2013) in f64, edges
+/// included: (t, barycentric coordinates). The triangle is sheared into the ray's frame and
+/// tested with 2D edge functions; a vertex shared by two triangles shears to the same point
+/// and a shared edge's function is exactly negated between them, so a ray through an edge
+/// hits both neighbours (one hit after [`Tracer::hits`] merges them), never neither.
 fn intersect(origin: DVec3, dir: DVec3, p: [DVec3; 3]) -> Option<(f64, [f64; 3])> {
-    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
-    let q = dir.cross(e2);
-    let det = e1.dot(q);
+    let a = dir.abs();
+    let kz = if a.x >= a.y && a.x >= a.z {
+        0
+    } else if a.y >= a.z {
+        1
+    } else {
+        2
+    };
+    let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+    if dir[kz] < 0.0 {
+        std::mem::swap(&mut kx, &mut ky);
+    }
+    let (sx, sy, sz) = (dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
+    let shear = |q: DVec3| {
+        let r = q - origin;
+        (r[kx] - sx * r[kz], r[ky] - sy * r[kz], sz * r[kz])
+    };
+    let (ax, ay, az) = shear(p[0]);
+    let (bx, by, bz) = shear(p[1]);
+    let (cx, cy, cz) = shear(p[2]);
+    let u = cx * by - cy * bx;
+    let v = ax * cy - ay * cx;
+    let w = bx * ay - by * ax;
+    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        return None;
+    }
+    let det = u + v + w;
     if det == 0.0 || !det.is_finite() {
         return None;
     }
-    let inv = 1.0 / det;
-    let s = origin - p[0];
-    let u = s.dot(q) * inv;
-    if !(0.0..=1.0).contains(&u) {
-        return None;
-    }
-    let r = s.cross(e1);
-    let v = dir.dot(r) * inv;
-    if v < 0.0 || u + v > 1.0 {
-        return None;
-    }
-    let t = e2.dot(r) * inv;
-    Some((t, [1.0 - u - v, u, v]))
+    let t = (u * az + v * bz + w * cz) / det;
+    Some((t, [u / det, v / det, w / det]))
 }
 
 #[cfg(test)]

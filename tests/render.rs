@@ -1,0 +1,389 @@
+//! The CPU renderer: every fixture's picture, the crossing diagram probed at known places,
+//! determinism, and bad settings.
+
+use crate::common::{fixture, fixture_scenes, halo4d};
+use glam::DVec3;
+use halo4d::Scene;
+use halo4d::pipeline::{halo_inputs, render_surfaces};
+use halo4d::render::camera::Camera;
+use halo4d::render::{Prober, RenderInput, RenderSettings, Seen};
+
+/// Small, fast settings for tests.
+fn small(scene: &mut Scene) {
+    (
+        scene.render.width,
+        scene.render.height,
+        scene.render.samples,
+    ) = (200, 200, 1);
+}
+
+#[test]
+fn every_fixture_renders_a_picture_of_its_surfaces() {
+    for path in fixture_scenes() {
+        let mut scene = Scene::load(&path).unwrap();
+        small(&mut scene);
+        let built = halo4d::run(&scene, true).unwrap();
+        let picture = built
+            .render(&scene.halo, &scene.render, &scene.camera)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let png = picture.png();
+        let decoded = image::load_from_memory(&png).unwrap().to_rgb8();
+        assert_eq!(decoded.dimensions(), (200, 200));
+        assert_eq!(decoded.as_raw(), &picture.rgb, "the PNG holds the picture");
+        // Some background, and a fair share of the frame covered by the surfaces.
+        let background = decoded.pixels().filter(|p| p.0 == [255, 255, 255]).count();
+        let covered = 200 * 200 - background;
+        assert!(
+            background > 0 && covered > 200 * 200 / 20,
+            "{}: {covered} pixels covered",
+            path.display()
+        );
+    }
+}
+
+#[test]
+fn renders_are_deterministic_and_stereo_is_two_views() {
+    let mut scene = Scene::load(&fixture("scenes/klein-bottle.json")).unwrap();
+    small(&mut scene);
+    let built = halo4d::run(&scene, true).unwrap();
+    let a = built
+        .render(&scene.halo, &scene.render, &scene.camera)
+        .unwrap();
+    let b = built
+        .render(&scene.halo, &scene.render, &scene.camera)
+        .unwrap();
+    assert_eq!(a.png(), b.png());
+    let stereo = RenderSettings {
+        stereo: true,
+        ..scene.render
+    };
+    let pair = built.render(&scene.halo, &stereo, &scene.camera).unwrap();
+    assert_eq!((pair.width, pair.height), (400, 200));
+    let half = |p: &halo4d::render::Picture, right: bool| -> Vec<u8> {
+        (0..200)
+            .flat_map(|y| {
+                let start = 3 * (y * 400 + if right { 200 } else { 0 });
+                p.rgb[start..start + 600].to_vec()
+            })
+            .collect()
+    };
+    assert_ne!(
+        half(&pair, false),
+        half(&pair, true),
+        "the eyes see differently"
+    );
+}
+
+/// The flat torus fixture, built, with what probing its picture needs.
+struct Torus {
+    scene: Scene,
+    built: halo4d::Built,
+}
+
+impl Torus {
+    fn new() -> Torus {
+        let mut scene = Scene::load(&fixture("scenes/flat-torus.json")).unwrap();
+        small(&mut scene);
+        let built = halo4d::run(&scene, true).unwrap();
+        Torus { scene, built }
+    }
+
+    fn camera(&self) -> Camera {
+        let (lo, hi) = self
+            .built
+            .surfaces
+            .iter()
+            .filter_map(|p| p.projected.bounds())
+            .fold(
+                (DVec3::INFINITY, DVec3::NEG_INFINITY),
+                |(a, b), (lo, hi)| (a.min(lo), b.max(hi)),
+            );
+        let r = &self.scene.render;
+        Camera::new(&self.scene.camera, (lo, hi), r.width, r.height, 0.0).unwrap()
+    }
+
+    /// What the picture shows at image points, with halos or without.
+    fn probe(&self, halos: bool, points: &[[f64; 2]]) -> Vec<Option<Seen>> {
+        let surfaces = render_surfaces(&self.built.surfaces);
+        let halo = halo_inputs(&self.built.surfaces, &self.scene.halo);
+        let settings = RenderSettings {
+            halos,
+            ..self.scene.render
+        };
+        let input = RenderInput {
+            surfaces: &surfaces,
+            halos: &halo,
+            curves: &self.built.curves,
+        };
+        let prober = Prober::new(&input, &settings, &self.scene.camera).unwrap();
+        points.iter().map(|&p| prober.seen(p)).collect()
+    }
+}
+
+#[test]
+fn along_a_crossing_the_sheet_nearer_in_w_is_drawn_and_the_farther_has_a_gap() {
+    let torus = Torus::new();
+    let cam = torus.camera();
+    let (w, h) = (torus.scene.render.width, torus.scene.render.height);
+    let products = &torus.built.surfaces;
+    let surfaces = render_surfaces(products);
+    let halo = halo_inputs(products, &torus.scene.halo);
+    let input = RenderInput {
+        surfaces: &surfaces,
+        halos: &halo,
+        curves: &torus.built.curves,
+    };
+    let with = torus.scene.render;
+    let without = RenderSettings {
+        halos: false,
+        ..with
+    };
+    let on = Prober::new(&input, &with, &torus.scene.camera).unwrap();
+    let off = Prober::new(&input, &without, &torus.scene.camera).unwrap();
+    let rho = &products[0].halo.rho;
+    let tris = &products[0].mesh.triangles;
+    let delta_t = torus.scene.halo.delta_t;
+    let scale = 2.0; // the torus's extent
+    let edge = std::f64::consts::TAU / 96.0; // the fixture's grid step
+    let (mut crossings, mut gaps, mut outside) = (0, 0, 0);
+    for curve in &torus.built.curves.curves {
+        let pts = &curve.points;
+        for k in 1..pts.len() - 1 {
+            let p = &pts[k];
+            // Away from the cross-caps, where the sheets differ clearly in w.
+            if p.dw() < 0.3 {
+                continue;
+            }
+            let (near, far) = (p.near(), 1 - p.near());
+            let Some((xy, _)) = cam.project(p.position, w, h) else {
+                continue;
+            };
+            // Only where the crossing itself is in view (nothing in front of it).
+            let bare = off.seen(xy);
+            if !bare.is_some_and(|s| (s.position - p.position).length() < 1e-6 * scale) {
+                continue;
+            }
+            crossings += 1;
+            let seen = on.seen(xy).unwrap_or_else(|| {
+                panic!(
+                    "nothing drawn at {} (w near {}, far {}), bare sees {bare:?}",
+                    p.position, p.w[near], p.w[far]
+                )
+            });
+            assert!(
+                (seen.w - p.w[near]).abs() < 1e-6,
+                "at {}: drawn w {} is not the near sheet's {} (far {})",
+                p.position,
+                seen.w,
+                p.w[near],
+                p.w[far]
+            );
+
+            // Across the curve within the far sheet: hidden within half the dead zone of
+            // the near sheet's halo, visible beyond three half-widths where the sheets
+            // cross steeply.
+            let near_face = tris[p.faces[near].triangle as usize];
+            let far_face = tris[p.faces[far].triangle as usize];
+            let rho_near = near_face.map(|v| rho[v as usize]);
+            let (rho_min, rho_max) = (
+                rho_near.iter().copied().fold(f64::INFINITY, f64::min),
+                rho_near.iter().copied().fold(0.0, f64::max),
+            );
+            if rho_min <= 0.0 {
+                continue;
+            }
+            let normal = |f: [u32; 3]| {
+                let q = f.map(|v| products[0].projected.positions[v as usize]);
+                (q[1] - q[0]).cross(q[2] - q[0]).normalize()
+            };
+            let (n_near, n_far) = (normal(near_face), normal(far_face));
+            let tangent = (pts[k + 1].position - pts[k - 1].position).normalize();
+            let across = n_far.cross(tangent).normalize();
+            let steep = n_near.cross(n_far).length() > 0.5;
+            for side in [-1.0, 1.0] {
+                for (distance, inside) in [(0.4 * rho_min * delta_t, true), (3.0 * rho_max, false)]
+                {
+                    if !inside && !steep {
+                        continue;
+                    }
+                    let q = p.position + across * (side * distance);
+                    let Some((qxy, _)) = cam.project(q, w, h) else {
+                        continue;
+                    };
+                    // The far sheet at q: there, and at the far sheet's w rather than the
+                    // near one's (near the curve the near sheet passes close by too).
+                    let on_far = |s: Option<Seen>| {
+                        s.is_some_and(|s| {
+                            (s.position - q).length() < 0.15 * distance.max(1e-3)
+                                && (s.w - p.w[far]).abs() < (s.w - p.w[near]).abs()
+                        })
+                    };
+                    if !on_far(off.seen(qxy)) {
+                        continue;
+                    }
+                    // Beyond the gap only where every other sheet (every triangle away from
+                    // the far face in the parameters) is farther than rho from q.
+                    let uv = &products[0].mesh.uv;
+                    let positions = &products[0].projected.positions;
+                    let centre = uv[far_face[0] as usize];
+                    let period = |a: f64, b: f64| {
+                        let d = (a - b).rem_euclid(std::f64::consts::TAU);
+                        d.min(std::f64::consts::TAU - d)
+                    };
+                    let local = |v: u32| {
+                        let t = uv[v as usize];
+                        period(t[0], centre[0]).hypot(period(t[1], centre[1]))
+                            < 2.0 * (distance + edge)
+                    };
+                    let alone = inside
+                        || tris.iter().all(|t| {
+                            t.iter().any(|&v| local(v))
+                                || triangle_distance(q, t.map(|v| positions[v as usize]))
+                                    > 1.05 * rho_max
+                        });
+                    if !inside && !alone {
+                        continue;
+                    }
+                    let drawn = on_far(on.seen(qxy));
+                    if inside {
+                        assert!(!drawn, "far sheet drawn {distance} from the curve at {q}");
+                        gaps += 1;
+                    } else {
+                        assert!(drawn, "far sheet hidden {distance} from the curve at {q}");
+                        outside += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        crossings >= 20 && gaps >= 10 && outside >= 10,
+        "{crossings} crossings, {gaps} gap probes, {outside} probes beyond the gap"
+    );
+}
+
+#[test]
+fn away_from_crossings_nothing_is_hidden() {
+    // Every pixel whose first surface, without halos, lies farther than rho (the scene's,
+    // absolute) from every other sheet is drawn the same with halos.
+    let torus = Torus::new();
+    let (w, h) = (torus.scene.render.width, torus.scene.render.height);
+    let curves: Vec<DVec3> = torus
+        .built
+        .curves
+        .curves
+        .iter()
+        .flat_map(|c| c.points.iter().map(|p| p.position))
+        .collect();
+    let rho = torus.built.surfaces[0].halo_report.rho;
+    let points: Vec<[f64; 2]> = (0..h)
+        .step_by(4)
+        .flat_map(|y| {
+            (0..w)
+                .step_by(4)
+                .map(move |x| [x as f64 + 0.5, y as f64 + 0.5])
+        })
+        .collect();
+    let bare = torus.probe(false, &points);
+    let halo = torus.probe(true, &points);
+    let mut checked = 0;
+    for (b, s) in bare.iter().zip(&halo) {
+        let Some(b) = b else { continue };
+        let far_from_curves = curves
+            .iter()
+            .all(|c| (*c - b.position).length() > 4.0 * rho);
+        if far_from_curves {
+            checked += 1;
+            assert_eq!(Some(*b), *s, "hidden away from every crossing");
+        }
+    }
+    assert!(checked > 500, "{checked} pixels checked");
+}
+
+#[test]
+fn bad_render_settings_are_refused_with_a_clear_message() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = |render: &str, camera: &str| {
+        format!(
+            r#"{{"name": "bad", "surfaces": [{{"surface": {{"type": "flat_torus"}}}}],
+                "sampling": {{"method": "uniform", "u": 8, "v": 8}},
+                "render": {render}, "camera": {camera}}}"#
+        )
+    };
+    for (name, render, camera, words) in [
+        (
+            "zero",
+            r#"{"width": 0}"#,
+            "{}",
+            &["render.width", "1 to 8192"][..],
+        ),
+        ("slices", r#"{"slices": 0}"#, "{}", &["render.slices"]),
+        (
+            "samples",
+            r#"{"samples": 3}"#,
+            "{}",
+            &["render.samples", "square"],
+        ),
+        (
+            "wide",
+            r#"{"line_width": 900}"#,
+            "{}",
+            &["render.line_width", "quarter"],
+        ),
+        ("nan", r#"{"opacity": 0}"#, "{}", &["render.opacity"]),
+        ("elev", "{}", r#"{"elevation": 95}"#, &["camera.elevation"]),
+    ] {
+        let path = dir.path().join(format!("{name}.json"));
+        std::fs::write(&path, scene(render, camera)).unwrap();
+        let out = halo4d(&["render", path.to_str().unwrap(), "--quiet"], dir.path());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{name}: {err}");
+        for w in words {
+            assert!(err.contains(w), "{name}: `{w}` not in {err}");
+        }
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    // An orthographic eye inside the torus's box.
+    let path = dir.path().join("inside.json");
+    std::fs::write(
+        &path,
+        scene(
+            r#"{"width": 32, "height": 32}"#,
+            r#"{"projection": "orthographic", "distance": 0.3}"#,
+        ),
+    )
+    .unwrap();
+    let out = halo4d(&["render", path.to_str().unwrap(), "--quiet"], dir.path());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("camera.distance") && err.contains("inside"),
+        "{err}"
+    );
+    // Flags are checked too.
+    let out = halo4d(&["render", "--width", "0", "--quiet"], dir.path());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("render.width"), "{err}");
+}
+
+/// Distance from `x` to a triangle.
+fn triangle_distance(x: DVec3, p: [DVec3; 3]) -> f64 {
+    let segment = |a: DVec3, b: DVec3| {
+        let t = ((x - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+        (x - (a + (b - a) * t)).length()
+    };
+    let n = (p[1] - p[0]).cross(p[2] - p[0]);
+    let foot = x - n * ((x - p[0]).dot(n) / n.length_squared());
+    let inside = (0..3).all(|k| {
+        let (a, b) = (p[k], p[(k + 1) % 3]);
+        (b - a).cross(foot - a).dot(n) >= 0.0
+    });
+    if inside {
+        (x - foot).length()
+    } else {
+        segment(p[0], p[1])
+            .min(segment(p[1], p[2]))
+            .min(segment(p[2], p[0]))
+    }
+}
