@@ -44,6 +44,15 @@ enum Command {
         /// The most triangles of any one mesh.
         #[arg(long, default_value_t = 8_000_000)]
         max_triangles: usize,
+        /// Instead: the picture's speed against error. Builds the scene, renders it in the
+        /// exact mode and with each of --slices, and writes render_speed_vs_error.csv and
+        /// render_speed_vs_error.png (time, share of pixels whose hidden/visible verdict
+        /// differs from the exact mode's, mean and 99th-percentile pixel difference).
+        #[arg(long)]
+        render: bool,
+        /// Slice counts for --render, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = [32u32, 64, 128, 256, 512])]
+        slices: Vec<u32>,
         /// No progress messages.
         #[arg(long, short)]
         quiet: bool,
@@ -107,6 +116,83 @@ enum ModeArg {
     Exact,
     /// Halo depth images on planes perpendicular to the view.
     Slices,
+}
+
+/// `halo4d sweep --render`.
+fn render_sweep(scene: &Scene, slices: &[u32], out: &Path, quiet: bool) -> ExitCode {
+    if let Some(bad) = slices.iter().find(|n| !(1..=4096).contains(*n)) {
+        eprintln!("error: --slices: every count must be 1 to 4096, got {bad}");
+        return ExitCode::FAILURE;
+    }
+    let built = match halo4d::run(scene, quiet) {
+        Ok(b) => b,
+        Err(e) => return fail(&e),
+    };
+    let surfaces = halo4d::pipeline::render_surfaces(&built.surfaces);
+    let halos = halo4d::pipeline::halo_inputs(&built.surfaces, &scene.halo);
+    let input = halo4d::render::RenderInput {
+        surfaces: &surfaces,
+        halos: &halos,
+        curves: &built.curves,
+    };
+    let mut progress = |r: &halo4d::render::compare::Comparison| {
+        if !quiet {
+            eprintln!(
+                "{:>5} {:>9.0} ms  verdict differs on {:.3}% of covered pixels, p99 difference {:.3}",
+                if r.slices == 0 {
+                    "exact".to_string()
+                } else {
+                    r.slices.to_string()
+                },
+                r.ms,
+                100.0 * r.verdict_differs,
+                r.p99_diff
+            );
+        }
+    };
+    let rows = match halo4d::render::compare::compare(
+        &input,
+        &scene.render,
+        &scene.camera,
+        slices,
+        &mut progress,
+    ) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    if let Err(e) = std::fs::create_dir_all(out) {
+        eprintln!("error: cannot create {}: {e}", out.display());
+        return ExitCode::FAILURE;
+    }
+    let title = format!(
+        "{}: multi-slice halos against the exact mode, {} x {}",
+        scene.name, scene.render.width, scene.render.height
+    );
+    let plot = match halo4d::export::render_speed_vs_error_png(&rows, &title) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    for (name, bytes) in [
+        (
+            "render_speed_vs_error.csv",
+            halo4d::render::compare::to_csv(&rows).into_bytes(),
+        ),
+        ("render_speed_vs_error.png", plot),
+    ] {
+        let path = out.join(name);
+        if let Err(e) = halo4d::export::write_atomic(&path, &bytes) {
+            eprintln!("error: cannot write {}: {e}", path.display());
+            return ExitCode::FAILURE;
+        }
+        println!("{}", path.display());
+    }
+    ExitCode::SUCCESS
 }
 
 fn load(scene: Option<PathBuf>) -> Result<Scene, halo4d::SceneError> {
@@ -239,12 +325,17 @@ fn main() -> ExitCode {
             out,
             tolerances,
             max_triangles,
+            render,
+            slices,
             quiet,
         } => {
             let scene = match load(scene) {
                 Ok(s) => s,
                 Err(e) => return fail(&e),
             };
+            if render {
+                return render_sweep(&scene, &slices, &out, quiet);
+            }
             if let Some(bad) = tolerances.iter().find(|t| !(1e-9..=0.5).contains(*t)) {
                 eprintln!(
                     "error: --tolerances: every tolerance must be from 1e-9 to 0.5 (a share of the bounding diagonal), got {bad}"

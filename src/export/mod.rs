@@ -18,7 +18,7 @@ mod vtk;
 
 pub use gltf::to_glb;
 pub use obj::to_obj;
-pub use plot::{encode_png, speed_vs_error_png};
+pub use plot::{encode_png, render_speed_vs_error_png, speed_vs_error_png};
 pub use ply::{to_curves_ply, to_ply};
 pub use vtk::to_vtk;
 

@@ -139,6 +139,133 @@ pub fn speed_vs_error_png(rows: &[Row], title: &str) -> Result<Vec<u8>, String> 
     encode_png(&rgb, w, h)
 }
 
+/// The multi-slice mode against the exact one: render time (left) and the share of covered
+/// pixels whose hidden/visible verdict differs with the 99th-percentile pixel difference
+/// (right), against slices on a log scale; the exact mode's time as a dashed line.
+pub fn render_speed_vs_error_png(
+    rows: &[crate::render::compare::Comparison],
+    title: &str,
+) -> Result<Vec<u8>, String> {
+    register_font()?;
+    let (w, h) = (1400u32, 650u32);
+    let mut rgb = vec![255u8; (w * h * 3) as usize];
+    let exact_ms = rows.iter().find(|r| r.slices == 0).map(|r| r.ms);
+    let sliced: Vec<_> = rows.iter().filter(|r| r.slices > 0).collect();
+    if sliced.is_empty() {
+        return Err("no slice-mode rows to plot".into());
+    }
+    let x0 = sliced
+        .iter()
+        .map(|r| f64::from(r.slices))
+        .fold(f64::MAX, f64::min);
+    let x1 = sliced
+        .iter()
+        .map(|r| f64::from(r.slices))
+        .fold(0.0, f64::max);
+    let t1 = sliced
+        .iter()
+        .map(|r| r.ms)
+        .chain(exact_ms)
+        .fold(0.0, f64::max);
+    let e1 = sliced
+        .iter()
+        .map(|r| (100.0 * r.verdict_differs).max(100.0 * r.p99_diff))
+        .fold(0.0, f64::max)
+        .max(1.0);
+    let draw = |rgb: &mut [u8]| -> Result<(), Box<dyn std::error::Error>> {
+        let root = BitMapBackend::with_buffer(rgb, (w, h)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let root = root.titled(title, (FAMILY, 24))?;
+        let (left, right) = root.split_horizontally(w / 2);
+        let xs = (x0 / 1.3..x1 * 1.3).log_scale();
+        let mut time = ChartBuilder::on(&left)
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d(xs.clone(), 0.0..t1 * 1.15)?;
+        time.configure_mesh()
+            .x_desc("slices")
+            .y_desc("render time (ms)")
+            .label_style((FAMILY, 15))
+            .axis_desc_style((FAMILY, 17))
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .draw()?;
+        let pts: Vec<(f64, f64)> = sliced.iter().map(|r| (f64::from(r.slices), r.ms)).collect();
+        time.draw_series(LineSeries::new(pts.clone(), COLOURS[0].stroke_width(2)))?
+            .label("slices")
+            .legend(|(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], COLOURS[0].stroke_width(2))
+            });
+        time.draw_series(pts.iter().map(|&p| Circle::new(p, 4, COLOURS[0].filled())))?;
+        if let Some(e) = exact_ms {
+            time.draw_series(DashedLineSeries::new(
+                vec![(x0 / 1.3, e), (x1 * 1.3, e)],
+                8,
+                5,
+                COLOURS[1].stroke_width(2),
+            ))?
+            .label("exact")
+            .legend(|(x, y)| {
+                PathElement::new(vec![(x, y), (x + 8, y)], COLOURS[1].stroke_width(2))
+            });
+        }
+        time.configure_series_labels()
+            .label_font((FAMILY, 15))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperLeft)
+            .draw()?;
+        let mut error = ChartBuilder::on(&right)
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d(xs, 0.0..e1 * 1.15)?;
+        error
+            .configure_mesh()
+            .x_desc("slices")
+            .y_desc("difference to the exact mode (%)")
+            .label_style((FAMILY, 15))
+            .axis_desc_style((FAMILY, 17))
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .draw()?;
+        for (k, (label, f)) in [
+            (
+                "pixels whose verdict differs",
+                (|r: &crate::render::compare::Comparison| r.verdict_differs)
+                    as fn(&crate::render::compare::Comparison) -> f64,
+            ),
+            ("99th percentile pixel difference", |r| r.p99_diff),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let colour = COLOURS[(k + 2) % COLOURS.len()];
+            let pts: Vec<(f64, f64)> = sliced
+                .iter()
+                .map(|r| (f64::from(r.slices), 100.0 * f(r)))
+                .collect();
+            error
+                .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?
+                .label(label)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(2))
+                });
+            error.draw_series(pts.iter().map(|&p| Circle::new(p, 4, colour.filled())))?;
+        }
+        error
+            .configure_series_labels()
+            .label_font((FAMILY, 15))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()?;
+        root.present()?;
+        Ok(())
+    };
+    draw(&mut rgb).map_err(|e| format!("plot failed: {e}"))?;
+    encode_png(&rgb, w, h)
+}
+
 /// A style filled or not.
 trait FilledIf {
     fn filled_if(self, filled: bool) -> ShapeStyle;

@@ -12,6 +12,7 @@
 //! width broadened through the FFT (paper 002, [`lines`]). Renders are deterministic.
 
 pub mod camera;
+pub mod compare;
 pub mod shade;
 pub mod slices;
 pub mod trace;
@@ -394,7 +395,6 @@ impl Picture {
 
 /// The image of one eye: linear RGB per pixel, and per pixel the ray distance of the
 /// first visible surface (infinite where none) for the lines' occlusion.
-#[allow(dead_code)] // `front` is for the lines overlay
 struct View {
     rgb: Vec<DVec3>,
     front: Vec<f64>,
@@ -406,21 +406,33 @@ pub fn render(
     settings: &RenderSettings,
     camera: &CameraSettings,
 ) -> Result<Picture, RenderError> {
+    Ok(render_with_depth(input, settings, camera)?.0)
+}
+
+/// [`render`], and per pixel of the first eye the ray distance of the first surface the
+/// halos leave visible along the pixel's centre sample (infinite where none), which tells
+/// where two renders disagree on what is hidden.
+pub fn render_with_depth(
+    input: &RenderInput,
+    settings: &RenderSettings,
+    camera: &CameraSettings,
+) -> Result<(Picture, Vec<f64>), RenderError> {
     let (bounds, scene) = prepare(input, settings, camera)?;
+    // Cross-eyed: the left image is the right eye's (turned right, +azimuth).
     let eyes: Vec<f64> = if settings.stereo {
-        // Cross-eyed: the left image is the right eye's (turned right, +azimuth).
-        vec![
-            settings.eye_separation * 0.5,
-            -settings.eye_separation * 0.5,
-        ]
+        vec![first_eye(settings), -first_eye(settings)]
     } else {
         vec![0.0]
     };
+    let mut depth = Vec::new();
     let (w, h) = (settings.width, settings.height);
     let mut rgb = vec![0u8; 3 * (w as usize * eyes.len()) * h as usize];
     for (e, &offset) in eyes.iter().enumerate() {
         let cam = Camera::new(camera, bounds, w, h, offset)?;
         let view = scene.view(&cam);
+        if e == 0 {
+            depth.clone_from(&view.front);
+        }
         for y in 0..h as usize {
             for x in 0..w as usize {
                 let c = view.rgb[y * w as usize + x];
@@ -431,11 +443,14 @@ pub fn render(
             }
         }
     }
-    Ok(Picture {
-        width: w * eyes.len() as u32,
-        height: h,
-        rgb,
-    })
+    Ok((
+        Picture {
+            width: w * eyes.len() as u32,
+            height: h,
+            rgb,
+        },
+        depth,
+    ))
 }
 
 /// What the centre ray of a pixel sees first, for probing a picture at known places.
@@ -712,30 +727,61 @@ impl<'a> Scene<'a> {
     /// are hidden, then the samples are composited.
     fn view_slices(&self, cam: &Camera, index: &HaloIndex) -> View {
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
-        // Per pixel, its hits over all its samples, in sample order.
+        // Per pixel, its hits over all its samples, in sample order; rows in bands on the
+        // cores, joined in order.
+        let threads = std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .min(h.max(1));
+        let rows_per = h.div_ceil(threads);
+        let bands: Vec<(Vec<u32>, Vec<slices::Probe>)> = std::thread::scope(|scope| {
+            let handles: Vec<_> = (0..threads)
+                .map(|band| {
+                    scope.spawn(move || {
+                        let mut counts = Vec::new();
+                        let mut probes = Vec::new();
+                        let mut hits = Vec::new();
+                        let rows = (band * rows_per).min(h)..((band + 1) * rows_per).min(h);
+                        for pixel in rows.start * w..rows.end * w {
+                            let before = probes.len();
+                            for (sx, sy, _) in self.samples(pixel % w, pixel / w) {
+                                let (origin, dir) = cam.ray(sx, sy);
+                                self.trace(origin, dir, &mut hits);
+                                for hit in &hits {
+                                    let surf = &self.input.surfaces[hit.surface as usize];
+                                    let tri = surf.triangles[hit.triangle as usize];
+                                    probes.push(slices::Probe {
+                                        pixel: pixel as u32,
+                                        x: origin + dir * hit.t,
+                                        w: (0..3)
+                                            .map(|i| hit.bary[i] * surf.w[tri[i] as usize])
+                                            .sum(),
+                                        surface: hit.surface,
+                                        triangle: tri,
+                                    });
+                                }
+                            }
+                            counts.push((probes.len() - before) as u32);
+                        }
+                        (counts, probes)
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|t| t.join().expect("render thread"))
+                .collect()
+        });
         let mut starts = vec![0u32; w * h + 1];
-        let mut probes: Vec<slices::Probe> = Vec::new();
-        let mut hits = Vec::new();
-        for pixel in 0..w * h {
-            for (sx, sy, _) in self.samples(pixel % w, pixel / w) {
-                let (origin, dir) = cam.ray(sx, sy);
-                self.trace(origin, dir, &mut hits);
-                for hit in &hits {
-                    let surf = &self.input.surfaces[hit.surface as usize];
-                    let tri = surf.triangles[hit.triangle as usize];
-                    probes.push(slices::Probe {
-                        pixel: pixel as u32,
-                        x: origin + dir * hit.t,
-                        w: (0..3).map(|i| hit.bary[i] * surf.w[tri[i] as usize]).sum(),
-                        surface: hit.surface,
-                        triangle: tri,
-                    });
-                }
+        let mut probes = Vec::new();
+        let mut pixel = 0;
+        for (counts, band) in bands {
+            for c in counts {
+                starts[pixel + 1] = starts[pixel] + c;
+                pixel += 1;
             }
-            starts[pixel + 1] = probes.len() as u32;
+            probes.extend(band);
         }
-        let centre = (cam.eye + cam.forward * self.centre_depth(cam), self.radius);
-        let depth = (centre.0 - cam.eye).dot(cam.forward);
+        let depth = (self.centre - cam.eye).dot(cam.forward);
         let hidden = slices::hidden(
             index,
             cam,
@@ -746,11 +792,6 @@ impl<'a> Scene<'a> {
         );
         drop(probes);
         self.view_with(cam, |pixel, k, _, _, _| hidden[starts[pixel] as usize + k])
-    }
-
-    /// The view depth of the scene's centre.
-    fn centre_depth(&self, cam: &Camera) -> f64 {
-        (self.centre - cam.eye).dot(cam.forward)
     }
 
     /// Composites the hits of one ray front to back, leaving out those `hidden(k, hit, x,
