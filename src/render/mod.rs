@@ -138,7 +138,7 @@ pub struct RenderSettings {
     pub silhouette_opacity: bool,
     /// Colour of w-depth.
     pub colormap: Colormap,
-    /// A colour bar of the w scale along the bottom of the image.
+    /// A colour bar of the w scale along the bottom of the image (near w at the left).
     pub legend: bool,
     /// Hither clipping: surfaces nearer the eye than this (in units of half the scene's
     /// diagonal) are cut away.
@@ -429,9 +429,12 @@ pub fn render_with_depth(
     let mut rgb = vec![0u8; 3 * (w as usize * eyes.len()) * h as usize];
     for (e, &offset) in eyes.iter().enumerate() {
         let cam = Camera::new(camera, bounds, w, h, offset)?;
-        let view = scene.view(&cam);
+        let mut view = scene.view(&cam);
         if e == 0 {
             depth.clone_from(&view.front);
+        }
+        if settings.legend {
+            legend(&mut view.rgb, w as usize, h as usize, settings.colormap);
         }
         for y in 0..h as usize {
             for x in 0..w as usize {
@@ -562,6 +565,28 @@ fn prepare<'a>(
         })
         .ok_or(RenderError::Empty)?;
     Ok((bounds, Scene::new(input, settings, bounds)))
+}
+
+/// A colour bar of the w scale along the bottom of an image, near w at the left, far at the
+/// right, framed in black.
+fn legend(rgb: &mut [DVec3], w: usize, h: usize, map: Colormap) {
+    let margin = (w.min(h) / 40).max(2);
+    let bar = (h / 40).max(4);
+    if w <= 2 * margin + 2 || h <= 2 * margin + bar + 2 {
+        return;
+    }
+    let (x0, x1) = (margin, w - margin);
+    let (y0, y1) = (h - margin - bar, h - margin);
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let frame = x == x0 || x == x1 - 1 || y == y0 || y == y1 - 1;
+            rgb[y * w + x] = if frame {
+                DVec3::ZERO
+            } else {
+                shade::colormap(map, (x - x0) as f64 / (x1 - x0 - 1) as f64)
+            };
+        }
+    }
 }
 
 /// Linear [0, 1] to an 8-bit sRGB value.
