@@ -16,6 +16,7 @@ pub mod halo;
 pub mod import;
 pub mod intersect;
 pub mod pipeline;
+pub mod render;
 pub mod sample;
 pub mod scene;
 pub mod surfaces;
