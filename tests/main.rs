@@ -8,6 +8,7 @@ mod export;
 mod halo;
 mod halo_export;
 mod intersect;
+mod lines;
 mod render;
 mod sample;
 mod scene;

@@ -13,6 +13,7 @@
 
 pub mod camera;
 pub mod compare;
+pub mod lines;
 pub mod shade;
 pub mod slices;
 pub mod trace;
