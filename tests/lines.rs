@@ -573,3 +573,38 @@ fn closed_polylines_are_one_pixel_wide_rings() {
         }
     }
 }
+
+#[test]
+fn tiny_images_and_single_points_broaden() {
+    let mut broadener = Broadener::new();
+    for (w, h) in [(1, 1), (1, 7), (7, 1), (2, 3)] {
+        let mut mask = Mask::new(w, h).expect("a valid size");
+        let centre = DVec2::new(w as f64, h as f64) * 0.5;
+        assert_eq!(mask.draw_polyline(&[(centre, 1.0)]), Ok(1), "{w} x {h}");
+        let (x, y) = (w / 2, h / 2);
+        assert_eq!(mask.ink()[y * w + x], 1.0);
+        for coverage in [
+            broadener.broaden(&mask, 1.0).expect("a valid width"),
+            broadener.broaden_varying(&mask).expect("a valid width"),
+        ] {
+            assert!(coverage.values().iter().all(|&c| (0.0..=1.0).contains(&c)));
+        }
+    }
+    // A point is a line of no length, whose ends recede (see the module docs): a band 1 px
+    // wide all but loses it, one 4 px wide keeps a dot about 3 px across.
+    let mut mask = Mask::new(9, 9).expect("a valid size");
+    mask.draw_polyline(&[(DVec2::new(4.5, 4.5), 4.0)])
+        .expect("a valid point");
+    let dot = broadener.broaden_varying(&mask).expect("a valid width");
+    assert_eq!(dot.get(4, 4), Some(1.0));
+    let area: f32 = dot.values().iter().sum();
+    assert!((4.0..10.0).contains(&area), "dot of {area} px²");
+    let mut mask = Mask::new(5, 5).expect("a valid size");
+    assert_eq!(mask.draw_polyline(&[]), Ok(0));
+    assert_eq!(
+        mask.draw_polyline(&[(DVec2::new(-1.0, 2.0), 1.0)]),
+        Ok(0),
+        "a point outside draws nothing"
+    );
+    assert!(mask.is_empty());
+}

@@ -31,14 +31,15 @@
 //! **Sigma.** `sigma = max(width / 4, 0.8 px)`: the threshold sits at d = 2 sigma, where the
 //! profile has fallen to e⁻² = 0.135 of its peak. A narrower Gaussian (the threshold further
 //! out in its tail) makes the band closer to the true set of points within w/2 of the line
-//! at ends, corners and near other lines: with w = 4 sigma a band reaches 0.55 w/2 beyond a
-//! line's end (a round cap would reach w/2), and the bands of two parallel lines merge only
-//! when the gap between them is less than 0.32 w/2. But sigma must stay near a pixel or more, or the
-//! staircase of a slanted line shows through: where it steps, the blur of two half-lines a
-//! pixel apart is wider than one line's, and the band widens there by about 0.375 / sigma px
-//! (measured at sigma = 0.8 px: up to 0.35 px on straight lines, 0.5 px on a polygonal
-//! circle). Below 0.8 px the sampled Gaussian also starts to depart from the continuous one.
-//! The threshold at e⁻² of the peak is far above the f32 rounding of the FFT.
+//! at ends, corners and near other lines: with w = 4 sigma a band reaches 0.55 w/2 beyond the
+//! middle of a line's last pixel (a round cap would reach w/2), and the bands of two parallel
+//! lines merge only when the gap between them is less than 0.32 w/2. But sigma must stay near
+//! a pixel or more, or the staircase of a slanted line shows through: where it steps, the
+//! blur of two half-lines a pixel apart is wider than one line's, and the band widens there
+//! by about 0.375 / sigma px (measured at sigma = 0.8 px: up to 0.35 px on straight lines,
+//! 0.5 px on a polygonal circle). Below 0.8 px the sampled Gaussian also starts to depart from
+//! the continuous one. The threshold at e⁻² of the peak is far above the f32 rounding of the
+//! FFT.
 //!
 //! **FFT and zero padding.** The blur is separable: each row is convolved with the sampled,
 //! normalized 1D Gaussian by an FFT (eq. 6), then each column, which is the same as the 2D
