@@ -14,6 +14,7 @@
 pub mod camera;
 pub mod compare;
 pub mod lines;
+mod overlay;
 pub mod shade;
 pub mod slices;
 pub mod trace;
@@ -434,6 +435,11 @@ pub fn render_with_depth(
         if e == 0 {
             depth.clone_from(&view.front);
         }
+        if let Some(coverage) = scene.lines(&cam)? {
+            for (c, &k) in view.rgb.iter_mut().zip(coverage.values()) {
+                *c = c.lerp(overlay::INK, f64::from(k));
+            }
+        }
         if settings.legend {
             legend(&mut view.rgb, w as usize, h as usize, settings.colormap);
         }
@@ -455,6 +461,27 @@ pub fn render_with_depth(
         },
         depth,
     ))
+}
+
+/// The coverage in [0, 1] of the lines (curves and silhouettes, as the settings ask) in the
+/// first eye's image, row-major; all zero when there are none.
+pub fn line_coverage(
+    input: &RenderInput,
+    settings: &RenderSettings,
+    camera: &CameraSettings,
+) -> Result<Vec<f32>, RenderError> {
+    let (bounds, scene) = prepare(input, settings, camera)?;
+    let cam = Camera::new(
+        camera,
+        bounds,
+        settings.width,
+        settings.height,
+        first_eye(settings),
+    )?;
+    Ok(match scene.lines(&cam)? {
+        Some(c) => c.values().to_vec(),
+        None => vec![0.0; settings.width as usize * settings.height as usize],
+    })
 }
 
 /// What the centre ray of a pixel sees first, for probing a picture at known places.
