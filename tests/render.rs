@@ -387,3 +387,117 @@ fn triangle_distance(x: DVec3, p: [DVec3; 3]) -> f64 {
             .min(segment(p[2], p[0]))
     }
 }
+
+#[test]
+fn the_drawn_curves_lie_on_the_computed_curves_at_the_width_asked_for() {
+    let mut scene = Scene::load(&fixture("scenes/flat-torus.json")).unwrap();
+    (
+        scene.render.width,
+        scene.render.height,
+        scene.render.samples,
+    ) = (400, 400, 1);
+    scene.render.silhouettes = false;
+    scene.render.line_width = 4.0;
+    let built = halo4d::run(&scene, true).unwrap();
+    let surfaces = render_surfaces(&built.surfaces);
+    let halos = halo_inputs(&built.surfaces, &scene.halo);
+    let input = RenderInput {
+        surfaces: &surfaces,
+        halos: &halos,
+        curves: &built.curves,
+    };
+    let coverage = halo4d::render::line_coverage(&input, &scene.render, &scene.camera).unwrap();
+    let cam = Prober::new(&input, &scene.render, &scene.camera)
+        .unwrap()
+        .camera()
+        .clone();
+    let (w, h) = (400usize, 400usize);
+    // The computed curves, projected: one polyline per curve.
+    let projected: Vec<Vec<[f64; 2]>> = built
+        .curves
+        .curves
+        .iter()
+        .map(|c| {
+            c.points
+                .iter()
+                .filter_map(|p| cam.project(p.position, 400, 400).map(|(xy, _)| xy))
+                .collect()
+        })
+        .collect();
+    let to_segment = |q: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        let (ab, aq) = ([b[0] - a[0], b[1] - a[1]], [q[0] - a[0], q[1] - a[1]]);
+        let len2 = ab[0] * ab[0] + ab[1] * ab[1];
+        let t = if len2 > 0.0 {
+            ((aq[0] * ab[0] + aq[1] * ab[1]) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (aq[0] - t * ab[0]).hypot(aq[1] - t * ab[1])
+    };
+    let nearest = |q: [f64; 2]| {
+        projected
+            .iter()
+            .flat_map(|c| c.windows(2))
+            .map(|s| to_segment(q, s[0], s[1]))
+            .fold(f64::INFINITY, f64::min)
+    };
+    // Every inked pixel is within half the width and a pixel of a projected curve.
+    let mut inked = 0;
+    for y in 0..h {
+        for x in 0..w {
+            if coverage[y * w + x] > 0.5 {
+                inked += 1;
+                let d = nearest([x as f64 + 0.5, y as f64 + 0.5]);
+                assert!(
+                    d <= 2.0 + 1.0,
+                    "pixel ({x}, {y}) is {d} px from every curve"
+                );
+            }
+        }
+    }
+    assert!(inked > 300, "{inked} pixels inked");
+    // Across the line, away from the image's edge and from other parts of the curves, the
+    // coverage adds up to the width.
+    let mut measured = 0;
+    for c in &projected {
+        for k in 2..c.len().saturating_sub(2) {
+            let (a, b) = (c[k - 1], c[k + 1]);
+            let tangent = [b[0] - a[0], b[1] - a[1]];
+            let len = tangent[0].hypot(tangent[1]);
+            if len < 1.0 {
+                continue;
+            }
+            let normal = [-tangent[1] / len, tangent[0] / len];
+            let q = c[k];
+            let within = |p: [f64; 2]| p[0] > 10.0 && p[1] > 10.0 && p[0] < 390.0 && p[1] < 390.0;
+            // Other parts of the curves (not this stretch) farther than 12 px.
+            let crowded = projected.iter().any(|other| {
+                other.iter().enumerate().any(|(j, &o)| {
+                    let same_stretch = std::ptr::eq(other, c) && j.abs_diff(k) < 12;
+                    !same_stretch && (o[0] - q[0]).hypot(o[1] - q[1]) < 12.0
+                })
+            });
+            if !within(q) || crowded {
+                continue;
+            }
+            // Only where this stretch of curve is drawn at all (it may be hidden).
+            let at = |p: [f64; 2]| coverage[p[1] as usize * w + p[0] as usize] as f64;
+            if at(q) < 0.5 {
+                continue;
+            }
+            let step = 0.125;
+            let sum: f64 = (-64..=64)
+                .map(|i| {
+                    let s = i as f64 * step;
+                    at([q[0] + normal[0] * s, q[1] + normal[1] * s]) * step
+                })
+                .sum();
+            assert!(
+                (sum - 4.0).abs() <= 1.0,
+                "width {sum} across the curve at {q:?}"
+            );
+            measured += 1;
+        }
+    }
+    assert!(measured >= 15, "{measured} widths measured");
+}
