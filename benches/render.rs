@@ -1,6 +1,7 @@
-//! Rendering costs: broadening one-pixel lines to bands (`render::lines`) with the FFT plans
-//! kept between calls. Masks of a few hundred seeded random segments, on a sweep of image
-//! sizes and widths, and with widths that vary along the segments.
+//! Rendering costs: the default scene's picture at 1024 x 1024 in the exact mode and with 256
+//! slices (both cores), and broadening one-pixel lines to bands (`render::lines`) with the
+//! FFT plans kept between calls: masks of a few hundred seeded random segments, on a sweep of
+//! image sizes and widths, and with widths that vary along the segments.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use glam::DVec2;
@@ -38,6 +39,31 @@ fn random_mask(side: usize, count: usize, widths: [f64; 2]) -> Mask {
     mask
 }
 
+fn pictures(c: &mut Criterion) {
+    let scene = halo4d::Scene::default_scene();
+    let built = halo4d::run(&scene, true).expect("the default scene builds");
+    let mut group = c.benchmark_group("render/default_scene_1024");
+    group.sample_size(10);
+    for (name, mode) in [
+        ("exact", halo4d::render::RenderMode::Exact),
+        ("slices_256", halo4d::render::RenderMode::Slices),
+    ] {
+        let settings = halo4d::render::RenderSettings {
+            mode,
+            slices: 256,
+            ..scene.render
+        };
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                built
+                    .render(&scene.halo, black_box(&settings), &scene.camera)
+                    .expect("the default scene renders")
+            })
+        });
+    }
+    group.finish();
+}
+
 fn broaden(c: &mut Criterion) {
     let mut group = c.benchmark_group("render/broaden");
     group.sample_size(20);
@@ -65,5 +91,5 @@ fn broaden(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, broaden);
+criterion_group!(benches, pictures, broaden);
 criterion_main!(benches);

@@ -407,10 +407,9 @@ fn the_drawn_curves_lie_on_the_computed_curves_at_the_width_asked_for() {
         curves: &built.curves,
     };
     let coverage = halo4d::render::line_coverage(&input, &scene.render, &scene.camera).unwrap();
-    let cam = Prober::new(&input, &scene.render, &scene.camera)
+    let cam = *Prober::new(&input, &scene.render, &scene.camera)
         .unwrap()
-        .camera()
-        .clone();
+        .camera();
     let (w, h) = (400usize, 400usize);
     // The computed curves, projected: one polyline per curve.
     let projected: Vec<Vec<[f64; 2]>> = built
@@ -500,4 +499,49 @@ fn the_drawn_curves_lie_on_the_computed_curves_at_the_width_asked_for() {
         }
     }
     assert!(measured >= 15, "{measured} widths measured");
+}
+
+#[test]
+fn sweep_render_writes_the_slice_modes_speed_against_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut scene: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fixture("scenes/flat-torus.json")).unwrap())
+            .unwrap();
+    scene["render"] = serde_json::json!({ "width": 160, "height": 160, "samples": 1 });
+    let path = dir.path().join("torus.json");
+    std::fs::write(&path, scene.to_string()).unwrap();
+    let out = halo4d(
+        &[
+            "sweep",
+            "--render",
+            path.to_str().unwrap(),
+            "--slices",
+            "4,64",
+            "--out",
+            "reports",
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv =
+        std::fs::read_to_string(dir.path().join("reports/render_speed_vs_error.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 3, "{csv}");
+    assert_eq!((rows[0][0], rows[1][1], rows[2][1]), ("exact", "4", "64"));
+    let differs = |r: &Vec<&str>| r[5].parse::<f64>().unwrap();
+    assert_eq!(differs(&rows[0]), 0.0);
+    // Four slices are far from the exact picture; 64 are much closer.
+    assert!(differs(&rows[1]) > differs(&rows[2]), "{csv}");
+    assert!(differs(&rows[2]) < 0.01, "{csv}");
+    let png = std::fs::read(dir.path().join("reports/render_speed_vs_error.png")).unwrap();
+    assert!(image::load_from_memory(&png).is_ok());
 }

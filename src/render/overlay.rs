@@ -29,7 +29,11 @@ impl Scene<'_> {
             }
         }
         if s.silhouettes {
-            polylines.extend(self.silhouette_edges(cam).into_iter().map(|[a, b]| vec![a, b]));
+            polylines.extend(
+                self.silhouette_edges(cam)
+                    .into_iter()
+                    .map(|[a, b]| vec![a, b]),
+            );
         }
         let depth_of = |p: DVec3| (p - cam.eye).dot(cam.forward);
         let (near, far) = {
@@ -71,7 +75,10 @@ impl Scene<'_> {
                         flush(&mut run)?;
                         continue;
                     };
-                    let inside = xy[0] >= 0.0 && xy[1] >= 0.0 && xy[0] < f64::from(w) && xy[1] < f64::from(h);
+                    let inside = xy[0] >= 0.0
+                        && xy[1] >= 0.0
+                        && xy[0] < f64::from(w)
+                        && xy[1] < f64::from(h);
                     let visible = inside && (see_through || !self.occluded(cam, p, &mut hits));
                     if visible {
                         run.push((DVec2::new(xy[0], xy[1]), width_at(p)));
