@@ -60,23 +60,7 @@ impl Built {
     pub fn sheets(&self) -> Vec<Sheet<'_>> {
         sheets(&self.surfaces)
     }
-}
 
-/// The surfaces as the renderer reads them.
-pub fn render_surfaces(surfaces: &[SurfaceProduct]) -> Vec<RenderSurface<'_>> {
-    surfaces
-        .iter()
-        .map(|p| RenderSurface {
-            positions: &p.projected.positions,
-            w: &p.projected.w,
-            normals: &p.projected.normals,
-            uv: &p.mesh.uv,
-            triangles: &p.mesh.triangles,
-        })
-        .collect()
-}
-
-impl Built {
     /// The picture of the scene's `render` settings through its `camera`, or the given
     /// ones.
     pub fn render(
@@ -97,6 +81,20 @@ impl Built {
             camera,
         )
     }
+}
+
+/// The surfaces as the renderer reads them.
+pub fn render_surfaces(surfaces: &[SurfaceProduct]) -> Vec<RenderSurface<'_>> {
+    surfaces
+        .iter()
+        .map(|p| RenderSurface {
+            positions: &p.projected.positions,
+            w: &p.projected.w,
+            normals: &p.projected.normals,
+            uv: &p.mesh.uv,
+            triangles: &p.mesh.triangles,
+        })
+        .collect()
 }
 
 fn sheets(surfaces: &[SurfaceProduct]) -> Vec<Sheet<'_>> {

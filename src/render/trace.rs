@@ -43,12 +43,16 @@ impl<'a> Tracer<'a> {
     pub fn new(surfaces: Vec<TraceSurface<'a>>, scale: f64) -> Self {
         let mut boxes = Vec::new();
         let mut tris = Vec::new();
+        // The f32 ray-box test can slip past a box corner (a ray through a mesh vertex, past
+        // the boxes of every triangle around it): boxes grow by a millionth of the scene, and
+        // the exact test decides.
+        let pad = DVec3::splat(1e-6 * scale);
         for (s, surf) in surfaces.iter().enumerate() {
             for (i, t) in surf.triangles.iter().enumerate() {
                 let p = t.map(|v| surf.positions[v as usize]);
                 boxes.push(broad::outward(
-                    p[0].min(p[1]).min(p[2]),
-                    p[0].max(p[1]).max(p[2]),
+                    p[0].min(p[1]).min(p[2]) - pad,
+                    p[0].max(p[1]).max(p[2]) + pad,
                 ));
                 tris.push((s as u32, i as u32));
             }
