@@ -128,13 +128,8 @@ fn render_sweep(scene: &Scene, slices: &[u32], out: &Path, quiet: bool) -> ExitC
         Ok(b) => b,
         Err(e) => return fail(&e),
     };
-    let surfaces = halo4d::pipeline::render_surfaces(&built.surfaces);
-    let halos = halo4d::pipeline::halo_inputs(&built.surfaces, &scene.halo);
-    let input = halo4d::render::RenderInput {
-        surfaces: &surfaces,
-        halos: &halos,
-        curves: &built.curves,
-    };
+    let parts = built.render_parts(&scene.halo);
+    let input = parts.input();
     let mut progress = |r: &halo4d::render::compare::Comparison| {
         if !quiet {
             eprintln!(

@@ -61,40 +61,56 @@ impl Built {
         sheets(&self.surfaces)
     }
 
-    /// The picture of the scene's `render` settings through its `camera`, or the given
-    /// ones.
+    /// The surfaces, halos (with the scene's `halo` parameters) and curves as the renderer
+    /// reads them.
+    pub fn render_parts(&self, halo: &HaloParams) -> RenderParts<'_> {
+        RenderParts {
+            surfaces: self
+                .surfaces
+                .iter()
+                .map(|p| RenderSurface {
+                    positions: &p.projected.positions,
+                    w: &p.projected.w,
+                    normals: &p.projected.normals,
+                    uv: &p.mesh.uv,
+                    triangles: &p.mesh.triangles,
+                })
+                .collect(),
+            halos: halo_inputs(&self.surfaces, halo),
+            curves: &self.curves,
+        }
+    }
+
+    /// The picture of the given settings (the scene's `render` and `camera`, usually).
     pub fn render(
         &self,
         halo: &HaloParams,
         settings: &RenderSettings,
         camera: &CameraSettings,
     ) -> Result<Picture, RenderError> {
-        let surfaces = render_surfaces(&self.surfaces);
-        let halos = halo_inputs(&self.surfaces, halo);
-        render::render(
-            &RenderInput {
-                surfaces: &surfaces,
-                halos: &halos,
-                curves: &self.curves,
-            },
-            settings,
-            camera,
-        )
+        render::render(&self.render_parts(halo).input(), settings, camera)
     }
 }
 
-/// The surfaces as the renderer reads them.
-pub fn render_surfaces(surfaces: &[SurfaceProduct]) -> Vec<RenderSurface<'_>> {
-    surfaces
-        .iter()
-        .map(|p| RenderSurface {
-            positions: &p.projected.positions,
-            w: &p.projected.w,
-            normals: &p.projected.normals,
-            uv: &p.mesh.uv,
-            triangles: &p.mesh.triangles,
-        })
-        .collect()
+/// A build's surfaces, halos and curves as the renderer reads them ([`Built::render_parts`]).
+pub struct RenderParts<'a> {
+    /// The surfaces.
+    pub surfaces: Vec<RenderSurface<'a>>,
+    /// Their halos.
+    pub halos: Vec<Option<HaloInput<'a>>>,
+    /// The curves.
+    pub curves: &'a Curves,
+}
+
+impl RenderParts<'_> {
+    /// The renderer's input.
+    pub fn input(&self) -> RenderInput<'_> {
+        RenderInput {
+            surfaces: &self.surfaces,
+            halos: &self.halos,
+            curves: self.curves,
+        }
+    }
 }
 
 fn sheets(surfaces: &[SurfaceProduct]) -> Vec<Sheet<'_>> {

@@ -4,9 +4,8 @@
 use crate::common::{fixture, fixture_scenes, halo4d};
 use glam::DVec3;
 use halo4d::Scene;
-use halo4d::pipeline::{halo_inputs, render_surfaces};
 use halo4d::render::camera::Camera;
-use halo4d::render::{Prober, RenderInput, RenderSettings, Seen};
+use halo4d::render::{Prober, RenderSettings, Seen};
 
 /// Small, fast settings for tests.
 fn small(scene: &mut Scene) {
@@ -104,17 +103,12 @@ impl Torus {
 
     /// What the picture shows at image points, with halos or without.
     fn probe(&self, halos: bool, points: &[[f64; 2]]) -> Vec<Option<Seen>> {
-        let surfaces = render_surfaces(&self.built.surfaces);
-        let halo = halo_inputs(&self.built.surfaces, &self.scene.halo);
+        let parts = self.built.render_parts(&self.scene.halo);
         let settings = RenderSettings {
             halos,
             ..self.scene.render
         };
-        let input = RenderInput {
-            surfaces: &surfaces,
-            halos: &halo,
-            curves: &self.built.curves,
-        };
+        let input = parts.input();
         let prober = Prober::new(&input, &settings, &self.scene.camera).unwrap();
         points.iter().map(|&p| prober.seen(p)).collect()
     }
@@ -126,13 +120,8 @@ fn along_a_crossing_the_sheet_nearer_in_w_is_drawn_and_the_farther_has_a_gap() {
     let cam = torus.camera();
     let (w, h) = (torus.scene.render.width, torus.scene.render.height);
     let products = &torus.built.surfaces;
-    let surfaces = render_surfaces(products);
-    let halo = halo_inputs(products, &torus.scene.halo);
-    let input = RenderInput {
-        surfaces: &surfaces,
-        halos: &halo,
-        curves: &torus.built.curves,
-    };
+    let parts = torus.built.render_parts(&torus.scene.halo);
+    let input = parts.input();
     let with = torus.scene.render;
     let without = RenderSettings {
         halos: false,
@@ -399,13 +388,8 @@ fn the_drawn_curves_lie_on_the_computed_curves_at_the_width_asked_for() {
     scene.render.silhouettes = false;
     scene.render.line_width = 4.0;
     let built = halo4d::run(&scene, true).unwrap();
-    let surfaces = render_surfaces(&built.surfaces);
-    let halos = halo_inputs(&built.surfaces, &scene.halo);
-    let input = RenderInput {
-        surfaces: &surfaces,
-        halos: &halos,
-        curves: &built.curves,
-    };
+    let parts = built.render_parts(&scene.halo);
+    let input = parts.input();
     let coverage = halo4d::render::line_coverage(&input, &scene.render, &scene.camera).unwrap();
     let cam = *Prober::new(&input, &scene.render, &scene.camera)
         .unwrap()
@@ -551,13 +535,8 @@ fn in_the_patches_of_paper_000_fig_1_the_nearer_patch_is_drawn_at_each_crossing(
     let mut scene = Scene::load(&fixture("scenes/patches.json")).unwrap();
     small(&mut scene);
     let built = halo4d::run(&scene, true).unwrap();
-    let surfaces = render_surfaces(&built.surfaces);
-    let halos = halo_inputs(&built.surfaces, &scene.halo);
-    let input = RenderInput {
-        surfaces: &surfaces,
-        halos: &halos,
-        curves: &built.curves,
-    };
+    let parts = built.render_parts(&scene.halo);
+    let input = parts.input();
     let without = RenderSettings {
         halos: false,
         ..scene.render
