@@ -295,12 +295,6 @@ impl<'a> HaloIndex<'a> {
         )
     }
 
-    /// Whether tetrahedron `g` belongs to the halo of a triangle sharing a vertex with the
-    /// triangle `own` of `surface` (a sheet's own halo, which never hides it).
-    pub(crate) fn is_own(&self, g: u32, surface: u32, own: &[u32; 3]) -> bool {
-        self.within(g, surface, own)
-    }
-
     /// Calls `f` with each tetrahedron whose box contains `x`, until it returns false.
     fn visit(&self, x: DVec3, mut f: impl FnMut(u32) -> bool) {
         self.bvh.aabb_traverse(broad::outward(x, x), |bvh, node| {
@@ -320,8 +314,9 @@ impl<'a> HaloIndex<'a> {
             .take_while(|&v| v != u32::MAX)
     }
 
-    /// Whether tetrahedron `g` is over a vertex of `ring` on `surface`.
-    fn within(&self, g: u32, surface: u32, ring: &[u32]) -> bool {
+    /// Whether tetrahedron `g` is over a vertex of `ring` on `surface` (with a triangle's
+    /// vertices: whether it belongs to the sheet's own halo there, which never hides it).
+    pub(crate) fn within(&self, g: u32, surface: u32, ring: &[u32]) -> bool {
         self.tets[g as usize].0 == surface && self.over(g).any(|v| ring.contains(&v))
     }
 
@@ -406,7 +401,7 @@ impl<'a> Index<'a> {
 
     /// The vertices of `face`: a tetrahedron over one of them belongs to the halo of a
     /// triangle that shares a vertex with `face`.
-    fn ring(&self, face: Face) -> [u32; 3] {
+    fn vertices(&self, face: Face) -> [u32; 3] {
         self.sheets[face.surface as usize].triangles[face.triangle as usize]
     }
 
@@ -436,7 +431,7 @@ impl<'a> Index<'a> {
         let near = usize::from(s.w[1] < s.w[0]);
         let far = 1 - near;
         let (fn_, ff) = (s.faces[near], s.faces[far]);
-        let (ring_near, ring_far) = (self.ring(fn_), self.ring(ff));
+        let (ring_near, ring_far) = (self.vertices(fn_), self.vertices(ff));
         let spread = |f: Face| {
             let sheet = &self.sheets[f.surface as usize];
             let w = sheet.triangles[f.triangle as usize].map(|k| sheet.w[k as usize]);
@@ -480,7 +475,7 @@ impl<'a> Index<'a> {
         v: &mut Verification,
     ) {
         v.surface_samples += 1;
-        let ring = self.ring(face);
+        let ring = self.vertices(face);
         let halos = &self.halos;
         let hiders = halos.hiders(x, w, (face.surface, &ring));
         if hiders.is_empty() {

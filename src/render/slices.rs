@@ -126,7 +126,7 @@ pub fn hidden(
                         for &pi in probes_here {
                             let p = &probes[pi as usize];
                             let (d, g) = image[p.pixel as usize];
-                            if d < p.w && !index.is_own(g, p.surface, &p.triangle) {
+                            if d < p.w && !index.within(g, p.surface, &p.triangle) {
                                 hidden.push(pi);
                             }
                         }
