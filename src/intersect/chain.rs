@@ -124,16 +124,18 @@ fn relabel(sheets: [u32; 2], node: Node, next: [u32; 2]) -> [u32; 2] {
 }
 
 fn point(soup: &Soup, node: Node, sheets: [u32; 2], face: &impl Fn(u32) -> Face) -> CurvePoint {
-    let (position, [w_edge, w_face], coplanar) = soup.place(node);
+    let placed = soup.place(node);
+    let [w_edge, w_face] = placed.w;
     let w = match node {
         Node::Crossing { face, .. } if sheets[0] == face => [w_face, w_edge],
         _ => [w_edge, w_face],
     };
     CurvePoint {
-        position,
+        position: placed.position,
         w,
         faces: sheets.map(face),
         node,
-        coplanar,
+        coplanar: placed.coplanar,
+        perturbed: placed.on_plane,
     }
 }

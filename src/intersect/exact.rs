@@ -195,13 +195,17 @@ impl Soup {
         })
     }
 
-    /// Where a node is and the w-depth of the sheet of its edge and of its face there (the
-    /// same for a vertex), and whether its edge lies in the face's plane (the point then
-    /// stands for a coplanar overlap and is placed in the middle of it).
-    pub fn place(&self, node: Node) -> (DVec3, [f64; 2], bool) {
+    /// Where a node is, the w-depth of the sheet of its edge and of its face there (the
+    /// same for a vertex), and how degenerate it is.
+    pub fn place(&self, node: Node) -> Placed {
         let p = &self.positions;
         match node {
-            Node::Vertex(v) => (p[v as usize], [self.w[v as usize]; 2], false),
+            Node::Vertex(v) => Placed {
+                position: p[v as usize],
+                w: [self.w[v as usize]; 2],
+                coplanar: false,
+                on_plane: false,
+            },
             Node::Crossing { edge, face } => {
                 let f = self.tris[face as usize].map(|v| p[v as usize]);
                 let (a, b) = (p[edge[0] as usize], p[edge[1] as usize]);
@@ -217,14 +221,15 @@ impl Soup {
                 let (wa, wb) = (self.w[edge[0] as usize], self.w[edge[1] as usize]);
                 let wf = self.tris[face as usize].map(|v| self.w[v as usize]);
                 let l = barycentric(x, f);
-                (
-                    x,
-                    [
+                Placed {
+                    position: x,
+                    w: [
                         wa + (wb - wa) * t,
                         l[0] * wf[0] + l[1] * wf[1] + l[2] * wf[2],
                     ],
                     coplanar,
-                )
+                    on_plane: oa == 0.0 || ob == 0.0,
+                }
             }
         }
     }
@@ -280,6 +285,20 @@ impl FilteredPlane {
             0
         }
     }
+}
+
+/// A node placed: [`Soup::place`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placed {
+    /// Where it is.
+    pub position: DVec3,
+    /// w of the sheet of its edge and of its face there.
+    pub w: [f64; 2],
+    /// Its edge lies in its face's plane (the point then stands for a coplanar overlap and
+    /// is placed in the middle of it).
+    pub coplanar: bool,
+    /// A vertex of its edge lies exactly in its face's plane: the perturbation decided it.
+    pub on_plane: bool,
 }
 
 fn crossing(p: u32, q: u32, face: u32) -> Node {
@@ -399,8 +418,9 @@ mod tests {
                 },
             ]
         );
-        let (x, _, coplanar) = s.place(ends[1]);
-        assert!(!coplanar && (x - DVec3::new(0.5, 0.5, 0.0)).length() < 1e-15);
+        let placed = s.place(ends[1]);
+        assert!(!placed.coplanar && !placed.on_plane);
+        assert!((placed.position - DVec3::new(0.5, 0.5, 0.0)).length() < 1e-15);
     }
 
     #[test]

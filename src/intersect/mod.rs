@@ -65,6 +65,9 @@ pub struct CurvePoint {
     /// The event's edge lies in its face's plane (a coplanar overlap decided by the
     /// perturbation; the point is placed in the middle of the overlap).
     pub coplanar: bool,
+    /// A vertex of the event's edge lies exactly in its face's plane: the perturbation
+    /// decided which side it is on.
+    pub perturbed: bool,
 }
 
 impl CurvePoint {
@@ -274,7 +277,7 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
         report.points += c.points.len();
         for p in &c.points {
             report.coplanar += usize::from(p.coplanar);
-            report.perturbed += usize::from(on_plane(&soup, p.node));
+            report.perturbed += usize::from(p.perturbed);
         }
         if c.closed {
             report.closed += 1;
@@ -344,18 +347,6 @@ fn merge(sheets: &[Sheet]) -> (Soup, Vec<u32>) {
     (soup, tri_start)
 }
 
-/// Whether an event had one of its edge's vertices exactly in its face's plane.
-fn on_plane(soup: &Soup, node: Node) -> bool {
-    match node {
-        Node::Vertex(_) => false,
-        Node::Crossing { edge, face } => {
-            let f = soup.tris[face as usize].map(|v| soup.positions[v as usize]);
-            edge.iter()
-                .any(|&v| sos::orient3d(f[0], f[1], f[2], soup.positions[v as usize]) == 0.0)
-        }
-    }
-}
-
 /// The edges with one triangle.
 struct BoundaryEdges(Vec<[u32; 2]>);
 
@@ -395,7 +386,7 @@ impl BoundaryEdges {
 fn triple_points(soup: &Soup, segments: &[Segment]) -> (usize, usize) {
     let places: Vec<[DVec3; 2]> = segments
         .iter()
-        .map(|s| s.ends.map(|n| soup.place(n).0))
+        .map(|s| s.ends.map(|n| soup.place(n).position))
         .collect();
     let mut by_tri: Vec<(u32, u32, u32)> = segments
         .iter()
