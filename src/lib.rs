@@ -24,6 +24,8 @@ pub mod sweep;
 pub mod tets;
 pub mod verify;
 pub mod view;
+#[cfg(feature = "viewer")]
+pub mod viewer;
 
 pub use error::Error;
 pub use pipeline::{Built, Report, build, run, write};

@@ -14,3 +14,5 @@ mod sample;
 mod scene;
 mod surfaces;
 mod view;
+#[cfg(feature = "viewer")]
+mod viewer;

@@ -1,7 +1,9 @@
 //! Halos and surfaces from `.glb`: the container, the JSON chunk (serde_json) and the
 //! accessors the meshes name, each bounds-checked against the BIN chunk before it is read.
 
-use super::{FileParams, ImportError, ImportedHalo, ImportedScene, ImportedSurface};
+use super::{
+    FileParams, ImportError, ImportedCurves, ImportedHalo, ImportedScene, ImportedSurface,
+};
 use crate::check::TetMesh;
 use glam::DVec3;
 use serde_json::Value;
@@ -115,7 +117,30 @@ pub fn read_scene_glb(bytes: &[u8]) -> Result<ImportedScene> {
         .pointer("/asset/extras/halo4d/scene/name")
         .and_then(Value::as_str)
         .map(String::from);
-    Ok(ImportedScene { name, surfaces })
+    let camera = json
+        .pointer("/asset/extras/halo4d/scene/camera")
+        .map(|c| {
+            serde_json::from_value(c.clone()).map_err(|e| {
+                glb_err(format!(
+                    "the scene camera recorded in asset.extras.halo4d.scene.camera is not valid: {e}"
+                ))
+            })
+        })
+        .transpose()?;
+    let curves = match meshes
+        .iter()
+        .enumerate()
+        .find(|(_, m)| extra(m, "curves").is_some())
+    {
+        Some((i, mesh)) => Some(doc.curves(i, mesh, mesh_name(mesh, i))?),
+        None => None,
+    };
+    Ok(ImportedScene {
+        name,
+        surfaces,
+        curves,
+        camera,
+    })
 }
 
 /// The JSON chunk parsed.
@@ -402,6 +427,15 @@ impl<'a> Doc<'a> {
             .into_iter()
             .map(f64::from)
             .collect();
+        let normals: Option<Vec<DVec3>> = match attributes.get("NORMAL") {
+            None => None,
+            Some(_) => Some(
+                self.floats(attribute("NORMAL")?, "VEC3", 3)?
+                    .chunks_exact(3)
+                    .map(|c| DVec3::new(c[0].into(), c[1].into(), c[2].into()))
+                    .collect(),
+            ),
+        };
         let indices = self.unsigned(index(
             primitive,
             "indices",
@@ -425,6 +459,17 @@ impl<'a> Doc<'a> {
         }
         if let Some(k) = w.iter().position(|x| !x.is_finite()) {
             return Err(bad(format!("_W of vertex {k} is not finite ({})", w[k])));
+        }
+        if let Some(normals) = &normals {
+            if normals.len() != nv {
+                return Err(bad(format!(
+                    "NORMAL has {} values for {nv} positions",
+                    normals.len()
+                )));
+            }
+            if let Some(k) = normals.iter().position(|n| !n.is_finite()) {
+                return Err(bad(format!("the normal of vertex {k} is not finite")));
+            }
         }
         if indices.len() % 3 != 0 {
             return Err(bad(format!(
@@ -454,7 +499,65 @@ impl<'a> Doc<'a> {
             positions,
             w,
             triangles,
+            normals,
             halo: None,
+        })
+    }
+
+    /// The curves of mesh `i` (extras `curves`): its first primitive's LINES with POSITION
+    /// and `_W`.
+    fn curves(&self, i: usize, mesh: &Value, name: String) -> Result<ImportedCurves> {
+        let what = format!("meshes[{i}] (`{name}`)");
+        let primitive = mesh
+            .get("primitives")
+            .and_then(|p| p.get(0))
+            .ok_or_else(|| glb_err(format!("{what} has no primitive")))?;
+        let mode = index(primitive, "mode", &format!("{what}.primitives[0]"), Some(4))?;
+        if mode != 1 {
+            return Err(glb_err(format!(
+                "{what} has primitives of mode {mode}, expected LINES (1)"
+            )));
+        }
+        let attributes = primitive
+            .get("attributes")
+            .ok_or_else(|| glb_err(format!("{what} has no attributes")))?;
+        let attribute = |key: &str| -> Result<u64> {
+            index(attributes, key, &format!("{what} attributes"), None)
+        };
+        let positions: Vec<DVec3> = self
+            .floats(attribute("POSITION")?, "VEC3", 3)?
+            .chunks_exact(3)
+            .map(|c| DVec3::new(c[0].into(), c[1].into(), c[2].into()))
+            .collect();
+        let w: Vec<f64> = self
+            .floats(attribute("_W")?, "SCALAR", 1)?
+            .into_iter()
+            .map(f64::from)
+            .collect();
+        let indices = self.unsigned(index(
+            primitive,
+            "indices",
+            &format!("{what}.primitives[0]"),
+            None,
+        )?)?;
+        let nv = positions.len();
+        let bad = |message: String| glb_err(format!("{what}: {message}"));
+        if w.len() != nv {
+            return Err(bad(format!("_W has {} values for {nv} positions", w.len())));
+        }
+        if positions.iter().any(|p| !p.is_finite()) || w.iter().any(|x| !x.is_finite()) {
+            return Err(bad("a curve point is not finite".into()));
+        }
+        if indices.len() % 2 != 0 || indices.iter().any(|&v| v as usize >= nv) {
+            return Err(bad(format!(
+                "{} line indices for {nv} points: not pairs of points in range",
+                indices.len()
+            )));
+        }
+        Ok(ImportedCurves {
+            positions,
+            w,
+            segments: indices.chunks_exact(2).map(|c| [c[0], c[1]]).collect(),
         })
     }
 

@@ -21,6 +21,7 @@ pub use vtk::read_vtk;
 
 use crate::check::TetMesh;
 use crate::intersect::{self, Curves, Sheet};
+use crate::render::CameraSettings;
 use crate::verify::{self, HaloInput, Verification};
 use glam::DVec3;
 use std::path::Path;
@@ -53,6 +54,8 @@ pub struct ImportedSurface {
     pub w: Vec<f64>,
     /// Triangles, none of which repeats a vertex.
     pub triangles: Vec<[u32; 3]>,
+    /// Unit normal of each vertex (`NORMAL`), when the file has them.
+    pub normals: Option<Vec<DVec3>>,
     /// Its halo, when the file has one: with t, d_orig, delta_d and delta_t, and as many
     /// surface vertices as the surface has vertices.
     pub halo: Option<ImportedHalo>,
@@ -65,6 +68,22 @@ pub struct ImportedScene {
     pub name: Option<String>,
     /// Its surfaces, in the file's order.
     pub surfaces: Vec<ImportedSurface>,
+    /// The intersection curves (the `curves` mesh), when the file has them.
+    pub curves: Option<ImportedCurves>,
+    /// The camera the scene was built with (`camera` of the scene recorded in the asset's
+    /// extras), when recorded.
+    pub camera: Option<CameraSettings>,
+}
+
+/// The intersection curves of a scene's `.glb`, as line segments.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ImportedCurves {
+    /// Curve points.
+    pub positions: Vec<DVec3>,
+    /// w of the nearer sheet at each point (`_W`).
+    pub w: Vec<f64>,
+    /// Segments between points.
+    pub segments: Vec<[u32; 2]>,
 }
 
 impl ImportedScene {

@@ -82,27 +82,33 @@ pub fn compare(
             .get(((diffs.len() as f64 * 0.99) as usize).min(diffs.len().saturating_sub(1)))
             .copied()
             .unwrap_or(0.0);
-        let (mut covered, mut differs) = (0usize, 0usize);
-        for (&a, &b) in exact_depth.iter().zip(&depth) {
-            if a.is_finite() || b.is_finite() {
-                covered += 1;
-                // The same surface point gives the same distance to rounding.
-                if !(a.is_finite() && b.is_finite() && (a - b).abs() <= 1e-9 * a.abs().max(1.0)) {
-                    differs += 1;
-                }
-            }
-        }
         let row = Comparison {
             slices: n,
             ms,
             mean_diff,
             p99_diff,
-            verdict_differs: differs as f64 / covered.max(1) as f64,
+            verdict_differs: verdict_differs(&exact_depth, &depth, 1e-9),
         };
         progress(&row);
         rows.push(row);
     }
     Ok(rows)
+}
+
+/// The share of covered pixels (finite in either) where the first visible surface differs:
+/// where the distances to it (infinite where none) differ by more than `tolerance` of the
+/// larger (or of 1).
+pub fn verdict_differs(exact: &[f64], other: &[f64], tolerance: f64) -> f64 {
+    let (mut covered, mut differs) = (0usize, 0usize);
+    for (&a, &b) in exact.iter().zip(other) {
+        if a.is_finite() || b.is_finite() {
+            covered += 1;
+            if !(a.is_finite() && b.is_finite() && (a - b).abs() <= tolerance * a.abs().max(1.0)) {
+                differs += 1;
+            }
+        }
+    }
+    differs as f64 / covered.max(1) as f64
 }
 
 /// The rows as CSV, with a header.

@@ -16,7 +16,16 @@ pub fn colormap(map: Colormap, s: f64) -> DVec3 {
     } else {
         0.5
     };
-    let stops: &[[f64; 3]] = match map {
+    let stops = stops(map);
+    let x = s * (stops.len() - 1) as f64;
+    let i = (x.floor() as usize).min(stops.len() - 2);
+    let f = x - i as f64;
+    DVec3::from(stops[i]).lerp(DVec3::from(stops[i + 1]), f)
+}
+
+/// The colours of `map`, nearest in w first, evenly spaced.
+pub(crate) fn stops(map: Colormap) -> &'static [[f64; 3]] {
+    match map {
         Colormap::Diverging => &[
             [0.23, 0.30, 0.75],
             [0.55, 0.65, 0.92],
@@ -35,11 +44,7 @@ pub fn colormap(map: Colormap, s: f64) -> DVec3 {
             [0.993, 0.906, 0.144],
         ],
         Colormap::Gray => &[[0.25, 0.25, 0.25], [0.9, 0.9, 0.9]],
-    };
-    let x = s * (stops.len() - 1) as f64;
-    let i = (x.floor() as usize).min(stops.len() - 2);
-    let f = x - i as f64;
-    DVec3::from(stops[i]).lerp(DVec3::from(stops[i + 1]), f)
+    }
 }
 
 /// Phong shading of a surface of colour `base` with unit normal `n` seen along unit `view`

@@ -1,0 +1,602 @@
+//! The wgpu viewer of exported scenes (`halo4d-view`, cargo feature `viewer`).
+//!
+//! Takes: a scene's `.glb` as `halo4d build` writes it ([`crate::import::read_scene_glb`]:
+//! surfaces with w, halo tetrahedra with t, d_orig and the eq. 3 parameters, curves). Gives:
+//! pictures on the GPU, in a window ([`window`]) or offscreen ([`screenshot`]), with the
+//! camera of [`crate::render`], so that the two renderers can be compared pixel for pixel.
+//!
+//! A surface fragment at x with depth w is hidden when the halo depth there (paper 000 eq. 3)
+//! is below w, by more than the sheet's own halo can be (see below). The halo depth comes
+//! from the tetrahedra sliced into N planes in one of two ways ([`HaloMode`]):
+//! - `grid` (the default): once per loaded asset and slice count, a compute pass writes the
+//!   smallest halo depth at the centre of every voxel of an N-voxel-wide grid over the scene
+//!   into a 3D texture. The halos of an exported asset depend on the 4D view, not on the
+//!   3D camera, so every camera angle reuses it; a fragment reads its nearest voxel.
+//! - `view`: paper 000's method, per frame: N planes perpendicular to the view; per plane,
+//!   the cut of every tetrahedron it crosses is drawn into a halo-depth image (the depth
+//!   test keeping the smallest), then the surface fragments between that plane's neighbours
+//!   are drawn against it, front slab first, sharing one depth buffer.
+//!
+//! A sheet's own halo: the CPU renderer leaves out the tetrahedra over the fragment's
+//! triangle's vertices. A halo-depth sample taken at a distance r from the fragment, in the
+//! sheet's own halo, holds d_orig of a surface point within r of it, so it can fall below w
+//! by at most |grad w| r. A fragment is therefore hidden only where the sample is below
+//! w - |grad w| r - 1e-6 of the w range, with r the largest distance from a point to its
+//! sample (half a voxel's diagonal, or half a slab). Other sheets' halos hide as in the CPU
+//! renderer except within that margin of where they start hiding.
+
+mod gpu;
+mod renderer;
+pub mod window;
+
+pub use gpu::Gpu;
+pub use renderer::{FrameTimes, Renderer};
+
+use crate::import::{ImportError, ImportedScene};
+use crate::render::camera::Camera;
+use crate::render::{CameraSettings, Colormap, RenderError};
+use glam::{DMat4, DVec3, DVec4};
+use std::path::Path;
+
+/// The most surface triangles the viewer loads.
+pub const MAX_TRIANGLES: usize = 4 << 20;
+/// The most halo tetrahedra the viewer loads.
+pub const MAX_TETRAHEDRA: usize = 16 << 20;
+/// The slice counts the viewer offers.
+pub const SLICE_COUNTS: [u32; 4] = [64, 128, 256, 512];
+
+/// How the halo depth is sliced.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum HaloMode {
+    /// Once per asset, into a 3D texture that every camera reuses.
+    #[default]
+    Grid,
+    /// Per frame, on planes perpendicular to the view (paper 000 section 4.6).
+    View,
+}
+
+impl HaloMode {
+    /// The mode's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            HaloMode::Grid => "grid",
+            HaloMode::View => "view",
+        }
+    }
+}
+
+/// What a frame shows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewSettings {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// The camera, as in a scene file.
+    pub camera: CameraSettings,
+    /// Slices of the halo depth (N planes, N voxels across the grid).
+    pub slices: u32,
+    /// How the halo depth is sliced.
+    pub mode: HaloMode,
+    /// Whether halos hide anything.
+    pub halos: bool,
+    /// Whether the curves are drawn.
+    pub curves: bool,
+    /// Whether surfaces are half transparent (composited in any order, weighted by depth).
+    pub transparent: bool,
+    /// Colour by w (else one grey).
+    pub colour_by_w: bool,
+    /// The colour scale of w.
+    pub colormap: Colormap,
+}
+
+impl Default for ViewSettings {
+    fn default() -> Self {
+        ViewSettings {
+            width: 1024,
+            height: 1024,
+            camera: CameraSettings::default(),
+            slices: 256,
+            mode: HaloMode::Grid,
+            halos: true,
+            curves: true,
+            transparent: false,
+            colour_by_w: true,
+            colormap: Colormap::Diverging,
+        }
+    }
+}
+
+impl ViewSettings {
+    /// Checks the settings, naming the one that is wrong.
+    pub fn check(&self) -> Result<(), ViewerError> {
+        let bad = |field: &str, message: String| {
+            Err(ViewerError::Setting {
+                field: field.into(),
+                message,
+            })
+        };
+        if !(1..=crate::render::MAX_SIDE).contains(&self.width)
+            || !(1..=crate::render::MAX_SIDE).contains(&self.height)
+        {
+            return bad(
+                "size",
+                format!(
+                    "{}x{} is not between 1x1 and {m}x{m}",
+                    self.width,
+                    self.height,
+                    m = crate::render::MAX_SIDE
+                ),
+            );
+        }
+        if !(2..=1024).contains(&self.slices) {
+            return bad(
+                "slices",
+                format!(
+                    "{} is not between 2 and 1024 (the viewer offers 64, 128, 256 and 512)",
+                    self.slices
+                ),
+            );
+        }
+        self.camera.check().map_err(|(f, m)| ViewerError::Setting {
+            field: format!("camera.{f}"),
+            message: m,
+        })
+    }
+}
+
+/// Why the viewer cannot show a file.
+#[derive(Debug, thiserror::Error)]
+pub enum ViewerError {
+    /// The file is not a scene `.glb` the viewer can read.
+    #[error("{path}: {source}")]
+    File {
+        /// The file.
+        path: String,
+        /// Why.
+        source: ImportError,
+    },
+    /// The scene is too large for the viewer or the GPU.
+    #[error(
+        "{what}: {count} is more than {limit}, {why}; build the scene at a coarser tolerance (sampling.tolerance) or with fewer surfaces"
+    )]
+    TooLarge {
+        /// What is counted.
+        what: String,
+        /// How many there are.
+        count: u64,
+        /// How many fit.
+        limit: u64,
+        /// Which limit.
+        why: String,
+    },
+    /// A setting is out of range.
+    #[error("{field}: {message}")]
+    Setting {
+        /// The setting.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// No GPU adapter, or no device from it.
+    #[error(
+        "no GPU: {0}. On Linux without a GPU, install a software Vulkan driver (Debian: apt-get install mesa-vulkan-drivers)"
+    )]
+    NoAdapter(String),
+    /// The GPU refused or lost the work.
+    #[error("the GPU failed: {0}")]
+    Gpu(String),
+    /// A camera cannot be placed.
+    #[error(transparent)]
+    Camera(#[from] RenderError),
+    /// An output could not be written.
+    #[error("cannot write {path}: {message}")]
+    Write {
+        /// The file.
+        path: String,
+        /// Why.
+        message: String,
+    },
+}
+
+/// A surface vertex as the GPU reads it (32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct SurfaceVertex {
+    /// Position relative to the scene's centre.
+    pub pos: [f32; 3],
+    /// w-depth.
+    pub w: f32,
+    /// Unit normal.
+    pub normal: [f32; 3],
+    /// The largest |grad w| of the triangles around the vertex.
+    pub slope: f32,
+}
+
+/// A halo vertex as the GPU reads it (32 bytes), with its halo's eq. 3 parameters.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct HaloVertex {
+    /// Position relative to the scene's centre.
+    pub pos: [f32; 3],
+    /// t.
+    pub t: f32,
+    /// d_orig.
+    pub d: f32,
+    /// delta_t of its halo.
+    pub delta_t: f32,
+    /// delta_d of its halo.
+    pub delta_d: f32,
+    /// Padding.
+    pub pad: f32,
+}
+
+/// A scene ready for the GPU: every surface, halo and curve in one set of arrays, positions
+/// relative to the centre of the surfaces' bounding box.
+#[derive(Clone, Debug)]
+pub struct Asset {
+    /// The scene's name.
+    pub name: String,
+    /// The camera recorded with the scene, if any.
+    pub camera: Option<CameraSettings>,
+    /// The surfaces' bounding box (absolute), as the CPU renderer computes it.
+    pub bounds: (DVec3, DVec3),
+    /// The range of w over the surfaces.
+    pub w_range: (f64, f64),
+    /// The range of halo depth (eq. 3) the tetrahedra can reach, with the surfaces' w.
+    pub depth_range: (f64, f64),
+    pub(crate) vertices: Vec<SurfaceVertex>,
+    pub(crate) triangles: Vec<[u32; 3]>,
+    pub(crate) halo_vertices: Vec<HaloVertex>,
+    pub(crate) tets: Vec<[u32; 4]>,
+    /// Curve points: position relative to the centre, and w.
+    pub(crate) curve_points: Vec<[f32; 4]>,
+    pub(crate) curve_segments: Vec<[u32; 2]>,
+    /// Surfaces without a halo, by name.
+    pub surfaces_without_halo: Vec<String>,
+}
+
+impl Asset {
+    /// Reads a scene's `.glb`.
+    pub fn load(path: &Path) -> Result<Asset, ViewerError> {
+        let file = |source: ImportError| ViewerError::File {
+            path: path.display().to_string(),
+            source,
+        };
+        let bytes = std::fs::read(path).map_err(|e| file(e.into()))?;
+        let scene = crate::import::read_scene_glb(&bytes).map_err(file)?;
+        let name = scene.name.clone().unwrap_or_else(|| {
+            path.file_stem()
+                .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned())
+        });
+        Asset::new(&scene, name)
+    }
+
+    /// Gathers an imported scene, checking its size against [`MAX_TRIANGLES`] and
+    /// [`MAX_TETRAHEDRA`].
+    pub fn new(scene: &ImportedScene, name: String) -> Result<Asset, ViewerError> {
+        let triangles: usize = scene.surfaces.iter().map(|s| s.triangles.len()).sum();
+        let tets: usize = scene
+            .surfaces
+            .iter()
+            .filter_map(|s| s.halo.as_ref())
+            .map(|h| h.mesh.tets.len())
+            .sum();
+        for (what, count, limit) in [
+            ("surface triangles", triangles, MAX_TRIANGLES),
+            ("halo tetrahedra", tets, MAX_TETRAHEDRA),
+        ] {
+            if count > limit {
+                return Err(ViewerError::TooLarge {
+                    what: format!("the scene's {what}"),
+                    count: count as u64,
+                    limit: limit as u64,
+                    why: "the most the viewer loads".into(),
+                });
+            }
+        }
+        let bounds = scene
+            .surfaces
+            .iter()
+            .flat_map(|s| {
+                s.triangles
+                    .iter()
+                    .flatten()
+                    .map(|&v| s.positions[v as usize])
+            })
+            .fold(None, |b: Option<(DVec3, DVec3)>, p| {
+                Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
+            })
+            .ok_or(ViewerError::Camera(RenderError::Empty))?;
+        let centre = (bounds.0 + bounds.1) * 0.5;
+        let rel = |p: DVec3| (p - centre).as_vec3().to_array();
+        let mut w_range = (f64::INFINITY, f64::NEG_INFINITY);
+        let mut vertices = Vec::new();
+        let mut all_triangles = Vec::with_capacity(triangles);
+        let mut halo_vertices = Vec::new();
+        let mut all_tets = Vec::with_capacity(tets);
+        let mut without = Vec::new();
+        let mut depth_hi = f64::NEG_INFINITY;
+        for s in &scene.surfaces {
+            let base = vertices.len() as u32;
+            for &w in &s.w {
+                w_range = (w_range.0.min(w), w_range.1.max(w));
+            }
+            let normals = s
+                .normals
+                .clone()
+                .unwrap_or_else(|| vertex_normals(&s.positions, &s.triangles));
+            let slopes = w_slopes(&s.positions, &s.w, &s.triangles);
+            for (i, &p) in s.positions.iter().enumerate() {
+                vertices.push(SurfaceVertex {
+                    pos: rel(p),
+                    w: s.w[i] as f32,
+                    normal: normals[i].as_vec3().to_array(),
+                    slope: slopes[i] as f32,
+                });
+            }
+            all_triangles.extend(s.triangles.iter().map(|t| t.map(|v| v + base)));
+            let Some(h) = &s.halo else {
+                without.push(s.name.clone());
+                continue;
+            };
+            let (Some(t), Some(d), Some(delta_t), Some(delta_d)) =
+                (&h.t, &h.d_orig, h.params.delta_t, h.params.delta_d)
+            else {
+                without.push(s.name.clone());
+                continue;
+            };
+            let base = halo_vertices.len() as u32;
+            for (i, p) in h.mesh.positions.iter().enumerate() {
+                halo_vertices.push(HaloVertex {
+                    pos: rel(DVec3::from(*p)),
+                    t: t[i] as f32,
+                    d: d[i] as f32,
+                    delta_t: delta_t as f32,
+                    delta_d: delta_d as f32,
+                    pad: 0.0,
+                });
+                depth_hi = depth_hi.max(d[i] + (1.0 - delta_t).max(0.0) * delta_d.max(0.0));
+            }
+            all_tets.extend(h.mesh.tets.iter().map(|k| k.map(|v| v + base)));
+        }
+        let curve_points = scene.curves.as_ref().map_or_else(Vec::new, |c| {
+            c.positions
+                .iter()
+                .zip(&c.w)
+                .map(|(&p, &w)| {
+                    let [x, y, z] = rel(p);
+                    [x, y, z, w as f32]
+                })
+                .collect()
+        });
+        let curve_segments = scene
+            .curves
+            .as_ref()
+            .map_or_else(Vec::new, |c| c.segments.clone());
+        let depth_lo = halo_vertices
+            .iter()
+            .map(|v| f64::from(v.d))
+            .fold(w_range.0, f64::min);
+        let depth_hi = depth_hi.max(w_range.1);
+        Ok(Asset {
+            name,
+            camera: scene.camera,
+            bounds,
+            w_range,
+            depth_range: (depth_lo, depth_hi),
+            vertices,
+            triangles: all_triangles,
+            halo_vertices,
+            tets: all_tets,
+            curve_points,
+            curve_segments,
+            surfaces_without_halo: without,
+        })
+    }
+
+    /// The centre of the bounding box (the origin of the GPU's coordinates).
+    pub fn centre(&self) -> DVec3 {
+        (self.bounds.0 + self.bounds.1) * 0.5
+    }
+
+    /// Surface triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Halo tetrahedra.
+    pub fn tet_count(&self) -> usize {
+        self.tets.len()
+    }
+}
+
+/// Area-weighted vertex normals, for files without `NORMAL`.
+fn vertex_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
+    let mut n = vec![DVec3::ZERO; positions.len()];
+    for t in triangles {
+        let p = t.map(|v| positions[v as usize]);
+        let a = (p[1] - p[0]).cross(p[2] - p[0]);
+        for &v in t {
+            n[v as usize] += a;
+        }
+    }
+    n.into_iter().map(|v| v.normalize_or_zero()).collect()
+}
+
+/// Per vertex, the largest |grad w| over the triangles around it (w linear on each).
+fn w_slopes(positions: &[DVec3], w: &[f64], triangles: &[[u32; 3]]) -> Vec<f64> {
+    let mut out = vec![0.0f64; positions.len()];
+    for t in triangles {
+        let [a, b, c] = t.map(|v| v as usize);
+        let (e1, e2) = (positions[b] - positions[a], positions[c] - positions[a]);
+        let (d1, d2) = (w[b] - w[a], w[c] - w[a]);
+        let area2 = e1.cross(e2).length_squared();
+        if area2 <= 0.0 {
+            continue;
+        }
+        let g2 = (d1 * d1 * e2.length_squared() - 2.0 * d1 * d2 * e1.dot(e2)
+            + d2 * d2 * e1.length_squared())
+            / area2;
+        let g = g2.max(0.0).sqrt();
+        if g.is_finite() {
+            for v in [a, b, c] {
+                out[v] = out[v].max(g);
+            }
+        }
+    }
+    out
+}
+
+/// The camera of `settings` as the GPU uses it: the CPU renderer's [`Camera`] with a clip
+/// matrix from coordinates relative to `centre`, and its near and far depths.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct GpuCamera {
+    pub cam: Camera,
+    /// Clip from centre-relative coordinates.
+    pub clip: DMat4,
+    /// Eye relative to the centre.
+    pub eye: DVec3,
+}
+
+impl GpuCamera {
+    pub fn new(settings: &ViewSettings, bounds: (DVec3, DVec3)) -> Result<GpuCamera, ViewerError> {
+        let cam = Camera::new(
+            &settings.camera,
+            bounds,
+            settings.width,
+            settings.height,
+            0.0,
+        )?;
+        let centre = (bounds.0 + bounds.1) * 0.5;
+        let radius = ((bounds.1 - bounds.0).length() * 0.5).max(f64::MIN_POSITIVE);
+        let eye = cam.eye - centre;
+        let dist = eye.length();
+        let sx = 1.0 / (cam.half_height * cam.aspect);
+        let sy = 1.0 / cam.half_height;
+        // Rows of the clip matrix acting on (p, 1), p relative to the centre.
+        let row = |axis: DVec3, scale: f64, add: f64| {
+            DVec4::new(axis.x, axis.y, axis.z, -axis.dot(eye)) * scale + DVec4::W * add
+        };
+        let far = dist + radius * 1.01;
+        let rows = match settings.camera.projection {
+            crate::render::CameraProjection::Perspective => {
+                let near = (dist - radius * 1.01).max(radius * 1e-3);
+                let a = far / (far - near);
+                [
+                    row(cam.right, sx, 0.0),
+                    row(cam.up, sy, 0.0),
+                    row(cam.forward, a, -near * a),
+                    row(cam.forward, 1.0, 0.0),
+                ]
+            }
+            crate::render::CameraProjection::Orthographic => {
+                let near = dist - radius * 1.01;
+                let a = 1.0 / (far - near);
+                [
+                    row(cam.right, sx, 0.0),
+                    row(cam.up, sy, 0.0),
+                    row(cam.forward, a, -near * a),
+                    DVec4::W,
+                ]
+            }
+        };
+        let clip = DMat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose();
+        Ok(GpuCamera { cam, clip, eye })
+    }
+}
+
+/// A rendered picture with, per pixel, the distance along the camera ray to the first
+/// visible surface (infinite where none), as [`crate::render::render_with_depth`] reports.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    /// The picture.
+    pub picture: crate::render::Picture,
+    /// Distances, row-major from the top.
+    pub distance: Vec<f32>,
+    /// What the frame cost.
+    pub times: FrameTimes,
+}
+
+/// Renders one frame offscreen (no window, no display).
+pub fn screenshot(gpu: &Gpu, asset: &Asset, settings: &ViewSettings) -> Result<Frame, ViewerError> {
+    settings.check()?;
+    let mut renderer = Renderer::new(gpu, asset, renderer::OFFSCREEN_FORMAT)?;
+    renderer.read_frame(gpu, settings)
+}
+
+/// One line of [`bench`]: a mode and slice count over a fixed orbit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BenchRow {
+    /// How the halo depth was sliced.
+    pub mode: HaloMode,
+    /// Slices.
+    pub slices: u32,
+    /// Building the grid (grid mode), once before the orbit.
+    pub grid_ms: Option<f64>,
+    /// Frames rendered.
+    pub frames: u32,
+    /// Mean milliseconds per frame, from the first command to the GPU finishing it.
+    pub mean_ms: f64,
+    /// Median milliseconds per frame.
+    pub median_ms: f64,
+}
+
+/// Renders `frames` frames on a full orbit (azimuth in equal steps from the settings') for
+/// each mode and each of `slices`, after one frame that is not counted, offscreen.
+/// `progress` hears of each row.
+pub fn bench(
+    gpu: &Gpu,
+    asset: &Asset,
+    settings: &ViewSettings,
+    slices: &[u32],
+    frames: u32,
+    progress: &mut dyn FnMut(&BenchRow),
+) -> Result<Vec<BenchRow>, ViewerError> {
+    settings.check()?;
+    let mut renderer = Renderer::new(gpu, asset, renderer::OFFSCREEN_FORMAT)?;
+    let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("bench frame"),
+        size: wgpu::Extent3d {
+            width: settings.width,
+            height: settings.height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: renderer::OFFSCREEN_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    });
+    let view = target.create_view(&Default::default());
+    let mut rows = Vec::new();
+    for mode in [HaloMode::Grid, HaloMode::View] {
+        for &n in slices {
+            let mut s = ViewSettings {
+                mode,
+                slices: n,
+                ..*settings
+            };
+            let grid_ms = renderer.render(gpu, &view, &s)?.grid_ms;
+            let mut times = Vec::with_capacity(frames as usize);
+            for f in 0..frames {
+                s.camera.azimuth =
+                    settings.camera.azimuth + 360.0 * f64::from(f) / f64::from(frames);
+                times.push(renderer.render(gpu, &view, &s)?.frame_ms);
+            }
+            times.sort_by(f64::total_cmp);
+            let row = BenchRow {
+                mode,
+                slices: n,
+                grid_ms,
+                frames,
+                mean_ms: times.iter().sum::<f64>() / times.len().max(1) as f64,
+                median_ms: times.get(times.len() / 2).copied().unwrap_or(0.0),
+            };
+            progress(&row);
+            rows.push(row);
+        }
+    }
+    Ok(rows)
+}

@@ -1,0 +1,1090 @@
+//! Pipelines, targets and the passes of a frame.
+
+use super::{Asset, Frame, Gpu, GpuCamera, HaloMode, ViewSettings, ViewerError};
+use crate::render::{Picture, shade};
+use bytemuck::{Pod, Zeroable};
+use glam::DVec3;
+use std::time::Instant;
+use wgpu::util::DeviceExt;
+
+/// The colour format of offscreen frames (linear colour written as sRGB, as the CPU
+/// renderer's PNGs are).
+pub(crate) const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+const DISTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+const ACCUM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+const REVEAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
+/// Opacity of a surface face-on in transparent mode.
+const OPACITY: f32 = 0.45;
+
+/// The uniform block `View` of `viewer.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ViewUniform {
+    clip: [[f32; 4]; 4],
+    eye: [f32; 4],
+    forward: [f32; 4],
+    right: [f32; 4],
+    up: [f32; 4],
+    background: [f32; 4],
+    w_norm: [f32; 4],
+    depth_norm: [f32; 4],
+    grid_lo: [f32; 4],
+    slabs: [f32; 4],
+    grid_dims: [u32; 4],
+    options: [u32; 4],
+    stops: [[f32; 4]; 8],
+}
+
+/// What a frame cost, in milliseconds of wall time.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameTimes {
+    /// Building the halo-depth grid, when this frame built it.
+    pub grid_ms: Option<f64>,
+    /// Preparing the frame on the CPU (the view mode's slab lists).
+    pub prepare_ms: f64,
+    /// From the first command to the GPU finishing the frame.
+    pub frame_ms: f64,
+}
+
+/// The halo-depth grid of one slice count.
+struct Grid {
+    slices: u32,
+    /// Low corner (relative to the centre) and voxel size.
+    lo: DVec3,
+    voxel: f64,
+    dims: [u32; 3],
+    view: wgpu::TextureView,
+}
+
+/// Render targets of one size.
+struct Targets {
+    size: (u32, u32),
+    distance: wgpu::Texture,
+    distance_view: wgpu::TextureView,
+    depth_view: wgpu::TextureView,
+    halo_view: wgpu::TextureView,
+    accum_view: wgpu::TextureView,
+    reveal_view: wgpu::TextureView,
+}
+
+/// Draws an [`Asset`]: its buffers on the GPU and the pipelines that draw them.
+pub struct Renderer {
+    asset: Asset,
+    colour_format: wgpu::TextureFormat,
+    uniform: wgpu::Buffer,
+    vertices: wgpu::Buffer,
+    triangles: wgpu::Buffer,
+    curve_points: wgpu::Buffer,
+    curve_segments: wgpu::Buffer,
+    halo_vertices: wgpu::Buffer,
+    tets: wgpu::Buffer,
+    /// The view mode's per-frame lists: triangle indices and (tetrahedron, slab) items.
+    slab_triangles: Option<wgpu::Buffer>,
+    slab_items: Option<wgpu::Buffer>,
+    surface_grid: wgpu::RenderPipeline,
+    surface_view: wgpu::RenderPipeline,
+    surface_grid_blend: wgpu::RenderPipeline,
+    surface_view_blend: wgpu::RenderPipeline,
+    composite: wgpu::RenderPipeline,
+    curves: wgpu::RenderPipeline,
+    cut: wgpu::RenderPipeline,
+    voxelize: wgpu::ComputePipeline,
+    empty_grid: wgpu::TextureView,
+    grid: Option<Grid>,
+    targets: Option<Targets>,
+}
+
+impl Renderer {
+    /// Uploads `asset` and builds the pipelines, drawing into `colour_format`.
+    pub fn new(
+        gpu: &Gpu,
+        asset: &Asset,
+        colour_format: wgpu::TextureFormat,
+    ) -> Result<Renderer, ViewerError> {
+        use wgpu::BufferUsages as U;
+        let device = &gpu.device;
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let storage = U::STORAGE;
+        let vertices = gpu.buffer(
+            "surface vertices",
+            bytemuck::cast_slice(&asset.vertices),
+            storage,
+        )?;
+        let triangles = gpu.buffer(
+            "surface triangles",
+            bytemuck::cast_slice(&asset.triangles),
+            U::INDEX,
+        )?;
+        let curve_points = gpu.buffer(
+            "curve points",
+            bytemuck::cast_slice(&asset.curve_points),
+            storage,
+        )?;
+        let curve_segments = gpu.buffer(
+            "curve segments",
+            bytemuck::cast_slice(&asset.curve_segments),
+            U::INDEX,
+        )?;
+        let halo_vertices = gpu.buffer(
+            "halo vertices",
+            bytemuck::cast_slice(&asset.halo_vertices),
+            storage,
+        )?;
+        let tets = gpu.buffer(
+            "halo tetrahedra",
+            bytemuck::cast_slice(&asset.tets),
+            storage,
+        )?;
+        let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("view"),
+            contents: bytemuck::bytes_of(&ViewUniform::zeroed()),
+            usage: U::UNIFORM | U::COPY_DST,
+        });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("viewer.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("viewer.wgsl").into()),
+        });
+        let opaque_targets = |distance: bool| {
+            [
+                Some(wgpu::ColorTargetState {
+                    format: colour_format,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                }),
+                Some(wgpu::ColorTargetState {
+                    format: DISTANCE_FORMAT,
+                    blend: None,
+                    write_mask: if distance {
+                        wgpu::ColorWrites::ALL
+                    } else {
+                        wgpu::ColorWrites::empty()
+                    },
+                }),
+            ]
+        };
+        let depth = |write: bool, compare: wgpu::CompareFunction| {
+            Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(write),
+                depth_compare: Some(compare),
+                stencil: Default::default(),
+                bias: Default::default(),
+            })
+        };
+        let blend_targets = [
+            Some(wgpu::ColorTargetState {
+                format: ACCUM_FORMAT,
+                blend: Some(wgpu::BlendState {
+                    color: wgpu::BlendComponent {
+                        src_factor: wgpu::BlendFactor::One,
+                        dst_factor: wgpu::BlendFactor::One,
+                        operation: wgpu::BlendOperation::Add,
+                    },
+                    alpha: wgpu::BlendComponent {
+                        src_factor: wgpu::BlendFactor::One,
+                        dst_factor: wgpu::BlendFactor::One,
+                        operation: wgpu::BlendOperation::Add,
+                    },
+                }),
+                write_mask: wgpu::ColorWrites::ALL,
+            }),
+            Some(wgpu::ColorTargetState {
+                format: REVEAL_FORMAT,
+                blend: Some(wgpu::BlendState {
+                    color: wgpu::BlendComponent {
+                        src_factor: wgpu::BlendFactor::Zero,
+                        dst_factor: wgpu::BlendFactor::OneMinusSrc,
+                        operation: wgpu::BlendOperation::Add,
+                    },
+                    alpha: wgpu::BlendComponent::REPLACE,
+                }),
+                write_mask: wgpu::ColorWrites::ALL,
+            }),
+        ];
+        let pipeline = |label: &str,
+                        vs: &str,
+                        fs: &str,
+                        topology: wgpu::PrimitiveTopology,
+                        targets: &[Option<wgpu::ColorTargetState>],
+                        depth_stencil: Option<wgpu::DepthStencilState>| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: None,
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some(vs),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology,
+                    ..Default::default()
+                },
+                depth_stencil,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(fs),
+                    compilation_options: Default::default(),
+                    targets,
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        use wgpu::CompareFunction as C;
+        use wgpu::PrimitiveTopology as P;
+        let surface_grid = pipeline(
+            "surfaces (grid)",
+            "surface_vs",
+            "surface_grid_fs",
+            P::TriangleList,
+            &opaque_targets(true),
+            depth(true, C::Less),
+        );
+        let surface_view = pipeline(
+            "surfaces (view slices)",
+            "surface_vs",
+            "surface_view_fs",
+            P::TriangleList,
+            &opaque_targets(true),
+            depth(true, C::Less),
+        );
+        let surface_grid_blend = pipeline(
+            "transparent surfaces (grid)",
+            "surface_vs",
+            "surface_grid_blend_fs",
+            P::TriangleList,
+            &blend_targets,
+            None,
+        );
+        let surface_view_blend = pipeline(
+            "transparent surfaces (view slices)",
+            "surface_vs",
+            "surface_view_blend_fs",
+            P::TriangleList,
+            &blend_targets,
+            None,
+        );
+        let composite = pipeline(
+            "transparency composite",
+            "composite_vs",
+            "composite_fs",
+            P::TriangleList,
+            &opaque_targets(false),
+            depth(false, C::Always),
+        );
+        let curves = pipeline(
+            "curves",
+            "curve_vs",
+            "curve_fs",
+            P::LineList,
+            &opaque_targets(false),
+            depth(false, C::LessEqual),
+        );
+        let cut = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("halo cuts"),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("cut_vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: depth(true, C::Less),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("cut_fs"),
+                compilation_options: Default::default(),
+                targets: &[],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let voxelize = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("voxelize"),
+            layout: None,
+            module: &module,
+            entry_point: Some("voxelize"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let empty_grid = device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("no grid"),
+                size: wgpu::Extent3d {
+                    width: 1,
+                    height: 1,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D3,
+                format: wgpu::TextureFormat::R32Uint,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+            .create_view(&Default::default());
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(ViewerError::Gpu(e.to_string()));
+        }
+        gpu.take_errors()?;
+        Ok(Renderer {
+            asset: asset.clone(),
+            colour_format,
+            uniform,
+            vertices,
+            triangles,
+            curve_points,
+            curve_segments,
+            halo_vertices,
+            tets,
+            slab_triangles: None,
+            slab_items: None,
+            surface_grid,
+            surface_view,
+            surface_grid_blend,
+            surface_view_blend,
+            composite,
+            curves,
+            cut,
+            voxelize,
+            empty_grid,
+            grid: None,
+            targets: None,
+        })
+    }
+
+    /// The asset drawn.
+    pub fn asset(&self) -> &Asset {
+        &self.asset
+    }
+
+    /// Renders one frame into `target` (a view of a texture of `colour_format`, of the
+    /// settings' size) and waits for the GPU to finish it.
+    pub fn render(
+        &mut self,
+        gpu: &Gpu,
+        target: &wgpu::TextureView,
+        settings: &ViewSettings,
+    ) -> Result<FrameTimes, ViewerError> {
+        settings.check()?;
+        let start = Instant::now();
+        let mut times = FrameTimes::default();
+        let halos = settings.halos && !self.asset.tets.is_empty();
+        if halos
+            && settings.mode == HaloMode::Grid
+            && self
+                .grid
+                .as_ref()
+                .is_none_or(|g| g.slices != settings.slices)
+        {
+            let t = Instant::now();
+            self.grid = None;
+            self.grid = Some(self.build_grid(gpu, settings.slices)?);
+            times.grid_ms = Some(t.elapsed().as_secs_f64() * 1e3);
+        }
+        let prepare = Instant::now();
+        self.ensure_targets(gpu, (settings.width, settings.height));
+        let camera = GpuCamera::new(settings, self.asset.bounds)?;
+        let slabs = self.slabs(&camera, settings.slices);
+        let uniform = self.uniform(&camera, settings, halos, slabs);
+        gpu.queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+        let lists = (settings.mode == HaloMode::View)
+            .then(|| self.slab_lists(gpu, &camera, slabs, halos))
+            .transpose()?;
+        times.prepare_ms = prepare.elapsed().as_secs_f64() * 1e3;
+
+        let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let targets = self.targets.as_ref().expect("targets made above");
+        let triangle_count = self.asset.triangles.len() as u32 * 3;
+        match &lists {
+            None => {
+                let (pipeline, grid) = if settings.transparent {
+                    (&self.surface_grid_blend, self.grid_view())
+                } else {
+                    (&self.surface_grid, self.grid_view())
+                };
+                let bind = self.bind(
+                    gpu,
+                    pipeline.get_bind_group_layout(0),
+                    &[
+                        (1, self.vertices.as_entire_binding()),
+                        (2, wgpu::BindingResource::TextureView(grid)),
+                    ],
+                );
+                let mut pass = if settings.transparent {
+                    blend_pass(&mut encoder, targets, true)
+                } else {
+                    opaque_pass(&mut encoder, target, targets, true, settings)
+                };
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, &bind, &[]);
+                pass.set_index_buffer(self.triangles.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..triangle_count, 0, 0..1);
+            }
+            Some(lists) => {
+                let pipeline = if settings.transparent {
+                    &self.surface_view_blend
+                } else {
+                    &self.surface_view
+                };
+                let surface_bind = self.bind(
+                    gpu,
+                    pipeline.get_bind_group_layout(0),
+                    &[
+                        (1, self.vertices.as_entire_binding()),
+                        (3, wgpu::BindingResource::TextureView(&targets.halo_view)),
+                    ],
+                );
+                let cut_bind = self.bind(
+                    gpu,
+                    self.cut.get_bind_group_layout(0),
+                    &[
+                        (5, self.halo_vertices.as_entire_binding()),
+                        (6, self.tets.as_entire_binding()),
+                        (
+                            7,
+                            self.slab_items
+                                .as_ref()
+                                .expect("slab lists made above")
+                                .as_entire_binding(),
+                        ),
+                    ],
+                );
+                let indices = self.slab_triangles.as_ref().expect("slab lists made above");
+                let mut first = true;
+                for k in 0..settings.slices as usize {
+                    let tris = lists.triangles[k]..lists.triangles[k + 1];
+                    if tris.is_empty() && !first {
+                        continue;
+                    }
+                    {
+                        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                            label: Some("halo cut"),
+                            color_attachments: &[],
+                            depth_stencil_attachment: Some(
+                                wgpu::RenderPassDepthStencilAttachment {
+                                    view: &targets.halo_view,
+                                    depth_ops: Some(wgpu::Operations {
+                                        load: wgpu::LoadOp::Clear(1.0),
+                                        store: wgpu::StoreOp::Store,
+                                    }),
+                                    stencil_ops: None,
+                                },
+                            ),
+                            ..Default::default()
+                        });
+                        let items = lists.items[k]..lists.items[k + 1];
+                        if !items.is_empty() {
+                            pass.set_pipeline(&self.cut);
+                            pass.set_bind_group(0, &cut_bind, &[]);
+                            pass.draw(0..6, items);
+                        }
+                    }
+                    let mut pass = if settings.transparent {
+                        blend_pass(&mut encoder, targets, first)
+                    } else {
+                        opaque_pass(&mut encoder, target, targets, first, settings)
+                    };
+                    first = false;
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, &surface_bind, &[]);
+                    pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
+                    pass.draw_indexed(tris, 0, k as u32..k as u32 + 1);
+                }
+            }
+        }
+        // The transparency composite, then the curves.
+        let composite = settings.transparent;
+        let curves = settings.curves && !self.asset.curve_segments.is_empty();
+        if composite || curves {
+            let mut pass = if composite {
+                opaque_pass(&mut encoder, target, targets, true, settings)
+            } else {
+                opaque_pass(&mut encoder, target, targets, false, settings)
+            };
+            if composite {
+                let bind = self.bind(
+                    gpu,
+                    self.composite.get_bind_group_layout(0),
+                    &[
+                        (9, wgpu::BindingResource::TextureView(&targets.accum_view)),
+                        (10, wgpu::BindingResource::TextureView(&targets.reveal_view)),
+                    ],
+                );
+                pass.set_pipeline(&self.composite);
+                pass.set_bind_group(0, &bind, &[]);
+                pass.draw(0..3, 0..1);
+            }
+            if curves {
+                let bind = self.bind(
+                    gpu,
+                    self.curves.get_bind_group_layout(0),
+                    &[(4, self.curve_points.as_entire_binding())],
+                );
+                pass.set_pipeline(&self.curves);
+                pass.set_bind_group(0, &bind, &[]);
+                pass.set_index_buffer(self.curve_segments.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..self.asset.curve_segments.len() as u32 * 2, 0, 0..1);
+            }
+        }
+        gpu.queue.submit([encoder.finish()]);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(ViewerError::Gpu(e.to_string()));
+        }
+        gpu.finish()?;
+        times.frame_ms = start.elapsed().as_secs_f64() * 1e3 - times.grid_ms.unwrap_or(0.0);
+        Ok(times)
+    }
+
+    /// Renders one frame offscreen and reads it back with its distances.
+    pub fn read_frame(&mut self, gpu: &Gpu, settings: &ViewSettings) -> Result<Frame, ViewerError> {
+        settings.check()?;
+        let colour = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("frame"),
+            size: wgpu::Extent3d {
+                width: settings.width,
+                height: settings.height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: self.colour_format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let times = self.render(gpu, &colour.create_view(&Default::default()), settings)?;
+        let texels = gpu.read_texture(&colour)?;
+        let bgra = matches!(
+            self.colour_format,
+            wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+        );
+        let rgb = texels
+            .iter()
+            .flat_map(|c| {
+                if bgra {
+                    [c[2], c[1], c[0]]
+                } else {
+                    [c[0], c[1], c[2]]
+                }
+            })
+            .collect();
+        let targets = self.targets.as_ref().expect("targets made by render");
+        let distance = gpu
+            .read_texture(&targets.distance)?
+            .into_iter()
+            .map(|b| {
+                let d = f32::from_le_bytes(b);
+                if d >= 0.0 { d } else { f32::INFINITY }
+            })
+            .collect();
+        Ok(Frame {
+            picture: Picture {
+                width: settings.width,
+                height: settings.height,
+                rgb,
+            },
+            distance,
+            times,
+        })
+    }
+
+    /// The grid's 3D texture, or a 1-voxel stand-in.
+    fn grid_view(&self) -> &wgpu::TextureView {
+        self.grid.as_ref().map_or(&self.empty_grid, |g| &g.view)
+    }
+
+    /// A bind group for `layout` with the view uniform at binding 0 and `entries`.
+    fn bind(
+        &self,
+        gpu: &Gpu,
+        layout: wgpu::BindGroupLayout,
+        entries: &[(u32, wgpu::BindingResource)],
+    ) -> wgpu::BindGroup {
+        let mut all = vec![wgpu::BindGroupEntry {
+            binding: 0,
+            resource: self.uniform.as_entire_binding(),
+        }];
+        all.extend(
+            entries
+                .iter()
+                .map(|(binding, resource)| wgpu::BindGroupEntry {
+                    binding: *binding,
+                    resource: resource.clone(),
+                }),
+        );
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &layout,
+            entries: &all,
+        })
+    }
+
+    /// Render targets of `size`, made when the size changes.
+    fn ensure_targets(&mut self, gpu: &Gpu, size: (u32, u32)) {
+        if self.targets.as_ref().is_some_and(|t| t.size == size) {
+            return;
+        }
+        let texture = |label: &str, format: wgpu::TextureFormat, extra: wgpu::TextureUsages| {
+            gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: size.0,
+                    height: size.1,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | extra,
+                view_formats: &[],
+            })
+        };
+        use wgpu::TextureUsages as T;
+        let distance = texture("distance", DISTANCE_FORMAT, T::COPY_SRC);
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        self.targets = Some(Targets {
+            size,
+            distance_view: view(&distance),
+            distance,
+            depth_view: view(&texture("depth", DEPTH_FORMAT, T::empty())),
+            halo_view: view(&texture("halo depth", DEPTH_FORMAT, T::TEXTURE_BINDING)),
+            accum_view: view(&texture("accumulated", ACCUM_FORMAT, T::TEXTURE_BINDING)),
+            reveal_view: view(&texture("revealage", REVEAL_FORMAT, T::TEXTURE_BINDING)),
+        });
+    }
+
+    /// The planes of the view mode: the near side of the first slab and the slab thickness,
+    /// spanning the bounding sphere as the CPU renderer's slice mode does.
+    fn slabs(&self, camera: &GpuCamera, slices: u32) -> (f64, f64) {
+        let (lo, hi) = self.asset.bounds;
+        let radius = ((hi - lo).length() * 0.5).max(f64::MIN_POSITIVE);
+        let centre_depth = (-camera.eye).dot(camera.cam.forward);
+        (centre_depth - radius, 2.0 * radius / f64::from(slices))
+    }
+
+    fn uniform(
+        &self,
+        camera: &GpuCamera,
+        settings: &ViewSettings,
+        halos: bool,
+        (near, step): (f64, f64),
+    ) -> ViewUniform {
+        let cam = &camera.cam;
+        let v4 = |v: DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
+        let (w0, w1) = self.asset.w_range;
+        let span = if w1 > w0 { w1 - w0 } else { 1.0 };
+        let (d0, d1) = self.asset.depth_range;
+        let depth_scale = 1.0 / (d1 - d0).max(f64::MIN_POSITIVE) * 0.999;
+        let stops = shade::stops(settings.colormap);
+        let mut stop_array = [[0.0f32; 4]; 8];
+        for (slot, s) in stop_array.iter_mut().zip(stops) {
+            *slot = [s[0] as f32, s[1] as f32, s[2] as f32, 1.0];
+        }
+        let (grid_lo, grid_voxel, dims) = self
+            .grid
+            .as_ref()
+            .map_or((DVec3::ZERO, 1.0, [0; 3]), |g| (g.lo, g.voxel, g.dims));
+        // A ray through a slab crosses at most this much more than its thickness.
+        let obliquity = match settings.camera.projection {
+            crate::render::CameraProjection::Perspective => {
+                (1.0 + cam.half_height.powi(2) * (1.0 + cam.aspect.powi(2))).sqrt()
+            }
+            crate::render::CameraProjection::Orthographic => 1.0,
+        };
+        let flags = u32::from(halos) | (u32::from(settings.colour_by_w) << 1);
+        ViewUniform {
+            clip: camera.clip.as_mat4().to_cols_array_2d(),
+            eye: v4(
+                camera.eye,
+                f64::from(u8::from(
+                    settings.camera.projection == crate::render::CameraProjection::Perspective,
+                )),
+            ),
+            forward: v4(cam.forward, 0.0),
+            right: v4(cam.right, 0.0),
+            up: v4(cam.up, 0.0),
+            background: [1.0, 1.0, 1.0, OPACITY],
+            w_norm: [w0 as f32, (1.0 / span) as f32, 0.0, 0.0],
+            depth_norm: [
+                d0 as f32,
+                depth_scale as f32,
+                (grid_voxel * 3f64.sqrt() * 0.5) as f32,
+                (step * 0.5 * obliquity) as f32,
+            ],
+            grid_lo: v4(grid_lo, grid_voxel),
+            slabs: [
+                near as f32,
+                step as f32,
+                settings.slices as f32,
+                (step * f64::from(settings.slices)) as f32,
+            ],
+            grid_dims: [dims[0], dims[1], dims[2], dims[0].next_multiple_of(64)],
+            options: [flags, stops.len() as u32, 0, 0],
+            stops: stop_array,
+        }
+    }
+
+    /// Builds the halo-depth grid: `slices` voxels across the halos' longest side.
+    fn build_grid(&mut self, gpu: &Gpu, slices: u32) -> Result<Grid, ViewerError> {
+        let (lo, hi) = self
+            .asset
+            .halo_vertices
+            .iter()
+            .map(|v| DVec3::from(v.pos.map(f64::from)))
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p), hi.max(p))
+            });
+        let side = (hi - lo).max_element().max(f64::MIN_POSITIVE);
+        let voxel = side / f64::from(slices);
+        let dims = ((hi - lo) / voxel)
+            .ceil()
+            .max(DVec3::ONE)
+            .as_uvec3()
+            .min(glam::UVec3::splat(slices))
+            .to_array();
+        let row = dims[0].next_multiple_of(64);
+        let bytes = u64::from(row) * u64::from(dims[1]) * u64::from(dims[2]) * 4;
+        let usage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
+        gpu.fits(
+            &format!("the halo-depth grid of {slices} slices"),
+            bytes,
+            usage,
+        )?;
+        // Work items: (tetrahedron, z layer) for every layer of voxel centres its box spans.
+        let mut items: Vec<[u32; 2]> = Vec::new();
+        for (i, k) in self.asset.tets.iter().enumerate() {
+            let z = k.map(|v| f64::from(self.asset.halo_vertices[v as usize].pos[2]));
+            let (z0, z1) = (
+                z.iter().copied().fold(f64::INFINITY, f64::min),
+                z.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            );
+            let first = ((z0 - lo.z) / voxel - 0.5).ceil().max(0.0) as u32;
+            let last = ((z1 - lo.z) / voxel - 0.5)
+                .floor()
+                .min(f64::from(dims[2]) - 1.0);
+            if last < 0.0 {
+                continue;
+            }
+            items.extend((first..=last as u32).map(|layer| [i as u32, layer]));
+        }
+        let item_buffer = gpu.buffer(
+            "voxelization items",
+            bytemuck::cast_slice(&items),
+            wgpu::BufferUsages::STORAGE,
+        )?;
+        let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let grid_buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("halo-depth grid"),
+            size: bytes,
+            usage,
+            mapped_at_creation: false,
+        });
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("halo-depth grid"),
+            size: wgpu::Extent3d {
+                width: dims[0],
+                height: dims[1],
+                depth_or_array_layers: dims[2],
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format: wgpu::TextureFormat::R32Uint,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let grid = Grid {
+            slices,
+            lo,
+            voxel,
+            dims,
+            view: texture.create_view(&Default::default()),
+        };
+        // The uniform carries the grid's placement.
+        self.grid = Some(grid);
+        let camera = GpuCamera::new(&ViewSettings::default(), self.asset.bounds)?;
+        let uniform = self.uniform(&camera, &ViewSettings::default(), true, (0.0, 1.0));
+        let grid = self.grid.take().expect("set above");
+        gpu.queue
+            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+        let bind = self.bind(
+            gpu,
+            self.voxelize.get_bind_group_layout(0),
+            &[
+                (5, self.halo_vertices.as_entire_binding()),
+                (6, self.tets.as_entire_binding()),
+                (7, item_buffer.as_entire_binding()),
+                (8, grid_buffer.as_entire_binding()),
+            ],
+        );
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        encoder.clear_buffer(&grid_buffer, 0, None);
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.voxelize);
+            pass.set_bind_group(0, &bind, &[]);
+            let groups = (items.len() as u32).div_ceil(64);
+            let max = gpu.limits().max_compute_workgroups_per_dimension.max(1);
+            if groups > 0 {
+                pass.dispatch_workgroups(groups.min(max), groups.div_ceil(max), 1);
+            }
+        }
+        encoder.copy_buffer_to_texture(
+            wgpu::TexelCopyBufferInfo {
+                buffer: &grid_buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row * 4),
+                    rows_per_image: Some(dims[1]),
+                },
+            },
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::Extent3d {
+                width: dims[0],
+                height: dims[1],
+                depth_or_array_layers: dims[2],
+            },
+        );
+        gpu.queue.submit([encoder.finish()]);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(ViewerError::Gpu(e.to_string()));
+        }
+        gpu.finish()?;
+        Ok(grid)
+    }
+
+    /// The view mode's lists for this frame: triangles by the slabs they reach (indices,
+    /// duplicated across slabs) and (tetrahedron, slab) for every slab plane a tetrahedron
+    /// spans, both grouped by slab; uploaded, with each slab's ranges returned.
+    fn slab_lists(
+        &mut self,
+        gpu: &Gpu,
+        camera: &GpuCamera,
+        (near, step): (f64, f64),
+        halos: bool,
+    ) -> Result<SlabLists, ViewerError> {
+        let n = ((2.0 * camera_radius(self.asset.bounds)) / step).round() as usize;
+        let forward = camera.cam.forward;
+        let eye = camera.eye;
+        let depth = |p: [f32; 3]| (DVec3::from(p.map(f64::from)) - eye).dot(forward);
+        let slab_of = |z: f64| (((z - near) / step).floor().max(0.0) as usize).min(n - 1);
+        let vertex_depth: Vec<f64> = self.asset.vertices.iter().map(|v| depth(v.pos)).collect();
+        // Counting sorts into slabs.
+        let mut tri_spans = Vec::with_capacity(self.asset.triangles.len());
+        let mut tri_count = vec![0u32; n + 1];
+        for t in &self.asset.triangles {
+            let z = t.map(|v| vertex_depth[v as usize]);
+            let (a, b) = (
+                slab_of(z[0].min(z[1]).min(z[2])),
+                slab_of(z[0].max(z[1]).max(z[2])),
+            );
+            for k in a..=b {
+                tri_count[k + 1] += 1;
+            }
+            tri_spans.push((a, b));
+        }
+        let mut item_count = vec![0u32; n + 1];
+        let mut tet_spans = Vec::new();
+        if halos {
+            let halo_depth: Vec<f64> = self
+                .asset
+                .halo_vertices
+                .iter()
+                .map(|v| depth(v.pos))
+                .collect();
+            for (i, k) in self.asset.tets.iter().enumerate() {
+                let z = k.map(|v| halo_depth[v as usize]);
+                let lo = z.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = z.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                let first = ((lo - near) / step - 0.5).ceil().max(0.0);
+                let last = ((hi - near) / step - 0.5).floor().min(n as f64 - 1.0);
+                if first <= last {
+                    for k in first as usize..=last as usize {
+                        item_count[k + 1] += 1;
+                    }
+                    tet_spans.push((first as usize, last as usize, i as u32));
+                }
+            }
+        }
+        for k in 0..n {
+            tri_count[k + 1] += tri_count[k];
+            item_count[k + 1] += item_count[k];
+        }
+        let mut fill = tri_count.clone();
+        let mut indices = vec![0u32; tri_count[n] as usize * 3];
+        for (t, &(a, b)) in self.asset.triangles.iter().zip(&tri_spans) {
+            for k in a..=b {
+                let at = fill[k] as usize;
+                indices[at * 3..at * 3 + 3].copy_from_slice(t);
+                fill[k] += 1;
+            }
+        }
+        let mut fill = item_count.clone();
+        let mut items = vec![[0u32; 2]; item_count[n] as usize];
+        for &(a, b, tet) in &tet_spans {
+            for k in a..=b {
+                items[fill[k] as usize] = [tet, k as u32];
+                fill[k] += 1;
+            }
+        }
+        upload(
+            gpu,
+            &mut self.slab_triangles,
+            "slab triangles",
+            bytemuck::cast_slice(&indices),
+            wgpu::BufferUsages::INDEX,
+        )?;
+        upload(
+            gpu,
+            &mut self.slab_items,
+            "slab cuts",
+            bytemuck::cast_slice(&items),
+            wgpu::BufferUsages::STORAGE,
+        )?;
+        Ok(SlabLists {
+            triangles: tri_count.iter().map(|&c| c * 3).collect(),
+            items: item_count,
+        })
+    }
+}
+
+/// Per slab, where its triangle indices and its cut items start (one more entry than slabs).
+struct SlabLists {
+    triangles: Vec<u32>,
+    items: Vec<u32>,
+}
+
+fn camera_radius((lo, hi): (DVec3, DVec3)) -> f64 {
+    ((hi - lo).length() * 0.5).max(f64::MIN_POSITIVE)
+}
+
+/// Writes `bytes` into `buffer`, replacing it with a larger one when they do not fit.
+fn upload(
+    gpu: &Gpu,
+    buffer: &mut Option<wgpu::Buffer>,
+    what: &str,
+    bytes: &[u8],
+    usage: wgpu::BufferUsages,
+) -> Result<(), ViewerError> {
+    let needed = (bytes.len() as u64).max(16);
+    if buffer.as_ref().is_none_or(|b| b.size() < needed) {
+        gpu.fits(what, needed, usage)?;
+        *buffer = Some(gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(what),
+            size: needed.next_power_of_two(),
+            usage: usage | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        }));
+    }
+    if !bytes.is_empty() {
+        gpu.queue
+            .write_buffer(buffer.as_ref().expect("made above"), 0, bytes);
+    }
+    Ok(())
+}
+
+/// A pass drawing opaque surfaces (or the composite and curves) into the frame; `clear`
+/// starts the frame.
+fn opaque_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    target: &wgpu::TextureView,
+    targets: &Targets,
+    clear: bool,
+    _settings: &ViewSettings,
+) -> wgpu::RenderPass<'e> {
+    let load = |c: wgpu::Color| {
+        if clear {
+            wgpu::LoadOp::Clear(c)
+        } else {
+            wgpu::LoadOp::Load
+        }
+    };
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("frame"),
+        color_attachments: &[
+            Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: load(wgpu::Color::WHITE),
+                    store: wgpu::StoreOp::Store,
+                },
+            }),
+            Some(wgpu::RenderPassColorAttachment {
+                view: &targets.distance_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: load(wgpu::Color {
+                        r: -1.0,
+                        g: 0.0,
+                        b: 0.0,
+                        a: 0.0,
+                    }),
+                    store: wgpu::StoreOp::Store,
+                },
+            }),
+        ],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &targets.depth_view,
+            depth_ops: Some(wgpu::Operations {
+                load: if clear {
+                    wgpu::LoadOp::Clear(1.0)
+                } else {
+                    wgpu::LoadOp::Load
+                },
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: None,
+        }),
+        ..Default::default()
+    })
+}
+
+/// A pass accumulating transparent surfaces; `clear` starts the frame.
+fn blend_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    targets: &Targets,
+    clear: bool,
+) -> wgpu::RenderPass<'e> {
+    let attachment = |view, colour| {
+        Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: if clear {
+                    wgpu::LoadOp::Clear(colour)
+                } else {
+                    wgpu::LoadOp::Load
+                },
+                store: wgpu::StoreOp::Store,
+            },
+        })
+    };
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("transparent surfaces"),
+        color_attachments: &[
+            attachment(&targets.accum_view, wgpu::Color::TRANSPARENT),
+            attachment(&targets.reveal_view, wgpu::Color::WHITE),
+        ],
+        ..Default::default()
+    })
+}

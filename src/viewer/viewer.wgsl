@@ -1,0 +1,428 @@
+// halo4d-view: surfaces, halo depth (grid voxelization and per-frame cuts), curves and the
+// transparency composite. Positions are relative to the scene's centre. Halo depth is
+// stored normalized: (depth - depth_norm.x) * depth_norm.y, in [0, 1).
+
+struct View {
+    clip: mat4x4<f32>,
+    // xyz: eye; w: 1 perspective, 0 orthographic.
+    eye: vec4<f32>,
+    forward: vec4<f32>,
+    right: vec4<f32>,
+    up: vec4<f32>,
+    // rgb: background; a: opacity of transparent surfaces.
+    background: vec4<f32>,
+    // x: w of the near end of the colour scale; y: 1 / its span.
+    w_norm: vec4<f32>,
+    // x: depth offset; y: depth scale; z: the grid's sample distance; w: the slabs'.
+    depth_norm: vec4<f32>,
+    // xyz: the grid's low corner; w: voxel size.
+    grid_lo: vec4<f32>,
+    // x: depth of the first slab's near side; y: slab thickness; z: slab count; w: far - near.
+    slabs: vec4<f32>,
+    // x, y, z: voxels; w: texels per row of the grid buffer.
+    grid_dims: vec4<u32>,
+    // x: flags (1 halos, 2 colour by w); y: colour stops.
+    options: vec4<u32>,
+    stops: array<vec4<f32>, 8>,
+}
+
+struct SurfaceVertex {
+    pos: vec3<f32>,
+    w: f32,
+    normal: vec3<f32>,
+    slope: f32,
+}
+
+struct HaloVertex {
+    pos: vec3<f32>,
+    t: f32,
+    d: f32,
+    delta_t: f32,
+    delta_d: f32,
+    pad: f32,
+}
+
+@group(0) @binding(0) var<uniform> view: View;
+@group(0) @binding(1) var<storage, read> vertices: array<SurfaceVertex>;
+@group(0) @binding(2) var grid: texture_3d<u32>;
+@group(0) @binding(3) var halo_image: texture_depth_2d;
+@group(0) @binding(4) var<storage, read> curve_points: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> halo_vertices: array<HaloVertex>;
+@group(0) @binding(6) var<storage, read> tets: array<vec4<u32>>;
+// Voxelization: (tetrahedron, z layer); cuts: (tetrahedron, slab).
+@group(0) @binding(7) var<storage, read> items: array<vec2<u32>>;
+@group(0) @binding(8) var<storage, read_write> grid_buffer: array<atomic<u32>>;
+@group(0) @binding(9) var accum_image: texture_2d<f32>;
+@group(0) @binding(10) var reveal_image: texture_2d<f32>;
+
+const QUANTUM: f32 = 2147483648.0;
+const INK: vec3<f32> = vec3<f32>(0.02, 0.02, 0.02);
+
+// Paper 000 eq. 3: d_new = d_orig + max(0, |2t - 1| - delta_t) delta_d.
+fn halo_depth(t: f32, d: f32, delta_t: f32, delta_d: f32) -> f32 {
+    return d + max(0.0, abs(2.0 * t - 1.0) - delta_t) * delta_d;
+}
+
+fn normalized(depth: f32) -> f32 {
+    return (depth - view.depth_norm.x) * view.depth_norm.y;
+}
+
+fn colormap(s: f32) -> vec3<f32> {
+    let n = view.options.y;
+    let x = clamp(s, 0.0, 1.0) * f32(n - 1u);
+    let i = min(u32(floor(x)), n - 2u);
+    return mix(view.stops[i].rgb, view.stops[i + 1u].rgb, x - f32(i));
+}
+
+// The CPU renderer's Phong shading (render::shade::phong), two-sided.
+fn phong(base: vec3<f32>, normal: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
+    var n = normal;
+    if dot(n, dir) > 0.0 {
+        n = -n;
+    }
+    let to_eye = -dir;
+    let right = view.right.xyz;
+    let up = view.up.xyz;
+    let lights = array<vec4<f32>, 2>(
+        vec4<f32>(normalize(to_eye + up * 0.8 - right * 0.6), 0.75),
+        vec4<f32>(normalize(to_eye + right * 0.9 - up * 0.2), 0.35),
+    );
+    var c = base * 0.22;
+    for (var k = 0; k < 2; k++) {
+        let l = lights[k].xyz;
+        let diffuse = max(dot(n, l), 0.0);
+        var specular = 0.0;
+        if diffuse > 0.0 {
+            specular = pow(max(dot(n, normalize(l + to_eye)), 0.0), 40.0);
+        }
+        c += base * (diffuse * lights[k].w) + vec3<f32>(0.35 * lights[k].w * specular);
+    }
+    return clamp(c, vec3<f32>(0.0), vec3<f32>(1.0));
+}
+
+// The direction of the eye ray through p.
+fn ray_dir(p: vec3<f32>) -> vec3<f32> {
+    if view.eye.w > 0.5 {
+        return normalize(p - view.eye.xyz);
+    }
+    return view.forward.xyz;
+}
+
+// ---------------------------------------------------------------- surfaces
+
+struct SurfaceOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) pos: vec3<f32>,
+    @location(1) w: f32,
+    @location(2) normal: vec3<f32>,
+    @location(3) slope: f32,
+    @location(4) @interpolate(flat) slab: u32,
+}
+
+@vertex
+fn surface_vs(@builtin(vertex_index) i: u32, @builtin(instance_index) slab: u32) -> SurfaceOut {
+    let v = vertices[i];
+    var out: SurfaceOut;
+    out.clip = view.clip * vec4<f32>(v.pos, 1.0);
+    out.pos = v.pos;
+    out.w = v.w;
+    out.normal = v.normal;
+    out.slope = v.slope;
+    out.slab = slab;
+    return out;
+}
+
+// Whether a fragment at p with depth w is hidden, given the normalized halo depth sampled
+// at distance at most r from it.
+fn hidden_by(sample: f32, w: f32, slope: f32, r: f32) -> bool {
+    let margin = slope * r * view.depth_norm.y + 1e-6;
+    return sample < normalized(w) - margin;
+}
+
+fn hidden_in_grid(p: vec3<f32>, w: f32, slope: f32) -> bool {
+    if (view.options.x & 1u) == 0u {
+        return false;
+    }
+    let g = (p - view.grid_lo.xyz) / view.grid_lo.w - vec3<f32>(0.5);
+    let i = vec3<i32>(round(g));
+    let dims = vec3<i32>(view.grid_dims.xyz);
+    if any(i < vec3<i32>(0)) || any(i >= dims) {
+        return false;
+    }
+    let v = textureLoad(grid, i, 0).r;
+    if v == 0u {
+        return false;
+    }
+    return hidden_by(f32(~v) / QUANTUM, w, slope, view.depth_norm.z);
+}
+
+fn view_depth(p: vec3<f32>) -> f32 {
+    return dot(p - view.eye.xyz, view.forward.xyz);
+}
+
+// The slab a view depth falls in, as the CPU renderer's slice mode assigns it.
+fn slab_of(z: f32) -> u32 {
+    let k = floor((z - view.slabs.x) / view.slabs.y);
+    return u32(clamp(k, 0.0, view.slabs.z - 1.0));
+}
+
+fn hidden_in_slab(frag: vec4<f32>, p: vec3<f32>, w: f32, slope: f32) -> bool {
+    if (view.options.x & 1u) == 0u {
+        return false;
+    }
+    let sample = textureLoad(halo_image, vec2<i32>(floor(frag.xy)), 0);
+    if sample >= 1.0 {
+        return false;
+    }
+    return hidden_by(sample, w, slope, view.depth_norm.w);
+}
+
+fn surface_colour(in: SurfaceOut) -> vec3<f32> {
+    var base = vec3<f32>(0.8);
+    if (view.options.x & 2u) != 0u {
+        base = colormap((in.w - view.w_norm.x) * view.w_norm.y);
+    }
+    var n = in.normal;
+    if dot(n, n) < 1e-20 {
+        n = view.forward.xyz;
+    }
+    return phong(base, normalize(n), ray_dir(in.pos));
+}
+
+fn ray_distance(p: vec3<f32>) -> f32 {
+    if view.eye.w > 0.5 {
+        return length(p - view.eye.xyz);
+    }
+    return view_depth(p);
+}
+
+struct OpaqueOut {
+    @location(0) colour: vec4<f32>,
+    @location(1) distance: f32,
+}
+
+@fragment
+fn surface_grid_fs(in: SurfaceOut) -> OpaqueOut {
+    if hidden_in_grid(in.pos, in.w, in.slope) {
+        discard;
+    }
+    return OpaqueOut(vec4<f32>(surface_colour(in), 1.0), ray_distance(in.pos));
+}
+
+@fragment
+fn surface_view_fs(in: SurfaceOut) -> OpaqueOut {
+    if slab_of(view_depth(in.pos)) != in.slab || hidden_in_slab(in.clip, in.pos, in.w, in.slope) {
+        discard;
+    }
+    return OpaqueOut(vec4<f32>(surface_colour(in), 1.0), ray_distance(in.pos));
+}
+
+// Weighted blended order-independent transparency (McGuire and Bavoil 2013), with paper
+// 001's silhouette opacity.
+struct BlendOut {
+    @location(0) accum: vec4<f32>,
+    @location(1) reveal: f32,
+}
+
+fn blended(in: SurfaceOut) -> BlendOut {
+    let dir = ray_dir(in.pos);
+    var n = in.normal;
+    if dot(n, n) < 1e-20 {
+        n = view.forward.xyz;
+    }
+    let c = abs(dot(normalize(n), dir));
+    let alpha = 1.0 - pow(1.0 - view.background.a, 1.0 / max(c, 0.02));
+    let d = clamp((view_depth(in.pos) - view.slabs.x) / view.slabs.w, 0.0, 1.0);
+    let weight = alpha * clamp(3e3 * pow(1.0 - d, 3.0), 1e-2, 3e3);
+    return BlendOut(vec4<f32>(surface_colour(in) * weight, weight), alpha);
+}
+
+@fragment
+fn surface_grid_blend_fs(in: SurfaceOut) -> BlendOut {
+    if hidden_in_grid(in.pos, in.w, in.slope) {
+        discard;
+    }
+    return blended(in);
+}
+
+@fragment
+fn surface_view_blend_fs(in: SurfaceOut) -> BlendOut {
+    if slab_of(view_depth(in.pos)) != in.slab || hidden_in_slab(in.clip, in.pos, in.w, in.slope) {
+        discard;
+    }
+    return blended(in);
+}
+
+// ---------------------------------------------------------------- composite
+
+@vertex
+fn composite_vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    let x = f32(i32(i & 1u) * 4 - 1);
+    let y = f32(i32(i >> 1u) * 4 - 1);
+    return vec4<f32>(x, y, 0.0, 1.0);
+}
+
+@fragment
+fn composite_fs(@builtin(position) frag: vec4<f32>) -> OpaqueOut {
+    let at = vec2<i32>(floor(frag.xy));
+    let accum = textureLoad(accum_image, at, 0);
+    let reveal = textureLoad(reveal_image, at, 0).r;
+    let colour = accum.rgb / max(accum.a, 1e-5);
+    let alpha = 1.0 - reveal;
+    return OpaqueOut(vec4<f32>(mix(view.background.rgb, colour, alpha), 1.0), 0.0);
+}
+
+// ---------------------------------------------------------------- curves
+
+@vertex
+fn curve_vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    var clip = view.clip * vec4<f32>(curve_points[i].xyz, 1.0);
+    // Pulled slightly towards the eye: the curves lie on the surfaces.
+    clip.z -= 2e-4 * clip.w;
+    return clip;
+}
+
+@fragment
+fn curve_fs() -> OpaqueOut {
+    return OpaqueOut(vec4<f32>(INK, 1.0), 0.0);
+}
+
+// ---------------------------------------------------------------- halo depth
+
+// The smallest halo depth at the centre of every voxel in one z layer of a tetrahedron's
+// box, into the grid buffer: quantized and complemented, so that atomicMax keeps the
+// smallest and 0 (a cleared buffer) means no halo.
+@compute @workgroup_size(64)
+fn voxelize(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let index = id.x + id.y * groups.x * 64u;
+    if index >= arrayLength(&items) {
+        return;
+    }
+    let item = items[index];
+    let k = tets[item.x];
+    let a = halo_vertices[k.x];
+    let b = halo_vertices[k.y];
+    let c = halo_vertices[k.z];
+    let d = halo_vertices[k.w];
+    let e1 = b.pos - a.pos;
+    let e2 = c.pos - a.pos;
+    let e3 = d.pos - a.pos;
+    let det = dot(e1, cross(e2, e3));
+    let scale = max(max(length(e1), length(e2)), length(e3));
+    if abs(det) <= 1e-7 * scale * scale * scale {
+        return;
+    }
+    let r1 = cross(e2, e3) / det;
+    let r2 = cross(e3, e1) / det;
+    let r3 = cross(e1, e2) / det;
+    let lo = min(min(a.pos, b.pos), min(c.pos, d.pos));
+    let hi = max(max(a.pos, b.pos), max(c.pos, d.pos));
+    let h = view.grid_lo.w;
+    let first = vec2<i32>(ceil((lo.xy - view.grid_lo.xy) / h - 0.5));
+    let last = vec2<i32>(floor((hi.xy - view.grid_lo.xy) / h - 0.5));
+    let x0 = max(first.x, 0);
+    let x1 = min(last.x, i32(view.grid_dims.x) - 1);
+    let y0 = max(first.y, 0);
+    let y1 = min(last.y, i32(view.grid_dims.y) - 1);
+    let z = item.y;
+    let tol = -1e-6;
+    for (var y = y0; y <= y1; y++) {
+        for (var x = x0; x <= x1; x++) {
+            let centre = view.grid_lo.xyz + (vec3<f32>(f32(x), f32(y), f32(z)) + 0.5) * h;
+            let q = centre - a.pos;
+            let l1 = dot(r1, q);
+            let l2 = dot(r2, q);
+            let l3 = dot(r3, q);
+            let l0 = 1.0 - l1 - l2 - l3;
+            if l0 < tol || l1 < tol || l2 < tol || l3 < tol {
+                continue;
+            }
+            let t = l0 * a.t + l1 * b.t + l2 * c.t + l3 * d.t;
+            let dd = l0 * a.d + l1 * b.d + l2 * c.d + l3 * d.d;
+            let depth = normalized(halo_depth(t, dd, a.delta_t, a.delta_d));
+            let quantized = u32(clamp(depth, 0.0, 0.9999999) * QUANTUM);
+            let at = (z * view.grid_dims.y + u32(y)) * view.grid_dims.w + u32(x);
+            atomicMax(&grid_buffer[at], ~quantized);
+        }
+    }
+}
+
+struct CutOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) t: f32,
+    @location(1) d: f32,
+    @location(2) @interpolate(flat) delta: vec2<f32>,
+}
+
+// Corner `vertex` (0..6, two triangles) of the cut of tetrahedron items[instance].x by the
+// plane in the middle of slab items[instance].y; a triangle's second half is empty.
+@vertex
+fn cut_vs(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> CutOut {
+    let item = items[instance];
+    let k = tets[item.x];
+    let plane = view.slabs.x + (f32(item.y) + 0.5) * view.slabs.y;
+    var v = array<HaloVertex, 4>(
+        halo_vertices[k.x], halo_vertices[k.y], halo_vertices[k.z], halo_vertices[k.w]
+    );
+    var s: array<f32, 4>;
+    var below: array<u32, 4>;
+    var above: array<u32, 4>;
+    var nb = 0u;
+    var na = 0u;
+    for (var i = 0u; i < 4u; i++) {
+        s[i] = view_depth(v[i].pos) - plane;
+        if s[i] < 0.0 {
+            below[nb] = i;
+            nb++;
+        } else {
+            above[na] = i;
+            na++;
+        }
+    }
+    // The cut's corners as edges (a, b) crossing the plane, in order around it.
+    var edges: array<vec2<u32>, 4>;
+    var count = 0u;
+    if nb == 1u || nb == 3u {
+        var lone = below[0];
+        var others = above;
+        if nb == 3u {
+            lone = above[0];
+            others = below;
+        }
+        edges[0] = vec2<u32>(lone, others[0]);
+        edges[1] = vec2<u32>(lone, others[1]);
+        edges[2] = vec2<u32>(lone, others[2]);
+        count = 3u;
+    } else if nb == 2u {
+        edges[0] = vec2<u32>(below[0], above[0]);
+        edges[1] = vec2<u32>(below[0], above[1]);
+        edges[2] = vec2<u32>(below[1], above[1]);
+        edges[3] = vec2<u32>(below[1], above[0]);
+        count = 4u;
+    }
+    var out: CutOut;
+    out.delta = vec2<f32>(v[0].delta_t, v[0].delta_d);
+    let corners = array<u32, 6>(0u, 1u, 2u, 0u, 2u, 3u);
+    var corner = corners[vertex];
+    if count == 0u || (count == 3u && vertex >= 3u) {
+        // Nothing, or the empty half: a degenerate triangle outside the view.
+        out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+        out.t = 0.0;
+        out.d = 0.0;
+        return out;
+    }
+    let e = edges[corner];
+    let a = v[e.x];
+    let b = v[e.y];
+    let u = s[e.x] / (s[e.x] - s[e.y]);
+    let p = mix(a.pos, b.pos, u);
+    out.clip = view.clip * vec4<f32>(p, 1.0);
+    out.t = mix(a.t, b.t, u);
+    out.d = mix(a.d, b.d, u);
+    return out;
+}
+
+@fragment
+fn cut_fs(in: CutOut) -> @builtin(frag_depth) f32 {
+    return clamp(normalized(halo_depth(in.t, in.d, in.delta.x, in.delta.y)), 0.0, 0.9999999);
+}
