@@ -18,12 +18,18 @@
 //!   are drawn against it, front slab first, sharing one depth buffer.
 //!
 //! A sheet's own halo: the CPU renderer leaves out the tetrahedra over the fragment's
-//! triangle's vertices. A halo-depth sample taken at a distance r from the fragment, in the
-//! sheet's own halo, holds d_orig of a surface point within r of it, so it can fall below w
-//! by at most |grad w| r. A fragment is therefore hidden only where the sample is below
-//! w - |grad w| r - 1e-6 of the w range, with r the largest distance from a point to its
-//! sample (half a voxel's diagonal, or half a slab). Other sheets' halos hide as in the CPU
-//! renderer except within that margin of where they start hiding.
+//! triangle's vertices; a sample of the slices cannot tell whose halo it holds. Where a
+//! sample taken at distance r from the fragment is the sheet's own halo, it holds d_orig of
+//! a surface point about r away, so it can fall below w by |grad w| r; where flips and
+//! inserted vertices made tetrahedra across neighbouring prisms, by up to |grad w| times a
+//! fraction of an edge. A fragment is therefore hidden only where the sample is below
+//! w - |grad w| (r + l / 4) - 1e-6 of the depth range, with r the largest distance from a
+//! point to its sample (half a voxel's diagonal, or half a slab, stretched by the ray's
+//! slant) and l the longest mesh edge at the fragment's triangle's vertices (both
+//! interpolated from the vertices). The quarter is measured: the smallest fraction that
+//! leaves no sheet hidden by its own halo on any fixture (the viewer tests compare every
+//! fixture with the exact CPU render). Other sheets' halos hide as in the CPU renderer
+//! except within that margin of where they start hiding.
 
 mod gpu;
 mod renderer;
@@ -199,7 +205,7 @@ pub enum ViewerError {
     },
 }
 
-/// A surface vertex as the GPU reads it (32 bytes).
+/// A surface vertex as the GPU reads it (48 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub(crate) struct SurfaceVertex {
@@ -211,6 +217,11 @@ pub(crate) struct SurfaceVertex {
     pub normal: [f32; 3],
     /// The largest |grad w| of the triangles around the vertex.
     pub slope: f32,
+    /// `slope` times a quarter of the longest edge at the vertex: how far below w the
+    /// halo depth of the tetrahedra around it can reach (see the module's documentation).
+    pub spread: f32,
+    /// Padding.
+    pub pad: [f32; 3],
 }
 
 /// A halo vertex as the GPU reads it (32 bytes), with its halo's eq. 3 parameters.
@@ -326,13 +337,15 @@ impl Asset {
                 .normals
                 .clone()
                 .unwrap_or_else(|| vertex_normals(&s.positions, &s.triangles));
-            let slopes = w_slopes(&s.positions, &s.w, &s.triangles);
+            let (slopes, reach) = w_slopes(&s.positions, &s.w, &s.triangles);
             for (i, &p) in s.positions.iter().enumerate() {
                 vertices.push(SurfaceVertex {
                     pos: rel(p),
                     w: s.w[i] as f32,
                     normal: normals[i].as_vec3().to_array(),
                     slope: slopes[i] as f32,
+                    spread: (slopes[i] * reach[i] * 0.25) as f32,
+                    pad: [0.0; 3],
                 });
             }
             all_triangles.extend(s.triangles.iter().map(|t| t.map(|v| v + base)));
@@ -424,11 +437,20 @@ fn vertex_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
     n.into_iter().map(|v| v.normalize_or_zero()).collect()
 }
 
-/// Per vertex, the largest |grad w| over the triangles around it (w linear on each).
-fn w_slopes(positions: &[DVec3], w: &[f64], triangles: &[[u32; 3]]) -> Vec<f64> {
+/// Per vertex, the largest |grad w| over the triangles around it (w linear on each), and
+/// the longest edge there.
+fn w_slopes(positions: &[DVec3], w: &[f64], triangles: &[[u32; 3]]) -> (Vec<f64>, Vec<f64>) {
     let mut out = vec![0.0f64; positions.len()];
+    let mut reach = vec![0.0f64; positions.len()];
     for t in triangles {
         let [a, b, c] = t.map(|v| v as usize);
+        let longest = [(a, b), (b, c), (c, a)]
+            .iter()
+            .map(|&(i, j)| positions[i].distance(positions[j]))
+            .fold(0.0, f64::max);
+        for v in [a, b, c] {
+            reach[v] = reach[v].max(longest);
+        }
         let (e1, e2) = (positions[b] - positions[a], positions[c] - positions[a]);
         let (d1, d2) = (w[b] - w[a], w[c] - w[a]);
         let area2 = e1.cross(e2).length_squared();
@@ -445,7 +467,7 @@ fn w_slopes(positions: &[DVec3], w: &[f64], triangles: &[[u32; 3]]) -> Vec<f64> 
             }
         }
     }
-    out
+    (out, reach)
 }
 
 /// The camera of `settings` as the GPU uses it: the CPU renderer's [`Camera`] with a clip

@@ -31,6 +31,10 @@ struct SurfaceVertex {
     w: f32,
     normal: vec3<f32>,
     slope: f32,
+    spread: f32,
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
 }
 
 struct HaloVertex {
@@ -116,7 +120,8 @@ struct SurfaceOut {
     @location(1) w: f32,
     @location(2) normal: vec3<f32>,
     @location(3) slope: f32,
-    @location(4) @interpolate(flat) slab: u32,
+    @location(4) spread: f32,
+    @location(5) @interpolate(flat) slab: u32,
 }
 
 @vertex
@@ -128,22 +133,24 @@ fn surface_vs(@builtin(vertex_index) i: u32, @builtin(instance_index) slab: u32)
     out.w = v.w;
     out.normal = v.normal;
     out.slope = v.slope;
+    out.spread = v.spread;
     out.slab = slab;
     return out;
 }
 
-// Whether a fragment at p with depth w is hidden, given the normalized halo depth sampled
-// at distance at most r from it.
-fn hidden_by(sample: f32, w: f32, slope: f32, r: f32) -> bool {
-    let margin = slope * r * view.depth_norm.y + 1e-6;
+// Whether a fragment with depth w is hidden, given the normalized halo depth sampled at
+// distance at most r from it: below w by more than its own halo can be there (slope r
+// for the distance, spread for the tetrahedron's corners around the sample).
+fn hidden_by(sample: f32, w: f32, slope: f32, spread: f32, r: f32) -> bool {
+    let margin = (slope * r + spread) * view.depth_norm.y + 1e-6;
     return sample < normalized(w) - margin;
 }
 
-fn hidden_in_grid(p: vec3<f32>, w: f32, slope: f32) -> bool {
+fn hidden_in_grid(in: SurfaceOut) -> bool {
     if (view.options.x & 1u) == 0u {
         return false;
     }
-    let g = (p - view.grid_lo.xyz) / view.grid_lo.w - vec3<f32>(0.5);
+    let g = (in.pos - view.grid_lo.xyz) / view.grid_lo.w - vec3<f32>(0.5);
     let i = vec3<i32>(round(g));
     let dims = vec3<i32>(view.grid_dims.xyz);
     if any(i < vec3<i32>(0)) || any(i >= dims) {
@@ -153,7 +160,7 @@ fn hidden_in_grid(p: vec3<f32>, w: f32, slope: f32) -> bool {
     if v == 0u {
         return false;
     }
-    return hidden_by(f32(~v) / QUANTUM, w, slope, view.depth_norm.z);
+    return hidden_by(f32(~v) / QUANTUM, in.w, in.slope, in.spread, view.depth_norm.z);
 }
 
 fn view_depth(p: vec3<f32>) -> f32 {
@@ -166,15 +173,15 @@ fn slab_of(z: f32) -> u32 {
     return u32(clamp(k, 0.0, view.slabs.z - 1.0));
 }
 
-fn hidden_in_slab(frag: vec4<f32>, p: vec3<f32>, w: f32, slope: f32) -> bool {
+fn hidden_in_slab(in: SurfaceOut) -> bool {
     if (view.options.x & 1u) == 0u {
         return false;
     }
-    let sample = textureLoad(halo_image, vec2<i32>(floor(frag.xy)), 0);
+    let sample = textureLoad(halo_image, vec2<i32>(floor(in.clip.xy)), 0);
     if sample >= 1.0 {
         return false;
     }
-    return hidden_by(sample, w, slope, view.depth_norm.w);
+    return hidden_by(sample, in.w, in.slope, in.spread, view.depth_norm.w);
 }
 
 fn surface_colour(in: SurfaceOut) -> vec3<f32> {
@@ -203,7 +210,7 @@ struct OpaqueOut {
 
 @fragment
 fn surface_grid_fs(in: SurfaceOut) -> OpaqueOut {
-    if hidden_in_grid(in.pos, in.w, in.slope) {
+    if hidden_in_grid(in) {
         discard;
     }
     return OpaqueOut(vec4<f32>(surface_colour(in), 1.0), ray_distance(in.pos));
@@ -211,7 +218,7 @@ fn surface_grid_fs(in: SurfaceOut) -> OpaqueOut {
 
 @fragment
 fn surface_view_fs(in: SurfaceOut) -> OpaqueOut {
-    if slab_of(view_depth(in.pos)) != in.slab || hidden_in_slab(in.clip, in.pos, in.w, in.slope) {
+    if slab_of(view_depth(in.pos)) != in.slab || hidden_in_slab(in) {
         discard;
     }
     return OpaqueOut(vec4<f32>(surface_colour(in), 1.0), ray_distance(in.pos));
@@ -239,7 +246,7 @@ fn blended(in: SurfaceOut) -> BlendOut {
 
 @fragment
 fn surface_grid_blend_fs(in: SurfaceOut) -> BlendOut {
-    if hidden_in_grid(in.pos, in.w, in.slope) {
+    if hidden_in_grid(in) {
         discard;
     }
     return blended(in);
@@ -247,7 +254,7 @@ fn surface_grid_blend_fs(in: SurfaceOut) -> BlendOut {
 
 @fragment
 fn surface_view_blend_fs(in: SurfaceOut) -> BlendOut {
-    if slab_of(view_depth(in.pos)) != in.slab || hidden_in_slab(in.clip, in.pos, in.w, in.slope) {
+    if slab_of(view_depth(in.pos)) != in.slab || hidden_in_slab(in) {
         discard;
     }
     return blended(in);
