@@ -5,7 +5,7 @@ use crate::common::fixture_scenes;
 use halo4d::Scene;
 use halo4d::render::compare::verdict_differs;
 use halo4d::render::{RenderMode, RenderSettings, render_with_depth};
-use halo4d::viewer::{self, Asset, Gpu, HaloMode, ViewSettings, ViewerError};
+use halo4d::viewer::{self, Asset, Gpu, HaloMode, ViewSettings};
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -122,4 +122,337 @@ fn every_fixture_matches_the_exact_cpu_render_at_256_slices() {
         worst.0 * 100.0,
         worst.1
     );
+}
+
+/// The default fixture, exported, with its built products.
+fn default_export() -> (Scene, tempfile::TempDir, halo4d::Built, Asset) {
+    let scene = Scene::load(&crate::common::fixture("scenes/default.json")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let (built, asset) = exported(&scene, dir.path());
+    (scene, dir, built, asset)
+}
+
+#[test]
+fn the_grid_is_built_once_per_slice_count_and_every_camera_reuses_it() {
+    let gpu = gpu();
+    let (scene, _dir, built, asset) = default_export();
+    let mut renderer =
+        viewer::Renderer::new(gpu, &asset, wgpu::TextureFormat::Rgba8UnormSrgb).unwrap();
+    let mut s = settings(&scene, HaloMode::Grid, 128);
+    let first = renderer.read_frame(gpu, &s).unwrap();
+    assert!(
+        first.times.grid_ms.is_some(),
+        "the first frame builds the grid"
+    );
+    s.camera.azimuth += 90.0;
+    let turned = renderer.read_frame(gpu, &s).unwrap();
+    assert_eq!(turned.times.grid_ms, None, "a new camera reuses the grid");
+    assert_ne!(first.picture, turned.picture, "the camera turned");
+    s.slices = 256;
+    assert!(
+        renderer
+            .read_frame(gpu, &s)
+            .unwrap()
+            .times
+            .grid_ms
+            .is_some()
+    );
+    // The view mode slices per frame and builds no grid.
+    s.mode = HaloMode::View;
+    assert_eq!(renderer.read_frame(gpu, &s).unwrap().times.grid_ms, None);
+    // 512 slices: a grid larger than one storage binding on lavapipe (128 MiB), built in
+    // bands of layers, still agrees with the exact render.
+    s.mode = HaloMode::Grid;
+    s.slices = 512;
+    s.camera = scene.camera;
+    let fine = renderer.read_frame(gpu, &s).unwrap();
+    let differs = verdict_differs(&exact_distances(&scene, &built), &distances(&fine), SAME);
+    eprintln!("default scene, grid of 512 slices: {:.3}%", differs * 100.0);
+    assert!(differs < 0.01, "{:.2}%", differs * 100.0);
+}
+
+#[test]
+fn curves_colour_and_transparency_toggle_what_they_should() {
+    let gpu = gpu();
+    let (scene, _dir, built, asset) = default_export();
+    let base = settings(&scene, HaloMode::Grid, 256);
+    let shot = |s: &ViewSettings| viewer::screenshot(gpu, &asset, s).unwrap();
+    let with = shot(&base);
+    let without = shot(&ViewSettings {
+        curves: false,
+        ..base
+    });
+    // Every pixel the curves change is on a projected curve segment (within a pixel).
+    let camera =
+        halo4d::render::camera::Camera::new(&scene.camera, asset.bounds, SIDE, SIDE, 0.0).unwrap();
+    let mut segments = Vec::new();
+    for curve in &built.curves.curves {
+        let p: Vec<[f64; 2]> = curve
+            .points
+            .iter()
+            .filter_map(|q| camera.project(q.position, SIDE, SIDE).map(|(xy, _)| xy))
+            .collect();
+        segments.extend(p.windows(2).map(|w| (w[0], w[1])));
+        if curve.closed && p.len() > 2 {
+            segments.push((p[p.len() - 1], p[0]));
+        }
+    }
+    let near_curve = |x: f64, y: f64| {
+        segments.iter().any(|&(a, b)| {
+            let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+            let len2 = dx * dx + dy * dy;
+            let s = if len2 > 0.0 {
+                (((x - a[0]) * dx + (y - a[1]) * dy) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let (px, py) = (a[0] + s * dx - x, a[1] + s * dy - y);
+            px * px + py * py <= 1.5 * 1.5
+        })
+    };
+    let mut changed = 0;
+    for (i, (a, b)) in with
+        .picture
+        .rgb
+        .chunks(3)
+        .zip(without.picture.rgb.chunks(3))
+        .enumerate()
+    {
+        if a != b {
+            changed += 1;
+            let (x, y) = (
+                (i as u32 % SIDE) as f64 + 0.5,
+                (i as u32 / SIDE) as f64 + 0.5,
+            );
+            assert!(
+                near_curve(x, y),
+                "pixel ({x}, {y}) changed away from every curve"
+            );
+        }
+    }
+    assert!(changed > 20, "the curves are drawn ({changed} pixels)");
+    // Grey: every pixel neutral; colour by w: not.
+    let neutral = |p: &viewer::Frame| {
+        p.picture
+            .rgb
+            .chunks(3)
+            .all(|c| c[0].abs_diff(c[1]) <= 1 && c[1].abs_diff(c[2]) <= 1)
+    };
+    assert!(!neutral(&without));
+    assert!(neutral(&shot(&ViewSettings {
+        colour_by_w: false,
+        curves: false,
+        ..base
+    })));
+    // Transparent surfaces let the background through: the picture is lighter, and no
+    // distance is reported.
+    let clear = shot(&ViewSettings {
+        transparent: true,
+        curves: false,
+        ..base
+    });
+    let brightness = |f: &viewer::Frame| f.picture.rgb.iter().map(|&c| u64::from(c)).sum::<u64>();
+    assert!(brightness(&clear) > brightness(&without));
+    assert!(clear.distance.iter().all(|d| d.is_infinite()));
+    assert!(without.distance.iter().any(|d| d.is_finite()));
+}
+
+/// `bytes` (a `.glb`) with its JSON chunk changed by `edit`.
+fn edited(bytes: &[u8], edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
+    let u32_at = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    let json_len = u32_at(12);
+    let mut json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+    edit(&mut json);
+    let bin = &bytes[20 + json_len.next_multiple_of(4) + 8..];
+    glb(&json, bin)
+}
+
+/// A `.glb` of `json` and `bin`.
+fn glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
+    let mut text = serde_json::to_vec(json).unwrap();
+    while !text.len().is_multiple_of(4) {
+        text.push(b' ');
+    }
+    let mut bin = bin.to_vec();
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
+    let total = 12 + 8 + text.len() + 8 + bin.len();
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(text.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&text);
+    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&bin);
+    out
+}
+
+/// Loading `bytes` fails with a message containing every one of `words`.
+fn refused(bytes: &[u8], words: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.glb");
+    std::fs::write(&path, bytes).unwrap();
+    let message = match Asset::load(&path) {
+        Ok(_) => panic!("loaded a file that should be refused ({words:?})"),
+        Err(e) => e.to_string(),
+    };
+    for w in words {
+        assert!(message.contains(w), "`{w}` not in: {message}");
+    }
+}
+
+#[test]
+fn malformed_and_foreign_files_get_a_clear_message() {
+    let (scene, dir, _, asset) = default_export();
+    let bytes = std::fs::read(dir.path().join(format!("{}.glb", scene.name))).unwrap();
+    refused(&bytes[..bytes.len() / 2], &["bad.glb", "truncated"]);
+    refused(b"not a glb at all", &["wrong magic"]);
+    // A foreign file: meshes without halo4d's extras.
+    let foreign = edited(&bytes, |j| {
+        for m in j["meshes"].as_array_mut().unwrap() {
+            m.as_object_mut().unwrap().remove("extras");
+        }
+        j["asset"].as_object_mut().unwrap().remove("extras");
+    });
+    refused(&foreign, &["no surface", "halo4d build"]);
+    // A scene camera that is not one.
+    let camera = edited(&bytes, |j| {
+        j["asset"]["extras"]["halo4d"]["scene"]["camera"] = serde_json::json!({"azimuth": "east"});
+    });
+    refused(&camera, &["camera", "azimuth"]);
+    // No halo: the surfaces load, are named, and nothing is hidden.
+    let no_halo = edited(&bytes, |j| {
+        for m in j["meshes"].as_array_mut().unwrap() {
+            if let Some(e) = m.get_mut("extras").and_then(|e| e.as_object_mut()) {
+                e.remove("halo");
+            }
+        }
+    });
+    let path = dir.path().join("no-halo.glb");
+    std::fs::write(&path, &no_halo).unwrap();
+    let bare = Asset::load(&path).unwrap();
+    assert_eq!(bare.tet_count(), 0);
+    assert!(!bare.surfaces_without_halo.is_empty());
+    let s = ViewSettings {
+        curves: false,
+        ..settings(&scene, HaloMode::Grid, 64)
+    };
+    let gpu = gpu();
+    let off = viewer::screenshot(gpu, &asset, &ViewSettings { halos: false, ..s }).unwrap();
+    assert_eq!(
+        viewer::screenshot(gpu, &bare, &s).unwrap().picture,
+        off.picture
+    );
+}
+
+#[test]
+fn a_mesh_of_ten_million_triangles_is_refused_before_the_gpu_sees_it() {
+    let triangles = 10_000_000u32;
+    let mut bin = Vec::new();
+    for p in [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+        bin.extend(p.iter().flat_map(|x| x.to_le_bytes()));
+    }
+    bin.extend([0f32; 3].iter().flat_map(|x| x.to_le_bytes()));
+    let indices_at = bin.len();
+    bin.reserve(triangles as usize * 12);
+    for _ in 0..triangles {
+        bin.extend([0u32, 1, 2].iter().flat_map(|x| x.to_le_bytes()));
+    }
+    let json = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "buffers": [{"byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 36},
+            {"buffer": 0, "byteOffset": 36, "byteLength": 12},
+            {"buffer": 0, "byteOffset": indices_at, "byteLength": triangles as usize * 12},
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
+            {"bufferView": 1, "componentType": 5126, "count": 3, "type": "SCALAR"},
+            {"bufferView": 2, "componentType": 5125, "count": triangles * 3, "type": "SCALAR"},
+        ],
+        "meshes": [{
+            "name": "huge",
+            "extras": {"surface": "plane"},
+            "primitives": [{"attributes": {"POSITION": 0, "_W": 1}, "indices": 2}],
+        }],
+    });
+    refused(
+        &glb(&json, &bin),
+        &["10000000", "surface triangles", "coarser tolerance"],
+    );
+}
+
+#[test]
+fn the_binary_writes_a_screenshot_and_refuses_bad_flags() {
+    let (scene, dir, _, _) = default_export();
+    let glb = dir.path().join(format!("{}.glb", scene.name));
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_halo4d-view"))
+            .arg(&glb)
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let png = dir.path().join("shot.png");
+    let out = run(&[
+        "--headless",
+        "--screenshot",
+        png.to_str().unwrap(),
+        "--size",
+        "96x64",
+        "--slices",
+        "64",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let image = image::open(&png).unwrap();
+    assert_eq!((image.width(), image.height()), (96, 64));
+    for (args, words) in [
+        (&["--headless"][..], &["--screenshot"][..]),
+        (
+            &["--headless", "--screenshot", "x.png", "--size", "0x64"],
+            &["size"],
+        ),
+        (
+            &["--headless", "--screenshot", "x.png", "--slices", "1"],
+            &["slices"],
+        ),
+        (
+            &["--headless", "--screenshot", "x.png", "--elevation", "95"],
+            &["elevation"],
+        ),
+    ] {
+        let out = run(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains("error: "), "{err}");
+        for w in words {
+            assert!(err.contains(w), "{args:?}: `{w}` not in {err}");
+        }
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    // --bench prints a row per mode and slice count.
+    let out = run(&["--bench", "--frames", "2", "--size", "64x48"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    for mode in ["grid", "view"] {
+        for n in [64, 128, 256, 512] {
+            assert!(
+                text.contains(&format!("| {mode} | {n} |")),
+                "no {mode} {n} row in {text}"
+            );
+        }
+    }
 }

@@ -120,7 +120,7 @@ pub fn read_scene_glb(bytes: &[u8]) -> Result<ImportedScene> {
     let camera = json
         .pointer("/asset/extras/halo4d/scene/camera")
         .map(|c| {
-            serde_json::from_value(c.clone()).map_err(|e| {
+            serde_path_to_error::deserialize(c.clone()).map_err(|e| {
                 glb_err(format!(
                     "the scene camera recorded in asset.extras.halo4d.scene.camera is not valid: {e}"
                 ))

@@ -132,7 +132,7 @@ impl Gpu {
         let mut limit = (limits.max_buffer_size, "max_buffer_size");
         if usage.contains(wgpu::BufferUsages::STORAGE) {
             limit = limit.min((
-                u64::from(limits.max_storage_buffer_binding_size),
+                limits.max_storage_buffer_binding_size,
                 "max_storage_buffer_binding_size",
             ));
         }

@@ -33,6 +33,7 @@ struct ViewUniform {
     slabs: [f32; 4],
     grid_dims: [u32; 4],
     options: [u32; 4],
+    band: [u32; 4],
     stops: [[f32; 4]; 8],
 }
 
@@ -391,7 +392,7 @@ impl Renderer {
         self.ensure_targets(gpu, (settings.width, settings.height));
         let camera = GpuCamera::new(settings, self.asset.bounds)?;
         let slabs = self.slabs(&camera, settings.slices);
-        let uniform = self.uniform(&camera, settings, halos, slabs);
+        let uniform = self.uniform(&camera, settings, halos, slabs, self.grid.as_ref());
         gpu.queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
         let lists = (settings.mode == HaloMode::View)
@@ -421,7 +422,7 @@ impl Renderer {
                 let mut pass = if settings.transparent {
                     blend_pass(&mut encoder, targets, true)
                 } else {
-                    opaque_pass(&mut encoder, target, targets, true, settings)
+                    opaque_pass(&mut encoder, target, targets, true)
                 };
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &bind, &[]);
@@ -490,7 +491,7 @@ impl Renderer {
                     let mut pass = if settings.transparent {
                         blend_pass(&mut encoder, targets, first)
                     } else {
-                        opaque_pass(&mut encoder, target, targets, first, settings)
+                        opaque_pass(&mut encoder, target, targets, first)
                     };
                     first = false;
                     pass.set_pipeline(pipeline);
@@ -505,9 +506,9 @@ impl Renderer {
         let curves = settings.curves && !self.asset.curve_segments.is_empty();
         if composite || curves {
             let mut pass = if composite {
-                opaque_pass(&mut encoder, target, targets, true, settings)
+                opaque_pass(&mut encoder, target, targets, true)
             } else {
-                opaque_pass(&mut encoder, target, targets, false, settings)
+                opaque_pass(&mut encoder, target, targets, false)
             };
             if composite {
                 let bind = self.bind(
@@ -677,6 +678,7 @@ impl Renderer {
         settings: &ViewSettings,
         halos: bool,
         (near, step): (f64, f64),
+        grid: Option<&Grid>,
     ) -> ViewUniform {
         let cam = &camera.cam;
         let v4 = |v: DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
@@ -689,10 +691,8 @@ impl Renderer {
         for (slot, s) in stop_array.iter_mut().zip(stops) {
             *slot = [s[0] as f32, s[1] as f32, s[2] as f32, 1.0];
         }
-        let (grid_lo, grid_voxel, dims) = self
-            .grid
-            .as_ref()
-            .map_or((DVec3::ZERO, 1.0, [0; 3]), |g| (g.lo, g.voxel, g.dims));
+        let (grid_lo, grid_voxel, dims) =
+            grid.map_or((DVec3::ZERO, 1.0, [0; 3]), |g| (g.lo, g.voxel, g.dims));
         // A ray through a slab crosses at most this much more than its thickness.
         let obliquity = match settings.camera.projection {
             crate::render::CameraProjection::Perspective => {
@@ -729,11 +729,13 @@ impl Renderer {
             ],
             grid_dims: [dims[0], dims[1], dims[2], dims[0].next_multiple_of(64)],
             options: [flags, stops.len() as u32, 0, 0],
+            band: [0; 4],
             stops: stop_array,
         }
     }
 
-    /// Builds the halo-depth grid: `slices` voxels across the halos' longest side.
+    /// Builds the halo-depth grid: `slices` voxels across the halos' longest side, in bands
+    /// of z layers as large as one storage binding holds.
     fn build_grid(&mut self, gpu: &Gpu, slices: u32) -> Result<Grid, ViewerError> {
         let (lo, hi) = self
             .asset
@@ -752,42 +754,69 @@ impl Renderer {
             .min(glam::UVec3::splat(slices))
             .to_array();
         let row = dims[0].next_multiple_of(64);
-        let bytes = u64::from(row) * u64::from(dims[1]) * u64::from(dims[2]) * 4;
-        let usage = wgpu::BufferUsages::STORAGE
-            | wgpu::BufferUsages::COPY_SRC
-            | wgpu::BufferUsages::COPY_DST;
-        gpu.fits(
-            &format!("the halo-depth grid of {slices} slices"),
-            bytes,
-            usage,
-        )?;
-        // Work items: (tetrahedron, z layer) for every layer of voxel centres its box spans.
-        let mut items: Vec<[u32; 2]> = Vec::new();
+        let layer_bytes = u64::from(row) * u64::from(dims[1]) * 4;
+        let limits = gpu.limits();
+        let binding = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
+        let band = (binding / layer_bytes).min(u64::from(dims[2])) as u32;
+        if band == 0 {
+            return Err(ViewerError::TooLarge {
+                what: format!("one layer of the halo-depth grid of {slices} slices (bytes)"),
+                count: layer_bytes,
+                limit: binding,
+                why: "this GPU's max_storage_buffer_binding_size".into(),
+            });
+        }
+        if dims[0] > limits.max_texture_dimension_3d
+            || dims[1] > limits.max_texture_dimension_3d
+            || dims[2] > limits.max_texture_dimension_3d
+        {
+            return Err(ViewerError::Setting {
+                field: "slices".into(),
+                message: format!(
+                    "{slices} is more than this GPU's 3D textures hold ({}); use fewer",
+                    limits.max_texture_dimension_3d
+                ),
+            });
+        }
+        // Work items (tetrahedron, z layer) for every layer of voxel centres a
+        // tetrahedron's box spans, sorted by layer.
+        let mut spans = Vec::with_capacity(self.asset.tets.len());
+        let mut per_layer = vec![0usize; dims[2] as usize + 1];
         for (i, k) in self.asset.tets.iter().enumerate() {
             let z = k.map(|v| f64::from(self.asset.halo_vertices[v as usize].pos[2]));
-            let (z0, z1) = (
-                z.iter().copied().fold(f64::INFINITY, f64::min),
-                z.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            );
-            let first = ((z0 - lo.z) / voxel - 0.5).ceil().max(0.0) as u32;
+            let z0 = z.iter().copied().fold(f64::INFINITY, f64::min);
+            let z1 = z.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let first = ((z0 - lo.z) / voxel - 0.5).ceil().max(0.0);
             let last = ((z1 - lo.z) / voxel - 0.5)
                 .floor()
                 .min(f64::from(dims[2]) - 1.0);
-            if last < 0.0 {
-                continue;
+            if first <= last {
+                for layer in first as usize..=last as usize {
+                    per_layer[layer + 1] += 1;
+                }
+                spans.push((i as u32, first as u32, last as u32));
             }
-            items.extend((first..=last as u32).map(|layer| [i as u32, layer]));
         }
-        let item_buffer = gpu.buffer(
-            "voxelization items",
-            bytemuck::cast_slice(&items),
-            wgpu::BufferUsages::STORAGE,
-        )?;
+        for layer in 0..dims[2] as usize {
+            per_layer[layer + 1] += per_layer[layer];
+        }
+        let mut fill = per_layer.clone();
+        let mut items = vec![[0u32; 2]; per_layer[dims[2] as usize]];
+        for &(tet, first, last) in &spans {
+            for layer in first..=last {
+                items[fill[layer as usize]] = [tet, layer];
+                fill[layer as usize] += 1;
+            }
+        }
         let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let grid_buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("halo-depth grid"),
-            size: bytes,
-            usage,
+            label: Some("halo-depth grid band"),
+            size: layer_bytes * u64::from(band),
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
@@ -811,57 +840,86 @@ impl Renderer {
             dims,
             view: texture.create_view(&Default::default()),
         };
-        // The uniform carries the grid's placement.
-        self.grid = Some(grid);
         let camera = GpuCamera::new(&ViewSettings::default(), self.asset.bounds)?;
-        let uniform = self.uniform(&camera, &ViewSettings::default(), true, (0.0, 1.0));
-        let grid = self.grid.take().expect("set above");
-        gpu.queue
-            .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
-        let bind = self.bind(
-            gpu,
-            self.voxelize.get_bind_group_layout(0),
-            &[
-                (5, self.halo_vertices.as_entire_binding()),
-                (6, self.tets.as_entire_binding()),
-                (7, item_buffer.as_entire_binding()),
-                (8, grid_buffer.as_entire_binding()),
-            ],
-        );
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        encoder.clear_buffer(&grid_buffer, 0, None);
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&self.voxelize);
-            pass.set_bind_group(0, &bind, &[]);
-            let groups = (items.len() as u32).div_ceil(64);
-            let max = gpu.limits().max_compute_workgroups_per_dimension.max(1);
-            if groups > 0 {
-                pass.dispatch_workgroups(groups.min(max), groups.div_ceil(max), 1);
+        let mut item_buffer = None;
+        for first in (0..dims[2]).step_by(band as usize) {
+            let layers = band.min(dims[2] - first);
+            let band_items =
+                &items[per_layer[first as usize]..per_layer[(first + layers) as usize]];
+            upload(
+                gpu,
+                &mut item_buffer,
+                "voxelization items",
+                bytemuck::cast_slice(band_items),
+                wgpu::BufferUsages::STORAGE,
+            )?;
+            let mut uniform = self.uniform(
+                &camera,
+                &ViewSettings::default(),
+                true,
+                (0.0, 1.0),
+                Some(&grid),
+            );
+            uniform.band = [band_items.len() as u32, first, 0, 0];
+            gpu.queue
+                .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+            let bind = self.bind(
+                gpu,
+                self.voxelize.get_bind_group_layout(0),
+                &[
+                    (5, self.halo_vertices.as_entire_binding()),
+                    (6, self.tets.as_entire_binding()),
+                    (
+                        7,
+                        item_buffer
+                            .as_ref()
+                            .expect("uploaded above")
+                            .as_entire_binding(),
+                    ),
+                    (8, grid_buffer.as_entire_binding()),
+                ],
+            );
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            encoder.clear_buffer(&grid_buffer, 0, None);
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                pass.set_pipeline(&self.voxelize);
+                pass.set_bind_group(0, &bind, &[]);
+                let groups = (band_items.len() as u32).div_ceil(64);
+                let max = limits.max_compute_workgroups_per_dimension.max(1);
+                if groups > 0 {
+                    pass.dispatch_workgroups(groups.min(max), groups.div_ceil(max), 1);
+                }
             }
-        }
-        encoder.copy_buffer_to_texture(
-            wgpu::TexelCopyBufferInfo {
-                buffer: &grid_buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row * 4),
-                    rows_per_image: Some(dims[1]),
+            encoder.copy_buffer_to_texture(
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &grid_buffer,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(row * 4),
+                        rows_per_image: Some(dims[1]),
+                    },
                 },
-            },
-            wgpu::TexelCopyTextureInfo {
-                texture: &texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::Extent3d {
-                width: dims[0],
-                height: dims[1],
-                depth_or_array_layers: dims[2],
-            },
-        );
-        gpu.queue.submit([encoder.finish()]);
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d {
+                        x: 0,
+                        y: 0,
+                        z: first,
+                    },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::Extent3d {
+                    width: dims[0],
+                    height: dims[1],
+                    depth_or_array_layers: layers,
+                },
+            );
+            gpu.queue.submit([encoder.finish()]);
+            // One band at a time: the next band's uniform must wait for this one.
+            gpu.finish()?;
+        }
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(ViewerError::Gpu(e.to_string()));
         }
@@ -929,10 +987,10 @@ impl Renderer {
         let mut fill = tri_count.clone();
         let mut indices = vec![0u32; tri_count[n] as usize * 3];
         for (t, &(a, b)) in self.asset.triangles.iter().zip(&tri_spans) {
-            for k in a..=b {
-                let at = fill[k] as usize;
+            for slot in &mut fill[a..=b] {
+                let at = *slot as usize;
                 indices[at * 3..at * 3 + 3].copy_from_slice(t);
-                fill[k] += 1;
+                *slot += 1;
             }
         }
         let mut fill = item_count.clone();
@@ -1006,7 +1064,6 @@ fn opaque_pass<'e>(
     target: &wgpu::TextureView,
     targets: &Targets,
     clear: bool,
-    _settings: &ViewSettings,
 ) -> wgpu::RenderPass<'e> {
     let load = |c: wgpu::Color| {
         if clear {

@@ -23,6 +23,8 @@ struct View {
     grid_dims: vec4<u32>,
     // x: flags (1 halos, 2 colour by w); y: colour stops.
     options: vec4<u32>,
+    // Voxelization of one band of the grid: x: items; y: the band's first z layer.
+    band: vec4<u32>,
     stops: array<vec4<f32>, 8>,
 }
 
@@ -297,12 +299,12 @@ fn curve_fs() -> OpaqueOut {
 // ---------------------------------------------------------------- halo depth
 
 // The smallest halo depth at the centre of every voxel in one z layer of a tetrahedron's
-// box, into the grid buffer: quantized and complemented, so that atomicMax keeps the
+// box, into the grid buffer (which holds the band of layers from band.y): quantized and complemented, so that atomicMax keeps the
 // smallest and 0 (a cleared buffer) means no halo.
 @compute @workgroup_size(64)
 fn voxelize(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let index = id.x + id.y * groups.x * 64u;
-    if index >= arrayLength(&items) {
+    if index >= view.band.x {
         return;
     }
     let item = items[index];
@@ -348,7 +350,7 @@ fn voxelize(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroup
             let dd = l0 * a.d + l1 * b.d + l2 * c.d + l3 * d.d;
             let depth = normalized(halo_depth(t, dd, a.delta_t, a.delta_d));
             let quantized = u32(clamp(depth, 0.0, 0.9999999) * QUANTUM);
-            let at = (z * view.grid_dims.y + u32(y)) * view.grid_dims.w + u32(x);
+            let at = ((z - view.band.y) * view.grid_dims.y + u32(y)) * view.grid_dims.w + u32(x);
             atomicMax(&grid_buffer[at], ~quantized);
         }
     }
