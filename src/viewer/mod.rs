@@ -491,7 +491,7 @@ impl GpuCamera {
             0.0,
         )?;
         let centre = (bounds.0 + bounds.1) * 0.5;
-        let radius = ((bounds.1 - bounds.0).length() * 0.5).max(f64::MIN_POSITIVE);
+        let radius = bounding_radius(bounds);
         let eye = cam.eye - centre;
         let dist = eye.length();
         let sx = 1.0 / (cam.half_height * cam.aspect);
@@ -526,6 +526,11 @@ impl GpuCamera {
         let clip = DMat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose();
         Ok(GpuCamera { cam, clip, eye })
     }
+}
+
+/// The radius of a box's bounding sphere, as the CPU renderer's camera takes it.
+pub(crate) fn bounding_radius((lo, hi): (DVec3, DVec3)) -> f64 {
+    ((hi - lo).length() * 0.5).max(f64::MIN_POSITIVE)
 }
 
 /// A rendered picture with, per pixel, the distance along the camera ray to the first

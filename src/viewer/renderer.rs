@@ -1,6 +1,6 @@
 //! Pipelines, targets and the passes of a frame.
 
-use super::{Asset, Frame, Gpu, GpuCamera, HaloMode, ViewSettings, ViewerError};
+use super::{Asset, Frame, Gpu, GpuCamera, HaloMode, ViewSettings, ViewerError, bounding_radius};
 use crate::render::{Picture, shade};
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
@@ -359,11 +359,6 @@ impl Renderer {
         })
     }
 
-    /// The asset drawn.
-    pub fn asset(&self) -> &Asset {
-        &self.asset
-    }
-
     /// Renders one frame into `target` (a view of a texture of `colour_format`, of the
     /// settings' size) and waits for the GPU to finish it.
     pub fn render(
@@ -384,6 +379,7 @@ impl Renderer {
                 .is_none_or(|g| g.slices != settings.slices)
         {
             let t = Instant::now();
+            // The old grid's memory goes before the new one is made.
             self.grid = None;
             self.grid = Some(self.build_grid(gpu, settings.slices)?);
             times.grid_ms = Some(t.elapsed().as_secs_f64() * 1e3);
@@ -396,7 +392,7 @@ impl Renderer {
         gpu.queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
         let lists = (settings.mode == HaloMode::View)
-            .then(|| self.slab_lists(gpu, &camera, slabs, halos))
+            .then(|| self.slab_lists(gpu, &camera, (slabs, settings.slices), halos))
             .transpose()?;
         times.prepare_ms = prepare.elapsed().as_secs_f64() * 1e3;
 
@@ -406,11 +402,12 @@ impl Renderer {
         let triangle_count = self.asset.triangles.len() as u32 * 3;
         match &lists {
             None => {
-                let (pipeline, grid) = if settings.transparent {
-                    (&self.surface_grid_blend, self.grid_view())
+                let pipeline = if settings.transparent {
+                    &self.surface_grid_blend
                 } else {
-                    (&self.surface_grid, self.grid_view())
+                    &self.surface_grid
                 };
+                let grid = self.grid.as_ref().map_or(&self.empty_grid, |g| &g.view);
                 let bind = self.bind(
                     gpu,
                     pipeline.get_bind_group_layout(0),
@@ -597,11 +594,6 @@ impl Renderer {
         })
     }
 
-    /// The grid's 3D texture, or a 1-voxel stand-in.
-    fn grid_view(&self) -> &wgpu::TextureView {
-        self.grid.as_ref().map_or(&self.empty_grid, |g| &g.view)
-    }
-
     /// A bind group for `layout` with the view uniform at binding 0 and `entries`.
     fn bind(
         &self,
@@ -666,8 +658,7 @@ impl Renderer {
     /// The planes of the view mode: the near side of the first slab and the slab thickness,
     /// spanning the bounding sphere as the CPU renderer's slice mode does.
     fn slabs(&self, camera: &GpuCamera, slices: u32) -> (f64, f64) {
-        let (lo, hi) = self.asset.bounds;
-        let radius = ((hi - lo).length() * 0.5).max(f64::MIN_POSITIVE);
+        let radius = bounding_radius(self.asset.bounds);
         let centre_depth = (-camera.eye).dot(camera.cam.forward);
         (centre_depth - radius, 2.0 * radius / f64::from(slices))
     }
@@ -934,10 +925,10 @@ impl Renderer {
         &mut self,
         gpu: &Gpu,
         camera: &GpuCamera,
-        (near, step): (f64, f64),
+        ((near, step), slices): ((f64, f64), u32),
         halos: bool,
     ) -> Result<SlabLists, ViewerError> {
-        let n = ((2.0 * camera_radius(self.asset.bounds)) / step).round() as usize;
+        let n = slices as usize;
         let forward = camera.cam.forward;
         let eye = camera.eye;
         let depth = |p: [f32; 3]| (DVec3::from(p.map(f64::from)) - eye).dot(forward);
@@ -1026,10 +1017,6 @@ impl Renderer {
 struct SlabLists {
     triangles: Vec<u32>,
     items: Vec<u32>,
-}
-
-fn camera_radius((lo, hi): (DVec3, DVec3)) -> f64 {
-    ((hi - lo).length() * 0.5).max(f64::MIN_POSITIVE)
 }
 
 /// Writes `bytes` into `buffer`, replacing it with a larger one when they do not fit.

@@ -2,7 +2,7 @@
 //! settings and frame time in the title.
 //!
 //! Drag with the left button to turn (azimuth, elevation), wheel to zoom, `R` to reset the
-//! camera, `S` to cycle the slice count (64, 128, 256, 512), `M` to switch between the grid
+//! camera (the title shows it, in `halo4d render`'s terms), `S` to cycle the slice count (64, 128, 256, 512), `M` to switch between the grid
 //! and view-slice modes, `H` halos, `C` curves, `T` transparency, `W` colour by w,
 //! `Escape` or `Q` to quit.
 
@@ -119,18 +119,17 @@ impl App {
         let s = &self.settings;
         let on = |b: bool| if b { "on" } else { "off" };
         state.window.set_title(&format!(
-            "halo4d-view: {} | {} {} slices | halos {} | curves {} | {} | colour {} | {:.1} ms{}",
+            "halo4d-view: {} | {} {} slices | halos {} | curves {} | {} | colour {} | azimuth {:.0} elevation {:.0} distance {:.2} | {:.1} ms{}",
             self.asset.name,
             s.mode.name(),
             s.slices,
             on(s.halos),
             on(s.curves),
-            if s.transparent {
-                "transparent"
-            } else {
-                "opaque"
-            },
+            if s.transparent { "transparent" } else { "opaque" },
             if s.colour_by_w { "by w" } else { "grey" },
+            s.camera.azimuth,
+            s.camera.elevation,
+            s.camera.distance,
             self.last_ms,
             times
                 .grid_ms
