@@ -182,7 +182,8 @@ fn curves_colour_and_transparency_toggle_what_they_should() {
         curves: false,
         ..base
     });
-    // Every pixel the curves change is on a projected curve segment (within a pixel).
+    // Every pixel the curves change is on a projected curve segment: within half the
+    // curves' 2.5-pixel width and a pixel.
     let camera =
         halo4d::render::camera::Camera::new(&scene.camera, asset.bounds, SIDE, SIDE, 0.0).unwrap();
     let mut segments = Vec::new();
@@ -207,7 +208,7 @@ fn curves_colour_and_transparency_toggle_what_they_should() {
                 0.0
             };
             let (px, py) = (a[0] + s * dx - x, a[1] + s * dy - y);
-            px * px + py * py <= 1.5 * 1.5
+            px * px + py * py <= 2.25 * 2.25
         })
     };
     let mut changed = 0;

@@ -14,6 +14,8 @@ const DISTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const ACCUM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 const REVEAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
+/// Width of the curves in pixels (the CPU renderer's default `line_width`).
+const CURVE_WIDTH: f32 = 2.5;
 /// Opacity of a surface face-on in transparent mode.
 const OPACITY: f32 = 0.45;
 
@@ -34,6 +36,7 @@ struct ViewUniform {
     grid_dims: [u32; 4],
     options: [u32; 4],
     band: [u32; 4],
+    viewport: [f32; 4],
     stops: [[f32; 4]; 8],
 }
 
@@ -125,7 +128,7 @@ impl Renderer {
         let curve_segments = gpu.buffer(
             "curve segments",
             bytemuck::cast_slice(&asset.curve_segments),
-            U::INDEX,
+            storage,
         )?;
         let halo_vertices = gpu.buffer(
             "halo vertices",
@@ -280,7 +283,7 @@ impl Renderer {
             "curves",
             "curve_vs",
             "curve_fs",
-            P::LineList,
+            P::TriangleList,
             &opaque_targets(false),
             depth(false, C::LessEqual),
         );
@@ -524,12 +527,14 @@ impl Renderer {
                 let bind = self.bind(
                     gpu,
                     self.curves.get_bind_group_layout(0),
-                    &[(4, self.curve_points.as_entire_binding())],
+                    &[
+                        (4, self.curve_points.as_entire_binding()),
+                        (11, self.curve_segments.as_entire_binding()),
+                    ],
                 );
                 pass.set_pipeline(&self.curves);
                 pass.set_bind_group(0, &bind, &[]);
-                pass.set_index_buffer(self.curve_segments.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..self.asset.curve_segments.len() as u32 * 2, 0, 0..1);
+                pass.draw(0..6, 0..self.asset.curve_segments.len() as u32);
             }
         }
         gpu.queue.submit([encoder.finish()]);
@@ -721,6 +726,12 @@ impl Renderer {
             grid_dims: [dims[0], dims[1], dims[2], dims[0].next_multiple_of(64)],
             options: [flags, stops.len() as u32, 0, 0],
             band: [0; 4],
+            viewport: [
+                settings.width as f32,
+                settings.height as f32,
+                CURVE_WIDTH * 0.5,
+                (2.0 * cam.half_height / f64::from(settings.height)) as f32,
+            ],
             stops: stop_array,
         }
     }

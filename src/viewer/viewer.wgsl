@@ -25,6 +25,9 @@ struct View {
     options: vec4<u32>,
     // Voxelization of one band of the grid: x: items; y: the band's first z layer.
     band: vec4<u32>,
+    // x, y: the frame's size in pixels; z: half the curves' width in pixels; w: a pixel's
+    // size at unit depth (perspective) or anywhere (orthographic).
+    viewport: vec4<f32>,
     stops: array<vec4<f32>, 8>,
 }
 
@@ -60,6 +63,7 @@ struct HaloVertex {
 @group(0) @binding(8) var<storage, read_write> grid_buffer: array<atomic<u32>>;
 @group(0) @binding(9) var accum_image: texture_2d<f32>;
 @group(0) @binding(10) var reveal_image: texture_2d<f32>;
+@group(0) @binding(11) var<storage, read> curve_segments: array<vec2<u32>>;
 
 const QUANTUM: f32 = 2147483648.0;
 const INK: vec3<f32> = vec3<f32>(0.02, 0.02, 0.02);
@@ -283,11 +287,44 @@ fn composite_fs(@builtin(position) frag: vec4<f32>) -> OpaqueOut {
 
 // ---------------------------------------------------------------- curves
 
+// Corner `vertex` (0..6, two triangles) of segment `segment` of the curves drawn as a band
+// `viewport.z` pixels either side of it, capped as far beyond its ends.
 @vertex
-fn curve_vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    var clip = view.clip * vec4<f32>(curve_points[i].xyz, 1.0);
-    // Pulled slightly towards the eye: the curves lie on the surfaces.
-    clip.z -= 2e-4 * clip.w;
+fn curve_vs(@builtin(vertex_index) vertex: u32, @builtin(instance_index) segment: u32) -> @builtin(position) vec4<f32> {
+    let ends = curve_segments[segment];
+    let a = view.clip * vec4<f32>(curve_points[ends.x].xyz, 1.0);
+    let b = view.clip * vec4<f32>(curve_points[ends.y].xyz, 1.0);
+    if a.w <= 0.0 || b.w <= 0.0 {
+        // Behind the eye: nothing.
+        return vec4<f32>(2.0, 2.0, 2.0, 1.0);
+    }
+    let half_size = view.viewport.xy * 0.5;
+    let sa = a.xy / a.w * half_size;
+    let sb = b.xy / b.w * half_size;
+    var along = sb - sa;
+    if dot(along, along) < 1e-12 {
+        along = vec2<f32>(1.0, 0.0);
+    }
+    along = normalize(along) * view.viewport.z;
+    let across = vec2<f32>(-along.y, along.x);
+    let corners = array<vec2<f32>, 6>(
+        vec2<f32>(0.0, -1.0), vec2<f32>(0.0, 1.0), vec2<f32>(1.0, 1.0),
+        vec2<f32>(0.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(1.0, -1.0),
+    );
+    let c = corners[vertex];
+    let end = select(ends.x, ends.y, c.x > 0.5);
+    let p = curve_points[end].xyz;
+    var clip = select(a, b, c.x > 0.5);
+    let offset = (across * c.y + along * (c.x * 2.0 - 1.0)) / half_size;
+    // The band is tested for depth as if three of its half-widths nearer the eye, so that
+    // a sheet rising towards the eye beside the curve (up to about 70 degrees) does not
+    // cover it where its centre line is in view.
+    var pixel = view.viewport.w;
+    if view.eye.w > 0.5 {
+        pixel *= clip.w;
+    }
+    let nearer = view.clip * vec4<f32>(p - ray_dir(p) * (3.0 * view.viewport.z * pixel), 1.0);
+    clip = vec4<f32>(clip.xy + offset * clip.w, nearer.z / nearer.w * clip.w, clip.w);
     return clip;
 }
 
