@@ -68,6 +68,10 @@ struct Args {
     /// Frames per orbit for --bench.
     #[arg(long, default_value_t = 36)]
     frames: u32,
+    /// Render with the CPU renderer's exact mode too, and print for each mode and slice
+    /// count the share of covered pixels where what is visible differs.
+    #[arg(long)]
+    compare: bool,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -107,13 +111,13 @@ fn main() -> ExitCode {
 }
 
 fn run(args: &Args) -> Result<(), ViewerError> {
-    if args.headless && args.screenshot.is_none() && !args.bench {
+    if args.headless && args.screenshot.is_none() && !args.bench && !args.compare {
         return Err(ViewerError::Setting {
             field: "--headless".into(),
-            message: "needs --screenshot OUT.png (or --bench)".into(),
+            message: "needs --screenshot OUT.png (or --bench, or --compare)".into(),
         });
     }
-    let asset = Asset::load(&args.file)?;
+    let (scene, asset) = Asset::read(&args.file)?;
     if !asset.surfaces_without_halo.is_empty() {
         eprintln!(
             "note: no halo for {}: those surfaces are never hidden (build with halo.enabled)",
@@ -153,6 +157,9 @@ fn run(args: &Args) -> Result<(), ViewerError> {
     settings.check()?;
     if args.bench {
         return bench(&asset, &settings, args.frames);
+    }
+    if args.compare {
+        return compare(&scene, &asset, &settings);
     }
     if let Some(out) = &args.screenshot {
         let gpu = Gpu::headless()?;
@@ -216,5 +223,33 @@ fn bench(asset: &Asset, settings: &ViewSettings, frames: u32) -> Result<(), View
             1e3 / r.mean_ms
         );
     })?;
+    Ok(())
+}
+
+fn compare(
+    scene: &halo4d::import::ImportedScene,
+    asset: &Asset,
+    settings: &ViewSettings,
+) -> Result<(), ViewerError> {
+    let gpu = Gpu::headless()?;
+    println!(
+        "{}: {}x{}, against the CPU renderer's exact mode (one sample per pixel), on {}",
+        asset.name,
+        settings.width,
+        settings.height,
+        gpu.describe()
+    );
+    println!("| mode | slices | verdict differs | ms (GPU frame) |");
+    println!("| --- | --- | --- | --- |");
+    let (cpu_ms, _) = viewer::compare(&gpu, scene, asset, settings, &SLICE_COUNTS, &mut |r| {
+        println!(
+            "| {} | {} | {:.3}% | {:.1} |",
+            r.mode.name(),
+            r.slices,
+            r.verdict_differs * 100.0,
+            r.ms
+        );
+    })?;
+    println!("exact CPU render: {cpu_ms:.0} ms");
     Ok(())
 }

@@ -106,6 +106,13 @@ impl ImportedScene {
     pub fn verify(&self) -> (Curves, Verification) {
         let sheets = self.sheets();
         let curves = intersect::curves(&sheets);
+        let verification = self.with_halos(|halos| verify::verify(&sheets, halos, &curves));
+        (curves, verification)
+    }
+
+    /// Calls `f` with the halos as the verification and the renderer read them (one per
+    /// surface; a halo without tetrahedra, t, d_orig, delta_d or delta_t counts as none).
+    pub fn with_halos<R>(&self, f: impl FnOnce(&[Option<HaloInput>]) -> R) -> R {
         let positions: Vec<Vec<DVec3>> = self
             .surfaces
             .iter()
@@ -132,8 +139,7 @@ impl ImportedScene {
                 })
             })
             .collect();
-        let verification = verify::verify(&sheets, &halos, &curves);
-        (curves, verification)
+        f(&halos)
     }
 }
 

@@ -270,6 +270,11 @@ pub struct Asset {
 impl Asset {
     /// Reads a scene's `.glb`.
     pub fn load(path: &Path) -> Result<Asset, ViewerError> {
+        Asset::read(path).map(|(_, asset)| asset)
+    }
+
+    /// Reads a scene's `.glb`: the scene as imported, and the asset made from it.
+    pub fn read(path: &Path) -> Result<(ImportedScene, Asset), ViewerError> {
         let file = |source: ImportError| ViewerError::File {
             path: path.display().to_string(),
             source,
@@ -280,7 +285,8 @@ impl Asset {
             path.file_stem()
                 .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned())
         });
-        Asset::new(&scene, name)
+        let asset = Asset::new(&scene, name)?;
+        Ok((scene, asset))
     }
 
     /// Gathers an imported scene, checking its size against [`MAX_TRIANGLES`] and
@@ -626,4 +632,109 @@ pub fn bench(
         }
     }
     Ok(rows)
+}
+
+/// One line of [`compare`]: a mode and slice count against the exact CPU render.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CompareRow {
+    /// How the halo depth was sliced.
+    pub mode: HaloMode,
+    /// Slices.
+    pub slices: u32,
+    /// Share of covered pixels whose first visible surface differs from the exact render's.
+    pub verdict_differs: f64,
+    /// Milliseconds for the GPU frame (a grid built for it included).
+    pub ms: f64,
+}
+
+/// Renders `scene` (as [`Asset::read`] gives it, with `asset` made from it) with the CPU
+/// renderer's exact mode (one sample per pixel, at the pixel centres where the GPU
+/// rasterizes, no lines) and on the GPU with each mode and each of `slices`, at the
+/// settings' camera and size, and compares what is visible ([`verdict_differs`] of the
+/// distances, to 1e-4). Gives the CPU's milliseconds and a row per GPU frame; `progress`
+/// hears of each row.
+///
+/// [`verdict_differs`]: crate::render::compare::verdict_differs
+pub fn compare(
+    gpu: &Gpu,
+    scene: &ImportedScene,
+    asset: &Asset,
+    settings: &ViewSettings,
+    slices: &[u32],
+    progress: &mut dyn FnMut(&CompareRow),
+) -> Result<(f64, Vec<CompareRow>), ViewerError> {
+    settings.check()?;
+    let normals: Vec<Vec<DVec3>> = scene
+        .surfaces
+        .iter()
+        .map(|s| {
+            s.normals
+                .clone()
+                .unwrap_or_else(|| vertex_normals(&s.positions, &s.triangles))
+        })
+        .collect();
+    let uv: Vec<Vec<[f64; 2]>> = scene
+        .surfaces
+        .iter()
+        .map(|s| vec![[0.0; 2]; s.positions.len()])
+        .collect();
+    let surfaces: Vec<crate::render::RenderSurface> = scene
+        .surfaces
+        .iter()
+        .zip(normals.iter().zip(&uv))
+        .map(|(s, (normals, uv))| crate::render::RenderSurface {
+            positions: &s.positions,
+            w: &s.w,
+            normals,
+            uv,
+            triangles: &s.triangles,
+        })
+        .collect();
+    let cpu_settings = crate::render::RenderSettings {
+        width: settings.width,
+        height: settings.height,
+        samples: 1,
+        mode: crate::render::RenderMode::Exact,
+        halos: settings.halos,
+        curves: false,
+        silhouettes: false,
+        colormap: settings.colormap,
+        ..Default::default()
+    };
+    let no_curves = crate::intersect::Curves::default();
+    let start = std::time::Instant::now();
+    let exact = scene.with_halos(|halos| {
+        let input = crate::render::RenderInput {
+            surfaces: &surfaces,
+            halos,
+            curves: &no_curves,
+        };
+        crate::render::render_with_depth(&input, &cpu_settings, &settings.camera)
+    })?;
+    let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+    let mut renderer = Renderer::new(gpu, asset, renderer::OFFSCREEN_FORMAT)?;
+    let mut rows = Vec::new();
+    for mode in [HaloMode::Grid, HaloMode::View] {
+        for &n in slices {
+            let s = ViewSettings {
+                mode,
+                slices: n,
+                curves: false,
+                ..*settings
+            };
+            let start = std::time::Instant::now();
+            let frame = renderer.read_frame(gpu, &s)?;
+            let ms = start.elapsed().as_secs_f64() * 1e3;
+            let distance: Vec<f64> = frame.distance.iter().map(|&d| f64::from(d)).collect();
+            let row = CompareRow {
+                mode,
+                slices: n,
+                verdict_differs: crate::render::compare::verdict_differs(&exact.1, &distance, 1e-4),
+                ms,
+            };
+            progress(&row);
+            rows.push(row);
+        }
+    }
+    Ok((cpu_ms, rows))
 }
