@@ -506,7 +506,7 @@ fn curves_mesh(
 
 /// Wraps JSON and binary chunks in the GLB container (header, JSON chunk padded with spaces,
 /// BIN chunk padded with zeros).
-fn glb_container(mut text: Vec<u8>, mut bin: Vec<u8>) -> Vec<u8> {
+pub fn glb_container(mut text: Vec<u8>, mut bin: Vec<u8>) -> Vec<u8> {
     text.resize(text.len().next_multiple_of(4), b' ');
     bin.resize(bin.len().next_multiple_of(4), 0);
     let total = 12 + 8 + text.len() + 8 + bin.len();

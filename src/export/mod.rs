@@ -16,7 +16,7 @@ mod plot;
 mod ply;
 mod vtk;
 
-pub use gltf::to_glb;
+pub use gltf::{glb_container, to_glb};
 pub use obj::to_obj;
 pub use plot::{encode_png, render_speed_vs_error_png, speed_vs_error_png};
 pub use ply::{to_curves_ply, to_ply};

@@ -242,6 +242,16 @@ fn chunks(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>)> {
     Ok((json, bin))
 }
 
+/// A primitive's points as [`Doc::points`] reads them.
+struct Points<'a> {
+    /// `meshes[i] (`name`)`, for messages.
+    what: String,
+    attributes: &'a Value,
+    positions: Vec<DVec3>,
+    w: Vec<f64>,
+    indices: Vec<u32>,
+}
+
 /// A parsed glTF document and its binary chunk.
 struct Doc<'a> {
     json: &'a Value,
@@ -398,17 +408,24 @@ impl<'a> Doc<'a> {
             .collect())
     }
 
-    /// The surface of mesh `i`: its first primitive's POSITION, `_W` and triangles.
-    fn surface(&self, i: usize, mesh: &Value, name: String) -> Result<ImportedSurface> {
+    /// The first primitive of mesh `i`, which must be of `mode` (`(4, "TRIANGLES")` or
+    /// `(1, "LINES")`): its POSITION, `_W` and indices, and its attributes.
+    fn points(
+        &self,
+        i: usize,
+        mesh: &'a Value,
+        name: &str,
+        (mode, mode_name): (u64, &str),
+    ) -> Result<Points<'a>> {
         let what = format!("meshes[{i}] (`{name}`)");
         let primitive = mesh
             .get("primitives")
             .and_then(|p| p.get(0))
             .ok_or_else(|| glb_err(format!("{what} has no primitive")))?;
-        let mode = index(primitive, "mode", &format!("{what}.primitives[0]"), Some(4))?;
-        if mode != 4 {
+        let found = index(primitive, "mode", &format!("{what}.primitives[0]"), Some(4))?;
+        if found != mode {
             return Err(glb_err(format!(
-                "{what} has primitives of mode {mode}, expected TRIANGLES (4)"
+                "{what} has primitives of mode {found}, expected {mode_name} ({mode})"
             )));
         }
         let attributes = primitive
@@ -427,6 +444,34 @@ impl<'a> Doc<'a> {
             .into_iter()
             .map(f64::from)
             .collect();
+        let indices = self.unsigned(index(
+            primitive,
+            "indices",
+            &format!("{what}.primitives[0]"),
+            None,
+        )?)?;
+        Ok(Points {
+            what,
+            attributes,
+            positions,
+            w,
+            indices,
+        })
+    }
+
+    /// The surface of mesh `i`: its first primitive's POSITION, `_W`, NORMAL if any, and
+    /// triangles.
+    fn surface(&self, i: usize, mesh: &'a Value, name: String) -> Result<ImportedSurface> {
+        let Points {
+            attributes,
+            positions,
+            w,
+            indices,
+            what,
+        } = self.points(i, mesh, &name, (4, "TRIANGLES"))?;
+        let attribute = |key: &str| -> Result<u64> {
+            index(attributes, key, &format!("{what} attributes"), None)
+        };
         let normals: Option<Vec<DVec3>> = match attributes.get("NORMAL") {
             None => None,
             Some(_) => Some(
@@ -436,12 +481,6 @@ impl<'a> Doc<'a> {
                     .collect(),
             ),
         };
-        let indices = self.unsigned(index(
-            primitive,
-            "indices",
-            &format!("{what}.primitives[0]"),
-            None,
-        )?)?;
         let bad = |message: String| ImportError::BadSurface {
             name: name.clone(),
             message,
@@ -506,40 +545,14 @@ impl<'a> Doc<'a> {
 
     /// The curves of mesh `i` (extras `curves`): its first primitive's LINES with POSITION
     /// and `_W`.
-    fn curves(&self, i: usize, mesh: &Value, name: String) -> Result<ImportedCurves> {
-        let what = format!("meshes[{i}] (`{name}`)");
-        let primitive = mesh
-            .get("primitives")
-            .and_then(|p| p.get(0))
-            .ok_or_else(|| glb_err(format!("{what} has no primitive")))?;
-        let mode = index(primitive, "mode", &format!("{what}.primitives[0]"), Some(4))?;
-        if mode != 1 {
-            return Err(glb_err(format!(
-                "{what} has primitives of mode {mode}, expected LINES (1)"
-            )));
-        }
-        let attributes = primitive
-            .get("attributes")
-            .ok_or_else(|| glb_err(format!("{what} has no attributes")))?;
-        let attribute = |key: &str| -> Result<u64> {
-            index(attributes, key, &format!("{what} attributes"), None)
-        };
-        let positions: Vec<DVec3> = self
-            .floats(attribute("POSITION")?, "VEC3", 3)?
-            .chunks_exact(3)
-            .map(|c| DVec3::new(c[0].into(), c[1].into(), c[2].into()))
-            .collect();
-        let w: Vec<f64> = self
-            .floats(attribute("_W")?, "SCALAR", 1)?
-            .into_iter()
-            .map(f64::from)
-            .collect();
-        let indices = self.unsigned(index(
-            primitive,
-            "indices",
-            &format!("{what}.primitives[0]"),
-            None,
-        )?)?;
+    fn curves(&self, i: usize, mesh: &'a Value, name: String) -> Result<ImportedCurves> {
+        let Points {
+            what,
+            positions,
+            w,
+            indices,
+            ..
+        } = self.points(i, mesh, &name, (1, "LINES"))?;
         let nv = positions.len();
         let bad = |message: String| glb_err(format!("{what}: {message}"));
         if w.len() != nv {

@@ -579,20 +579,26 @@ fn prepare<'a>(
         field: format!("camera.{f}"),
         message: m,
     })?;
-    let bounds = input
-        .surfaces
-        .iter()
-        .flat_map(|s| {
-            s.triangles
+    let bounds = triangle_bounds(input.surfaces.iter().map(|s| (s.positions, s.triangles)))
+        .ok_or(RenderError::Empty)?;
+    Ok((bounds, Scene::new(input, settings, bounds)))
+}
+
+/// The box around every vertex of a triangle of the surfaces (positions, triangles), which
+/// the camera frames; `None` when there is no triangle.
+pub fn triangle_bounds<'a>(
+    surfaces: impl Iterator<Item = (&'a [DVec3], &'a [[u32; 3]])>,
+) -> Option<(DVec3, DVec3)> {
+    surfaces
+        .flat_map(|(positions, triangles)| {
+            triangles
                 .iter()
                 .flatten()
-                .map(|&v| s.positions[v as usize])
+                .map(move |&v| positions[v as usize])
         })
         .fold(None, |b: Option<(DVec3, DVec3)>, p| {
             Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
         })
-        .ok_or(RenderError::Empty)?;
-    Ok((bounds, Scene::new(input, settings, bounds)))
 }
 
 /// A colour bar of the w scale along the bottom of an image, near w at the left, far at the

@@ -312,19 +312,13 @@ impl Asset {
                 });
             }
         }
-        let bounds = scene
-            .surfaces
-            .iter()
-            .flat_map(|s| {
-                s.triangles
-                    .iter()
-                    .flatten()
-                    .map(|&v| s.positions[v as usize])
-            })
-            .fold(None, |b: Option<(DVec3, DVec3)>, p| {
-                Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
-            })
-            .ok_or(ViewerError::Camera(RenderError::Empty))?;
+        let bounds = crate::render::triangle_bounds(
+            scene
+                .surfaces
+                .iter()
+                .map(|s| (s.positions.as_slice(), s.triangles.as_slice())),
+        )
+        .ok_or(ViewerError::Camera(RenderError::Empty))?;
         let centre = (bounds.0 + bounds.1) * 0.5;
         let rel = |p: DVec3| (p - centre).as_vec3().to_array();
         let mut w_range = (f64::INFINITY, f64::NEG_INFINITY);
@@ -588,20 +582,13 @@ pub fn bench(
 ) -> Result<Vec<BenchRow>, ViewerError> {
     settings.check()?;
     let mut renderer = Renderer::new(gpu, asset, renderer::OFFSCREEN_FORMAT)?;
-    let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("bench frame"),
-        size: wgpu::Extent3d {
-            width: settings.width,
-            height: settings.height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: renderer::OFFSCREEN_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-        view_formats: &[],
-    });
+    let target = renderer::frame_texture(
+        gpu,
+        "bench frame",
+        (settings.width, settings.height),
+        renderer::OFFSCREEN_FORMAT,
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+    );
     let view = target.create_view(&Default::default());
     let mut rows = Vec::new();
     for mode in [HaloMode::Grid, HaloMode::View] {

@@ -549,20 +549,13 @@ impl Renderer {
     /// Renders one frame offscreen and reads it back with its distances.
     pub fn read_frame(&mut self, gpu: &Gpu, settings: &ViewSettings) -> Result<Frame, ViewerError> {
         settings.check()?;
-        let colour = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("frame"),
-            size: wgpu::Extent3d {
-                width: settings.width,
-                height: settings.height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: self.colour_format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let colour = frame_texture(
+            gpu,
+            "frame",
+            (settings.width, settings.height),
+            self.colour_format,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        );
         let times = self.render(gpu, &colour.create_view(&Default::default()), settings)?;
         let texels = gpu.read_texture(&colour)?;
         let bgra = matches!(
@@ -630,21 +623,14 @@ impl Renderer {
         if self.targets.as_ref().is_some_and(|t| t.size == size) {
             return;
         }
-        let texture = |label: &str, format: wgpu::TextureFormat, extra: wgpu::TextureUsages| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: size.0,
-                    height: size.1,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
+        let texture = |label, format, extra| {
+            frame_texture(
+                gpu,
+                label,
+                size,
                 format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | extra,
-                view_formats: &[],
-            })
+                wgpu::TextureUsages::RENDER_ATTACHMENT | extra,
+            )
         };
         use wgpu::TextureUsages as T;
         let distance = texture("distance", DISTANCE_FORMAT, T::COPY_SRC);
@@ -1022,6 +1008,30 @@ impl Renderer {
             items: item_count,
         })
     }
+}
+
+/// A 2D texture of a frame's `size`.
+pub(crate) fn frame_texture(
+    gpu: &Gpu,
+    label: &str,
+    size: (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: size.0,
+            height: size.1,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
 }
 
 /// Per slab, where its triangle indices and its cut items start (one more entry than slabs).
