@@ -33,16 +33,17 @@ expect() {
   echo "the window's title never showed '$1' (last: '$t')"
   exit 1
 }
-expect "grid 64 slices | halos on | curves on | opaque | colour by w | azimuth 35"
+expect "grid 64 slices | halos on | curves on | silhouettes on | opaque | colour by w | azimuth 35"
 xdotool key s; expect "grid 128 slices"
 xdotool key m; expect "view 128 slices"
 xdotool key h; expect "halos off"
 xdotool key c; expect "curves off"
+xdotool key o; expect "silhouettes off"
 xdotool key t; expect "transparent"
 xdotool key w; expect "colour grey"
 xdotool mousemove --window "$w" 200 150 mousedown 1 mousemove --window "$w" 300 150 mouseup 1
 expect "azimuth 355"
-xdotool mousemove --window "$w" 240 180 click 4; expect "distance 2.88"
+xdotool mousemove --window "$w" 240 180 click 4; expect "distance 2."
 xdotool key r; expect "azimuth 35 elevation 25 distance 3.20"
 xdotool key q
 wait "$viewer"

@@ -182,6 +182,67 @@ fn curves_colour_and_transparency_toggle_what_they_should() {
         curves: false,
         ..base
     });
+    let bare = shot(&ViewSettings {
+        curves: false,
+        silhouettes: false,
+        ..base
+    });
+    // Silhouettes are drawn where the surfaces turn away: the pixels they change are within
+    // two pixels of a jump in distance (to the background, or to a surface behind by more
+    // than a hundredth of the scene's size), in the picture with halos or in the one
+    // without (where a halo has cut away the sheet in front of a silhouette, the CPU
+    // renderer draws it too).
+    let unhidden = shot(&ViewSettings {
+        curves: false,
+        silhouettes: false,
+        halos: false,
+        ..base
+    });
+    let jump = {
+        let (lo, hi) = asset.bounds;
+        0.01 * (hi - lo).length()
+    };
+    let at = |frame: &viewer::Frame, x: i64, y: i64| {
+        let (x, y) = (x.clamp(0, SIDE as i64 - 1), y.clamp(0, SIDE as i64 - 1));
+        f64::from(frame.distance[(y * SIDE as i64 + x) as usize])
+    };
+    let breaks = |a: f64, b: f64| a.is_finite() != b.is_finite() || (a - b).abs() > jump;
+    let near_jump = |x: i64, y: i64| {
+        [&bare, &unhidden].iter().any(|f| {
+            (-2..=2).any(|dy| {
+                (-2..=2).any(|dx| {
+                    let (px, py) = (x + dx, y + dy);
+                    breaks(at(f, px, py), at(f, px + 1, py))
+                        || breaks(at(f, px, py), at(f, px, py + 1))
+                })
+            })
+        })
+    };
+    let (mut outlined, mut at_jump) = (0u32, 0u32);
+    for (i, (a, b)) in without
+        .picture
+        .rgb
+        .chunks(3)
+        .zip(bare.picture.rgb.chunks(3))
+        .enumerate()
+    {
+        if a != b {
+            outlined += 1;
+            let (x, y) = ((i as u32 % SIDE) as i64, (i as u32 / SIDE) as i64);
+            at_jump += u32::from(near_jump(x, y));
+        }
+    }
+    assert!(
+        outlined > 200,
+        "the silhouettes are drawn ({outlined} pixels)"
+    );
+    // Where a silhouette passes in front of a sheet it crosses, the jump behind it shrinks
+    // to nothing: a few pixels there.
+    assert!(
+        f64::from(at_jump) >= 0.95 * f64::from(outlined),
+        "{} of {outlined} silhouette pixels away from every contour",
+        outlined - at_jump
+    );
     // Every pixel the curves change is on a projected curve segment: within half the
     // curves' 2.5-pixel width and a pixel.
     let camera =
@@ -250,12 +311,13 @@ fn curves_colour_and_transparency_toggle_what_they_should() {
     let clear = shot(&ViewSettings {
         transparent: true,
         curves: false,
+        silhouettes: false,
         ..base
     });
     let brightness = |f: &viewer::Frame| f.picture.rgb.iter().map(|&c| u64::from(c)).sum::<u64>();
-    assert!(brightness(&clear) > brightness(&without));
+    assert!(brightness(&clear) > brightness(&bare));
     assert!(clear.distance.iter().all(|d| d.is_infinite()));
-    assert!(without.distance.iter().any(|d| d.is_finite()));
+    assert!(bare.distance.iter().any(|d| d.is_finite()));
 }
 
 /// `bytes` (a `.glb`) with its JSON chunk changed by `edit`.

@@ -52,6 +52,9 @@ struct Args {
     /// Leave the curves out.
     #[arg(long)]
     no_curves: bool,
+    /// Leave the silhouettes out.
+    #[arg(long)]
+    no_silhouettes: bool,
     /// Half-transparent surfaces.
     #[arg(long)]
     transparent: bool,
@@ -146,6 +149,7 @@ fn run(args: &Args) -> Result<(), ViewerError> {
         },
         halos: !args.no_halos,
         curves: !args.no_curves,
+        silhouettes: !args.no_silhouettes,
         transparent: args.transparent,
         colour_by_w: !args.grey,
         colormap: match args.colormap {

@@ -88,6 +88,9 @@ pub struct ViewSettings {
     pub halos: bool,
     /// Whether the curves are drawn.
     pub curves: bool,
+    /// Whether the silhouettes are drawn (edges between a triangle facing the eye and one
+    /// facing away, as the CPU renderer draws them).
+    pub silhouettes: bool,
     /// Whether surfaces are half transparent (composited in any order, weighted by depth).
     pub transparent: bool,
     /// Colour by w (else one grey).
@@ -106,6 +109,7 @@ impl Default for ViewSettings {
             mode: HaloMode::Grid,
             halos: true,
             curves: true,
+            silhouettes: true,
             transparent: false,
             colour_by_w: true,
             colormap: Colormap::Diverging,
@@ -263,6 +267,10 @@ pub struct Asset {
     /// Curve points: position relative to the centre, and w.
     pub(crate) curve_points: Vec<[f32; 4]>,
     pub(crate) curve_segments: Vec<[u32; 2]>,
+    /// Interior edges: (a, b, triangle i, triangle j | 1 << 31 where their windings agree).
+    pub(crate) edges: Vec<[u32; 4]>,
+    /// Per triangle, its normal as wound (unnormalized).
+    pub(crate) face_normals: Vec<[f32; 4]>,
     /// Surfaces without a halo, by name.
     pub surfaces_without_halo: Vec<String>,
 }
@@ -328,8 +336,29 @@ impl Asset {
         let mut all_tets = Vec::with_capacity(tets);
         let mut without = Vec::new();
         let mut depth_hi = f64::NEG_INFINITY;
+        let mut edges = Vec::new();
+        let mut face_normals = Vec::with_capacity(triangles);
         for s in &scene.surfaces {
             let base = vertices.len() as u32;
+            let first_triangle = face_normals.len() as u32;
+            edges.extend(
+                interior_edges(&s.triangles)
+                    .into_iter()
+                    .map(|[a, b, i, j]| {
+                        let agree = j & AGREE;
+                        [
+                            a + base,
+                            b + base,
+                            i + first_triangle,
+                            ((j & !AGREE) + first_triangle) | agree,
+                        ]
+                    }),
+            );
+            face_normals.extend(s.triangles.iter().map(|t| {
+                let p = t.map(|v| s.positions[v as usize]);
+                let [x, y, z] = (p[1] - p[0]).cross(p[2] - p[0]).as_vec3().to_array();
+                [x, y, z, 0.0]
+            }));
             for &w in &s.w {
                 w_range = (w_range.0.min(w), w_range.1.max(w));
             }
@@ -404,6 +433,8 @@ impl Asset {
             tets: all_tets,
             curve_points,
             curve_segments,
+            edges,
+            face_normals,
             surfaces_without_halo: without,
         })
     }
@@ -435,6 +466,33 @@ fn vertex_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
         }
     }
     n.into_iter().map(|v| v.normalize_or_zero()).collect()
+}
+
+/// The flag of an interior edge whose two triangles' windings agree.
+const AGREE: u32 = 1 << 31;
+
+/// The edges between two triangles: (a, b, triangle i, triangle j | 1 << 31 where the two
+/// windings agree, that is the triangles run along the edge in opposite directions).
+fn interior_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 4]> {
+    let mut sides: Vec<([u32; 2], u32, bool)> = triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(i, t)| {
+            (0..3).map(move |k| {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                ([a.min(b), a.max(b)], i as u32, a < b)
+            })
+        })
+        .collect();
+    sides.sort_unstable();
+    sides
+        .windows(2)
+        .filter(|w| w[0].0 == w[1].0)
+        .map(|w| {
+            let agree = if w[0].2 != w[1].2 { AGREE } else { 0 };
+            [w[0].0[0], w[0].0[1], w[0].1, w[1].1 | agree]
+        })
+        .collect()
 }
 
 /// Per vertex, the largest |grad w| over the triangles around it (w linear on each), and
@@ -479,6 +537,9 @@ pub(crate) struct GpuCamera {
     pub clip: DMat4,
     /// Eye relative to the centre.
     pub eye: DVec3,
+    /// The view depths the clip matrix maps to depth 0 and 1.
+    pub near: f64,
+    pub far: f64,
 }
 
 impl GpuCamera {
@@ -501,9 +562,14 @@ impl GpuCamera {
             DVec4::new(axis.x, axis.y, axis.z, -axis.dot(eye)) * scale + DVec4::W * add
         };
         let far = dist + radius * 1.01;
+        let near = match settings.camera.projection {
+            crate::render::CameraProjection::Perspective => {
+                (dist - radius * 1.01).max(radius * 1e-3)
+            }
+            crate::render::CameraProjection::Orthographic => dist - radius * 1.01,
+        };
         let rows = match settings.camera.projection {
             crate::render::CameraProjection::Perspective => {
-                let near = (dist - radius * 1.01).max(radius * 1e-3);
                 let a = far / (far - near);
                 [
                     row(cam.right, sx, 0.0),
@@ -513,7 +579,6 @@ impl GpuCamera {
                 ]
             }
             crate::render::CameraProjection::Orthographic => {
-                let near = dist - radius * 1.01;
                 let a = 1.0 / (far - near);
                 [
                     row(cam.right, sx, 0.0),
@@ -524,7 +589,13 @@ impl GpuCamera {
             }
         };
         let clip = DMat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose();
-        Ok(GpuCamera { cam, clip, eye })
+        Ok(GpuCamera {
+            cam,
+            clip,
+            eye,
+            near,
+            far,
+        })
     }
 }
 
@@ -707,6 +778,7 @@ pub fn compare(
                 mode,
                 slices: n,
                 curves: false,
+                silhouettes: false,
                 ..*settings
             };
             let start = std::time::Instant::now();

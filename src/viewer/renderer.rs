@@ -16,6 +16,13 @@ const ACCUM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 const REVEAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
 /// Width of the curves in pixels (the CPU renderer's default `line_width`).
 const CURVE_WIDTH: f32 = 2.5;
+/// The distance target's value where no surface is (read back as infinite).
+const NO_DISTANCE: wgpu::Color = wgpu::Color {
+    r: -1.0,
+    g: 0.0,
+    b: 0.0,
+    a: 0.0,
+};
 /// Opacity of a surface face-on in transparent mode.
 const OPACITY: f32 = 0.45;
 
@@ -37,6 +44,7 @@ struct ViewUniform {
     options: [u32; 4],
     band: [u32; 4],
     viewport: [f32; 4],
+    depth_proj: [f32; 4],
     stops: [[f32; 4]; 8],
 }
 
@@ -83,6 +91,8 @@ pub struct Renderer {
     curve_segments: wgpu::Buffer,
     halo_vertices: wgpu::Buffer,
     tets: wgpu::Buffer,
+    edges: wgpu::Buffer,
+    face_normals: wgpu::Buffer,
     /// The view mode's per-frame lists: triangle indices and (tetrahedron, slab) items.
     slab_triangles: Option<wgpu::Buffer>,
     slab_items: Option<wgpu::Buffer>,
@@ -92,6 +102,7 @@ pub struct Renderer {
     surface_view_blend: wgpu::RenderPipeline,
     composite: wgpu::RenderPipeline,
     curves: wgpu::RenderPipeline,
+    silhouettes: wgpu::RenderPipeline,
     cut: wgpu::RenderPipeline,
     voxelize: wgpu::ComputePipeline,
     empty_grid: wgpu::TextureView,
@@ -138,6 +149,12 @@ impl Renderer {
         let tets = gpu.buffer(
             "halo tetrahedra",
             bytemuck::cast_slice(&asset.tets),
+            storage,
+        )?;
+        let edges = gpu.buffer("mesh edges", bytemuck::cast_slice(&asset.edges), storage)?;
+        let face_normals = gpu.buffer(
+            "face normals",
+            bytemuck::cast_slice(&asset.face_normals),
             storage,
         )?;
         let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -277,15 +294,23 @@ impl Renderer {
             "composite_fs",
             P::TriangleList,
             &opaque_targets(false),
-            depth(false, C::Always),
+            None,
         );
         let curves = pipeline(
             "curves",
             "curve_vs",
-            "curve_fs",
+            "line_fs",
             P::TriangleList,
             &opaque_targets(false),
-            depth(false, C::LessEqual),
+            None,
+        );
+        let silhouettes = pipeline(
+            "silhouettes",
+            "silhouette_vs",
+            "line_fs",
+            P::TriangleList,
+            &opaque_targets(false),
+            None,
         );
         let cut = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("halo cuts"),
@@ -346,6 +371,8 @@ impl Renderer {
             curve_segments,
             halo_vertices,
             tets,
+            edges,
+            face_normals,
             slab_triangles: None,
             slab_items: None,
             surface_grid,
@@ -354,6 +381,7 @@ impl Renderer {
             surface_view_blend,
             composite,
             curves,
+            silhouettes,
             cut,
             voxelize,
             empty_grid,
@@ -501,15 +529,12 @@ impl Renderer {
                 }
             }
         }
-        // The transparency composite, then the curves.
+        // The transparency composite, then the lines.
         let composite = settings.transparent;
         let curves = settings.curves && !self.asset.curve_segments.is_empty();
-        if composite || curves {
-            let mut pass = if composite {
-                opaque_pass(&mut encoder, target, targets, true)
-            } else {
-                opaque_pass(&mut encoder, target, targets, false)
-            };
+        let silhouettes = settings.silhouettes && !self.asset.edges.is_empty();
+        if composite || curves || silhouettes {
+            let mut pass = lines_pass(&mut encoder, target, targets, composite);
             if composite {
                 let bind = self.bind(
                     gpu,
@@ -530,11 +555,27 @@ impl Renderer {
                     &[
                         (4, self.curve_points.as_entire_binding()),
                         (11, self.curve_segments.as_entire_binding()),
+                        (14, wgpu::BindingResource::TextureView(&targets.depth_view)),
                     ],
                 );
                 pass.set_pipeline(&self.curves);
                 pass.set_bind_group(0, &bind, &[]);
                 pass.draw(0..6, 0..self.asset.curve_segments.len() as u32);
+            }
+            if silhouettes {
+                let bind = self.bind(
+                    gpu,
+                    self.silhouettes.get_bind_group_layout(0),
+                    &[
+                        (1, self.vertices.as_entire_binding()),
+                        (12, self.edges.as_entire_binding()),
+                        (13, self.face_normals.as_entire_binding()),
+                        (14, wgpu::BindingResource::TextureView(&targets.depth_view)),
+                    ],
+                );
+                pass.set_pipeline(&self.silhouettes);
+                pass.set_bind_group(0, &bind, &[]);
+                pass.draw(0..6, 0..self.asset.edges.len() as u32);
             }
         }
         gpu.queue.submit([encoder.finish()]);
@@ -639,7 +680,7 @@ impl Renderer {
             size,
             distance_view: view(&distance),
             distance,
-            depth_view: view(&texture("depth", DEPTH_FORMAT, T::empty())),
+            depth_view: view(&texture("depth", DEPTH_FORMAT, T::TEXTURE_BINDING)),
             halo_view: view(&texture("halo depth", DEPTH_FORMAT, T::TEXTURE_BINDING)),
             accum_view: view(&texture("accumulated", ACCUM_FORMAT, T::TEXTURE_BINDING)),
             reveal_view: view(&texture("revealage", REVEAL_FORMAT, T::TEXTURE_BINDING)),
@@ -682,7 +723,10 @@ impl Renderer {
             }
             crate::render::CameraProjection::Orthographic => 1.0,
         };
-        let flags = u32::from(halos) | (u32::from(settings.colour_by_w) << 1);
+        // Lines test the surfaces' depth, which transparent frames do not write.
+        let flags = u32::from(halos)
+            | (u32::from(settings.colour_by_w) << 1)
+            | (u32::from(!settings.transparent) << 2);
         ViewUniform {
             clip: camera.clip.as_mat4().to_cols_array_2d(),
             eye: v4(
@@ -712,6 +756,10 @@ impl Renderer {
             grid_dims: [dims[0], dims[1], dims[2], dims[0].next_multiple_of(64)],
             options: [flags, stops.len() as u32, 0, 0],
             band: [0; 4],
+            depth_proj: {
+                let (near, far) = (camera.near, camera.far);
+                [near as f32, far as f32, 0.0, 0.0]
+            },
             viewport: [
                 settings.width as f32,
                 settings.height as f32,
@@ -1065,8 +1113,48 @@ fn upload(
     Ok(())
 }
 
-/// A pass drawing opaque surfaces (or the composite and curves) into the frame; `clear`
-/// starts the frame.
+/// A pass drawing the lines (after the transparency composite, which starts the frame when
+/// `clear`) over the frame, reading the surfaces' depth.
+fn lines_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    target: &wgpu::TextureView,
+    targets: &Targets,
+    clear: bool,
+) -> wgpu::RenderPass<'e> {
+    let load = |c: wgpu::Color| {
+        if clear {
+            wgpu::LoadOp::Clear(c)
+        } else {
+            wgpu::LoadOp::Load
+        }
+    };
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("lines"),
+        color_attachments: &[
+            Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: load(wgpu::Color::WHITE),
+                    store: wgpu::StoreOp::Store,
+                },
+            }),
+            Some(wgpu::RenderPassColorAttachment {
+                view: &targets.distance_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: load(NO_DISTANCE),
+                    store: wgpu::StoreOp::Store,
+                },
+            }),
+        ],
+        ..Default::default()
+    })
+}
+
+/// A pass drawing opaque surfaces into the frame; `clear` starts the frame.
 fn opaque_pass<'e>(
     encoder: &'e mut wgpu::CommandEncoder,
     target: &wgpu::TextureView,
@@ -1097,12 +1185,7 @@ fn opaque_pass<'e>(
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: load(wgpu::Color {
-                        r: -1.0,
-                        g: 0.0,
-                        b: 0.0,
-                        a: 0.0,
-                    }),
+                    load: load(NO_DISTANCE),
                     store: wgpu::StoreOp::Store,
                 },
             }),

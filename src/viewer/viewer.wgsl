@@ -21,13 +21,15 @@ struct View {
     slabs: vec4<f32>,
     // x, y, z: voxels; w: texels per row of the grid buffer.
     grid_dims: vec4<u32>,
-    // x: flags (1 halos, 2 colour by w); y: colour stops.
+    // x: flags (1 halos, 2 colour by w, 4 lines test the surfaces' depth); y: colour stops.
     options: vec4<u32>,
     // Voxelization of one band of the grid: x: items; y: the band's first z layer.
     band: vec4<u32>,
     // x, y: the frame's size in pixels; z: half the curves' width in pixels; w: a pixel's
     // size at unit depth (perspective) or anywhere (orthographic).
     viewport: vec4<f32>,
+    // x, y: the view depths of depth 0 and 1.
+    depth_proj: vec4<f32>,
     stops: array<vec4<f32>, 8>,
 }
 
@@ -64,6 +66,11 @@ struct HaloVertex {
 @group(0) @binding(9) var accum_image: texture_2d<f32>;
 @group(0) @binding(10) var reveal_image: texture_2d<f32>;
 @group(0) @binding(11) var<storage, read> curve_segments: array<vec2<u32>>;
+// Interior mesh edges: (a, b, triangle i, triangle j | 1 << 31 where their windings agree).
+@group(0) @binding(12) var<storage, read> edges: array<vec4<u32>>;
+// Per triangle, its (unnormalized) normal as wound.
+@group(0) @binding(13) var<storage, read> face_normals: array<vec4<f32>>;
+@group(0) @binding(14) var surface_depth: texture_depth_2d;
 
 const QUANTUM: f32 = 2147483648.0;
 const INK: vec3<f32> = vec3<f32>(0.02, 0.02, 0.02);
@@ -287,16 +294,24 @@ fn composite_fs(@builtin(position) frag: vec4<f32>) -> OpaqueOut {
 
 // ---------------------------------------------------------------- curves
 
-// Corner `vertex` (0..6, two triangles) of segment `segment` of the curves drawn as a band
+const NOTHING: vec4<f32> = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+
+struct LineOut {
+    @builtin(position) clip: vec4<f32>,
+    // The line's centre under this fragment: pixel position and view depth.
+    @location(0) @interpolate(linear) centre: vec3<f32>,
+}
+
+// Corner `vertex` (0..6, two triangles) of the segment from p to q drawn as a band
 // `viewport.z` pixels either side of it, capped as far beyond its ends.
-@vertex
-fn curve_vs(@builtin(vertex_index) vertex: u32, @builtin(instance_index) segment: u32) -> @builtin(position) vec4<f32> {
-    let ends = curve_segments[segment];
-    let a = view.clip * vec4<f32>(curve_points[ends.x].xyz, 1.0);
-    let b = view.clip * vec4<f32>(curve_points[ends.y].xyz, 1.0);
+fn band(p: vec3<f32>, q: vec3<f32>, vertex: u32) -> LineOut {
+    var out: LineOut;
+    let a = view.clip * vec4<f32>(p, 1.0);
+    let b = view.clip * vec4<f32>(q, 1.0);
     if a.w <= 0.0 || b.w <= 0.0 {
         // Behind the eye: nothing.
-        return vec4<f32>(2.0, 2.0, 2.0, 1.0);
+        out.clip = NOTHING;
+        return out;
     }
     let half_size = view.viewport.xy * 0.5;
     let sa = a.xy / a.w * half_size;
@@ -312,24 +327,85 @@ fn curve_vs(@builtin(vertex_index) vertex: u32, @builtin(instance_index) segment
         vec2<f32>(0.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(1.0, -1.0),
     );
     let c = corners[vertex];
-    let end = select(ends.x, ends.y, c.x > 0.5);
-    let p = curve_points[end].xyz;
-    var clip = select(a, b, c.x > 0.5);
+    let clip = select(a, b, c.x > 0.5);
+    let end = select(sa, sb, c.x > 0.5) + along * (c.x * 2.0 - 1.0);
     let offset = (across * c.y + along * (c.x * 2.0 - 1.0)) / half_size;
-    // The band is tested for depth as if three of its half-widths nearer the eye, so that
-    // a sheet rising towards the eye beside the curve (up to about 70 degrees) does not
-    // cover it where its centre line is in view.
-    var pixel = view.viewport.w;
-    if view.eye.w > 0.5 {
-        pixel *= clip.w;
-    }
-    let nearer = view.clip * vec4<f32>(p - ray_dir(p) * (3.0 * view.viewport.z * pixel), 1.0);
-    clip = vec4<f32>(clip.xy + offset * clip.w, nearer.z / nearer.w * clip.w, clip.w);
-    return clip;
+    out.clip = vec4<f32>(clip.xy + offset * clip.w, 0.0, clip.w);
+    // Pixels from the top left, as the fragment position.
+    out.centre = vec3<f32>(
+        half_size.x + end.x,
+        half_size.y - end.y,
+        view_depth(select(p, q, c.x > 0.5)),
+    );
+    return out;
 }
 
+@vertex
+fn curve_vs(@builtin(vertex_index) vertex: u32, @builtin(instance_index) segment: u32) -> LineOut {
+    let ends = curve_segments[segment];
+    return band(curve_points[ends.x].xyz, curve_points[ends.y].xyz, vertex);
+}
+
+// Whether triangle `k`, whose vertex `p` is, faces the eye.
+fn facing(k: u32, p: vec3<f32>) -> bool {
+    var towards = -view.forward.xyz;
+    if view.eye.w > 0.5 {
+        towards = view.eye.xyz - p;
+    }
+    return dot(face_normals[k].xyz, towards) > 0.0;
+}
+
+// An edge between a triangle facing the eye and one facing away (as the CPU renderer
+// finds them: across a seam of a non-orientable surface the windings disagree, and so do
+// the facings of two triangles on the same side), drawn as a band like the curves.
+@vertex
+fn silhouette_vs(@builtin(vertex_index) vertex: u32, @builtin(instance_index) edge: u32) -> LineOut {
+    let e = edges[edge];
+    let p = vertices[e.x].pos;
+    let agree = (e.w >> 31u) == 1u;
+    let j = e.w & 0x7fffffffu;
+    if (facing(e.z, p) != facing(j, p)) != agree {
+        var out: LineOut;
+        out.clip = NOTHING;
+        return out;
+    }
+    return band(p, vertices[e.y].pos, vertex);
+}
+
+// The view depth of the surfaces' depth buffer value z.
+fn depth_of(z: f32) -> f32 {
+    let near = view.depth_proj.x;
+    let far = view.depth_proj.y;
+    if view.eye.w > 0.5 {
+        return near * far / (far - z * (far - near));
+    }
+    return near + z * (far - near);
+}
+
+// A line is drawn where its centre is in view: not behind the farthest surface within a
+// pixel of it (by more than its half-width), so that neither the sheets a curve lies
+// between nor a surface turning away at its silhouette cover it, while a sheet lying over
+// it does.
 @fragment
-fn curve_fs() -> OpaqueOut {
+fn line_fs(in: LineOut) -> OpaqueOut {
+    if (view.options.x & 4u) != 0u {
+        let size = vec2<i32>(view.viewport.xy);
+        let at = vec2<i32>(floor(in.centre.xy));
+        var farthest = 0.0;
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let q = clamp(at + vec2<i32>(dx, dy), vec2<i32>(0), size - 1);
+                farthest = max(farthest, textureLoad(surface_depth, q, 0));
+            }
+        }
+        var pixel = view.viewport.w;
+        if view.eye.w > 0.5 {
+            pixel *= in.centre.z;
+        }
+        if farthest < 1.0 && in.centre.z > depth_of(farthest) + view.viewport.z * pixel {
+            discard;
+        }
+    }
     return OpaqueOut(vec4<f32>(INK, 1.0), 0.0);
 }
 
@@ -452,7 +528,7 @@ fn cut_vs(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance:
     var corner = corners[vertex];
     if count == 0u || (count == 3u && vertex >= 3u) {
         // Nothing, or the empty half: a degenerate triangle outside the view.
-        out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+        out.clip = NOTHING;
         out.t = 0.0;
         out.d = 0.0;
         return out;

@@ -3,7 +3,7 @@
 //!
 //! Drag with the left button to turn (azimuth, elevation), wheel to zoom, `R` to reset the
 //! camera (the title shows it, in `halo4d render`'s terms), `S` to cycle the slice count (64, 128, 256, 512), `M` to switch between the grid
-//! and view-slice modes, `H` halos, `C` curves, `T` transparency, `W` colour by w,
+//! and view-slice modes, `H` halos, `C` curves, `O` silhouettes (outlines), `T` transparency, `W` colour by w,
 //! `Escape` or `Q` to quit.
 
 use super::{Asset, Gpu, HaloMode, Renderer, SLICE_COUNTS, ViewSettings, ViewerError};
@@ -15,7 +15,7 @@ use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
 
 /// The window's help, printed when it opens.
-pub const HELP: &str = "drag: turn | wheel: zoom | R: reset camera | S: slices | M: grid/view mode | H: halos | C: curves | T: transparency | W: colour by w | Q/Esc: quit";
+pub const HELP: &str = "drag: turn | wheel: zoom | R: reset camera | S: slices | M: grid/view mode | H: halos | C: curves | O: silhouettes | T: transparency | W: colour by w | Q/Esc: quit";
 
 /// Opens a window on `asset` with `settings` (its size the window's first size) and runs
 /// until it is closed.
@@ -119,12 +119,13 @@ impl App {
         let s = &self.settings;
         let on = |b: bool| if b { "on" } else { "off" };
         state.window.set_title(&format!(
-            "halo4d-view: {} | {} {} slices | halos {} | curves {} | {} | colour {} | azimuth {:.0} elevation {:.0} distance {:.2} | {:.1} ms{}",
+            "halo4d-view: {} | {} {} slices | halos {} | curves {} | silhouettes {} | {} | colour {} | azimuth {:.0} elevation {:.0} distance {:.2} | {:.1} ms{}",
             self.asset.name,
             s.mode.name(),
             s.slices,
             on(s.halos),
             on(s.curves),
+            on(s.silhouettes),
             if s.transparent { "transparent" } else { "opaque" },
             if s.colour_by_w { "by w" } else { "grey" },
             s.camera.azimuth,
@@ -158,6 +159,7 @@ impl App {
                 }
                 "h" => s.halos = !s.halos,
                 "c" => s.curves = !s.curves,
+                "o" => s.silhouettes = !s.silhouettes,
                 "t" => s.transparent = !s.transparent,
                 "w" => s.colour_by_w = !s.colour_by_w,
                 _ => return false,
