@@ -641,7 +641,8 @@ pub struct BenchRow {
 }
 
 /// Renders `frames` frames on a full orbit (azimuth in equal steps from the settings') for
-/// each mode and each of `slices`, after one frame that is not counted, offscreen.
+/// each mode and each of `slices`, offscreen, after one frame that is not counted (and
+/// before each mode's first slice count, a whole orbit that is not).
 /// `progress` hears of each row.
 pub fn bench(
     gpu: &Gpu,
@@ -670,10 +671,18 @@ pub fn bench(
                 ..*settings
             };
             let grid_ms = renderer.render(gpu, &view, &s)?.grid_ms;
+            let orbit = |f: u32| settings.camera.azimuth + 360.0 * f64::from(f) / f64::from(frames);
+            if n == slices[0] {
+                // A whole orbit first, untimed: drivers finish compiling shaders on the
+                // first frames that need them (lavapipe does, over several frames).
+                for f in 0..frames {
+                    s.camera.azimuth = orbit(f);
+                    renderer.render(gpu, &view, &s)?;
+                }
+            }
             let mut times = Vec::with_capacity(frames as usize);
             for f in 0..frames {
-                s.camera.azimuth =
-                    settings.camera.azimuth + 360.0 * f64::from(f) / f64::from(frames);
+                s.camera.azimuth = orbit(f);
                 times.push(renderer.render(gpu, &view, &s)?.frame_ms);
             }
             times.sort_by(f64::total_cmp);
