@@ -9,8 +9,8 @@
 //! is below w, by more than the sheet's own halo can be (see below). The halo depth comes
 //! from the tetrahedra sliced into N planes in one of two ways ([`HaloMode`]):
 //! - `grid` (the default): once per loaded asset and slice count, a compute pass writes the
-//!   smallest halo depth at the centre of every voxel of an N-voxel-wide grid over the scene
-//!   into a 3D texture. The halos of an exported asset depend on the 4D view, not on the
+//!   smallest halo depth at the centre of every voxel of a grid N voxels across the halos
+//!   into a 3D texture (in bands of layers as large as one storage binding holds). The halos of an exported asset depend on the 4D view, not on the
 //!   3D camera, so every camera angle reuses it; a fragment reads its nearest voxel.
 //! - `view`: paper 000's method, per frame: N planes perpendicular to the view; per plane,
 //!   the cut of every tetrahedron it crosses is drawn into a halo-depth image (the depth
@@ -30,6 +30,10 @@
 //! leaves no sheet hidden by its own halo on any fixture (the viewer tests compare every
 //! fixture with the exact CPU render). Other sheets' halos hide as in the CPU renderer
 //! except within that margin of where they start hiding.
+//!
+//! Curves and silhouettes are bands of the CPU renderer's line width, drawn after the
+//! surfaces where their centre is in view: not behind the farthest surface within a pixel
+//! of it (by more than half the width).
 
 mod gpu;
 mod renderer;
@@ -532,17 +536,20 @@ fn w_slopes(positions: &[DVec3], w: &[f64], triangles: &[[u32; 3]]) -> (Vec<f64>
 /// matrix from coordinates relative to `centre`, and its near and far depths.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct GpuCamera {
+    /// The CPU renderer's camera.
     pub cam: Camera,
     /// Clip from centre-relative coordinates.
     pub clip: DMat4,
     /// Eye relative to the centre.
     pub eye: DVec3,
-    /// The view depths the clip matrix maps to depth 0 and 1.
+    /// The view depth the clip matrix maps to depth 0.
     pub near: f64,
+    /// The view depth it maps to depth 1.
     pub far: f64,
 }
 
 impl GpuCamera {
+    /// The camera of `settings` framing `bounds`, as the CPU renderer places it.
     pub fn new(settings: &ViewSettings, bounds: (DVec3, DVec3)) -> Result<GpuCamera, ViewerError> {
         let cam = Camera::new(
             &settings.camera,

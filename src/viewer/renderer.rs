@@ -695,6 +695,8 @@ impl Renderer {
         (centre_depth - radius, 2.0 * radius / f64::from(slices))
     }
 
+    /// The uniform block for a frame of `settings` through `camera`, with the view mode's
+    /// slabs and the grid, if any.
     fn uniform(
         &self,
         camera: &GpuCamera,

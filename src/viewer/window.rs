@@ -2,9 +2,10 @@
 //! settings and frame time in the title.
 //!
 //! Drag with the left button to turn (azimuth, elevation), wheel to zoom, `R` to reset the
-//! camera (the title shows it, in `halo4d render`'s terms), `S` to cycle the slice count (64, 128, 256, 512), `M` to switch between the grid
-//! and view-slice modes, `H` halos, `C` curves, `O` silhouettes (outlines), `T` transparency, `W` colour by w,
-//! `Escape` or `Q` to quit.
+//! camera (the title shows it, in `halo4d render`'s terms), `S` to cycle the slice count
+//! (64, 128, 256, 512), `M` to switch between the grid and view-slice modes, `H` halos, `C`
+//! curves, `O` silhouettes (outlines), `T` transparency, `W` colour by w, `Escape` or `Q`
+//! to quit.
 
 use super::{Asset, Gpu, HaloMode, Renderer, SLICE_COUNTS, ViewSettings, ViewerError};
 use std::sync::Arc;
@@ -32,6 +33,7 @@ pub fn run(asset: Asset, settings: ViewSettings) -> Result<(), ViewerError> {
         drag: None,
         cursor: (0.0, 0.0),
         last_ms: 0.0,
+        last_good: settings,
     };
     event_loop
         .run_app(&mut app)
@@ -56,6 +58,8 @@ struct App {
     drag: Option<(f64, f64)>,
     cursor: (f64, f64),
     last_ms: f64,
+    /// The last settings that rendered.
+    last_good: ViewSettings,
 }
 
 impl App {
@@ -113,8 +117,23 @@ impl App {
         self.settings.width = state.config.width;
         self.settings.height = state.config.height;
         let view = frame.texture.create_view(&Default::default());
-        let times = state.renderer.render(&state.gpu, &view, &self.settings)?;
+        let times = match state.renderer.render(&state.gpu, &view, &self.settings) {
+            Ok(times) => times,
+            // A setting this GPU cannot do (a grid too large, say): back to the last one
+            // that rendered, with the reason in the title; anything else ends the viewer.
+            Err(e @ (ViewerError::TooLarge { .. } | ViewerError::Setting { .. })) => {
+                self.settings = ViewSettings {
+                    width: self.settings.width,
+                    height: self.settings.height,
+                    ..self.last_good
+                };
+                state.window.set_title(&format!("halo4d-view: {e}"));
+                return Ok(());
+            }
+            Err(e) => return Err(e),
+        };
         state.gpu.queue.present(frame);
+        self.last_good = self.settings;
         self.last_ms = times.frame_ms;
         let s = &self.settings;
         let on = |b: bool| if b { "on" } else { "off" };
