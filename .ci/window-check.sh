@@ -33,7 +33,7 @@ expect() {
   echo "the window's title never showed '$1' (last: '$t')"
   exit 1
 }
-expect "grid 64 slices | halos on | curves on | silhouettes on | opaque | colour by w | azimuth 35"
+expect "grid 64 slices | 1 spp | halos on | curves on | silhouettes on | opaque | colour by w | azimuth 35"
 xdotool key s; expect "grid 128 slices"
 xdotool key m; expect "view 128 slices"
 xdotool key h; expect "halos off"

@@ -500,3 +500,63 @@ fn the_binary_writes_a_screenshot_and_refuses_bad_flags() {
         }
     }
 }
+
+#[test]
+fn supersampling_draws_what_the_cpu_renderer_draws_with_as_many_samples() {
+    let gpu = gpu();
+    let (scene, _dir, built, asset) = default_export();
+    let cpu = |samples| {
+        let settings = RenderSettings {
+            width: SIDE,
+            height: SIDE,
+            samples,
+            mode: RenderMode::Exact,
+            ..scene.render
+        };
+        let parts = built.render_parts(&scene.halo);
+        render_with_depth(&parts.input(), &settings, &scene.camera).unwrap()
+    };
+    let (reference, depth) = cpu(4);
+    let gpu_at = |samples| {
+        viewer::screenshot(
+            gpu,
+            &asset,
+            &ViewSettings {
+                samples,
+                ..settings(&scene, HaloMode::Grid, 256)
+            },
+        )
+        .unwrap()
+    };
+    let mean_diff = |p: &halo4d::render::Picture| {
+        p.rgb
+            .iter()
+            .zip(&reference.rgb)
+            .map(|(&a, &b)| f64::from(a.abs_diff(b)))
+            .sum::<f64>()
+            / p.rgb.len() as f64
+    };
+    let (one, four) = (gpu_at(1), gpu_at(4));
+    let (d1, d4) = (mean_diff(&one.picture), mean_diff(&four.picture));
+    eprintln!(
+        "mean difference from the CPU's 4-sample picture: 1 sample {d1:.2}, 4 samples {d4:.2} (of 255)"
+    );
+    assert!(
+        d4 < d1 * 0.8,
+        "4 samples ({d4:.2}) are not closer than 1 ({d1:.2})"
+    );
+    // The distances come from the sample the CPU renderer takes them from.
+    let differs = verdict_differs(&depth, &distances(&four), SAME);
+    assert!(differs < 0.02, "{:.2}%", differs * 100.0);
+    assert!(
+        viewer::screenshot(
+            gpu,
+            &asset,
+            &ViewSettings {
+                samples: 3,
+                ..settings(&scene, HaloMode::Grid, 64)
+            }
+        )
+        .is_err_and(|e| e.to_string().contains("samples"))
+    );
+}

@@ -28,6 +28,10 @@ struct Args {
     /// Slices of the halo depth (64, 128, 256 or 512 in the window; 2 to 1024 here).
     #[arg(long, default_value_t = 256)]
     slices: u32,
+    /// Samples per pixel (1, 4, 9 or 16; default 4 for --screenshot, as `halo4d render`,
+    /// else 1).
+    #[arg(long)]
+    samples: Option<u32>,
     /// How the halo depth is sliced: once into a 3D grid, or per frame along the view.
     #[arg(long, value_enum, default_value_t = Mode::Grid)]
     mode: Mode,
@@ -143,6 +147,9 @@ fn run(args: &Args) -> Result<(), ViewerError> {
             },
         },
         slices: args.slices,
+        samples: args
+            .samples
+            .unwrap_or(if args.screenshot.is_some() { 4 } else { 1 }),
         mode: match args.mode {
             Mode::Grid => HaloMode::Grid,
             Mode::View => HaloMode::View,

@@ -86,6 +86,9 @@ pub struct ViewSettings {
     pub camera: CameraSettings,
     /// Slices of the halo depth (N planes, N voxels across the grid).
     pub slices: u32,
+    /// Samples per pixel on a square grid (1, 4, 9 or 16), as the CPU renderer's: the frame
+    /// is drawn that many times larger and averaged.
+    pub samples: u32,
     /// How the halo depth is sliced.
     pub mode: HaloMode,
     /// Whether halos hide anything.
@@ -110,6 +113,7 @@ impl Default for ViewSettings {
             height: 1024,
             camera: CameraSettings::default(),
             slices: 256,
+            samples: 1,
             mode: HaloMode::Grid,
             halos: true,
             curves: true,
@@ -150,6 +154,12 @@ impl ViewSettings {
                     "{} is not between 2 and 1024 (the viewer offers 64, 128, 256 and 512)",
                     self.slices
                 ),
+            );
+        }
+        if ![1, 4, 9, 16].contains(&self.samples) {
+            return bad(
+                "samples",
+                format!("{} is not 1, 4, 9 or 16 (a square grid)", self.samples),
             );
         }
         self.camera.check().map_err(|(f, m)| ViewerError::Setting {
@@ -795,6 +805,7 @@ pub fn compare(
                 slices: n,
                 curves: false,
                 silhouettes: false,
+                samples: 1,
                 ..*settings
             };
             let start = std::time::Instant::now();

@@ -72,6 +72,8 @@ struct Grid {
 /// Render targets of one size.
 struct Targets {
     size: (u32, u32),
+    /// The supersampled picture, when samples > 1 (in the colour format).
+    samples_view: Option<wgpu::TextureView>,
     distance: wgpu::Texture,
     distance_view: wgpu::TextureView,
     depth_view: wgpu::TextureView,
@@ -103,6 +105,7 @@ pub struct Renderer {
     composite: wgpu::RenderPipeline,
     curves: wgpu::RenderPipeline,
     silhouettes: wgpu::RenderPipeline,
+    downsample: wgpu::RenderPipeline,
     cut: wgpu::RenderPipeline,
     voxelize: wgpu::ComputePipeline,
     empty_grid: wgpu::TextureView,
@@ -304,6 +307,14 @@ impl Renderer {
             &opaque_targets(false),
             None,
         );
+        let downsample = pipeline(
+            "downsample",
+            "composite_vs",
+            "downsample_fs",
+            P::TriangleList,
+            &opaque_targets(false)[..1],
+            None,
+        );
         let silhouettes = pipeline(
             "silhouettes",
             "silhouette_vs",
@@ -382,6 +393,7 @@ impl Renderer {
             composite,
             curves,
             silhouettes,
+            downsample,
             cut,
             voxelize,
             empty_grid,
@@ -416,7 +428,25 @@ impl Renderer {
             times.grid_ms = Some(t.elapsed().as_secs_f64() * 1e3);
         }
         let prepare = Instant::now();
-        self.ensure_targets(gpu, (settings.width, settings.height));
+        // Supersampling: the frame is drawn k times larger, then averaged k x k.
+        let k = settings.samples.isqrt();
+        let max = gpu.limits().max_texture_dimension_2d;
+        if settings.width * k > max || settings.height * k > max {
+            return Err(ViewerError::Setting {
+                field: "samples".into(),
+                message: format!(
+                    "{}x{} at {} samples per pixel is larger than this GPU's {max}-pixel textures; use fewer samples or a smaller size",
+                    settings.width, settings.height, settings.samples
+                ),
+            });
+        }
+        let final_target = target;
+        let settings = &ViewSettings {
+            width: settings.width * k,
+            height: settings.height * k,
+            ..*settings
+        };
+        self.ensure_targets(gpu, (settings.width, settings.height), k > 1);
         let camera = GpuCamera::new(settings, self.asset.bounds)?;
         let slabs = self.slabs(&camera, settings.slices);
         let uniform = self.uniform(&camera, settings, halos, slabs, self.grid.as_ref());
@@ -430,6 +460,7 @@ impl Renderer {
         let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let targets = self.targets.as_ref().expect("targets made above");
+        let target = targets.samples_view.as_ref().unwrap_or(final_target);
         let triangle_count = self.asset.triangles.len() as u32 * 3;
         match &lists {
             None => {
@@ -578,6 +609,29 @@ impl Renderer {
                 pass.draw(0..6, 0..self.asset.edges.len() as u32);
             }
         }
+        if let Some(samples) = &targets.samples_view {
+            let bind = self.bind(
+                gpu,
+                self.downsample.get_bind_group_layout(0),
+                &[(15, wgpu::BindingResource::TextureView(samples))],
+            );
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("downsample"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: final_target,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::WHITE),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                ..Default::default()
+            });
+            pass.set_pipeline(&self.downsample);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.draw(0..3, 0..1);
+        }
         gpu.queue.submit([encoder.finish()]);
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(ViewerError::Gpu(e.to_string()));
@@ -614,11 +668,15 @@ impl Renderer {
             })
             .collect();
         let targets = self.targets.as_ref().expect("targets made by render");
-        let distance = gpu
-            .read_texture(&targets.distance)?
-            .into_iter()
-            .map(|b| {
-                let d = f32::from_le_bytes(b);
+        let all = gpu.read_texture(&targets.distance)?;
+        // Each pixel's distance from its centre sample (of k x k, the one at (k/2, k/2), as
+        // the CPU renderer takes it).
+        let k = settings.samples.isqrt() as usize;
+        let (w, h) = (settings.width as usize, settings.height as usize);
+        let distance = (0..w * h)
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                let d = f32::from_le_bytes(all[(y * k + k / 2) * w * k + x * k + k / 2]);
                 if d >= 0.0 { d } else { f32::INFINITY }
             })
             .collect();
@@ -660,8 +718,12 @@ impl Renderer {
     }
 
     /// Render targets of `size`, made when the size changes.
-    fn ensure_targets(&mut self, gpu: &Gpu, size: (u32, u32)) {
-        if self.targets.as_ref().is_some_and(|t| t.size == size) {
+    fn ensure_targets(&mut self, gpu: &Gpu, size: (u32, u32), supersampled: bool) {
+        if self
+            .targets
+            .as_ref()
+            .is_some_and(|t| t.size == size && t.samples_view.is_some() == supersampled)
+        {
             return;
         }
         let texture = |label, format, extra| {
@@ -678,6 +740,8 @@ impl Renderer {
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         self.targets = Some(Targets {
             size,
+            samples_view: supersampled
+                .then(|| view(&texture("samples", self.colour_format, T::TEXTURE_BINDING))),
             distance_view: view(&distance),
             distance,
             depth_view: view(&texture("depth", DEPTH_FORMAT, T::TEXTURE_BINDING)),
@@ -756,7 +820,7 @@ impl Renderer {
                 (step * f64::from(settings.slices)) as f32,
             ],
             grid_dims: [dims[0], dims[1], dims[2], dims[0].next_multiple_of(64)],
-            options: [flags, stops.len() as u32, 0, 0],
+            options: [flags, stops.len() as u32, 0, settings.samples.isqrt()],
             band: [0; 4],
             depth_proj: {
                 let (near, far) = (camera.near, camera.far);
@@ -765,7 +829,7 @@ impl Renderer {
             viewport: [
                 settings.width as f32,
                 settings.height as f32,
-                CURVE_WIDTH * 0.5,
+                CURVE_WIDTH * 0.5 * settings.samples.isqrt() as f32,
                 (2.0 * cam.half_height / f64::from(settings.height)) as f32,
             ],
             stops: stop_array,

@@ -21,7 +21,8 @@ struct View {
     slabs: vec4<f32>,
     // x, y, z: voxels; w: texels per row of the grid buffer.
     grid_dims: vec4<u32>,
-    // x: flags (1 halos, 2 colour by w, 4 lines test the surfaces' depth); y: colour stops.
+    // x: flags (1 halos, 2 colour by w, 4 lines test the surfaces' depth); y: colour stops;
+    // w: samples per pixel along each side.
     options: vec4<u32>,
     // Voxelization of one band of the grid: x: items; y: the band's first z layer.
     band: vec4<u32>,
@@ -71,6 +72,7 @@ struct HaloVertex {
 // Per triangle, its (unnormalized) normal as wound.
 @group(0) @binding(13) var<storage, read> face_normals: array<vec4<f32>>;
 @group(0) @binding(14) var surface_depth: texture_depth_2d;
+@group(0) @binding(15) var samples_image: texture_2d<f32>;
 
 const QUANTUM: f32 = 2147483648.0;
 const INK: vec3<f32> = vec3<f32>(0.02, 0.02, 0.02);
@@ -290,6 +292,21 @@ fn composite_fs(@builtin(position) frag: vec4<f32>) -> OpaqueOut {
     let colour = accum.rgb / max(accum.a, 1e-5);
     let alpha = 1.0 - reveal;
     return OpaqueOut(vec4<f32>(mix(view.background.rgb, colour, alpha), 1.0), 0.0);
+}
+
+// The average of a pixel's k x k samples (linear colour: the sRGB texels are decoded on
+// load and encoded on store).
+@fragment
+fn downsample_fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let k = i32(view.options.w);
+    let base = vec2<i32>(floor(frag.xy)) * k;
+    var sum = vec4<f32>(0.0);
+    for (var y = 0; y < k; y++) {
+        for (var x = 0; x < k; x++) {
+            sum += textureLoad(samples_image, base + vec2<i32>(x, y), 0);
+        }
+    }
+    return sum / f32(k * k);
 }
 
 // ---------------------------------------------------------------- curves

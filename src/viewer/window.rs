@@ -138,10 +138,11 @@ impl App {
         let s = &self.settings;
         let on = |b: bool| if b { "on" } else { "off" };
         state.window.set_title(&format!(
-            "halo4d-view: {} | {} {} slices | halos {} | curves {} | silhouettes {} | {} | colour {} | azimuth {:.0} elevation {:.0} distance {:.2} | {:.1} ms{}",
+            "halo4d-view: {} | {} {} slices | {} spp | halos {} | curves {} | silhouettes {} | {} | colour {} | azimuth {:.0} elevation {:.0} distance {:.2} | {:.1} ms{}",
             self.asset.name,
             s.mode.name(),
             s.slices,
+            s.samples,
             on(s.halos),
             on(s.curves),
             on(s.silhouettes),
