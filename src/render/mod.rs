@@ -19,6 +19,8 @@ pub mod shade;
 pub mod slices;
 pub mod trace;
 
+pub(crate) use overlay::{AGREE, interior_edges};
+
 use crate::intersect::Curves;
 use crate::verify::{HaloIndex, HaloInput};
 use camera::Camera;

@@ -141,27 +141,12 @@ impl Scene<'_> {
                     n.dot(towards) > 0.0
                 })
                 .collect();
-            // Each edge with its triangle and whether the triangle runs along it from the
-            // smaller vertex: two neighbours wound alike run along it in opposite directions.
-            let mut edges: Vec<([u32; 2], u32, bool)> = surf
-                .triangles
-                .iter()
-                .enumerate()
-                .flat_map(|(i, t)| {
-                    (0..3).map(move |k| {
-                        let (a, b) = (t[k], t[(k + 1) % 3]);
-                        ([a.min(b), a.max(b)], i as u32, a < b)
-                    })
-                })
-                .collect();
-            edges.sort_unstable();
-            for pair in edges.windows(2) {
-                let ((e, i, di), (f, j, dj)) = (pair[0], pair[1]);
+            for [a, b, i, j] in interior_edges(surf.triangles) {
                 // Across a seam of a non-orientable surface the windings disagree, and so
                 // do the facings of two triangles on the same side.
-                let agree = di != dj;
-                if e == f && (facing[i as usize] != facing[j as usize]) == agree {
-                    out.push(e.map(|v| surf.positions[v as usize]));
+                let agree = j & AGREE != 0;
+                if (facing[i as usize] != facing[(j & !AGREE) as usize]) == agree {
+                    out.push([a, b].map(|v| surf.positions[v as usize]));
                 }
             }
         }
@@ -174,4 +159,31 @@ fn line_error(e: super::lines::LinesError) -> RenderError {
         field: "line_width".into(),
         message: e.to_string(),
     }
+}
+
+/// The flag of an interior edge whose two triangles' windings agree.
+pub(crate) const AGREE: u32 = 1 << 31;
+
+/// The edges between two triangles: (a, b, triangle i, triangle j | 1 << 31 where the two
+/// windings agree, that is the triangles run along the edge in opposite directions).
+pub(crate) fn interior_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 4]> {
+    let mut sides: Vec<([u32; 2], u32, bool)> = triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(i, t)| {
+            (0..3).map(move |k| {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                ([a.min(b), a.max(b)], i as u32, a < b)
+            })
+        })
+        .collect();
+    sides.sort_unstable();
+    sides
+        .windows(2)
+        .filter(|w| w[0].0 == w[1].0)
+        .map(|w| {
+            let agree = if w[0].2 != w[1].2 { AGREE } else { 0 };
+            [w[0].0[0], w[0].0[1], w[0].1, w[1].1 | agree]
+        })
+        .collect()
 }

@@ -44,7 +44,7 @@ pub use renderer::{FrameTimes, Renderer};
 
 use crate::import::{ImportError, ImportedScene};
 use crate::render::camera::Camera;
-use crate::render::{CameraSettings, Colormap, RenderError};
+use crate::render::{AGREE, CameraSettings, Colormap, RenderError, interior_edges};
 use glam::{DMat4, DVec3, DVec4};
 use std::path::Path;
 
@@ -480,33 +480,6 @@ fn vertex_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
         }
     }
     n.into_iter().map(|v| v.normalize_or_zero()).collect()
-}
-
-/// The flag of an interior edge whose two triangles' windings agree.
-const AGREE: u32 = 1 << 31;
-
-/// The edges between two triangles: (a, b, triangle i, triangle j | 1 << 31 where the two
-/// windings agree, that is the triangles run along the edge in opposite directions).
-fn interior_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 4]> {
-    let mut sides: Vec<([u32; 2], u32, bool)> = triangles
-        .iter()
-        .enumerate()
-        .flat_map(|(i, t)| {
-            (0..3).map(move |k| {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                ([a.min(b), a.max(b)], i as u32, a < b)
-            })
-        })
-        .collect();
-    sides.sort_unstable();
-    sides
-        .windows(2)
-        .filter(|w| w[0].0 == w[1].0)
-        .map(|w| {
-            let agree = if w[0].2 != w[1].2 { AGREE } else { 0 };
-            [w[0].0[0], w[0].0[1], w[0].1, w[1].1 | agree]
-        })
-        .collect()
 }
 
 /// Per vertex, the largest |grad w| over the triangles around it (w linear on each), and

@@ -617,15 +617,7 @@ impl Renderer {
             );
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("downsample"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: final_target,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::WHITE),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
+                color_attachments: &[attachment(final_target, true, wgpu::Color::WHITE)],
                 ..Default::default()
             });
             pass.set_pipeline(&self.downsample);
@@ -1179,6 +1171,27 @@ fn upload(
     Ok(())
 }
 
+/// A colour attachment of `view`, cleared to `colour` when `clear`, else loaded.
+fn attachment(
+    view: &wgpu::TextureView,
+    clear: bool,
+    colour: wgpu::Color,
+) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+    Some(wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: None,
+        ops: wgpu::Operations {
+            load: if clear {
+                wgpu::LoadOp::Clear(colour)
+            } else {
+                wgpu::LoadOp::Load
+            },
+            store: wgpu::StoreOp::Store,
+        },
+    })
+}
+
 /// A pass drawing the lines (after the transparency composite, which starts the frame when
 /// `clear`) over the frame, reading the surfaces' depth.
 fn lines_pass<'e>(
@@ -1187,34 +1200,11 @@ fn lines_pass<'e>(
     targets: &Targets,
     clear: bool,
 ) -> wgpu::RenderPass<'e> {
-    let load = |c: wgpu::Color| {
-        if clear {
-            wgpu::LoadOp::Clear(c)
-        } else {
-            wgpu::LoadOp::Load
-        }
-    };
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some("lines"),
         color_attachments: &[
-            Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: load(wgpu::Color::WHITE),
-                    store: wgpu::StoreOp::Store,
-                },
-            }),
-            Some(wgpu::RenderPassColorAttachment {
-                view: &targets.distance_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: load(NO_DISTANCE),
-                    store: wgpu::StoreOp::Store,
-                },
-            }),
+            attachment(target, clear, wgpu::Color::WHITE),
+            attachment(&targets.distance_view, clear, NO_DISTANCE),
         ],
         ..Default::default()
     })
@@ -1227,34 +1217,11 @@ fn opaque_pass<'e>(
     targets: &Targets,
     clear: bool,
 ) -> wgpu::RenderPass<'e> {
-    let load = |c: wgpu::Color| {
-        if clear {
-            wgpu::LoadOp::Clear(c)
-        } else {
-            wgpu::LoadOp::Load
-        }
-    };
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some("frame"),
         color_attachments: &[
-            Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: load(wgpu::Color::WHITE),
-                    store: wgpu::StoreOp::Store,
-                },
-            }),
-            Some(wgpu::RenderPassColorAttachment {
-                view: &targets.distance_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: load(NO_DISTANCE),
-                    store: wgpu::StoreOp::Store,
-                },
-            }),
+            attachment(target, clear, wgpu::Color::WHITE),
+            attachment(&targets.distance_view, clear, NO_DISTANCE),
         ],
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
             view: &targets.depth_view,
@@ -1278,26 +1245,11 @@ fn blend_pass<'e>(
     targets: &Targets,
     clear: bool,
 ) -> wgpu::RenderPass<'e> {
-    let attachment = |view, colour| {
-        Some(wgpu::RenderPassColorAttachment {
-            view,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations {
-                load: if clear {
-                    wgpu::LoadOp::Clear(colour)
-                } else {
-                    wgpu::LoadOp::Load
-                },
-                store: wgpu::StoreOp::Store,
-            },
-        })
-    };
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some("transparent surfaces"),
         color_attachments: &[
-            attachment(&targets.accum_view, wgpu::Color::TRANSPARENT),
-            attachment(&targets.reveal_view, wgpu::Color::WHITE),
+            attachment(&targets.accum_view, clear, wgpu::Color::TRANSPARENT),
+            attachment(&targets.reveal_view, clear, wgpu::Color::WHITE),
         ],
         ..Default::default()
     })
