@@ -566,63 +566,60 @@ impl Renderer {
         let silhouettes = settings.silhouettes && !self.asset.edges.is_empty();
         if composite || curves || silhouettes {
             let mut pass = lines_pass(&mut encoder, target, targets, composite);
+            let depth = wgpu::BindingResource::TextureView(&targets.depth_view);
             if composite {
-                let bind = self.bind(
+                self.draw(
                     gpu,
-                    self.composite.get_bind_group_layout(0),
+                    &mut pass,
+                    &self.composite,
                     &[
                         (9, wgpu::BindingResource::TextureView(&targets.accum_view)),
                         (10, wgpu::BindingResource::TextureView(&targets.reveal_view)),
                     ],
+                    (0..3, 0..1),
                 );
-                pass.set_pipeline(&self.composite);
-                pass.set_bind_group(0, &bind, &[]);
-                pass.draw(0..3, 0..1);
             }
             if curves {
-                let bind = self.bind(
+                self.draw(
                     gpu,
-                    self.curves.get_bind_group_layout(0),
+                    &mut pass,
+                    &self.curves,
                     &[
                         (4, self.curve_points.as_entire_binding()),
                         (11, self.curve_segments.as_entire_binding()),
-                        (14, wgpu::BindingResource::TextureView(&targets.depth_view)),
+                        (14, depth.clone()),
                     ],
+                    (0..6, 0..self.asset.curve_segments.len() as u32),
                 );
-                pass.set_pipeline(&self.curves);
-                pass.set_bind_group(0, &bind, &[]);
-                pass.draw(0..6, 0..self.asset.curve_segments.len() as u32);
             }
             if silhouettes {
-                let bind = self.bind(
+                self.draw(
                     gpu,
-                    self.silhouettes.get_bind_group_layout(0),
+                    &mut pass,
+                    &self.silhouettes,
                     &[
                         (1, self.vertices.as_entire_binding()),
                         (12, self.edges.as_entire_binding()),
                         (13, self.face_normals.as_entire_binding()),
-                        (14, wgpu::BindingResource::TextureView(&targets.depth_view)),
+                        (14, depth),
                     ],
+                    (0..6, 0..self.asset.edges.len() as u32),
                 );
-                pass.set_pipeline(&self.silhouettes);
-                pass.set_bind_group(0, &bind, &[]);
-                pass.draw(0..6, 0..self.asset.edges.len() as u32);
             }
         }
         if let Some(samples) = &targets.samples_view {
-            let bind = self.bind(
-                gpu,
-                self.downsample.get_bind_group_layout(0),
-                &[(15, wgpu::BindingResource::TextureView(samples))],
-            );
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("downsample"),
                 color_attachments: &[attachment(final_target, true, wgpu::Color::WHITE)],
                 ..Default::default()
             });
-            pass.set_pipeline(&self.downsample);
-            pass.set_bind_group(0, &bind, &[]);
-            pass.draw(0..3, 0..1);
+            self.draw(
+                gpu,
+                &mut pass,
+                &self.downsample,
+                &[(15, wgpu::BindingResource::TextureView(samples))],
+                (0..3, 0..1),
+            );
         }
         gpu.queue.submit([encoder.finish()]);
         if let Some(e) = pollster::block_on(scope.pop()) {
@@ -681,6 +678,21 @@ impl Renderer {
             distance,
             times,
         })
+    }
+
+    /// Draws `vertices` x `instances` with `pipeline` and a bind group of `entries`.
+    fn draw(
+        &self,
+        gpu: &Gpu,
+        pass: &mut wgpu::RenderPass<'_>,
+        pipeline: &wgpu::RenderPipeline,
+        entries: &[(u32, wgpu::BindingResource)],
+        (vertices, instances): (std::ops::Range<u32>, std::ops::Range<u32>),
+    ) {
+        let bind = self.bind(gpu, pipeline.get_bind_group_layout(0), entries);
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.draw(vertices, instances);
     }
 
     /// A bind group for `layout` with the view uniform at binding 0 and `entries`.
