@@ -14,12 +14,10 @@
 pub mod camera;
 pub mod compare;
 pub mod lines;
-mod overlay;
+pub(crate) mod overlay;
 pub mod shade;
 pub mod slices;
 pub mod trace;
-
-pub(crate) use overlay::{AGREE, interior_edges};
 
 use crate::intersect::Curves;
 use crate::verify::{HaloIndex, HaloInput};

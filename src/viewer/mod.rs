@@ -44,7 +44,8 @@ pub use renderer::{FrameTimes, Renderer};
 
 use crate::import::{ImportError, ImportedScene};
 use crate::render::camera::Camera;
-use crate::render::{AGREE, CameraSettings, Colormap, RenderError, interior_edges};
+use crate::render::overlay::{AGREE, interior_edges};
+use crate::render::{CameraSettings, Colormap, RenderError};
 use glam::{DMat4, DVec3, DVec4};
 use std::path::Path;
 
