@@ -12,7 +12,7 @@
 //!   consistently rather than skipped ([`exact`]). Triangles sharing an edge never cross;
 //!   triangles sharing a vertex cross only along a segment that ends at that vertex, which
 //!   is how a curve ends at a cross-cap (a branch point of the projection).
-//! - Chaining by shared events, without a distance tolerance ([`chain`]): closed curves
+//! - Chaining by shared events, without a distance tolerance (`chain.rs`): closed curves
 //!   close, open ones end at a mesh boundary or a branch point.
 //!
 //! Only the coordinates of the points are rounded; every decision is exact. What the

@@ -614,7 +614,7 @@ pub fn screenshot(gpu: &Gpu, asset: &Asset, settings: &ViewSettings) -> Result<F
     renderer.read_frame(gpu, settings)
 }
 
-/// One line of [`bench`]: a mode and slice count over a fixed orbit.
+/// One line of [`bench()`]: a mode and slice count over a fixed orbit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BenchRow {
     /// How the halo depth was sliced.
