@@ -946,7 +946,16 @@ impl Renderer {
             dims,
             view: texture.create_view(&Default::default()),
         };
+        // Voxelization reads only the grid's placement, the depth normalization and the band
+        // from the uniform block; any camera will do for the rest.
         let camera = GpuCamera::new(&ViewSettings::default(), self.asset.bounds)?;
+        let mut uniform = self.uniform(
+            &camera,
+            &ViewSettings::default(),
+            true,
+            (0.0, 1.0),
+            Some(&grid),
+        );
         let mut item_buffer = None;
         for first in (0..dims[2]).step_by(band as usize) {
             let layers = band.min(dims[2] - first);
@@ -959,13 +968,6 @@ impl Renderer {
                 bytemuck::cast_slice(band_items),
                 wgpu::BufferUsages::STORAGE,
             )?;
-            let mut uniform = self.uniform(
-                &camera,
-                &ViewSettings::default(),
-                true,
-                (0.0, 1.0),
-                Some(&grid),
-            );
             uniform.band = [band_items.len() as u32, first, 0, 0];
             gpu.queue
                 .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
