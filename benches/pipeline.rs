@@ -52,7 +52,7 @@ fn stages(c: &mut Criterion) {
             triangles: &mesh.triangles,
         }]);
         c.bench_function(&format!("export_glb/{name}/128"), |b| {
-            b.iter(|| to_glb(black_box(&data), &curves, &serde_json::Value::Null).unwrap())
+            b.iter(|| to_glb(black_box(&data), &curves, 0.01, &serde_json::Value::Null).unwrap())
         });
         c.bench_function(&format!("export_ply/{name}/128"), |b| {
             b.iter(|| to_ply(black_box(&data), name))

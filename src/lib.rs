@@ -10,6 +10,7 @@
 #![warn(missing_docs)]
 
 pub mod check;
+pub mod convention;
 pub mod error;
 pub mod export;
 pub mod halo;

@@ -53,6 +53,9 @@ pub struct Built {
     pub verification: Verification,
     /// Milliseconds per stage so far.
     pub timings: Timings,
+    /// The diagonal of the projected scene's bounding box, of which `halo.rho` and
+    /// `outputs.curve_radius` are shares (1 when the scene has no finite extent).
+    pub diagonal: f64,
 }
 
 impl Built {
@@ -396,8 +399,10 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
         (DVec3::INFINITY, DVec3::NEG_INFINITY),
         |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
     );
-    let diagonal = (hi - lo).length();
-    let rho = scene.halo.rho * if diagonal.is_finite() { diagonal } else { 1.0 };
+    let diagonal = Some((hi - lo).length())
+        .filter(|d| d.is_finite())
+        .unwrap_or(1.0);
+    let rho = scene.halo.rho * diagonal;
     for (name, entry, mesh, stats, report, projected) in projections {
         bar.set_message(format!("halo of {name}"));
         let start = Instant::now();
@@ -431,6 +436,7 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
     bar.finish_and_clear();
     Ok(Built {
         surfaces: products,
+        diagonal,
         curves,
         verification,
         timings,
@@ -466,11 +472,15 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
             stage: "export",
             message: e.to_string(),
         })?;
-        let glb = export::to_glb(&data, &built.curves, &scene_json).map_err(|message| {
-            Error::Internal {
-                stage: "export",
-                message,
-            }
+        let glb = export::to_glb(
+            &data,
+            &built.curves,
+            scene.outputs.curve_radius * built.diagonal,
+            &scene_json,
+        )
+        .map_err(|message| Error::Internal {
+            stage: "export",
+            message,
         })?;
         files.push(write(format!("{name}.glb"), &glb)?);
     }

@@ -82,6 +82,33 @@ pub struct Outputs {
     pub report: bool,
     /// `<name>.png`: the picture of the `render` settings through the `camera`.
     pub png: bool,
+    /// Radius of the intersection curves' tubes in `<name>.glb`, a share of the projected
+    /// scene's diagonal (as `halo.rho`).
+    pub curve_radius: f64,
+}
+
+/// The default [`Outputs::curve_radius`]: through the default camera, tubes about 7 pixels
+/// across in a 1024-pixel picture, so that a curve in the crease between two sheets, which
+/// bury most of its tube, still shows (measured in Blender by `.ci/real-programs.py
+/// --render`: a radius of 0.003 leaves half of the default scene's visible curve points
+/// light at 640 pixels, 0.004 one in twelve).
+pub const CURVE_RADIUS: f64 = 0.004;
+
+impl Outputs {
+    /// Checks the numbers: `Err((field, message))` names the first bad one.
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        if !(self.curve_radius.is_finite() && self.curve_radius > 0.0 && self.curve_radius <= 0.05)
+        {
+            return Err((
+                "curve_radius",
+                format!(
+                    "must be greater than 0 and at most 0.05 (a share of the scene's diagonal), got {}",
+                    self.curve_radius
+                ),
+            ));
+        }
+        Ok(())
+    }
 }
 
 impl Default for Outputs {
@@ -93,6 +120,7 @@ impl Default for Outputs {
             vtk: true,
             report: true,
             png: true,
+            curve_radius: CURVE_RADIUS,
         }
     }
 }
@@ -270,6 +298,9 @@ impl Scene {
         self.render
             .check()
             .map_err(|(f, m)| (format!("render.{f}"), m))?;
+        self.outputs
+            .check()
+            .map_err(|(f, m)| (format!("outputs.{f}"), m))?;
         Ok(())
     }
 }

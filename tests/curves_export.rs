@@ -1,9 +1,11 @@
-//! Intersection curves through their files: the .glb's `curves` mesh (read by the gltf crate)
-//! and `<name>-curves.ply` (read by ply-rs) hold exactly the curves of the build; a scene's
+//! Intersection curves through their files: the .glb's `curves` mesh (tubes, and the exact
+//! polylines as data, read by the gltf crate) and `<name>-curves.ply` (read by ply-rs) hold
+//! exactly the curves of the build; a scene's
 //! surfaces and halos read back from its .glb; `halo4d check DIR` passes a build and catches
 //! faults planted in its .glb; unreadable folders are errors.
 
 use crate::common::{Rng, assert_unreadable, fixture, halo4d};
+use glam::DVec3;
 use halo4d::import::{ImportError, ImportedScene, read_scene_glb};
 use halo4d::intersect::Curves;
 use halo4d::{Built, Scene};
@@ -58,8 +60,34 @@ fn scalars(blob: &[u8], acc: &gltf::Accessor) -> Vec<f32> {
         .collect()
 }
 
+/// The values of a float VEC3 accessor, in halo4d's frame (z up; the file's is glTF's).
+fn points3(blob: &[u8], acc: &gltf::Accessor) -> Vec<DVec3> {
+    assert_eq!(acc.data_type(), gltf::accessor::DataType::F32);
+    assert_eq!(acc.dimensions(), gltf::accessor::Dimensions::Vec3);
+    let view = acc.view().unwrap();
+    blob[view.offset() + acc.offset()..][..acc.count() * 12]
+        .chunks_exact(12)
+        .map(|c| {
+            let f =
+                |k: usize| f64::from(f32::from_le_bytes(c[4 * k..4 * k + 4].try_into().unwrap()));
+            DVec3::new(f(0), -f(2), f(1))
+        })
+        .collect()
+}
+
+/// Distance from `p` to the segment from `a` to `b`.
+fn to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let d = b - a;
+    let t = if d.length_squared() > 0.0 {
+        ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + t * d - p).length()
+}
+
 #[test]
-fn the_glb_curves_mesh_holds_every_curve_point_and_segment() {
+fn the_glb_curves_mesh_is_tubes_around_every_curve_and_carries_the_exact_polylines() {
     let dir = tempfile::tempdir().unwrap();
     let (mut closed, mut open) = (0, 0);
     for scene in scenes() {
@@ -93,52 +121,53 @@ fn the_glb_curves_mesh_holds_every_curve_point_and_segment() {
                 .any(|n| n.mesh().map(|m| m.index()) == Some(mesh.index())),
             "{name}: the node is in the scene"
         );
+        // No LINES anywhere: MeshLab crashes on them, Blender's renderers skip them.
+        assert!(
+            gltf.meshes()
+                .flat_map(|m| m.primitives())
+                .all(|p| p.mode() == gltf::mesh::Mode::Triangles)
+        );
         assert_eq!(mesh.primitives().count(), 1);
         let prim = mesh.primitives().next().unwrap();
-        assert_eq!(prim.mode(), gltf::mesh::Mode::Lines);
         let reader = prim.reader(|_| Some(blob));
 
-        // Positions: the f32 of each curve point, in order, min/max from the stored values.
-        let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
-        let expected: Vec<[f32; 3]> = points
+        // The exact polylines: own accessors that the extras name.
+        let extras: Value = serde_json::from_str(mesh.extras().as_ref().unwrap().get()).unwrap();
+        let e = &extras["curves"];
+        let r = &curves.report;
+        assert_eq!(
+            [&e["count"], &e["closed"], &e["open"], &e["points"]],
+            [r.count, r.closed, r.open, r.points]
+                .map(Value::from)
+                .each_ref(),
+            "{name}"
+        );
+        let radius = e["radius"].as_f64().unwrap();
+        assert_eq!(radius, scene.outputs.curve_radius * built.diagonal);
+        let own = |key: &str| {
+            let acc = gltf
+                .accessors()
+                .nth(e["polylines"][key].as_u64().unwrap() as usize)
+                .unwrap();
+            assert_eq!(acc.name(), Some(format!("curves polyline {key}").as_str()));
+            acc
+        };
+        let polyline = points3(blob, &own("POSITION"));
+        let expected: Vec<DVec3> = points
             .iter()
-            .map(|p| p.position.as_vec3().to_array())
+            .map(|p| p.position.as_vec3().as_dvec3())
             .collect();
-        assert_eq!(positions, expected, "{name}");
-        let acc = prim.get(&gltf::Semantic::Positions).unwrap();
-        let min: Vec<f32> = serde_json::from_value(acc.min().unwrap()).unwrap();
-        let max: Vec<f32> = serde_json::from_value(acc.max().unwrap()).unwrap();
-        for k in 0..3 {
-            let lo = positions.iter().map(|q| q[k]).fold(f32::INFINITY, f32::min);
-            let hi = positions
-                .iter()
-                .map(|q| q[k])
-                .fold(f32::NEG_INFINITY, f32::max);
-            assert_eq!((min[k], max[k]), (lo, hi), "{name}");
-        }
-
-        // _DW, _CURVE and _W, one per point.
+        assert_eq!(polyline, expected, "{name}");
         let curve_index: Vec<f32> = curves
             .curves
             .iter()
             .enumerate()
             .flat_map(|(k, c)| vec![k as f32; c.points.len()])
             .collect();
-        for (attr, want) in [
-            (
-                "_DW",
-                points.iter().map(|p| p.dw() as f32).collect::<Vec<_>>(),
-            ),
-            ("_CURVE", curve_index),
-            ("_W", points.iter().map(|p| p.w[p.near()] as f32).collect()),
-        ] {
-            let acc = prim
-                .attributes()
-                .find(|(s, _)| s.to_string() == attr)
-                .unwrap_or_else(|| panic!("{name}: no {attr}"))
-                .1;
-            let got = scalars(blob, &acc);
-            assert_eq!(got, want, "{name}: {attr}");
+        let dw: Vec<f32> = points.iter().map(|p| p.dw() as f32).collect();
+        let w: Vec<f32> = points.iter().map(|p| p.w[p.near()] as f32).collect();
+        for (attr, want) in [("_DW", &dw), ("_CURVE", &curve_index), ("_W", &w)] {
+            assert_eq!(&scalars(blob, &own(attr)), want, "{name}: {attr}");
         }
         // dw is the far sheet's w minus the near sheet's: never negative.
         assert!(
@@ -146,29 +175,101 @@ fn the_glb_curves_mesh_holds_every_curve_point_and_segment() {
                 .iter()
                 .all(|p| p.dw() >= 0.0 && p.w[1 - p.near()] - p.w[p.near()] == p.dw())
         );
-
-        // Segments: consecutive points, closed curves closed.
-        let indices: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
-        let segments: Vec<[u32; 2]> = indices.chunks_exact(2).map(|s| [s[0], s[1]]).collect();
-        assert_eq!(indices.len() % 2, 0);
+        let indices = own("indices");
+        assert_eq!(indices.data_type(), gltf::accessor::DataType::U32);
+        let view = indices.view().unwrap();
+        let segments: Vec<[u32; 2]> = blob[view.offset() + indices.offset()..]
+            [..indices.count() * 4]
+            .chunks_exact(8)
+            .map(|c| {
+                let u = |k: usize| u32::from_le_bytes(c[4 * k..4 * k + 4].try_into().unwrap());
+                [u(0), u(1)]
+            })
+            .collect();
         assert_eq!(segments, expected_segments(curves), "{name}");
-        let count: usize = curves
+
+        // The tubes: every vertex within the radius of its own curve (brute force over the
+        // curve's segments), carrying that curve's index and one of its points' dw and w;
+        // a closed surface turned outward, enclosing about the octagonal prism's volume.
+        let positions = points3(blob, &prim.get(&gltf::Semantic::Positions).unwrap());
+        let attr = |a: &str| {
+            scalars(
+                blob,
+                &prim
+                    .attributes()
+                    .find(|(s, _)| s.to_string() == a)
+                    .unwrap_or_else(|| panic!("{name}: no {a}"))
+                    .1,
+            )
+        };
+        let (tube_curve, tube_dw, tube_w) = (attr("_CURVE"), attr("_DW"), attr("_W"));
+        let mut first = 0;
+        let starts: Vec<usize> = curves
             .curves
             .iter()
-            .map(|c| c.points.len() - usize::from(!c.closed))
-            .sum();
-        assert_eq!(segments.len(), count, "{name}");
-
-        let extras: Value = serde_json::from_str(mesh.extras().as_ref().unwrap().get()).unwrap();
-        let r = &curves.report;
-        assert_eq!(
-            extras["curves"],
-            serde_json::json!({
-                "count": r.count, "closed": r.closed, "open": r.open, "points": r.points
-            }),
-            "{name}"
+            .map(|c| {
+                first += c.points.len();
+                first - c.points.len()
+            })
+            .collect();
+        for (v, p) in positions.iter().enumerate() {
+            let k = tube_curve[v] as usize;
+            let c = &curves.curves[k];
+            let pts = &expected[starts[k]..starts[k] + c.points.len()];
+            let d = pts
+                .windows(2)
+                .map(|s| to_segment(*p, s[0], s[1]))
+                .chain(c.closed.then(|| to_segment(*p, pts[pts.len() - 1], pts[0])))
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                d <= radius * (1.0 + 1e-4),
+                "{name}: tube vertex {v} at {d}, radius {radius}"
+            );
+            let at = (starts[k]..starts[k] + c.points.len())
+                .any(|i| dw[i] == tube_dw[v] && w[i] == tube_w[v]);
+            assert!(
+                at,
+                "{name}: tube vertex {v}'s _DW and _W are none of its curve's"
+            );
+        }
+        let normals: Vec<[f32; 3]> = reader.read_normals().expect("NORMAL").collect();
+        assert_eq!(normals.len(), positions.len());
+        let triangles: Vec<[u32; 3]> = reader
+            .read_indices()
+            .unwrap()
+            .into_u32()
+            .collect::<Vec<_>>()
+            .chunks_exact(3)
+            .map(|t| [t[0], t[1], t[2]])
+            .collect();
+        let mut edges = std::collections::HashMap::new();
+        for t in &triangles {
+            for k in 0..3 {
+                *edges.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;
+            }
+        }
+        assert!(
+            edges
+                .iter()
+                .all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1)),
+            "{name}: the tubes are not closed surfaces turned one way"
         );
-        assert_eq!(r.points, points.len());
+        let volume: f64 = triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| positions[i as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum();
+        let length: f64 = segments
+            .iter()
+            .map(|s| (expected[s[0] as usize] - expected[s[1] as usize]).length())
+            .sum();
+        let prism = 2.0 * 2f64.sqrt() * radius * radius * length;
+        assert!(
+            (volume / prism - 1.0).abs() < 0.2,
+            "{name}: the tubes enclose {volume}, the octagonal prism along the curves {prism}"
+        );
     }
     assert!(closed > 0 && open > 0, "{closed} closed, {open} open");
 }
@@ -242,7 +343,7 @@ fn without_curves_the_glb_has_no_curves_mesh_and_the_ply_is_empty_but_valid() {
     let built = halo4d::run(&scene, true).unwrap();
     let data: Vec<_> = built.surfaces.iter().map(|p| p.data(&scene.halo)).collect();
     let none = Curves::default();
-    let glb = halo4d::export::to_glb(&data, &none, &Value::Null).unwrap();
+    let glb = halo4d::export::to_glb(&data, &none, 0.01, &Value::Null).unwrap();
     let gltf = gltf::Gltf::from_slice(&glb).unwrap();
     assert_eq!(gltf.meshes().count(), 2);
     assert!(gltf.meshes().all(|m| m.name() != Some("curves")));

@@ -3,8 +3,10 @@
 //! by `halo4d check`; malformed files rejected with errors, never panics.
 
 use crate::common::{Rng, assert_unreadable, fixture, fixture_scenes, halo4d};
+use glam::{DVec3, Vec3};
 use halo4d::Scene;
 use halo4d::check::check;
+use halo4d::convention::file_order;
 use halo4d::import::{ImportError, ImportedHalo, read, read_glb, read_vtk};
 use halo4d::pipeline::SurfaceProduct;
 use serde_json::Value;
@@ -63,7 +65,8 @@ fn ascii_vtk(h: &ImportedHalo, with_layout: bool) -> String {
         s += &format!("{} {} {}\n", p[0], p[1], p[2]);
     }
     s += &format!("CELLS {} {}\n", m.tets.len(), 5 * m.tets.len());
-    for t in &m.tets {
+    for &t in &m.tets {
+        let t = file_order(t);
         s += &format!("4 {} {} {} {}\n", t[0], t[1], t[2], t[3]);
     }
     s += &format!("CELL_TYPES {}\n", m.tets.len());
@@ -213,8 +216,37 @@ fn the_glb_halo_is_plain_gltf_to_the_gltf_crate() {
         let prim = mesh.primitives().next().unwrap();
         assert_eq!(prim.mode(), gltf::mesh::Mode::Triangles);
         let reader = prim.reader(|_| Some(blob));
-        let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
-        assert_eq!(positions.len(), halo.positions.len());
+        // glTF's frame, y up: (x, y, z) of halo4d is (x, z, -y), and exact in f32.
+        let positions: Vec<DVec3> = reader
+            .read_positions()
+            .unwrap()
+            .map(|p| Vec3::from(p).as_dvec3())
+            .collect();
+        let expected: Vec<DVec3> = halo
+            .positions
+            .iter()
+            .map(|p| DVec3::new(p.x, p.z, -p.y))
+            .collect();
+        assert_eq!(positions, expected);
+        // Unit normals, turned out of the halo (along the offset from the surface).
+        let normals: Vec<DVec3> = reader
+            .read_normals()
+            .expect("NORMAL on the halo")
+            .map(|p| Vec3::from(p).as_dvec3())
+            .collect();
+        assert_eq!(normals.len(), positions.len());
+        assert!(normals.iter().all(|v| (v.length() - 1.0).abs() < 1e-6));
+        let outward = (0..2 * n)
+            .filter(|&i| {
+                let away = positions[i] - positions[(i + n) % (2 * n)];
+                away.length() == 0.0 || normals[i].dot(away) > 0.0
+            })
+            .count();
+        assert!(
+            outward as f64 >= 0.99 * (2 * n) as f64,
+            "{outward} of {}",
+            2 * n
+        );
         let patch: Vec<f64> = (0..halo.positions.len())
             .map(|i| {
                 f64::from(if i < 2 * n {
@@ -241,16 +273,23 @@ fn the_glb_halo_is_plain_gltf_to_the_gltf_crate() {
         }
 
         // The triangles are the boundary faces, turned outward: as many as the checker
-        // counts, enclosing the volume it measures (with the opposite sign, as the checker
-        // turns its faces the other way).
+        // counts, enclosing the volume it measures, and using every offset vertex (a
+        // collapsed one's second index too), so that an importer that drops unused vertices
+        // keeps them all at their indices.
         let faces: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
         let stats = check(&halo.tet_mesh());
         assert_eq!(faces.len(), 3 * stats.boundary_faces);
         let mut enclosed = 0.0;
         for f in faces.chunks_exact(3) {
-            let [a, b, c] = [f[0], f[1], f[2]].map(|i| halo.positions[i as usize]);
+            let [a, b, c] = [f[0], f[1], f[2]].map(|i| positions[i as usize]);
             enclosed += a.dot(b.cross(c)) / 6.0;
         }
+        let mut used = vec![false; positions.len()];
+        faces.iter().for_each(|&i| used[i as usize] = true);
+        assert!(
+            used[..2 * n].iter().all(|&u| u),
+            "an offset vertex on no triangle"
+        );
         assert!(
             (enclosed - stats.boundary_volume).abs() <= 1e-9 * stats.boundary_volume.abs(),
             "{enclosed} against {}",
@@ -282,7 +321,13 @@ fn the_glb_halo_is_plain_gltf_to_the_gltf_crate() {
             .chunks_exact(4)
             .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
             .collect();
-        assert_eq!(indices, halo.tets.concat());
+        let file: Vec<u32> = halo.tets.iter().flat_map(|&t| file_order(t)).collect();
+        assert_eq!(indices, file);
+        // In the file, every tetrahedron is positive as VTK counts: det[b-a, c-a, d-a] > 0.
+        for t in indices.chunks_exact(4) {
+            let [a, b, c, d] = [t[0], t[1], t[2], t[3]].map(|i| positions[i as usize]);
+            assert!((b - a).cross(c - a).dot(d - a) > 0.0, "{t:?}");
+        }
     }
 }
 
@@ -471,8 +516,64 @@ fn malformed_glb_files_are_clear_errors() {
     let edited = |edit: &dyn Fn(&mut Value)| with_json(&good, |j| edit(j));
     glb_fails(
         &edited(&|j| halo_mesh(j)["extras"]["halo"]["tetrahedra"] = 999.into()),
-        &["accessors[999] does not exist"],
+        &[
+            "no tetrahedra for patches-halo",
+            "accessors[999], which does not exist",
+        ],
     );
+    // What another program leaves when it re-saves the file keeping the extras but not the
+    // accessor: the number of a triangle index buffer (Blender 4.5), an accessor without our
+    // name, or one of another type. Never read as tetrahedra.
+    let no_tets = "this file has no tetrahedra for patches-halo (a program that re-saved it may have dropped them)";
+    let triangles = edited(&|j| {
+        let m = halo_mesh(j);
+        m["extras"]["halo"]["tetrahedra"] = m["primitives"][0]["indices"].clone();
+    });
+    glb_fails(&triangles, &[no_tets, "accessors[", "which has no name"]);
+    // Named as ours but read by a primitive: still not tetrahedra.
+    glb_fails(
+        &edited(&|j| {
+            let m = halo_mesh(j);
+            let a = m["primitives"][0]["indices"].clone();
+            m["extras"]["halo"]["tetrahedra"] = a.clone();
+            j["accessors"][a.as_u64().unwrap() as usize]["name"] = "patches-halo tetrahedra".into();
+        }),
+        &[no_tets, "a primitive reads as its indices"],
+    );
+    std::fs::write(dir.path().join("resaved.glb"), &triangles).unwrap();
+    let out = halo4d(&["check", "resaved.glb"], dir.path());
+    assert_unreadable(&out, "resaved.glb", &[no_tets]);
+    let tets_accessor = |j: &Value| {
+        halo_mesh(&mut j.clone())["extras"]["halo"]["tetrahedra"]
+            .as_u64()
+            .unwrap() as usize
+    };
+    glb_fails(
+        &edited(&|j| {
+            let a = tets_accessor(j);
+            j["accessors"][a].as_object_mut().unwrap().remove("name");
+        }),
+        &[no_tets, "has no name", "`patches-halo tetrahedra`"],
+    );
+    glb_fails(
+        &edited(&|j| {
+            let a = tets_accessor(j);
+            j["accessors"][a]["name"] = "other".into();
+        }),
+        &[no_tets, "is named `other`"],
+    );
+    glb_fails(
+        &edited(&|j| {
+            let a = tets_accessor(j);
+            j["accessors"][a]["componentType"] = 5126.into();
+        }),
+        &[no_tets, "not SCALAR of UNSIGNED_INT"],
+    );
+    // The same accessors under JSON written anew (as pygltflib re-saves): still read.
+    let rewritten = edited(&|j| {
+        j["asset"]["generator"] = "another writer".into();
+    });
+    assert_eq!(read_glb(&rewritten).unwrap(), read_glb(&good).unwrap());
     glb_fails(
         &edited(&|j| halo_mesh(j)["extras"]["halo"]["tetrahedra"] = (-1).into()),
         &["tetrahedra", "not a non-negative integer"],
@@ -541,10 +642,7 @@ fn malformed_glb_files_are_clear_errors() {
     let (tets_at, positions_at) = halo_offsets(&good);
     let mut index = good.clone();
     index[tets_at + 8..tets_at + 12].copy_from_slice(&7_000_000u32.to_le_bytes());
-    glb_fails(
-        &index,
-        &["patches-halo", "tetrahedron 0 names vertex 7000000"],
-    );
+    glb_fails(&index, &[no_tets, "names vertex 7000000 at index 2"]);
     let mut nan = good.clone();
     nan[positions_at + 16..positions_at + 20].copy_from_slice(&f32::NAN.to_le_bytes());
     glb_fails(

@@ -24,10 +24,12 @@
 //! attribute has its own tightly packed, 4-byte aligned buffer view. The asset's extras
 //! record the scene as parsed.
 
+use super::tubes::tubes;
 use super::{SurfaceData, curve_segments};
+use crate::convention::{file_order, to_gltf};
 use crate::halo::Halo;
-use crate::intersect::Curves;
-use glam::DVec3;
+use crate::intersect::{CurvePoint, Curves};
+use glam::{DVec3, Vec3};
 use gltf_json as json;
 use json::validation::Checked::Valid;
 use json::validation::USize64;
@@ -43,8 +45,8 @@ const PALETTE: [[f32; 4]; 6] = [
     [0.85, 0.85, 0.85, 1.0],
 ];
 
-/// Base colour of the curves' lines.
-const CURVE_COLOUR: [f32; 4] = [0.9, 0.1, 0.1, 1.0];
+/// Base colour of the curves' tubes: the renderer's ink.
+const CURVE_COLOUR: [f32; 4] = [0.02, 0.02, 0.02, 1.0];
 
 /// Accumulates the binary chunk and the JSON objects that describe it.
 struct Builder {
@@ -112,9 +114,13 @@ impl Builder {
         })
     }
 
-    /// Appends a tightly packed f32 VEC3 POSITION accessor with min/max of the stored values.
+    /// Appends a tightly packed f32 VEC3 POSITION accessor of `points` in glTF's frame, with
+    /// min/max of the stored values.
     fn positions(&mut self, points: &[DVec3]) -> json::Index<json::Accessor> {
-        let positions: Vec<f32> = points.iter().flat_map(|v| v.as_vec3().to_array()).collect();
+        let positions: Vec<f32> = points
+            .iter()
+            .flat_map(|&v| to_gltf(v).as_vec3().to_array())
+            .collect();
         let mut lo = [f32::INFINITY; 3];
         let mut hi = [f32::NEG_INFINITY; 3];
         for c in positions.chunks_exact(3) {
@@ -128,6 +134,20 @@ impl Builder {
             json::accessor::Type::Vec3,
             Some((lo.to_vec(), hi.to_vec())),
         )
+    }
+
+    /// Appends an f32 VEC3 NORMAL accessor of `normals` in glTF's frame, made unit (a zero
+    /// vector becomes up: glTF wants unit normals, and only a vertex that no triangle uses
+    /// has none).
+    fn normals(&mut self, normals: &[DVec3]) -> json::Index<json::Accessor> {
+        let unit: Vec<f32> = normals
+            .iter()
+            .flat_map(|&n| {
+                let n = to_gltf(n).normalize_or(DVec3::Y).as_vec3();
+                n.normalize_or(Vec3::Y).to_array()
+            })
+            .collect();
+        self.floats(&unit, json::accessor::Type::Vec3, None)
     }
 
     /// Appends an UNSIGNED_INT SCALAR accessor over `indices`, with `target` as in [`Self::view`].
@@ -208,6 +228,37 @@ fn boundary_faces(positions: &[DVec3], tets: &[[u32; 4]]) -> Vec<[u32; 3]> {
     out
 }
 
+/// The halo's boundary faces as [`boundary_faces`] finds them, except that a top face (one
+/// whose other corners are positive offsets) names a collapsed corner by its positive
+/// offset: both indices of a collapsed vertex are then used by some triangle, so that
+/// importers that drop unused vertices (Blender) keep every offset vertex at its index.
+fn halo_faces(halo: &Halo) -> Vec<[u32; 3]> {
+    let n = halo.surface_vertices as u32;
+    let positive = |v: u32| (n..2 * n).contains(&v);
+    let collapsed =
+        |v: u32| v < n && halo.positions[v as usize] == halo.positions[(v + n) as usize];
+    let mut faces = boundary_faces(&halo.positions, &halo.tets);
+    for f in &mut faces {
+        if f.iter().any(|&v| positive(v)) && f.iter().all(|&v| positive(v) || collapsed(v)) {
+            *f = f.map(|v| if collapsed(v) { v + n } else { v });
+        }
+    }
+    faces
+}
+
+/// Area-weighted normals of the vertices of `faces` (zero at a vertex that no face uses).
+fn vertex_normals(positions: &[DVec3], faces: &[[u32; 3]]) -> Vec<DVec3> {
+    let mut normals = vec![DVec3::ZERO; positions.len()];
+    for f in faces {
+        let [a, b, c] = f.map(|i| positions[i as usize]);
+        let n = (b - a).cross(c - a);
+        for &i in f {
+            normals[i as usize] += n;
+        }
+    }
+    normals
+}
+
 /// The patch of each halo vertex: that of its surface vertex for the offsets, that of the
 /// triangle whose prism it is in for an inserted vertex.
 fn halo_patches(s: &SurfaceData) -> Vec<f32> {
@@ -230,6 +281,7 @@ fn halo_patches(s: &SurfaceData) -> Vec<f32> {
 pub fn to_glb(
     surfaces: &[SurfaceData],
     curves: &Curves,
+    curve_radius: f64,
     scene_json: &serde_json::Value,
 ) -> Result<Vec<u8>, String> {
     let extras = |v: serde_json::Value| to_raw_value(&v).map(Some).map_err(|e| e.to_string());
@@ -247,21 +299,16 @@ pub fn to_glb(
     let mut nodes = Vec::new();
     for (k, s) in surfaces.iter().enumerate() {
         let p = s.projected;
-        let normals: Vec<f32> = p
-            .normals
-            .iter()
-            .flat_map(|n| n.as_vec3().normalize().to_array())
-            .collect();
         let scalar = |f: &dyn Fn(usize) -> f64| {
             (0..p.positions.len())
                 .map(|i| f(i) as f32)
                 .collect::<Vec<f32>>()
         };
-        use json::accessor::Type::{Scalar, Vec3};
+        use json::accessor::Type::Scalar;
         use json::mesh::Semantic;
         let attributes = [
             (Semantic::Positions, b.positions(&p.positions)),
-            (Semantic::Normals, b.floats(&normals, Vec3, None)),
+            (Semantic::Normals, b.normals(&p.normals)),
             (
                 Semantic::Extras("W".into()),
                 b.floats(&scalar(&|i| p.w[i]), Scalar, None),
@@ -329,7 +376,7 @@ pub fn to_glb(
             }));
         }
     }
-    if let Some(mesh) = curves_mesh(&mut b, curves)? {
+    if let Some(mesh) = curves_mesh(&mut b, curves, curve_radius)? {
         nodes.push(b.root.push(json::Node {
             mesh: Some(mesh),
             name: Some("curves".into()),
@@ -367,8 +414,11 @@ fn halo_mesh(
     let halo = s.halo;
     let name = format!("{}-halo", s.name);
     let scalar = |values: &[f64]| values.iter().map(|&x| x as f32).collect::<Vec<f32>>();
+    let faces = halo_faces(halo);
+    let normals = vertex_normals(&halo.positions, &faces);
     let attributes = [
         (Semantic::Positions, b.positions(&halo.positions)),
+        (Semantic::Normals, b.normals(&normals)),
         (
             Semantic::Extras("T".into()),
             b.floats(&scalar(&halo.t), Scalar, None),
@@ -382,12 +432,9 @@ fn halo_mesh(
             b.floats(&halo_patches(s), Scalar, None),
         ),
     ];
-    let faces: Vec<u32> = boundary_faces(&halo.positions, &halo.tets)
-        .into_iter()
-        .flatten()
-        .collect();
+    let faces: Vec<u32> = faces.into_iter().flatten().collect();
     let indices = b.indices(&faces, Some(json::buffer::Target::ElementArrayBuffer), None);
-    let tet_indices: Vec<u32> = halo.tets.iter().flatten().copied().collect();
+    let tet_indices: Vec<u32> = halo.tets.iter().flat_map(|&t| file_order(t)).collect();
     let tetrahedra = b.indices(&tet_indices, None, Some(format!("{name} tetrahedra")));
     let [r, g, bl, _] = colour;
     let material = b.root.push(json::Material {
@@ -435,42 +482,65 @@ fn halo_mesh(
 fn curves_mesh(
     b: &mut Builder,
     curves: &Curves,
+    radius: f64,
 ) -> Result<Option<json::Index<json::Mesh>>, String> {
     use json::accessor::Type::Scalar;
     use json::mesh::Semantic;
     let segments: Vec<u32> = curve_segments(curves).into_iter().flatten().collect();
-    if segments.is_empty() {
+    let tubes = tubes(curves, radius);
+    if segments.is_empty() || tubes.triangles.is_empty() {
         return Ok(None);
     }
-    let points = || curves.curves.iter().flat_map(|c| c.points.iter());
-    let positions: Vec<DVec3> = points().map(|p| p.position).collect();
-    let dw: Vec<f32> = points().map(|p| p.dw() as f32).collect();
+    let points: Vec<&CurvePoint> = curves.curves.iter().flat_map(|c| &c.points).collect();
+    let positions: Vec<DVec3> = points.iter().map(|p| p.position).collect();
+    let dw: Vec<f32> = points.iter().map(|p| p.dw() as f32).collect();
     let index: Vec<f32> = curves
         .curves
         .iter()
         .enumerate()
         .flat_map(|(k, c)| std::iter::repeat_n(k as f32, c.points.len()))
         .collect();
-    let w_near: Vec<f32> = points().map(|p| p.w[p.near()] as f32).collect();
+    let w_near: Vec<f32> = points.iter().map(|p| p.w[p.near()] as f32).collect();
+    let per_vertex =
+        |values: &[f32]| -> Vec<f32> { tubes.point.iter().map(|&k| values[k as usize]).collect() };
     let attributes = [
-        (Semantic::Positions, b.positions(&positions)),
-        (Semantic::Extras("DW".into()), b.floats(&dw, Scalar, None)),
+        (Semantic::Positions, b.positions(&tubes.positions)),
+        (Semantic::Normals, b.normals(&tubes.normals)),
+        (
+            Semantic::Extras("DW".into()),
+            b.floats(&per_vertex(&dw), Scalar, None),
+        ),
         (
             Semantic::Extras("CURVE".into()),
-            b.floats(&index, Scalar, None),
+            b.floats(&per_vertex(&index), Scalar, None),
         ),
         (
             Semantic::Extras("W".into()),
-            b.floats(&w_near, Scalar, None),
+            b.floats(&per_vertex(&w_near), Scalar, None),
         ),
     ];
+    let triangles: Vec<u32> = tubes.triangles.iter().flatten().copied().collect();
     let indices = b.indices(
-        &segments,
+        &triangles,
         Some(json::buffer::Target::ElementArrayBuffer),
         None,
     );
+    // The exact polylines, read by no primitive (see the module documentation).
+    let mut lines = serde_json::Map::new();
+    let polyline = [
+        ("POSITION", b.positions(&positions)),
+        ("_W", b.floats(&w_near, Scalar, None)),
+        ("_DW", b.floats(&dw, Scalar, None)),
+        ("_CURVE", b.floats(&index, Scalar, None)),
+        ("indices", b.indices(&segments, None, None)),
+    ];
+    for (key, accessor) in polyline {
+        b.root.accessors[accessor.value()].name = Some(format!("curves polyline {key}"));
+        lines.insert(key.into(), accessor.value().into());
+    }
     let material = b.root.push(json::Material {
         name: Some("curves".into()),
+        double_sided: true,
         pbr_metallic_roughness: json::material::PbrMetallicRoughness {
             base_color_factor: json::material::PbrBaseColorFactor(CURVE_COLOUR),
             metallic_factor: json::material::StrengthFactor(0.0),
@@ -485,6 +555,8 @@ fn curves_mesh(
             "closed": curves.curves.iter().filter(|c| c.closed).count(),
             "open": curves.curves.iter().filter(|c| !c.closed).count(),
             "points": positions.len(),
+            "radius": radius,
+            "polylines": lines,
         }
     });
     Ok(Some(b.root.push(json::Mesh {
@@ -497,7 +569,7 @@ fn curves_mesh(
             extras: None,
             indices: Some(indices),
             material: Some(material),
-            mode: Valid(json::mesh::Mode::Lines),
+            mode: Valid(json::mesh::Mode::Triangles),
             targets: None,
         }],
         weights: None,

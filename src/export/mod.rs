@@ -14,6 +14,7 @@ mod gltf;
 mod obj;
 mod plot;
 mod ply;
+mod tubes;
 mod vtk;
 
 pub use gltf::{glb_container, to_glb};

@@ -2,7 +2,8 @@
 //!
 //! One `UNSTRUCTURED_GRID` per halo: every halo vertex in the layout of [`crate::check`]
 //! (negative offsets, positive offsets, inserted vertices) as `double` POINTS, every
-//! tetrahedron as a cell of 4 ids and type 10 (`VTK_TETRA`), the dataset's field data
+//! tetrahedron as a cell of 4 ids and type 10 (`VTK_TETRA`) in VTK's orientation
+//! ([`file_order`]), the dataset's field data
 //! `surface_vertices` (int), `rho` (absolute), `delta_d` and `delta_t` (double), and the point
 //! scalars `t` and `d_orig` (double). Binary legacy VTK is big-endian; each binary block ends
 //! with a newline, as VTK's own writer does and meshio requires.
@@ -11,6 +12,7 @@
 //! takes it anywhere at the dataset level, but meshio files it as field data only there.
 
 use super::SurfaceData;
+use crate::convention::file_order;
 
 /// Builds the `.vtk` bytes of one surface's halo. The title line is
 /// `<surface>-halo: halo4d <version>, scene <scene_name>`.
@@ -36,9 +38,9 @@ pub fn to_vtk(surface: &SurfaceData, scene_name: &str) -> Vec<u8> {
     }
     // Ids are 32-bit ints in legacy VTK; a scene's triangle limit keeps them far below 2^31.
     text(&mut out, &format!("\nCELLS {tets} {}\n", 5 * tets));
-    for tet in &halo.tets {
+    for &tet in &halo.tets {
         out.extend_from_slice(&4i32.to_be_bytes());
-        for &i in tet {
+        for i in file_order(tet) {
             out.extend_from_slice(&(i as i32).to_be_bytes());
         }
     }

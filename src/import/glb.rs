@@ -5,6 +5,7 @@ use super::{
     FileParams, ImportError, ImportedCurves, ImportedHalo, ImportedScene, ImportedSurface,
 };
 use crate::check::TetMesh;
+use crate::convention::{file_order, from_gltf};
 use glam::DVec3;
 use serde_json::Value;
 
@@ -130,9 +131,9 @@ pub fn read_scene_glb(bytes: &[u8]) -> Result<ImportedScene> {
     let curves = match meshes
         .iter()
         .enumerate()
-        .find(|(_, m)| extra(m, "curves").is_some())
+        .find_map(|(i, m)| Some((i, m, extra(m, "curves")?)))
     {
-        Some((i, mesh)) => Some(doc.curves(i, mesh, mesh_name(mesh, i))?),
+        Some((i, mesh, curves)) => doc.curves(i, curves, &mesh_name(mesh, i))?,
         None => None,
     };
     Ok(ImportedScene {
@@ -378,6 +379,15 @@ impl<'a> Doc<'a> {
         Ok(out)
     }
 
+    /// Accessor `i` as FLOAT VEC3s (points or directions) in halo4d's frame.
+    fn vec3s(&self, i: u64) -> Result<Vec<DVec3>> {
+        Ok(self
+            .floats(i, "VEC3", 3)?
+            .chunks_exact(3)
+            .map(|c| from_gltf(DVec3::new(c[0].into(), c[1].into(), c[2].into())))
+            .collect())
+    }
+
     /// Accessor `i` as unsigned integer SCALARs (UNSIGNED_BYTE, _SHORT or _INT).
     fn unsigned(&self, i: u64) -> Result<Vec<u32>> {
         let accessor = self.item("accessors", i)?;
@@ -408,24 +418,18 @@ impl<'a> Doc<'a> {
             .collect())
     }
 
-    /// The first primitive of mesh `i`, which must be of `mode` (`(4, "TRIANGLES")` or
-    /// `(1, "LINES")`): its POSITION, `_W` and indices, and its attributes.
-    fn points(
-        &self,
-        i: usize,
-        mesh: &'a Value,
-        name: &str,
-        (mode, mode_name): (u64, &str),
-    ) -> Result<Points<'a>> {
+    /// The first primitive of mesh `i`, which must be of TRIANGLES: its POSITION, `_W` and
+    /// indices, and its attributes.
+    fn points(&self, i: usize, mesh: &'a Value, name: &str) -> Result<Points<'a>> {
         let what = format!("meshes[{i}] (`{name}`)");
         let primitive = mesh
             .get("primitives")
             .and_then(|p| p.get(0))
             .ok_or_else(|| glb_err(format!("{what} has no primitive")))?;
         let found = index(primitive, "mode", &format!("{what}.primitives[0]"), Some(4))?;
-        if found != mode {
+        if found != 4 {
             return Err(glb_err(format!(
-                "{what} has primitives of mode {found}, expected {mode_name} ({mode})"
+                "{what} has primitives of mode {found}, expected TRIANGLES (4)"
             )));
         }
         let attributes = primitive
@@ -434,11 +438,7 @@ impl<'a> Doc<'a> {
         let attribute = |key: &str| -> Result<u64> {
             index(attributes, key, &format!("{what} attributes"), None)
         };
-        let positions: Vec<DVec3> = self
-            .floats(attribute("POSITION")?, "VEC3", 3)?
-            .chunks_exact(3)
-            .map(|c| DVec3::new(c[0].into(), c[1].into(), c[2].into()))
-            .collect();
+        let positions: Vec<DVec3> = self.vec3s(attribute("POSITION")?)?;
         let w: Vec<f64> = self
             .floats(attribute("_W")?, "SCALAR", 1)?
             .into_iter()
@@ -468,18 +468,13 @@ impl<'a> Doc<'a> {
             w,
             indices,
             what,
-        } = self.points(i, mesh, &name, (4, "TRIANGLES"))?;
+        } = self.points(i, mesh, &name)?;
         let attribute = |key: &str| -> Result<u64> {
             index(attributes, key, &format!("{what} attributes"), None)
         };
         let normals: Option<Vec<DVec3>> = match attributes.get("NORMAL") {
             None => None,
-            Some(_) => Some(
-                self.floats(attribute("NORMAL")?, "VEC3", 3)?
-                    .chunks_exact(3)
-                    .map(|c| DVec3::new(c[0].into(), c[1].into(), c[2].into()))
-                    .collect(),
-            ),
+            Some(_) => Some(self.vec3s(attribute("NORMAL")?)?),
         };
         let bad = |message: String| ImportError::BadSurface {
             name: name.clone(),
@@ -543,16 +538,33 @@ impl<'a> Doc<'a> {
         })
     }
 
-    /// The curves of mesh `i` (extras `curves`): its first primitive's LINES with POSITION
-    /// and `_W`.
-    fn curves(&self, i: usize, mesh: &'a Value, name: String) -> Result<ImportedCurves> {
-        let Points {
-            what,
-            positions,
-            w,
-            indices,
-            ..
-        } = self.points(i, mesh, &name, (1, "LINES"))?;
+    /// The exact polylines of the curves mesh `i`, whose extras' `curves` is `curves`: the
+    /// own accessors ([`Self::own_accessor`]) its `polylines` names, POSITION, `_W` and
+    /// `indices` (pairs of points). `None` when the extras name none or name accessors that
+    /// are not (any more) halo4d's, as after a program re-saved the file.
+    fn curves(&self, i: usize, curves: &Value, name: &str) -> Result<Option<ImportedCurves>> {
+        let what = format!("meshes[{i}] (`{name}`).extras.curves.polylines");
+        let Some(lines) = curves.get("polylines") else {
+            return Ok(None);
+        };
+        let mut ids = [0u64; 3];
+        for (id, key) in ids.iter_mut().zip(["POSITION", "_W", "indices"]) {
+            *id = index(lines, key, &what, None)?;
+            if self
+                .own_accessor(*id, &format!("curves polyline {key}"))
+                .is_err()
+            {
+                return Ok(None);
+            }
+        }
+        let [position, w, indices] = ids;
+        let positions: Vec<DVec3> = self.vec3s(position)?;
+        let w: Vec<f64> = self
+            .floats(w, "SCALAR", 1)?
+            .into_iter()
+            .map(f64::from)
+            .collect();
+        let indices = self.unsigned(indices)?;
         let nv = positions.len();
         let bad = |message: String| glb_err(format!("{what}: {message}"));
         if w.len() != nv {
@@ -567,11 +579,83 @@ impl<'a> Doc<'a> {
                 indices.len()
             )));
         }
-        Ok(ImportedCurves {
+        Ok(Some(ImportedCurves {
             positions,
             w,
             segments: indices.chunks_exact(2).map(|c| [c[0], c[1]]).collect(),
-        })
+        }))
+    }
+
+    /// Accessor `i`, if it is one that halo4d writes for no primitive (tetrahedra,
+    /// polylines): named `expected` and read by no primitive. Else why not, to follow
+    /// "accessors[i] ". A program that re-saves a `.glb` keeps the meshes' extras but may
+    /// drop such accessors and give their numbers to others (Blender 4.5 makes the
+    /// tetrahedra's a triangle index buffer).
+    fn own_accessor(&self, i: u64, expected: &str) -> std::result::Result<&'a Value, String> {
+        let all = self.json.get("accessors").and_then(Value::as_array);
+        let accessor = all
+            .and_then(|a| a.get(usize::try_from(i).ok()?))
+            .ok_or_else(|| format!("does not exist (the file has {})", all.map_or(0, Vec::len)))?;
+        match accessor.get("name").and_then(Value::as_str) {
+            Some(n) if n == expected => {}
+            Some(n) => return Err(format!("is named `{n}`, not `{expected}`")),
+            None => return Err(format!("has no name (halo4d names it `{expected}`)")),
+        }
+        let used = self
+            .json
+            .get("meshes")
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+            .filter_map(|m| m.get("primitives").and_then(Value::as_array))
+            .flatten()
+            .any(|p| {
+                p.get("indices").and_then(Value::as_u64) == Some(i)
+                    || p.get("attributes")
+                        .and_then(Value::as_object)
+                        .is_some_and(|a| a.values().any(|v| v.as_u64() == Some(i)))
+            });
+        if used {
+            return Err("a primitive reads as its indices or an attribute".into());
+        }
+        Ok(accessor)
+    }
+
+    /// The indices of accessor `i`, which a halo mesh `name` of `vertices` vertices names
+    /// as its tetrahedra, if it is what [`crate::export::to_glb`] writes: an own accessor
+    /// ([`Self::own_accessor`]) named `<name> tetrahedra`, SCALAR of UNSIGNED_INT, a
+    /// multiple of 4 indices, each below `vertices`. Anything else is
+    /// [`ImportError::NoTetrahedra`], so that triangles are never read as tetrahedra.
+    fn tetrahedra(&self, i: u64, name: &str, vertices: usize) -> Result<Vec<u32>> {
+        let missing = |why: String| ImportError::NoTetrahedra {
+            mesh: name.to_string(),
+            why: format!("its extras name accessors[{i}], which {why}"),
+        };
+        let accessor = self
+            .own_accessor(i, &format!("{name} tetrahedra"))
+            .map_err(missing)?;
+        let type_ = accessor.get("type").and_then(Value::as_str).unwrap_or("?");
+        let component = accessor.get("componentType").and_then(Value::as_u64);
+        if type_ != "SCALAR" || component != Some(5125) {
+            return Err(missing(format!(
+                "is {type_} of component type {}, not SCALAR of UNSIGNED_INT (5125)",
+                component.map_or("?".into(), |c| c.to_string())
+            )));
+        }
+        let indices = self.unsigned(i)?;
+        if indices.len() % 4 != 0 {
+            return Err(missing(format!(
+                "has {} indices, not a multiple of 4",
+                indices.len()
+            )));
+        }
+        if let Some(k) = indices.iter().position(|&v| v as usize >= vertices) {
+            return Err(missing(format!(
+                "names vertex {} at index {k}, but the mesh has {vertices} vertices",
+                indices[k]
+            )));
+        }
+        Ok(indices)
     }
 
     /// The halo of mesh `i`, whose extras' `halo` is `halo`.
@@ -595,9 +679,9 @@ impl<'a> Doc<'a> {
         let position = attribute("POSITION")?
             .ok_or_else(|| glb_err(format!("{what} has no POSITION attribute")))?;
         let positions: Vec<[f64; 3]> = self
-            .floats(position, "VEC3", 3)?
-            .chunks_exact(3)
-            .map(|c| [c[0], c[1], c[2]].map(f64::from))
+            .vec3s(position)?
+            .into_iter()
+            .map(|p| p.to_array())
             .collect();
         let scalar = |key: &str| -> Result<Option<Vec<f64>>> {
             let Some(a) = attribute(key)? else {
@@ -616,13 +700,7 @@ impl<'a> Doc<'a> {
         let t = scalar("_T")?;
         let d_orig = scalar("_D")?;
         let tetrahedra = index(halo, "tetrahedra", &extras, None)?;
-        let indices = self.unsigned(tetrahedra)?;
-        if indices.len() % 4 != 0 {
-            return Err(glb_err(format!(
-                "the tetrahedra of {what} (accessors[{tetrahedra}]) have {} indices, not a multiple of 4",
-                indices.len()
-            )));
-        }
+        let indices = self.tetrahedra(tetrahedra, &name, positions.len())?;
         let surface_vertices = to_usize(
             index(halo, "surface_vertices", &extras, None)?,
             "surface_vertices",
@@ -635,7 +713,7 @@ impl<'a> Doc<'a> {
                 surface_vertices,
                 tets: indices
                     .chunks_exact(4)
-                    .map(|c| [c[0], c[1], c[2], c[3]])
+                    .map(|c| file_order([c[0], c[1], c[2], c[3]]))
                     .collect(),
             },
             t,

@@ -187,6 +187,17 @@ pub enum ImportError {
         /// What is wrong.
         message: String,
     },
+    /// A halo mesh whose extras name tetrahedra that the file does not hold as halo4d
+    /// writes them: an accessor that another program re-used for something else.
+    #[error(
+        "this file has no tetrahedra for {mesh} (a program that re-saved it may have dropped them): {why}"
+    )]
+    NoTetrahedra {
+        /// The halo mesh.
+        mesh: String,
+        /// What the accessor the extras name is instead.
+        why: String,
+    },
     /// A halo's data break the layout: an index out of range, a non-finite coordinate, ...
     #[error("halo `{name}`: {message}")]
     BadHalo {

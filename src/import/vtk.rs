@@ -7,6 +7,7 @@
 
 use super::{FileParams, ImportError, ImportedHalo};
 use crate::check::TetMesh;
+use crate::convention::file_order;
 use std::collections::HashMap;
 
 type Result<T> = std::result::Result<T, ImportError>;
@@ -393,7 +394,7 @@ impl Reader<'_> {
                 }
                 *slot = id as u32;
             }
-            g.tets.push(tet);
+            g.tets.push(file_order(tet));
         }
         Ok(g)
     }
