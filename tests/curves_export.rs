@@ -408,6 +408,35 @@ fn a_scene_reads_back_from_its_glb_with_every_surface_and_its_halo() {
         let d: Vec<f64> = p.halo.d_orig.iter().map(|&x| f32_of(x)).collect();
         assert_eq!(h.d_orig.as_deref(), Some(&d[..]));
     }
+    // The curves' exact polylines, in halo4d's frame, as the viewer draws them; gone (and
+    // no error) when another program re-used their accessors.
+    let c = read.curves.as_ref().expect("the curves' polylines");
+    let points: Vec<_> = built.curves.curves.iter().flat_map(|c| &c.points).collect();
+    let want: Vec<DVec3> = points
+        .iter()
+        .map(|p| p.position.as_vec3().as_dvec3())
+        .collect();
+    assert_eq!(c.positions, want);
+    let w: Vec<f64> = points
+        .iter()
+        .map(|p| f64::from(p.w[p.near()] as f32))
+        .collect();
+    assert_eq!(c.w, w);
+    assert_eq!(c.segments, expected_segments(&built.curves));
+    let reused = with_json(&bytes, |j| {
+        let a = j["meshes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["name"] == "curves")
+            .unwrap()["extras"]["curves"]["polylines"]["POSITION"]
+            .as_u64()
+            .unwrap() as usize;
+        j["accessors"][a].as_object_mut().unwrap().remove("name");
+    });
+    let again = read_scene_glb(&reused).unwrap();
+    assert!(again.curves.is_none());
+    assert_eq!(again.surfaces, read.surfaces);
     // The curves between the two surfaces are found again, and the halos explain them.
     let (curves, v) = read.verify();
     assert!(curves.report.count > 0 && v.curve_samples > 0, "{v:?}");

@@ -410,6 +410,14 @@ fn check_passes_a_valid_halo_and_catches_faults_planted_in_its_files() {
         &|h| h.mesh.tets[7].swap(0, 1),
         &["1 inverted"],
     );
+    // Every tetrahedron in halo4d's own orientation, which is VTK-negative: all inverted,
+    // as ParaView's Mesh Quality would show them.
+    let all = format!("{} inverted", halo.mesh.tets.len());
+    planted(
+        "vtk-negative.vtk",
+        &|h| h.mesh.tets.iter_mut().for_each(|t| *t = file_order(*t)),
+        &[&all],
+    );
     planted(
         "duplicated.vtk",
         &|h| h.mesh.tets.push(h.mesh.tets[3]),

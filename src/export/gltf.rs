@@ -1,24 +1,31 @@
-//! glTF 2.0 binary (`.glb`) export with gltf-json.
+//! glTF 2.0 binary (`.glb`) export with gltf-json. Points and normals are in glTF's frame
+//! (y up) and tetrahedra in VTK's orientation, both converted by [`crate::convention`].
 //!
 //! Per surface, two meshes, each with its own node:
 //! - the surface, named after it, as TRIANGLES with POSITION (min/max computed from the f32
 //!   values actually stored), unit NORMAL, and float SCALAR custom attributes `_W` (w-depth),
 //!   `_U`, `_V` (surface parameters) and `_PATCH` (patch index);
 //! - its halo, `<surface>-halo`: every halo vertex in the layout of [`crate::check`] with
-//!   POSITION and float SCALAR attributes `_T`, `_D` (d_orig) and `_PATCH`, and as TRIANGLES
-//!   only the halo's boundary faces (those of exactly one tetrahedron, turned outward), which is
-//!   all a renderer shows. glTF has no tetrahedron primitive: the tetrahedra are an UNSIGNED_INT
-//!   SCALAR accessor of 4 indices each, in a buffer view without a target, named by the halo
-//!   mesh's extras `{"halo": {"tetrahedra": accessor, "surface_vertices": n, "rho", "delta_d",
-//!   "delta_t", "split", "surface_mesh": mesh}}` ([`crate::import`] reads them back).
+//!   POSITION, unit NORMAL and float SCALAR attributes `_T`, `_D` (d_orig) and `_PATCH`, and
+//!   as TRIANGLES only the halo's boundary faces (those of exactly one tetrahedron, turned
+//!   outward), which is all a renderer shows; a top face names a collapsed corner by its
+//!   positive offset, so that every offset vertex is on a triangle (importers drop the others).
+//!   glTF has no tetrahedron primitive: the tetrahedra are an UNSIGNED_INT SCALAR accessor of
+//!   4 indices each named `<surface>-halo tetrahedra`, in a buffer view without a target,
+//!   numbered by the halo mesh's extras `{"halo": {"tetrahedra": accessor, "surface_vertices":
+//!   n, "rho", "delta_d", "delta_t", "split", "surface_mesh": mesh}}` ([`crate::import`]
+//!   reads them back).
 //!
 //! Then, when the scene has any, the intersection curves of all surfaces together in one mesh
-//! `curves` with its own node: a LINES primitive with POSITION (min/max of the stored f32
-//! values) and float SCALAR attributes `_DW` (w of the far sheet minus w of the near sheet,
-//! never negative), `_CURVE` (the curve's index) and `_W` (w of the near sheet), one per curve point;
-//! its indices join consecutive points, and a closed curve's last point back to its first.
-//! The mesh's extras count them: `{"curves": {"count", "closed", "open", "points"}}`.
-//! Blender imports the lines as loose edges.
+//! `curves` with its own node: [`super::tubes`] of the given radius as TRIANGLES with POSITION,
+//! NORMAL and float SCALAR attributes `_DW` (w of the far sheet minus w of the near sheet,
+//! never negative), `_CURVE` (the curve's index) and `_W` (w of the near sheet), each vertex
+//! those of its curve point. No glTF LINES: MeshLab crashes on them and Blender's renderers
+//! skip the loose edges it makes of them. The exact polylines are accessors that no primitive
+//! reads, named `curves polyline <key>`, numbered by the mesh's extras with the counts:
+//! `{"curves": {"count", "closed", "open", "points", "radius", "polylines": {"POSITION",
+//! "_W", "_DW", "_CURVE", "indices"}}}`; `indices` join consecutive points in pairs, and a
+//! closed curve's last point back to its first.
 //!
 //! Floats, because Blender 3.5+ imports float attributes and drops integer ones. Each
 //! attribute has its own tightly packed, 4-byte aligned buffer view. The asset's extras
@@ -276,8 +283,9 @@ fn halo_patches(s: &SurfaceData) -> Vec<f32> {
 }
 
 /// Builds the `.glb` bytes for the surfaces, their halos and the scene's intersection
-/// `curves`; `scene_json` goes into the asset's extras. A halo without tetrahedra, and
-/// curves without a segment, get no mesh (glTF accessors cannot be empty).
+/// `curves`, as tubes of `curve_radius` (absolute); `scene_json` goes into the asset's
+/// extras. A halo without tetrahedra, and curves without a segment, get no mesh (glTF
+/// accessors cannot be empty).
 pub fn to_glb(
     surfaces: &[SurfaceData],
     curves: &Curves,

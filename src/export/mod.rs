@@ -1,13 +1,14 @@
 //! Export: the products of a build as files.
 //!
-//! Takes: the sampled and projected surfaces, their halos and the intersection curves. Gives: `.glb` (glTF 2.0
-//! binary, for Blender: surfaces, halos and intersection curves), `.ply` (binary PLY with w
-//! as vertex `quality`, for MeshLab), `-curves.ply` (the intersection curves as PLY edges,
-//! with the depth gap dw as vertex `quality`, for MeshLab, which reads LINES from a `.glb`
-//! as bogus triangles), `.obj` (Wavefront, positions and normals only), `.vtk` (legacy VTK
-//! unstructured grids of the halos' tetrahedra, for ParaView and meshio) and `report.json`.
-//! Guarantees: every file is written to a temporary name and renamed into place, so a
-//! failure never leaves a half-written file. [`crate::import`] reads the halos and
+//! Takes: the sampled and projected surfaces, their halos and the intersection curves.
+//! Gives: `.glb` (glTF 2.0 binary, for Blender: surfaces, halos, and the intersection curves
+//! as tubes with their exact polylines as data), `.ply` (binary PLY with w as vertex
+//! `quality`, for MeshLab), `-curves.ply` (the intersection curves as PLY edges, with the
+//! depth gap dw as vertex `quality`, for MeshLab), `.obj` (Wavefront, positions and normals
+//! only), `.vtk` (legacy VTK unstructured grids of the halos' tetrahedra, for ParaView and
+//! meshio) and `report.json`. Guarantees: each file in its format's conventions
+//! ([`crate::convention`]); every file is written to a temporary name and renamed into place,
+//! so a failure never leaves a half-written file. [`crate::import`] reads the halos and
 //! surfaces back.
 
 mod gltf;

@@ -6,12 +6,14 @@
 //! binary, file version 2.0 to 5.1). Gives: [`ImportedHalo`]s, each a [`TetMesh`] in the
 //! halo layout of [`crate::check`] with its name, per-vertex t and d_orig and parameters;
 //! from a scene's `.glb` also its surfaces ([`read_scene_glb`]: positions, w-depth and
-//! triangles, each with its halo), from which [`ImportedScene::verify`] recomputes the
+//! triangles, each with its halo, and the curves' polylines), from which [`ImportedScene::verify`] recomputes the
 //! intersection curves and verifies the halos against them.
 //! Guarantees: malformed input (truncated, wrong magic, bad JSON, references out of range,
 //! counts that disagree, non-finite coordinates) is an [`ImportError`] that names the
 //! problem, never a panic; a count claimed in a file is checked against the bytes actually
-//! there before anything is allocated for it.
+//! there before anything is allocated for it; everything comes back in halo4d's frame and
+//! orientation ([`crate::convention`]); an accessor that another program re-used (the
+//! tetrahedra's, the polylines') is never read as ours.
 
 mod glb;
 mod vtk;
@@ -68,7 +70,8 @@ pub struct ImportedScene {
     pub name: Option<String>,
     /// Its surfaces, in the file's order.
     pub surfaces: Vec<ImportedSurface>,
-    /// The intersection curves (the `curves` mesh), when the file has them.
+    /// The intersection curves' exact polylines (named by the `curves` mesh's extras), when
+    /// the file has them and no other program re-used their accessors.
     pub curves: Option<ImportedCurves>,
     /// The camera the scene was built with (`camera` of the scene recorded in the asset's
     /// extras), when recorded.
