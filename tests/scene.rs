@@ -67,6 +67,10 @@ const BROKEN: &[(&str, &[&str])] = &[
     ("negative-rho.json", &["halo.rho", "greater than 0"]),
     ("zero-rho.json", &["halo.rho", "greater than 0"]),
     (
+        "curve-radius-too-large.json",
+        &["outputs.curve_radius", "at most 0.05", "0.5"],
+    ),
+    (
         "infinite-number.json",
         &["surfaces[0].surface", "out of range"],
     ),
