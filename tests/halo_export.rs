@@ -469,6 +469,11 @@ fn unreadable_files_are_errors_of_the_cli_with_the_file_named() {
         ),
         ("notes.txt", &["notes.txt", ".glb or a .vtk"]),
         ("absent.vtk", &["absent.vtk", "cannot read"]),
+        // Not there, and no extension: not found, not "unknown file type".
+        (
+            "no-such-file",
+            &["no-such-file", "cannot read", "No such file"],
+        ),
     ] {
         let out = halo4d(&["check", file], dir.path());
         assert_unreadable(&out, file, words);
@@ -685,6 +690,20 @@ fn malformed_vtk_files_are_clear_errors() {
         text.replacen(from, to, 1)
     };
     vtk_fails(replace("ASCII", "TEXT").as_bytes(), &["ASCII or BINARY"]);
+    // A huge line is quoted in part, not whole.
+    for long in [
+        format!("DATASET {}", "X".repeat(70_000)),
+        "Y".repeat(70_000),
+    ] {
+        let e = read_vtk(replace("DATASET UNSTRUCTURED_GRID", &long).as_bytes())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.len() < 300 && e.contains("..."),
+            "{} bytes: {e:.200}",
+            e.len()
+        );
+    }
     vtk_fails(
         replace("UNSTRUCTURED_GRID", "POLYDATA").as_bytes(),
         &["POLYDATA", "UNSTRUCTURED_GRID"],

@@ -319,6 +319,19 @@ fn bad_render_settings_are_refused_with_a_clear_message() {
             "{}",
             &["render.line_width", "quarter"],
         ),
+        // The default 2.5-pixel lines do not fit a 1-pixel picture: the message says the
+        // real range, not "0.5 to 0".
+        (
+            "tiny",
+            r#"{"width": 1, "height": 1}"#,
+            "{}",
+            &[
+                "render.line_width",
+                "0.5 to 0.5 pixels",
+                "1 pixels",
+                "got 2.5",
+            ],
+        ),
         ("nan", r#"{"opacity": 0}"#, "{}", &["render.opacity"]),
         ("elev", "{}", r#"{"elevation": 95}"#, &["camera.elevation"]),
     ] {

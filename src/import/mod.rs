@@ -213,6 +213,8 @@ pub enum ImportError {
 
 /// Reads the halos of a `.glb` or `.vtk` file, chosen by its extension.
 pub fn read(path: &Path) -> Result<Vec<ImportedHalo>, ImportError> {
+    // A path that is not there is that, whatever its extension says.
+    std::fs::metadata(path)?;
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())

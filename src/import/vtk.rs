@@ -60,14 +60,15 @@ pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
         Some([dataset, kind]) if dataset.eq_ignore_ascii_case("DATASET") => {
             if !kind.eq_ignore_ascii_case("UNSTRUCTURED_GRID") {
                 return Err(err(format!(
-                    "the dataset is {kind}; halos are UNSTRUCTURED_GRID"
+                    "the dataset is {}; halos are UNSTRUCTURED_GRID",
+                    truncate(kind)
                 )));
             }
         }
         other => {
             return Err(err(format!(
                 "expected `DATASET UNSTRUCTURED_GRID`, found {:?}",
-                other.map(|w| w.join(" ")).unwrap_or("end of file".into())
+                truncate(&other.map(|w| w.join(" ")).unwrap_or("end of file".into()))
             )));
         }
     }
@@ -115,9 +116,12 @@ pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
     .validate()
 }
 
-/// At most 60 characters of `s`, for error messages.
+/// At most 60 characters of `s` (then `...`), for error messages.
 fn truncate(s: &str) -> String {
-    s.chars().take(60).collect()
+    match s.char_indices().nth(60) {
+        Some((at, _)) => format!("{}...", &s[..at]),
+        None => s.to_string(),
+    }
 }
 
 /// A position in the file's bytes.
@@ -445,7 +449,7 @@ impl Reader<'_> {
                 }
                 other => Err(err(format!(
                     "CELLS: expected `{name} <type>`, found {:?}",
-                    other.map(|w| w.join(" ")).unwrap_or("end of file".into())
+                    truncate(&other.map(|w| w.join(" ")).unwrap_or("end of file".into()))
                 ))),
             }
         };

@@ -253,18 +253,19 @@ impl RenderSettings {
                 return Err(("ribbons.gap", format!("must be in (0, 1), got {}", r.gap)));
             }
         }
-        let max_width = f64::from(self.width.min(self.height)) / 4.0;
+        let side = self.width.min(self.height);
+        let max_width = (f64::from(side) / 4.0).max(0.5);
         for (field, w) in [
             ("line_width", Some(self.line_width)),
             ("line_width_far", self.line_width_far),
         ] {
             if let Some(w) = w
-                && !(w.is_finite() && w >= 0.5 && w <= max_width.max(0.5))
+                && !(w.is_finite() && w >= 0.5 && w <= max_width)
             {
                 return Err((
                     field,
                     format!(
-                        "must be 0.5 to {max_width:.0} pixels (a quarter of the image), got {w}"
+                        "must be 0.5 to {max_width} pixels (at most a quarter of the picture's smaller side, {side} pixels, or 0.5), got {w}: make the lines thinner or the picture larger"
                     ),
                 ));
             }
