@@ -37,6 +37,9 @@ pub enum Error {
         /// The cause.
         source: std::io::Error,
     },
+    /// Another build is writing into the output folder.
+    #[error(transparent)]
+    Busy(crate::export::StagedError),
     /// A stage produced something it must not (a bug, not bad input).
     #[error("internal error in stage {stage}: {message}")]
     Internal {

@@ -18,7 +18,7 @@ use crate::view::Projected;
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 /// One surface after sampling and projection.
@@ -455,15 +455,12 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     let products = &built.surfaces;
     let mut timings = built.timings;
     let export_start = Instant::now();
-    std::fs::create_dir_all(out_dir).map_err(|source| Error::Write {
-        path: out_dir.to_path_buf(),
-        source,
-    })?;
+    // Every file under a temporary name until all were made: a failure leaves the folder
+    // as it was.
+    let staged = std::cell::RefCell::new(export::Staged::new(out_dir).map_err(staged_error)?);
     let data: Vec<SurfaceData> = products.iter().map(|p| p.data(&scene.halo)).collect();
     let write = |file: String, bytes: &[u8]| -> Result<String, Error> {
-        let path: PathBuf = out_dir.join(&file);
-        export::write_atomic(&path, bytes).map_err(|source| Error::Write { path, source })?;
-        Ok(file)
+        staged.borrow_mut().write(file, bytes).map_err(staged_error)
     };
     let mut files = Vec::new();
     let name = &scene.name;
@@ -551,7 +548,16 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
         })?;
         write("report.json".into(), &text)?;
     }
+    staged.into_inner().commit().map_err(staged_error)?;
     Ok(report)
+}
+
+/// A [`export::StagedError`] as the pipeline's error.
+fn staged_error(e: export::StagedError) -> Error {
+    match e {
+        export::StagedError::Io { path, source } => Error::Write { path, source },
+        busy => Error::Busy(busy),
+    }
 }
 
 fn surface_report(p: &SurfaceProduct) -> SurfaceReport {

@@ -134,3 +134,127 @@ fn sweep_writes_csv_and_plot_for_a_scene() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--tolerances"));
 }
+
+/// Every file of a folder (hidden ones too) with its bytes.
+fn folder(dir: &std::path::Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .map(|p| {
+            let bytes = std::fs::read(&p).unwrap();
+            (p.file_name().unwrap().to_string_lossy().into_owned(), bytes)
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+/// The patches fixture with `edit` applied to its JSON, written to `dir/<name>.json`.
+fn patches_scene(dir: &std::path::Path, name: &str, edit: &str) -> String {
+    let mut scene: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(fixture("scenes/patches.json")).unwrap()).unwrap();
+    let edit: serde_json::Value = serde_json::from_str(edit).unwrap();
+    for (k, v) in edit.as_object().unwrap() {
+        scene[k] = v.clone();
+    }
+    let file = format!("{name}.json");
+    std::fs::write(dir.join(&file), serde_json::to_vec(&scene).unwrap()).unwrap();
+    file
+}
+
+#[test]
+fn a_build_that_fails_at_its_last_stage_leaves_the_previous_build_unchanged() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = patches_scene(dir.path(), "good", "{}");
+    let out = halo4d(&["build", "-q", &good, "--out", "o"], dir.path());
+    assert!(out.status.success());
+    let before = folder(&dir.path().join("o"));
+    assert!(before.iter().any(|(f, _)| f == "patches.png"));
+    // Valid as a scene, but the picture fails: an orthographic eye inside the scene, after
+    // every other file was made.
+    let bad = patches_scene(
+        dir.path(),
+        "bad",
+        r#"{"camera": {"projection": "orthographic", "distance": 0.5},
+            "halo": {"rho": 0.02}}"#,
+    );
+    let out = halo4d(&["build", "-q", &bad, "--out", "o"], dir.path());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("camera") || err.contains("distance"), "{err}");
+    assert_eq!(folder(&dir.path().join("o")), before, "the folder changed");
+}
+
+#[test]
+fn a_killed_build_leaves_the_previous_build_and_its_lock_is_taken_over() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = halo4d(&["build", "-q", "--out", "o"], dir.path());
+    assert!(out.status.success());
+    let o = dir.path().join("o");
+    let before = folder(&o);
+    // The same scene with another rho: every file would differ. Killed as soon as it takes
+    // the folder's lock, i.e. while it writes its files (the picture alone takes a second).
+    let other = r#"{"name": "spun-trefoil", "surfaces": [{"surface": {"type": "spun_trefoil"}}],
+                    "view": {"rotation": {"xw": 30, "yz": 30}}, "halo": {"rho": 0.02}}"#;
+    std::fs::write(dir.path().join("other.json"), other).unwrap();
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_halo4d"))
+        .args(["build", "-q", "other.json", "--out", "o"])
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let lock = o.join(halo4d::export::LOCK);
+    while !lock.exists() {
+        assert!(child.try_wait().unwrap().is_none(), "it finished unkilled");
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    // The previous files, unchanged; what the killed build left is hidden and temporary.
+    let after = folder(&o);
+    let visible = |files: &[(String, Vec<u8>)]| -> Vec<(String, Vec<u8>)> {
+        files
+            .iter()
+            .filter(|(f, _)| !f.starts_with('.'))
+            .cloned()
+            .collect()
+    };
+    assert_eq!(visible(&after), visible(&before), "the folder changed");
+    assert!(
+        after.iter().all(|(f, _)| !f.starts_with('.')
+            || f.ends_with(".partial")
+            || f == halo4d::export::LOCK)
+    );
+    // Its lock names a process that is gone: the next build takes it over.
+    let out = halo4d(&["build", "-q", "other.json", "--out", "o"], dir.path());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        folder(&o).iter().all(|(f, _)| !f.starts_with('.')),
+        "leftovers"
+    );
+}
+
+#[test]
+fn a_second_build_into_a_folder_in_use_fails_at_once_naming_the_other() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().join("o");
+    std::fs::create_dir(&o).unwrap();
+    // This test's own process holds the lock, as a running build would.
+    let me = std::process::id().to_string();
+    std::fs::write(o.join(halo4d::export::LOCK), &me).unwrap();
+    let scene = patches_scene(dir.path(), "p", "{}");
+    let out = halo4d(&["build", "-q", &scene, "--out", "o"], dir.path());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains(&format!("another halo4d build (process {me})"))
+            && err.contains(".halo4d-build.lock"),
+        "{err}"
+    );
+    assert_eq!(folder(&o).len(), 1, "it wrote something");
+}

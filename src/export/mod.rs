@@ -8,7 +8,8 @@
 //! only), `.vtk` (legacy VTK unstructured grids of the halos' tetrahedra, for ParaView and
 //! meshio) and `report.json`. Guarantees: each file in its format's conventions
 //! ([`crate::convention`]); every file is written to a temporary name and renamed into place,
-//! so a failure never leaves a half-written file. [`crate::import`] reads the halos and
+//! so a failure never leaves a half-written file, and a build's files move into place
+//! together ([`Staged`]). [`crate::import`] reads the halos and
 //! surfaces back.
 
 mod gltf;
@@ -23,6 +24,9 @@ pub use obj::to_obj;
 pub use plot::{encode_png, render_speed_vs_error_png, speed_vs_error_png};
 pub use ply::{to_curves_ply, to_ply};
 pub use vtk::to_vtk;
+
+mod staged;
+pub use staged::{LOCK, Staged, StagedError};
 
 use crate::halo::{Halo, HaloParams};
 use crate::intersect::Curves;

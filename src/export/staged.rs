@@ -1,0 +1,150 @@
+//! All-or-nothing output: a build's files are written under temporary names and moved into
+//! place together, only once every one of them was made, by one build at a time per folder.
+//!
+//! A build that fails (or is killed) before [`Staged::commit`] leaves the folder's previous
+//! files as they were: its temporary files (`.<file>.partial`) are removed on failure, and a
+//! killed build's are overwritten by the next. A lock file `.halo4d-build.lock` holding the
+//! build's process id keeps a second build out of the folder while one is writing; a lock
+//! whose process is gone (a killed build) is taken over.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The lock file's name in the output folder.
+pub const LOCK: &str = ".halo4d-build.lock";
+
+/// Why the files could not be staged or moved into place.
+#[derive(Debug, thiserror::Error)]
+pub enum StagedError {
+    /// Another build holds the folder's lock.
+    #[error(
+        "another halo4d build (process {pid}) is writing into {}; wait for it to finish, or delete {} if no build is running",
+        dir.display(),
+        lock.display()
+    )]
+    Busy {
+        /// The output folder.
+        dir: PathBuf,
+        /// The lock file.
+        lock: PathBuf,
+        /// The process that holds it.
+        pid: String,
+    },
+    /// A file or the folder could not be written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+}
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> StagedError + '_ {
+    move |source| StagedError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// The files of one build in one folder, staged until [`Staged::commit`].
+#[derive(Debug)]
+pub struct Staged {
+    dir: PathBuf,
+    lock: PathBuf,
+    /// (temporary, final) paths of the files written so far.
+    files: Vec<(PathBuf, PathBuf)>,
+}
+
+impl Staged {
+    /// Creates `dir` if needed and takes its lock.
+    pub fn new(dir: &Path) -> Result<Staged, StagedError> {
+        std::fs::create_dir_all(dir).map_err(io(dir))?;
+        let lock = dir.join(LOCK);
+        let pid = std::process::id().to_string();
+        for attempt in 0..2 {
+            match std::fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&lock)
+            {
+                Ok(mut f) => {
+                    f.write_all(pid.as_bytes()).map_err(io(&lock))?;
+                    return Ok(Staged {
+                        dir: dir.to_path_buf(),
+                        lock,
+                        files: Vec::new(),
+                    });
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    let holder = std::fs::read_to_string(&lock).unwrap_or_default();
+                    let holder = holder.trim().to_string();
+                    if attempt == 0 && !alive(&holder, &lock) {
+                        // A killed build's lock: take it over.
+                        let _ = std::fs::remove_file(&lock);
+                        continue;
+                    }
+                    return Err(StagedError::Busy {
+                        dir: dir.to_path_buf(),
+                        lock,
+                        pid: if holder.is_empty() {
+                            "?".into()
+                        } else {
+                            holder
+                        },
+                    });
+                }
+                Err(e) => return Err(io(&lock)(e)),
+            }
+        }
+        unreachable!("the second attempt returns")
+    }
+
+    /// Writes `bytes` as `file` in the folder under a temporary name; returns `file`.
+    pub fn write(&mut self, file: String, bytes: &[u8]) -> Result<String, StagedError> {
+        let path = self.dir.join(&file);
+        let tmp = self.dir.join(format!(".{file}.partial"));
+        std::fs::File::create(&tmp)
+            .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
+            .map_err(|e| {
+                let _ = std::fs::remove_file(&tmp);
+                io(&path)(e)
+            })?;
+        self.files.push((tmp, path));
+        Ok(file)
+    }
+
+    /// Moves every file written into place, then releases the lock.
+    pub fn commit(mut self) -> Result<(), StagedError> {
+        for (tmp, path) in std::mem::take(&mut self.files) {
+            std::fs::rename(&tmp, &path).map_err(io(&path))?;
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Staged {
+    /// Removes what was not committed, and the lock.
+    fn drop(&mut self) {
+        for (tmp, _) in &self.files {
+            let _ = std::fs::remove_file(tmp);
+        }
+        let _ = std::fs::remove_file(&self.lock);
+    }
+}
+
+/// Whether the process `pid` (as the lock file `lock` holds it) runs. Where that cannot be
+/// told (no `/proc`) it counts as running, and the message says to delete the lock; a lock
+/// without a process id counts as running for its first ten seconds (its build may not have
+/// written the id yet).
+fn alive(pid: &str, lock: &Path) -> bool {
+    match pid.parse::<u32>() {
+        Ok(p) if Path::new("/proc/self").exists() => Path::new(&format!("/proc/{p}")).exists(),
+        Ok(_) => true,
+        Err(_) => std::fs::metadata(lock)
+            .and_then(|m| m.modified())
+            .ok()
+            .and_then(|t| t.elapsed().ok())
+            .is_none_or(|age| age.as_secs() < 10),
+    }
+}
