@@ -90,6 +90,36 @@ impl CheckStats {
             && self.unexpected_boundary_faces == 0
     }
 
+    /// The verdict of `halo4d check` and of a build: the mesh conforms and has no inverted or
+    /// flat tetrahedron.
+    pub fn passes(&self) -> bool {
+        self.failures().is_empty()
+    }
+
+    /// What keeps the mesh from passing ([`Self::passes`]): each non-zero failure count as
+    /// `<count> <name>`, and `does not conform` when no count names why.
+    pub fn failures(&self) -> Vec<String> {
+        let counts = [
+            ("inverted", self.inverted),
+            ("flat", self.flat),
+            ("degenerate", self.degenerate),
+            ("duplicate_tets", self.duplicate_tets),
+            ("overshared_faces", self.overshared_faces),
+            ("quad_mismatches", self.quad_mismatches),
+            ("missing_offset_faces", self.missing_offset_faces),
+            ("unexpected_boundary_faces", self.unexpected_boundary_faces),
+        ];
+        let mut out: Vec<String> = counts
+            .iter()
+            .filter(|(_, c)| *c > 0)
+            .map(|(k, c)| format!("{c} {k}"))
+            .collect();
+        if !self.conforms() && counts[2..].iter().all(|(_, c)| *c == 0) {
+            out.push("does not conform".into());
+        }
+        out
+    }
+
     /// Whether the mesh conforms, every tetrahedron is positive, and the tetrahedra fill
     /// exactly the volume the boundary encloses (no overlap).
     pub fn valid(&self) -> bool {

@@ -59,6 +59,52 @@ pub struct Built {
 }
 
 impl Built {
+    /// The build's verdict: what keeps it from being verified, empty when it is. Every
+    /// surface has a halo that passes the checker ([`CheckStats::passes`]), every curve is
+    /// resolved, and the halos' verification found no wrong curve sample and no spurious
+    /// hidden surface sample.
+    pub fn failures(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for p in &self.surfaces {
+            let check = &p.halo_report.check;
+            if p.halo.tets.is_empty() {
+                out.push(format!("{}: no halo (no tetrahedron)", p.name));
+            } else if !check.passes() {
+                out.push(format!("{}-halo: {}", p.name, check.failures().join(", ")));
+            }
+        }
+        let c = &self.curves.report;
+        if c.unresolved > 0 {
+            out.push(format!(
+                "curves: {} unresolved (more than two segments meet at a point)",
+                c.unresolved
+            ));
+        }
+        let v = &self.verification;
+        let first = |at: &[[f64; 3]]| {
+            at.first()
+                .map(|p| format!(" (the first at ({:.6}, {:.6}, {:.6}))", p[0], p[1], p[2]))
+                .unwrap_or_default()
+        };
+        if v.wrong > 0 {
+            out.push(format!(
+                "halo verification: {} of {} curve samples wrong{}",
+                v.wrong,
+                v.curve_samples,
+                first(&v.wrong_at)
+            ));
+        }
+        if v.spurious_hidden_samples > 0 {
+            out.push(format!(
+                "halo verification: {} of {} surface samples spuriously hidden{}",
+                v.spurious_hidden_samples,
+                v.surface_samples,
+                first(&v.spurious_at)
+            ));
+        }
+        out
+    }
+
     /// The surfaces as the intersection stage reads them.
     pub fn sheets(&self) -> Vec<Sheet<'_>> {
         sheets(&self.surfaces)
@@ -326,6 +372,10 @@ pub struct Report {
     pub timings_ms: Timings,
     /// Warnings, also printed on stderr.
     pub warnings: Vec<String>,
+    /// Whether the build is verified: [`Built::failures`] found nothing.
+    pub verified: bool,
+    /// What [`Built::failures`] found.
+    pub failures: Vec<String>,
     /// Files written, relative to the output folder.
     pub files: Vec<String>,
     /// The scene as parsed, with every default filled in.
@@ -464,16 +514,22 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     };
     let mut files = Vec::new();
     let name = &scene.name;
+    let failures = built.failures();
     if scene.outputs.glb {
         let scene_json = serde_json::to_value(scene).map_err(|e| Error::Internal {
             stage: "export",
             message: e.to_string(),
         })?;
+        let asset = serde_json::json!({
+            "scene": scene_json,
+            "verified": failures.is_empty(),
+            "failures": failures,
+        });
         let glb = export::to_glb(
             &data,
             &built.curves,
             scene.outputs.curve_radius * built.diagonal,
-            &scene_json,
+            &asset,
         )
         .map_err(|message| Error::Internal {
             stage: "export",
@@ -538,6 +594,8 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
             .iter()
             .filter_map(|p| p.sampling.warning(&p.name))
             .collect(),
+        verified: failures.is_empty(),
+        failures,
         files,
         scene: scene.clone(),
     };

@@ -73,7 +73,19 @@ fn a_budget_too_small_for_the_tolerance_warns_and_reports_incomplete() {
              "outputs": { "glb": false, "ply": false } }"#,
     )
     .unwrap();
-    let out = halo4d(&["build", "tight.json", "--out", "o", "-q"], dir.path());
+    // So coarse a knot gets curve samples wrong: the build is not verified, which is not
+    // what this test is about.
+    let out = halo4d(
+        &[
+            "build",
+            "tight.json",
+            "--out",
+            "o",
+            "-q",
+            "--allow-unverified",
+        ],
+        dir.path(),
+    );
     assert!(out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -194,9 +206,14 @@ fn a_killed_build_leaves_the_previous_build_and_its_lock_is_taken_over() {
     let before = folder(&o);
     // The same scene with another rho: every file would differ. Killed as soon as it takes
     // the folder's lock, i.e. while it writes its files (the picture alone takes a second).
-    let other = r#"{"name": "spun-trefoil", "surfaces": [{"surface": {"type": "spun_trefoil"}}],
-                    "view": {"rotation": {"xw": 30, "yz": 30}}, "halo": {"rho": 0.02}}"#;
-    std::fs::write(dir.path().join("other.json"), other).unwrap();
+    let mut other: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(fixture("scenes/default.json")).unwrap()).unwrap();
+    other["halo"]["rho"] = 0.012.into();
+    std::fs::write(
+        dir.path().join("other.json"),
+        serde_json::to_vec(&other).unwrap(),
+    )
+    .unwrap();
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_halo4d"))
         .args(["build", "-q", "other.json", "--out", "o"])
         .current_dir(dir.path())
@@ -221,11 +238,9 @@ fn a_killed_build_leaves_the_previous_build_and_its_lock_is_taken_over() {
             .collect()
     };
     assert_eq!(visible(&after), visible(&before), "the folder changed");
-    assert!(
-        after.iter().all(|(f, _)| !f.starts_with('.')
-            || f.ends_with(".partial")
-            || f == halo4d::export::LOCK)
-    );
+    assert!(after.iter().all(|(f, _)| !f.starts_with('.')
+        || f.ends_with(".partial")
+        || f.starts_with(halo4d::export::LOCK)));
     // Its lock names a process that is gone: the next build takes it over.
     let out = halo4d(&["build", "-q", "other.json", "--out", "o"], dir.path());
     assert!(
@@ -257,4 +272,70 @@ fn a_second_build_into_a_folder_in_use_fails_at_once_naming_the_other() {
         "{err}"
     );
     assert_eq!(folder(&o).len(), 1, "it wrote something");
+}
+
+#[test]
+fn an_unverified_build_writes_its_files_marked_and_exits_3_unless_allowed() {
+    let dir = tempfile::tempdir().unwrap();
+    // rho far beyond what the torus allows, with folds reported rather than shrunk: inverted
+    // tetrahedra, and curve samples the folded halos get wrong.
+    let scene = r#"{ "name": "unv", "surfaces": [ { "surface": { "type": "flat_torus" } } ],
+        "sampling": { "method": "uniform", "u": 16, "v": 16 },
+        "view": { "rotation": { "yw": 30 } },
+        "halo": { "rho": 0.3, "fold": "report" }, "outputs": { "png": false } }"#;
+    std::fs::write(dir.path().join("unv.json"), scene).unwrap();
+    let out = halo4d(&["build", "-q", "unv.json", "--out", "o"], dir.path());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(
+        err.contains("UNVERIFIED flat_torus-halo: ") && err.contains(" inverted"),
+        "{err}"
+    );
+    assert!(err.contains("--allow-unverified"), "{err}");
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("o/report.json")).unwrap()).unwrap();
+    assert_eq!(report["verified"], false);
+    let failures = report["failures"].as_array().unwrap();
+    assert!(
+        failures
+            .iter()
+            .any(|f| f.as_str().unwrap().contains("inverted"))
+    );
+    // The .glb says so too, in its asset extras.
+    let glb =
+        gltf::Gltf::from_slice(&std::fs::read(dir.path().join("o/unv.glb")).unwrap()).unwrap();
+    let extras: serde_json::Value =
+        serde_json::from_str(glb.as_json().asset.extras.as_ref().unwrap().get()).unwrap();
+    assert_eq!(extras["halo4d"]["verified"], false);
+    assert_eq!(&extras["halo4d"]["failures"], &report["failures"]);
+    // `halo4d check` agrees that the halo fails.
+    let out = halo4d(&["check", "o/unv.glb"], dir.path());
+    assert_eq!(out.status.code(), Some(1));
+    let out = halo4d(
+        &[
+            "build",
+            "-q",
+            "unv.json",
+            "--out",
+            "o",
+            "--allow-unverified",
+        ],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("UNVERIFIED"));
+
+    // A verified build says so.
+    let out = halo4d(&["build", "-q", "--out", "d"], dir.path());
+    assert!(out.status.success());
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("d/report.json")).unwrap()).unwrap();
+    assert_eq!(
+        (&report["verified"], &report["failures"]),
+        (&true.into(), &serde_json::json!([]))
+    );
 }

@@ -29,7 +29,8 @@
 //!
 //! Floats, because Blender 3.5+ imports float attributes and drops integer ones. Each
 //! attribute has its own tightly packed, 4-byte aligned buffer view. The asset's extras
-//! record the scene as parsed.
+//! record the scene as parsed and the build's verdict: `{"halo4d": {"scene", "verified",
+//! "failures"}}`.
 
 use super::tubes::tubes;
 use super::{SurfaceData, curve_segments};
@@ -283,21 +284,21 @@ fn halo_patches(s: &SurfaceData) -> Vec<f32> {
 }
 
 /// Builds the `.glb` bytes for the surfaces, their halos and the scene's intersection
-/// `curves`, as tubes of `curve_radius` (absolute); `scene_json` goes into the asset's
-/// extras. A halo without tetrahedra, and curves without a segment, get no mesh (glTF
+/// `curves`, as tubes of `curve_radius` (absolute); `asset` goes into the asset's extras
+/// as `halo4d` (the build writes the scene as parsed and its verdict there). A halo without tetrahedra, and curves without a segment, get no mesh (glTF
 /// accessors cannot be empty).
 pub fn to_glb(
     surfaces: &[SurfaceData],
     curves: &Curves,
     curve_radius: f64,
-    scene_json: &serde_json::Value,
+    asset: &serde_json::Value,
 ) -> Result<Vec<u8>, String> {
     let extras = |v: serde_json::Value| to_raw_value(&v).map(Some).map_err(|e| e.to_string());
     let mut b = Builder {
         root: json::Root {
             asset: json::Asset {
                 generator: Some(format!("halo4d {}", env!("CARGO_PKG_VERSION"))),
-                extras: extras(serde_json::json!({ "halo4d": { "scene": scene_json } }))?,
+                extras: extras(serde_json::json!({ "halo4d": asset }))?,
                 ..Default::default()
             },
             ..Default::default()

@@ -62,42 +62,18 @@ impl Staged {
         std::fs::create_dir_all(dir).map_err(io(dir))?;
         let lock = dir.join(LOCK);
         let pid = std::process::id().to_string();
-        for attempt in 0..2 {
-            match std::fs::OpenOptions::new()
-                .write(true)
-                .create_new(true)
-                .open(&lock)
-            {
-                Ok(mut f) => {
-                    f.write_all(pid.as_bytes()).map_err(io(&lock))?;
-                    return Ok(Staged {
-                        dir: dir.to_path_buf(),
-                        lock,
-                        files: Vec::new(),
-                    });
-                }
-                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                    let holder = std::fs::read_to_string(&lock).unwrap_or_default();
-                    let holder = holder.trim().to_string();
-                    if attempt == 0 && !alive(&holder, &lock) {
-                        // A killed build's lock: take it over.
-                        let _ = std::fs::remove_file(&lock);
-                        continue;
-                    }
-                    return Err(StagedError::Busy {
-                        dir: dir.to_path_buf(),
-                        lock,
-                        pid: if holder.is_empty() {
-                            "?".into()
-                        } else {
-                            holder
-                        },
-                    });
-                }
-                Err(e) => return Err(io(&lock)(e)),
-            }
-        }
-        unreachable!("the second attempt returns")
+        // The lock appears with its process id in it, or not at all: written under another
+        // name, then linked to the lock's (which fails if the lock exists), so that a build
+        // killed at any moment never leaves a lock without its id.
+        let mine = dir.join(format!("{LOCK}.{pid}"));
+        std::fs::write(&mine, &pid).map_err(io(&mine))?;
+        let taken = link_lock(&mine, &lock, dir);
+        let _ = std::fs::remove_file(&mine);
+        taken.map(|()| Staged {
+            dir: dir.to_path_buf(),
+            lock,
+            files: Vec::new(),
+        })
     }
 
     /// Writes `bytes` as `file` in the folder under a temporary name; returns `file`.
@@ -131,6 +107,36 @@ impl Drop for Staged {
         }
         let _ = std::fs::remove_file(&self.lock);
     }
+}
+
+/// Links `mine` (a file holding this process's id) to `lock`, taking over a lock whose
+/// process is gone.
+fn link_lock(mine: &Path, lock: &Path, dir: &Path) -> Result<(), StagedError> {
+    for attempt in 0..2 {
+        match std::fs::hard_link(mine, lock) {
+            Ok(()) => return Ok(()),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                let holder = std::fs::read_to_string(lock).unwrap_or_default();
+                let holder = holder.trim().to_string();
+                if attempt == 0 && !alive(&holder, lock) {
+                    // A killed build's lock: take it over.
+                    let _ = std::fs::remove_file(lock);
+                    continue;
+                }
+                return Err(StagedError::Busy {
+                    dir: dir.to_path_buf(),
+                    lock: lock.to_path_buf(),
+                    pid: if holder.is_empty() {
+                        "?".into()
+                    } else {
+                        holder
+                    },
+                });
+            }
+            Err(e) => return Err(io(lock)(e)),
+        }
+    }
+    unreachable!("the second attempt takes the lock or returns")
 }
 
 /// Whether the process `pid` (as the lock file `lock` holds it) runs. Where that cannot be
