@@ -13,7 +13,9 @@
 //! offsets of three different surface vertices is an offset face over that surface triangle.
 //! What it checks, each as its own count:
 //! - every tetrahedron positively oriented under exact `robust::orient3d` (`inverted`, `flat`),
-//!   with four distinct vertices (`degenerate`) and no repeat (`duplicate_tets`);
+//!   with four distinct vertices (`degenerate`) and no repeat (`duplicate_tets`); decided on
+//!   the coordinates scaled as a whole by a power of two, so that the predicates neither
+//!   overflow nor underflow, and counted `undecidable` where no scaling can do that;
 //! - every face in one or two tetrahedra (`overshared_faces`);
 //! - every quad over a surface edge split along one of its diagonals, the same way from both
 //!   sides (`quad_mismatches`);
@@ -47,6 +49,10 @@ pub struct CheckStats {
     pub inverted: usize,
     /// Tetrahedra with zero volume (exactly).
     pub flat: usize,
+    /// Tetrahedra whose orientation the exact predicates cannot decide: a coordinate so much
+    /// smaller than the mesh's largest (by more than [`SAFE_RANGE`]) that their products
+    /// would underflow.
+    pub undecidable: usize,
     /// Tetrahedra repeating a vertex or naming one that does not exist.
     pub degenerate: usize,
     /// Tetrahedra listed more than once.
@@ -102,6 +108,7 @@ impl CheckStats {
         let counts = [
             ("inverted", self.inverted),
             ("flat", self.flat),
+            ("undecidable", self.undecidable),
             ("degenerate", self.degenerate),
             ("duplicate_tets", self.duplicate_tets),
             ("overshared_faces", self.overshared_faces),
@@ -114,7 +121,7 @@ impl CheckStats {
             .filter(|(_, c)| *c > 0)
             .map(|(k, c)| format!("{c} {k}"))
             .collect();
-        if !self.conforms() && counts[2..].iter().all(|(_, c)| *c == 0) {
+        if !self.conforms() && counts[3..].iter().all(|(_, c)| *c == 0) {
             out.push("does not conform".into());
         }
         out
@@ -123,7 +130,7 @@ impl CheckStats {
     /// Whether the mesh conforms, every tetrahedron is positive, and the tetrahedra fill
     /// exactly the volume the boundary encloses (no overlap).
     pub fn valid(&self) -> bool {
-        self.conforms() && self.inverted == 0 && self.flat == 0 && self.volume_defect <= 1e-9
+        self.passes() && self.volume_defect <= 1e-9
     }
 }
 
@@ -198,8 +205,39 @@ struct Partial {
     faces: Vec<([u32; 3], u32)>,
 }
 
-/// Orientation, volume, angle and faces of `tets[range]` (indices already canonical).
-fn examine(tets: &[[u32; 4]], positions: &[[f64; 3]]) -> Partial {
+/// How far below the largest coordinate (as a factor) a coordinate may be for
+/// `robust::orient3d` to stay exact: its determinants multiply three coordinate differences,
+/// and with every coordinate scaled into [2^-266, 1) those stay above f64's smallest normal
+/// number, where the exact arithmetic's assumption of no underflow holds.
+pub const SAFE_RANGE: f64 = 1e80;
+
+/// The positions scaled as a whole by the power of two that brings the largest coordinate
+/// into [0.5, 1) (exact: every orientation is kept, and `robust::orient3d` cannot overflow),
+/// the factor that scales volumes back, and which vertices have a coordinate too small for
+/// the predicates to stay exact ([`SAFE_RANGE`]).
+fn scaled(positions: &[[f64; 3]]) -> (Vec<[f64; 3]>, f64, Vec<bool>) {
+    let largest = positions
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    if !(largest.is_finite() && largest > 0.0) {
+        return (positions.to_vec(), 1.0, vec![false; positions.len()]);
+    }
+    // 2^-e with largest = m 2^e, m in [0.5, 1); in two steps, each a normal power of two.
+    let e = largest.log2().floor() as i32 + 1;
+    let (a, b) = (-e / 2, -e - (-e / 2));
+    let scale = |x: f64| x * 2f64.powi(a) * 2f64.powi(b);
+    let out: Vec<[f64; 3]> = positions.iter().map(|p| p.map(scale)).collect();
+    let tiny = out
+        .iter()
+        .map(|p| p.iter().any(|&x| x != 0.0 && x.abs() * SAFE_RANGE < 1.0))
+        .collect();
+    (out, 2f64.powi(3 * e), tiny)
+}
+
+/// Orientation, volume, angle and faces of `tets[range]` (indices already canonical), on
+/// positions [`scaled`], with which vertices are too small to decide.
+fn examine(tets: &[[u32; 4]], positions: &[[f64; 3]], tiny: &[bool]) -> Partial {
     let mut out = Partial {
         stats: CheckStats {
             min_volume: f64::INFINITY,
@@ -221,7 +259,9 @@ fn examine(tets: &[[u32; 4]], positions: &[[f64; 3]]) -> Partial {
         }
         let p = tet.map(|i| positions[i as usize]);
         let o = robust::orient3d(c3(p[0]), c3(p[1]), c3(p[2]), c3(p[3]));
-        if o < 0.0 {
+        if tet.iter().any(|&i| tiny[i as usize]) {
+            s.undecidable += 1;
+        } else if o < 0.0 {
             s.inverted += 1;
         } else if o == 0.0 {
             s.flat += 1;
@@ -325,6 +365,8 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     let surface_vertex = |i: u32| ((i as usize) < 2 * n).then(|| (i as usize % n.max(1)) as u32);
 
     let tets: Vec<[u32; 4]> = mesh.tets.iter().map(|t| t.map(canon)).collect();
+    let (scaled, volume_scale, tiny) = scaled(positions);
+    let (positions, tiny) = (&scaled, &tiny);
     let threads = std::thread::available_parallelism()
         .map_or(1, |t| t.get())
         .min(8);
@@ -332,7 +374,7 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     let partials: Vec<Partial> = std::thread::scope(|scope| {
         let handles: Vec<_> = tets
             .chunks(chunk)
-            .map(|part| scope.spawn(move || examine(part, positions)))
+            .map(|part| scope.spawn(move || examine(part, positions, tiny)))
             .collect();
         handles
             .into_iter()
@@ -354,6 +396,7 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
         s.degenerate += q.degenerate;
         s.inverted += q.inverted;
         s.flat += q.flat;
+        s.undecidable += q.undecidable;
         s.volume += q.volume;
         s.min_volume = s.min_volume.min(q.min_volume);
         s.max_volume = s.max_volume.max(q.max_volume);
@@ -516,5 +559,14 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     } else {
         f64::INFINITY
     };
+    // Volumes in the mesh's own units (infinite or zero where they do not fit an f64).
+    for v in [
+        &mut s.volume,
+        &mut s.boundary_volume,
+        &mut s.min_volume,
+        &mut s.max_volume,
+    ] {
+        *v *= volume_scale;
+    }
     s
 }

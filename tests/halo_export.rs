@@ -410,6 +410,35 @@ fn check_passes_a_valid_halo_and_catches_faults_planted_in_its_files() {
         &|h| h.mesh.tets[7].swap(0, 1),
         &["1 inverted"],
     );
+    // The same fault at scales where robust::orient3d would overflow (from about 1e103) or
+    // underflow: still caught, the mesh scaled as a whole before deciding.
+    for scale in [1e150, 1e-150, 1e300] {
+        planted(
+            &format!("flipped-{scale:e}.vtk"),
+            &|h| {
+                h.mesh.tets[7].swap(0, 1);
+                for p in &mut h.mesh.positions {
+                    *p = p.map(|x| x * scale);
+                }
+            },
+            &["1 inverted"],
+        );
+    }
+    // A coordinate 1e-100 of the largest: the tetrahedra at that vertex cannot be decided,
+    // and are not passed.
+    planted(
+        "undecidable.vtk",
+        &|h| {
+            let t = h.mesh.tets[0];
+            let p = &mut h.mesh.positions[t[0] as usize];
+            p[0] = if p[0] == 0.0 {
+                1e-100
+            } else {
+                p[0].signum() * 1e-100
+            };
+        },
+        &["undecidable"],
+    );
     // Every tetrahedron in halo4d's own orientation, which is VTK-negative: all inverted,
     // as ParaView's Mesh Quality would show them.
     let all = format!("{} inverted", halo.mesh.tets.len());
