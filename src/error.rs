@@ -21,6 +21,15 @@ pub enum Error {
         /// The offending vertex.
         source: BehindEye,
     },
+    /// The scene's numbers are finite but put its geometry where the files' f32 or the exact
+    /// predicates cannot follow (too large or too small).
+    #[error("scene `{scene}`: {message}")]
+    Scale {
+        /// The scene.
+        scene: String,
+        /// What is out of range, and what to change.
+        message: String,
+    },
     /// The picture could not be made (a camera inside the scene, a bad setting).
     #[error("scene `{scene}`: {source}")]
     Render {

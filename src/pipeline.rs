@@ -14,7 +14,7 @@ use crate::sample::{self, Audit, Mesh4, MeshStats, Sampling, audit};
 use crate::scene::Scene;
 use crate::surfaces::{Surface, Topology};
 use crate::verify::{self, HaloInput, Verification};
-use crate::view::Projected;
+use crate::view::{MAX_COORDINATE, MIN_EXTENT, Projected};
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
@@ -54,7 +54,7 @@ pub struct Built {
     /// Milliseconds per stage so far.
     pub timings: Timings,
     /// The diagonal of the projected scene's bounding box, of which `halo.rho` and
-    /// `outputs.curve_radius` are shares (1 when the scene has no finite extent).
+    /// `outputs.curve_radius` are shares, at least [`MIN_EXTENT`].
     pub diagonal: f64,
 }
 
@@ -435,10 +435,12 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
         })?;
         timings.view += ms(start);
         bar.inc(1);
-        if let Some(bad) = projected.positions.iter().position(|p| !p.is_finite()) {
-            return Err(Error::Internal {
-                stage: "view",
-                message: format!("vertex {bad} of `{name}` is not finite"),
+        if let Some(largest) = projected.out_of_range() {
+            return Err(Error::Scale {
+                scene: scene.name.clone(),
+                message: format!(
+                    "surface `{name}` reaches a coordinate of {largest:.3e} in the view, beyond {MAX_COORDINATE:e}, where the files' f32 and the exact predicates stay exact; make it smaller (its size parameters, or view.translation)"
+                ),
             });
         }
         projections.push((name, entry, mesh, stats, report, projected));
@@ -449,9 +451,15 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
         (DVec3::INFINITY, DVec3::NEG_INFINITY),
         |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
     );
-    let diagonal = Some((hi - lo).length())
-        .filter(|d| d.is_finite())
-        .unwrap_or(1.0);
+    let diagonal = (hi - lo).length();
+    if diagonal.is_nan() || diagonal < MIN_EXTENT {
+        return Err(Error::Scale {
+            scene: scene.name.clone(),
+            message: format!(
+                "the projected surfaces are {diagonal:.3e} across, less than {MIN_EXTENT:e}, below which the files' f32 and the exact predicates lose their digits; make them larger (their size parameters)"
+            ),
+        });
+    }
     let rho = scene.halo.rho * diagonal;
     for (name, entry, mesh, stats, report, projected) in projections {
         bar.set_message(format!("halo of {name}"));

@@ -339,3 +339,69 @@ fn an_unverified_build_writes_its_files_marked_and_exits_3_unless_allowed() {
         (&true.into(), &serde_json::json!([]))
     );
 }
+
+#[test]
+fn scenes_beyond_what_f32_and_the_predicates_hold_are_refused_and_the_rest_write_only_finite_numbers()
+ {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = |scale: f64| {
+        format!(
+            r#"{{"name": "s", "surfaces": [{{"surface": {{"type": "spun_trefoil", "scale": {scale:e}}}}}],
+                "sampling": {{"method": "uniform", "u": 8, "v": 8}}, "outputs": {{"png": false}}}}"#
+        )
+    };
+    for (scale, words) in [
+        (
+            1e39,
+            &["reaches a coordinate of", "beyond 1e30", "make it smaller"][..],
+        ),
+        (1e-300, &["across, less than 1e-30", "make them larger"]),
+    ] {
+        std::fs::write(dir.path().join("s.json"), scene(scale)).unwrap();
+        let out = halo4d(&["build", "-q", "s.json", "--out", "refused"], dir.path());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{scale:e}: {err}");
+        for w in words {
+            assert!(err.contains(w), "{scale:e}: `{w}` not in {err}");
+        }
+        assert!(
+            !dir.path().join("refused").exists(),
+            "{scale:e}: wrote files"
+        );
+    }
+    // Large and small but within range: every float of the .glb is finite, and report.json
+    // has no null (serde_json writes a non-finite number as null).
+    for scale in [1e25, 1e-25] {
+        std::fs::write(dir.path().join("s.json"), scene(scale)).unwrap();
+        let o = format!("o{scale:e}");
+        let out = halo4d(
+            &["build", "-q", "s.json", "--out", &o, "--allow-unverified"],
+            dir.path(),
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let bytes = std::fs::read(dir.path().join(&o).join("s.glb")).unwrap();
+        let gltf = gltf::Gltf::from_slice(&bytes).unwrap();
+        let blob = gltf.blob.as_deref().unwrap();
+        for a in gltf.accessors() {
+            if a.data_type() != gltf::accessor::DataType::F32 {
+                continue;
+            }
+            let view = a.view().unwrap();
+            let n = a.count() * a.dimensions().multiplicity();
+            let floats = blob[view.offset() + a.offset()..][..4 * n]
+                .chunks_exact(4)
+                .map(|c| f32::from_le_bytes(c.try_into().unwrap()));
+            assert!(
+                floats.clone().all(f32::is_finite),
+                "{scale:e}: accessor {}",
+                a.index()
+            );
+        }
+        let report = std::fs::read_to_string(dir.path().join(&o).join("report.json")).unwrap();
+        assert!(!report.contains("null"), "{scale:e}: a null in report.json");
+    }
+}
