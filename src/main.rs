@@ -377,6 +377,16 @@ fn main() -> ExitCode {
             let surfaces: Vec<_> = (0..scene.surfaces.len())
                 .map(|i| (scene.surface_name(i), scene.surfaces[i].surface.clone()))
                 .collect();
+            for (name, surface) in &surfaces {
+                let least = halo4d::sweep::coarsest_grid_triangles(surface);
+                if max_triangles < least {
+                    eprintln!(
+                        "error: --max-triangles {max_triangles} is less than the {least} triangles of the coarsest grid of `{name}` ({} patches); give at least {least}",
+                        surface.patch_count()
+                    );
+                    return ExitCode::FAILURE;
+                }
+            }
             let settings = halo4d::sweep::Settings {
                 tolerances,
                 max_triangles,

@@ -99,6 +99,13 @@ pub fn sweep_surface(
     rows
 }
 
+/// The triangles of the coarsest uniform grid the sweep tries on `surface` (the fewest
+/// cells along u and v that it allows, on every patch): a budget below it leaves no grid.
+pub fn coarsest_grid_triangles(surface: &Surface) -> usize {
+    let [u, v] = surface.min_cells();
+    2 * u.max(2) * v.max(2) * surface.patch_count()
+}
+
 /// A uniform grid and its audited relative errors.
 #[derive(Clone, Copy)]
 struct Measured {
@@ -176,10 +183,15 @@ impl<'a> GridSearch<'a> {
         for _ in 0..24 {
             let cells = self.cells(k, aspect);
             if self.triangles(cells) > self.max_triangles || cells.contains(&4096) {
-                // Beyond the budget: step back towards the last failing size, or stop.
-                match fail {
-                    Some((kf, _)) if k / kf > 1.03 => {
+                // Beyond the budget: step back towards the last failing size, or down
+                // towards the coarsest grid while nothing was measured, or stop.
+                match (fail, pass) {
+                    (Some((kf, _)), _) if k / kf > 1.03 => {
                         k = (k * kf).sqrt();
+                        continue;
+                    }
+                    (None, None) if k > 2.0 => {
+                        k = (k / 2.0).max(2.0);
                         continue;
                     }
                     _ => break,

@@ -145,6 +145,44 @@ fn sweep_writes_csv_and_plot_for_a_scene() {
     let out = halo4d(&["sweep", "--tolerances", "2"], dir.path());
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--tolerances"));
+
+    // The smallest budget: every grid within it, and one that meets 0.5 marked so.
+    let args = ["--tolerances", "0.5", "--max-triangles", "64", "--quiet"];
+    let out = halo4d(
+        &[&["sweep", "two.json", "--out", "tiny"][..], &args].concat(),
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.path().join("tiny/speed_vs_error.csv")).unwrap();
+    for r in csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect::<Vec<_>>())
+    {
+        let (triangles, max): (usize, f64) = (r[3].parse().unwrap(), r[5].parse().unwrap());
+        assert!(triangles <= 64, "{csv}");
+        assert_eq!(r[7] == "true", max <= 0.5, "{csv}");
+    }
+    // A budget below a surface's coarsest grid is refused, naming it.
+    std::fs::write(
+        dir.path().join("quartic.json"),
+        r#"{ "name": "q", "surfaces": [ { "surface": { "type": "fermat" } } ] }"#,
+    )
+    .unwrap();
+    let out = halo4d(
+        &[&["sweep", "quartic.json", "--out", "q"][..], &args].concat(),
+        dir.path(),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("--max-triangles 64") && err.contains("`fermat`") && err.contains("512"),
+        "{err}"
+    );
 }
 
 /// Every file of a folder (hidden ones too) with its bytes.
