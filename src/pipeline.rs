@@ -515,10 +515,10 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     let export_start = Instant::now();
     // Every file under a temporary name until all were made: a failure leaves the folder
     // as it was.
-    let staged = std::cell::RefCell::new(export::Staged::new(out_dir).map_err(staged_error)?);
+    let mut staged = export::Staged::new(out_dir).map_err(staged_error)?;
     let data: Vec<SurfaceData> = products.iter().map(|p| p.data(&scene.halo)).collect();
-    let write = |file: String, bytes: &[u8]| -> Result<String, Error> {
-        staged.borrow_mut().write(file, bytes).map_err(staged_error)
+    let mut write = |file: String, bytes: &[u8]| -> Result<String, Error> {
+        staged.write(file, bytes).map_err(staged_error)
     };
     let mut files = Vec::new();
     let name = &scene.name;
@@ -614,7 +614,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
         })?;
         write("report.json".into(), &text)?;
     }
-    staged.into_inner().commit().map_err(staged_error)?;
+    staged.commit().map_err(staged_error)?;
     Ok(report)
 }
 
