@@ -102,8 +102,13 @@ pub fn sweep_surface(
 /// The triangles of the coarsest uniform grid the sweep tries on `surface` (the fewest
 /// cells along u and v that it allows, on every patch): a budget below it leaves no grid.
 pub fn coarsest_grid_triangles(surface: &Surface) -> usize {
-    let [u, v] = surface.min_cells();
-    2 * u.max(2) * v.max(2) * surface.patch_count()
+    let [u, v] = coarsest_cells(surface);
+    2 * u * v * surface.patch_count()
+}
+
+/// The fewest cells along u and v of any grid the sweep tries on `surface`.
+fn coarsest_cells(surface: &Surface) -> [usize; 2] {
+    surface.min_cells().map(|n| (n + n % 2).max(2))
 }
 
 /// A uniform grid and its audited relative errors.
@@ -222,7 +227,12 @@ impl<'a> GridSearch<'a> {
                 self.exhausted.push((aspect.to_bits(), m));
                 (m, false)
             }
-            (None, None) => (self.measure(self.cells(2.0, aspect)), false),
+            // Nothing measured within the budget: the coarsest grid, which the budget holds
+            // (`coarsest_grid_triangles`); it may still meet the tolerance.
+            (None, None) => {
+                let m = self.measure(coarsest_cells(self.surface));
+                (m, m.max <= tolerance)
+            }
         }
     }
 

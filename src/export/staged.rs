@@ -7,7 +7,6 @@
 //! build's process id keeps a second build out of the folder while one is writing; a lock
 //! whose process is gone (a killed build) is taken over.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The lock file's name in the output folder.
@@ -79,13 +78,7 @@ impl Staged {
     /// Writes `bytes` as `file` in the folder under a temporary name; returns `file`.
     pub fn write(&mut self, file: String, bytes: &[u8]) -> Result<String, StagedError> {
         let path = self.dir.join(&file);
-        let tmp = self.dir.join(format!(".{file}.partial"));
-        std::fs::File::create(&tmp)
-            .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
-            .map_err(|e| {
-                let _ = std::fs::remove_file(&tmp);
-                io(&path)(e)
-            })?;
+        let tmp = super::write_partial(&path, bytes).map_err(io(&path))?;
         self.files.push((tmp, path));
         Ok(file)
     }
@@ -118,7 +111,7 @@ fn link_lock(mine: &Path, lock: &Path, dir: &Path) -> Result<(), StagedError> {
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
                 let holder = std::fs::read_to_string(lock).unwrap_or_default();
                 let holder = holder.trim().to_string();
-                if attempt == 0 && !alive(&holder, lock) {
+                if attempt == 0 && !alive(&holder) {
                     // A killed build's lock: take it over.
                     let _ = std::fs::remove_file(lock);
                     continue;
@@ -139,18 +132,13 @@ fn link_lock(mine: &Path, lock: &Path, dir: &Path) -> Result<(), StagedError> {
     unreachable!("the second attempt takes the lock or returns")
 }
 
-/// Whether the process `pid` (as the lock file `lock` holds it) runs. Where that cannot be
-/// told (no `/proc`) it counts as running, and the message says to delete the lock; a lock
-/// without a process id counts as running for its first ten seconds (its build may not have
-/// written the id yet).
-fn alive(pid: &str, lock: &Path) -> bool {
+/// Whether the process `pid` (as a lock file holds it) runs. Where that cannot be told (no
+/// `/proc`) it counts as running, and the message says to delete the lock. A lock without a
+/// process id is no build's: ours appear with theirs.
+fn alive(pid: &str) -> bool {
     match pid.parse::<u32>() {
         Ok(p) if Path::new("/proc/self").exists() => Path::new(&format!("/proc/{p}")).exists(),
         Ok(_) => true,
-        Err(_) => std::fs::metadata(lock)
-            .and_then(|m| m.modified())
-            .ok()
-            .and_then(|t| t.elapsed().ok())
-            .is_none_or(|age| age.as_secs() < 10),
+        Err(_) => false,
     }
 }

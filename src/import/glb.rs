@@ -587,10 +587,10 @@ impl<'a> Doc<'a> {
     }
 
     /// Accessor `i`, if it is one that halo4d writes for no primitive (tetrahedra,
-    /// polylines): named `expected` and read by no primitive. Else why not, to follow
-    /// "accessors[i] ". A program that re-saves a `.glb` keeps the meshes' extras but may
-    /// drop such accessors and give their numbers to others (Blender 4.5 makes the
-    /// tetrahedra's a triangle index buffer).
+    /// polylines): named `expected` and read by no primitive; else why not, as a phrase
+    /// that follows "accessors[i], which". A program that re-saves a `.glb` keeps the
+    /// meshes' extras but may drop such accessors and give their numbers to others (Blender
+    /// 4.5 makes the tetrahedra's a triangle index buffer).
     fn own_accessor(&self, i: u64, expected: &str) -> std::result::Result<&'a Value, String> {
         let all = self.json.get("accessors").and_then(Value::as_array);
         let accessor = all
