@@ -402,9 +402,6 @@ fn frame(p: &Projected, triangles: &[[u32; 3]], stars: &Stars) -> Frame {
 /// Halvings of rho at a vertex before it collapses to zero.
 pub const HALVINGS: u32 = 10;
 
-/// Rounds of shrinking at most; each round halves rho around every inverted prism.
-const MAX_ROUNDS: usize = 4 * HALVINGS as usize;
-
 /// How many times rho is graded (each followed by shrinking what grading inverted).
 const MAX_GRADINGS: usize = 8;
 
@@ -582,10 +579,17 @@ pub fn build_halo(
                 }
             }
         };
-        for _ in 0..MAX_GRADINGS {
-            for _ in 0..MAX_ROUNDS {
+        // Each round lowers the rho of every corner of an inverted tetrahedron (halved, or
+        // zero from the floor on), so the loop ends: every vertex can be lowered at most
+        // HALVINGS + 1 times. A round that lowers nothing (every corner already collapsed:
+        // the prism is as thin as it can be) ends it too, and the checker counts what is
+        // left. Grading comes after shrinking and never after the last shrink, which keeps
+        // the halo free of inversions at the price of a steeper grade there.
+        for grading in 0..=MAX_GRADINGS {
+            loop {
                 bad.sort_unstable();
                 bad.dedup();
+                bad.retain(|&v| offsets.rho[v as usize] > 0.0);
                 if bad.is_empty() {
                     break;
                 }
@@ -600,6 +604,9 @@ pub fn build_halo(
                 }
                 let touched = std::mem::take(&mut bad);
                 reexamine(&touched, &offsets, &mut bad);
+            }
+            if grading == MAX_GRADINGS {
+                break;
             }
             let changed = graded(&mut offsets.rho, &stars, triangles, grade);
             if changed.is_empty() {
@@ -623,13 +630,13 @@ pub fn build_halo(
     for &tri in &tets.inserted_in {
         let corners = triangles[tri as usize];
         t.push(0.5);
-        d_orig.push(
-            corners
-                .iter()
-                .map(|&i| projected.w[i as usize])
-                .sum::<f64>()
-                / 3.0,
-        );
+        // Rounded to f32 like every value the files store.
+        let mean = corners
+            .iter()
+            .map(|&i| projected.w[i as usize])
+            .sum::<f64>()
+            / 3.0;
+        d_orig.push(mean as f32 as f64);
     }
     let mut positions = offsets.positions;
     positions.extend_from_slice(&tets.inserted);

@@ -15,9 +15,14 @@
 //!   by the farther's (`correct`, else `wrong`). A sample is `ambiguous` where the two
 //!   sheets' w differ by no more than w varies across their triangles there (what the mesh
 //!   resolves), where the two triangles are within two rings of each other on one surface
-//!   (a branch point, as at a cross-cap, where the halo must vanish), or where the nearer
+//!   (a branch point, as at a cross-cap, where the halo must vanish), where the nearer
 //!   sheet's triangle is on its mesh's boundary (where its halo ends in a side wall, whose
-//!   split quads leave the boundary edge itself just inside or just outside). Where a
+//!   split quads leave the boundary edge itself just inside or just outside), or where the
+//!   nearer sheet's halo has zero width at a corner of its triangle (collapsed where the
+//!   projection is singular or folds tighter than any halo fits: the halo vanishes there
+//!   by construction, as at a cross-cap, and is too thin around it for its t = 1/2 layer
+//!   to follow the triangle). Each ambiguous sample counts under its
+//!   first reason in that order ([`Ambiguous`]). Where a
 //!   third sheet's halo hides the nearer sheet (near triple points) the sample counts as
 //!   `third_sheet`.
 //! - Away from the curves: at every surface vertex and triangle centroid, a hidden point must
@@ -60,9 +65,12 @@ pub struct Verification {
     pub correct: usize,
     /// Far sheet not hidden by the near sheet's halo, or near sheet hidden by the far's.
     pub wrong: usize,
-    /// The sheets' w differ by no more than the mesh resolves there, or the sample is at a
-    /// branch point or on the nearer sheet's boundary.
+    /// The sheets' w differ by no more than the mesh resolves there, the sample is at a
+    /// branch point or on the nearer sheet's boundary, or the nearer sheet's halo vanishes
+    /// there.
     pub ambiguous: usize,
+    /// The ambiguous samples by reason.
+    pub ambiguous_reasons: Ambiguous,
     /// The near sheet hidden by a third sheet's halo (near triple points).
     pub third_sheet: usize,
     /// Samples away from the curves: surface vertices and triangle centroids.
@@ -77,6 +85,31 @@ pub struct Verification {
     pub spurious_at: Vec<[f64; 3]>,
     /// Milliseconds.
     pub ms: f64,
+}
+
+/// Why curve samples are ambiguous, one reason per sample (the first that applies, in the
+/// order of the fields).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Ambiguous {
+    /// The two triangles are within two rings of each other on one surface: a branch point
+    /// (a cross-cap), where the halo must vanish.
+    pub branch_point: usize,
+    /// The nearer sheet's triangle is on its mesh's boundary, where its halo ends in a wall.
+    pub boundary: usize,
+    /// The sheets' w differ by no more than w varies across their triangles.
+    pub resolution: usize,
+    /// The nearer sheet's halo has zero width at a corner of its triangle (collapsed where
+    /// the projection is singular or folds tighter than any halo fits).
+    pub vanished_halo: usize,
+}
+
+impl Ambiguous {
+    fn add(&mut self, other: &Ambiguous) {
+        self.branch_point += other.branch_point;
+        self.boundary += other.boundary;
+        self.resolution += other.resolution;
+        self.vanished_halo += other.vanished_halo;
+    }
 }
 
 /// Verifies `halos` (one per sheet, `None` for a sheet without one) against `curves`.
@@ -170,6 +203,7 @@ fn parallel<T: Sync>(items: &[T], f: impl Fn(&[T]) -> Verification + Sync) -> Ve
     v.correct += b.correct;
     v.wrong += b.wrong;
     v.ambiguous += b.ambiguous;
+    v.ambiguous_reasons.add(&b.ambiguous_reasons);
     v.third_sheet += b.third_sheet;
     v.surface_samples += b.surface_samples;
     v.hidden_samples += b.hidden_samples;
@@ -273,6 +307,18 @@ impl<'a> HaloIndex<'a> {
             !hidden
         });
         hidden
+    }
+
+    /// Whether the halo of `surface` has zero width at a vertex of `triangle` (its two
+    /// offsets coincide there: collapsed). False where the surface has no halo: then
+    /// nothing vanished, nothing was built.
+    fn vanishes(&self, surface: u32, triangle: &[u32; 3]) -> bool {
+        self.halos[surface as usize].as_ref().is_some_and(|h| {
+            let n = h.surface_vertices;
+            triangle
+                .iter()
+                .any(|&k| h.positions[k as usize] == h.positions[k as usize + n])
+        })
     }
 
     /// The number of tetrahedra.
@@ -438,14 +484,24 @@ impl<'a> Index<'a> {
             w[0].max(w[1]).max(w[2]) - w[0].min(w[1]).min(w[2])
         };
         let dw = s.w[far] - s.w[near];
-        if self.close(fn_, ff)
-            || self.at_boundary[fn_.surface as usize][fn_.triangle as usize]
-            || dw <= spread(fn_).max(spread(ff))
-        {
+        let halos = &self.halos;
+        let reason = &mut v.ambiguous_reasons;
+        let counter = if self.close(fn_, ff) {
+            Some(&mut reason.branch_point)
+        } else if self.at_boundary[fn_.surface as usize][fn_.triangle as usize] {
+            Some(&mut reason.boundary)
+        } else if dw <= spread(fn_).max(spread(ff)) {
+            Some(&mut reason.resolution)
+        } else if halos.vanishes(fn_.surface, &ring_near) {
+            Some(&mut reason.vanished_halo)
+        } else {
+            None
+        };
+        if let Some(counter) = counter {
+            *counter += 1;
             v.ambiguous += 1;
             return;
         }
-        let halos = &self.halos;
         let far_hidden = halos
             .hiders(s.x, s.w[far], (ff.surface, &ring_far))
             .into_iter()

@@ -247,6 +247,11 @@ impl View {
     /// vanishes (poles, cross-caps of the projection, parametrization singularities) they
     /// are the normalized sum of the incident triangles' area-weighted normals, and where
     /// that vanishes too (a surface projected edge-on), +z.
+    ///
+    /// Positions and w are rounded to f32, the precision the files store, so that every
+    /// later stage (halos, curves, the verification) works on the geometry as written and
+    /// `halo4d check` on the files finds what the build found. Tangents and normals are
+    /// those of the exact point.
     pub fn project(&self, mesh: &Mesh4) -> Result<Projected, BehindEye> {
         let rot = self.rotation.matrix();
         let shift = DVec4::from_array(self.translation);
@@ -265,8 +270,8 @@ impl View {
                 w: p.w,
                 eye: self.projection.eye_w(),
             })?;
-            out.positions.push(pos);
-            out.w.push(p.w);
+            out.positions.push(pos.as_vec3().as_dvec3());
+            out.w.push(p.w as f32 as f64);
             out.tangent_u.push(jac(rot * mesh.tangent_u[i]));
             out.tangent_v.push(jac(rot * mesh.tangent_v[i]));
         }

@@ -12,17 +12,30 @@ pub fn fixture(rel: &str) -> PathBuf {
 
 /// Every scene in `fixtures/scenes/`, sorted.
 pub fn fixture_scenes() -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(fixture("scenes"))
-        .expect("fixtures/scenes exists")
-        .map(|e| e.expect("readable entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "json"))
-        .collect();
-    v.sort();
+    let v = scenes_in("scenes");
     assert!(
         v.len() >= 9,
         "expected a scene per catalogue surface, found {}",
         v.len()
     );
+    v
+}
+
+/// Every scene in `fixtures/hard/` (hard cases that must build verified), sorted.
+pub fn hard_scenes() -> Vec<PathBuf> {
+    let v = scenes_in("hard");
+    assert!(!v.is_empty(), "fixtures/hard has no scene");
+    v
+}
+
+/// The `.json` files directly in `fixtures/<folder>`, sorted.
+pub fn scenes_in(folder: &str) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(fixture(folder))
+        .unwrap_or_else(|e| panic!("fixtures/{folder}: {e}"))
+        .map(|e| e.expect("readable entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "json"))
+        .collect();
+    v.sort();
     v
 }
 

@@ -4,7 +4,7 @@
 //! surfaces and halos read back from its .glb; `halo4d check DIR` passes a build and catches
 //! faults planted in its .glb; unreadable folders are errors.
 
-use crate::common::{Rng, assert_unreadable, fixture, halo4d};
+use crate::common::{Rng, assert_unreadable, fixture, fixture_scenes, halo4d, hard_scenes};
 use glam::DVec3;
 use halo4d::import::{ImportError, ImportedScene, read_scene_glb};
 use halo4d::intersect::Curves;
@@ -338,6 +338,43 @@ fn the_curves_ply_holds_the_same_points_and_edges() {
 }
 
 #[test]
+fn check_on_the_written_glb_finds_exactly_what_the_build_found() {
+    // Every fixture and every hard case builds verified. The build works on positions and w
+    // rounded to f32, what the files store: the curves and the verification recomputed
+    // from the .glb have the same counts.
+    for path in fixture_scenes().into_iter().chain(hard_scenes()) {
+        let scene = Scene::load(&path).unwrap();
+        let built = halo4d::run(&scene, true).unwrap();
+        let what = path.display();
+        assert_eq!(built.failures(), Vec::<String>::new(), "{what}");
+        let data: Vec<_> = built.surfaces.iter().map(|p| p.data(&scene.halo)).collect();
+        let glb = halo4d::export::to_glb(&data, &built.curves, 0.01, &Value::Null).unwrap();
+        let (curves, v) = read_scene_glb(&glb).unwrap().verify();
+        let counts = |r: &halo4d::intersect::CurvesReport| {
+            [
+                r.count,
+                r.closed,
+                r.open,
+                r.points,
+                r.segments,
+                r.triple_points,
+                r.unresolved,
+            ]
+        };
+        assert_eq!(
+            counts(&curves.report),
+            counts(&built.curves.report),
+            "{what}"
+        );
+        let untimed = |v: &halo4d::verify::Verification| halo4d::verify::Verification {
+            ms: 0.0,
+            ..v.clone()
+        };
+        assert_eq!(untimed(&v), untimed(&built.verification), "{what}");
+    }
+}
+
+#[test]
 fn without_curves_the_glb_has_no_curves_mesh_and_the_ply_is_empty_but_valid() {
     let scene = Scene::load(&fixture("scenes/patches.json")).unwrap();
     let built = halo4d::run(&scene, true).unwrap();
@@ -385,17 +422,9 @@ fn a_scene_reads_back_from_its_glb_with_every_surface_and_its_halo() {
             gltf.meshes().nth(s.mesh).unwrap().name(),
             Some(p.name.as_str())
         );
-        let f32_of = |x: f64| f64::from(x as f32);
-        let want: Vec<[f64; 3]> = p
-            .projected
-            .positions
-            .iter()
-            .map(|v| v.to_array().map(f32_of))
-            .collect();
-        let got: Vec<[f64; 3]> = s.positions.iter().map(|v| v.to_array()).collect();
-        assert_eq!(got, want, "{}", p.name);
-        let w: Vec<f64> = p.projected.w.iter().map(|&x| f32_of(x)).collect();
-        assert_eq!(s.w, w, "{}", p.name);
+        // Exactly what the build worked on: it rounds to f32 at the projection.
+        assert_eq!(s.positions, p.projected.positions, "{}", p.name);
+        assert_eq!(s.w, p.projected.w, "{}", p.name);
         assert_eq!(s.triangles, p.mesh.triangles, "{}", p.name);
 
         let h = s.halo.as_ref().expect("a halo per surface");
@@ -405,8 +434,7 @@ fn a_scene_reads_back_from_its_glb_with_every_surface_and_its_halo() {
         assert_eq!(h.params.delta_d, Some(scene.halo.delta_d));
         assert_eq!(h.params.delta_t, Some(scene.halo.delta_t));
         assert_eq!(h.params.surface_mesh, Some(s.mesh));
-        let d: Vec<f64> = p.halo.d_orig.iter().map(|&x| f32_of(x)).collect();
-        assert_eq!(h.d_orig.as_deref(), Some(&d[..]));
+        assert_eq!(h.d_orig.as_deref(), Some(&p.halo.d_orig[..]));
     }
     // The curves' exact polylines, in halo4d's frame, as the viewer draws them; gone (and
     // no error) when another program re-used their accessors.

@@ -392,6 +392,12 @@ fn every_fixture_halo_is_verified_by_its_curves() {
         assert_eq!(v.wrong, 0, "{what}");
         assert_eq!(v.spurious_hidden_samples, 0, "{what}");
         assert!(v.correct > 0 && v.hidden_samples > 0, "{what}");
+        let r = &v.ambiguous_reasons;
+        assert_eq!(
+            r.branch_point + r.boundary + r.resolution + r.vanished_halo,
+            v.ambiguous,
+            "{what}"
+        );
         correct += v.correct;
         ambiguous += v.ambiguous;
     }
@@ -400,6 +406,42 @@ fn every_fixture_halo_is_verified_by_its_curves() {
         correct > 10 * ambiguous,
         "{correct} correct, {ambiguous} ambiguous"
     );
+}
+
+#[test]
+fn where_a_view_folds_fermat_patches_together_the_curves_end_at_the_vertex() {
+    // The Fermat quartic turned 30 degrees in yw: at z = (-1, 0) four patches meet, the
+    // tangent plane there is the z2 plane, which holds the view direction, so the projection
+    // drops to rank 1 and three double curves (z2 against iz2, -z2, -iz2 along three lines)
+    // end at that vertex. Ends there are branch points, not unresolved branches; the halo
+    // collapses around it, and the samples there are ambiguous for that reason, not wrong.
+    let scene = Scene::load(&fixture("hard/two-surfaces.json")).unwrap();
+    let built = halo4d::run(&scene, true).unwrap();
+    let report = &built.curves.report;
+    assert_eq!(report.unresolved, 0, "{report:?}");
+    let at_fold = |p: &halo4d::intersect::CurvePoint| {
+        matches!(p.node, Node::Vertex(_))
+            && (p.position - DVec3::new(-1.0, 0.0, 0.0)).length() < 1e-9
+    };
+    let ends = built
+        .curves
+        .curves
+        .iter()
+        .flat_map(|c| {
+            [
+                (c.ends[0], c.points.first().unwrap()),
+                (c.ends[1], c.points.last().unwrap()),
+            ]
+        })
+        .filter(|(_, p)| at_fold(p))
+        .inspect(|(end, _)| assert_eq!(*end, End::BranchPoint))
+        .count();
+    assert!(ends > 2, "{ends} curve ends at the fold");
+    let v = &built.verification;
+    assert_eq!(v.wrong, 0, "{v:?}");
+    assert!(v.ambiguous_reasons.vanished_halo > 0, "{v:?}");
+    let fermat = &built.surfaces[1].halo_report;
+    assert!(fermat.collapsed_vertices > 0, "{fermat:?}");
 }
 
 /// The flat torus fixture's build, for planting faults in its halo.

@@ -5,8 +5,13 @@
 use super::exact::{Node, Segment, Soup};
 use super::{Curve, CurvePoint, End, Face};
 
-/// The curves through `segments`, and the number of nodes where more than two segments
-/// meet (branches, which end every curve through them).
+/// The curves through `segments`, and the number of crossing nodes where more than two
+/// segments meet (branches, which end every curve through them, unresolved: an edge of a
+/// closed manifold mesh crosses a triangle in at most two segments). Several segments
+/// ending at one mesh vertex are curves ending at a singular point of the projection (where
+/// the triangles around the vertex intersect each other, as at a cross-cap, or where
+/// several double curves meet, as where patches of a Fermat surface meet in a view that
+/// folds them together): each ends there as at a branch point.
 pub fn chain(soup: &Soup, segments: &[Segment], face: impl Fn(u32) -> Face) -> (Vec<Curve>, usize) {
     // Each segment end, sorted by node: equal nodes are adjacent.
     let mut ends: Vec<(Node, u32)> = segments
@@ -32,7 +37,10 @@ pub fn chain(soup: &Soup, segments: &[Segment], face: impl Fn(u32) -> Face) -> (
         }
     }
     let degree = |g: u32| groups[g as usize].1 - groups[g as usize].0;
-    let branches = groups.iter().filter(|&&(a, b)| b - a > 2).count();
+    let branches = groups
+        .iter()
+        .filter(|&&(a, b)| b - a > 2 && matches!(ends[a].0, Node::Crossing { .. }))
+        .count();
     let mut used = vec![false; segments.len()];
     let mut curves = Vec::new();
     let walk = |first: u32, from_side: usize, used: &mut [bool]| -> Curve {
@@ -102,8 +110,8 @@ fn s_end(segments: &[Segment], s: u32, side: usize) -> Node {
 
 fn end_kind(node: Node, degree: usize) -> End {
     match (node, degree) {
-        (_, d) if d > 2 => End::Branch,
         (Node::Vertex(_), _) => End::BranchPoint,
+        (_, d) if d > 2 => End::Branch,
         (Node::Crossing { .. }, _) => End::Boundary,
     }
 }

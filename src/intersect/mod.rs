@@ -89,9 +89,10 @@ pub enum End {
     Closed,
     /// At a boundary edge of a mesh.
     Boundary,
-    /// At a mesh vertex where the projection folds (a cross-cap).
+    /// At a mesh vertex where the projection folds (a cross-cap) or where several curves meet
+    /// at a singular point of the projection.
     BranchPoint,
-    /// At a node where more than two segments meet; counted as unresolved.
+    /// Where an edge crosses a triangle in more than two segments; counted as unresolved.
     Branch,
 }
 
@@ -129,7 +130,8 @@ pub struct CurvesReport {
     pub points: usize,
     /// Open-curve ends at a mesh boundary.
     pub boundary_ends: usize,
-    /// Open-curve ends at a branch point (cross-cap).
+    /// Open-curve ends at a branch point: a mesh vertex where the projection is singular
+    /// (a cross-cap, or where several curves meet).
     pub branch_point_ends: usize,
     /// Points where three sheets cross.
     pub triple_points: usize,
@@ -138,7 +140,7 @@ pub struct CurvesReport {
     /// Events with a vertex exactly on the other triangle's plane, decided by the
     /// perturbation.
     pub perturbed: usize,
-    /// What could not be resolved: nodes where more than two segments meet, curves ending
+    /// What could not be resolved: crossings where more than two segments meet, curves ending
     /// at an edge that is not a boundary, triangle pairs whose predicates disagreed, and
     /// triple points whose constructed points lie exactly on a plane.
     pub unresolved: usize,
