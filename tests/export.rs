@@ -1,6 +1,6 @@
 //! Export round trips through real readers: gltf for .glb, ply-rs for .ply, tobj for .obj.
 
-use crate::common::fixture_scenes;
+use crate::common::{fixture_scenes, hard_scenes};
 use halo4d::Scene;
 use ply_rs::ply::Property;
 
@@ -15,7 +15,7 @@ fn float(p: &Property) -> f64 {
 #[test]
 fn every_fixture_builds_and_reads_back() {
     let dir = tempfile::tempdir().unwrap();
-    for path in fixture_scenes() {
+    for path in fixture_scenes().into_iter().chain(hard_scenes()) {
         let mut scene = Scene::load(&path).unwrap();
         scene.outputs.obj = true;
         // The picture's own tests look at it; here it only has to be written.
@@ -178,6 +178,106 @@ fn every_fixture_builds_and_reads_back() {
             !text.contains("NaN") && !text.contains("null,"),
             "report has a non-number"
         );
+        let files: Vec<_> = std::fs::read_dir(&out).unwrap().collect();
+        assert_eq!(files.len(), report.files.len(), "{name}: {files:?}");
+        for file in files {
+            assert_only_finite_numbers(&file.unwrap().path());
+        }
+    }
+}
+
+/// Fails unless every number `path` stores is finite: each float of a .glb's accessors (and
+/// their bounds), of a .ply's elements and of a .vtk's points and data, each number of a
+/// .json (serde_json writes a non-finite one as null: only fields documented as optional
+/// may be null) and each coordinate of an .obj.
+fn assert_only_finite_numbers(path: &std::path::Path) {
+    let what = path.display();
+    let bytes = std::fs::read(path).unwrap();
+    let finite = |x: f64, at: &str| assert!(x.is_finite(), "{what}: {x} in {at}");
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or_default()
+    {
+        "glb" => {
+            let gltf = gltf::Gltf::from_slice(&bytes).unwrap();
+            let blob = gltf.blob.as_deref().unwrap();
+            for a in gltf.accessors() {
+                let at = a.name().unwrap_or("an accessor").to_string();
+                for bound in [a.min(), a.max()] {
+                    let bound = bound.map(|b| serde_json::to_string(&b).unwrap());
+                    assert!(bound.is_none_or(|b| !b.contains("null")), "{what}: {at}");
+                }
+                if a.data_type() != gltf::accessor::DataType::F32 {
+                    continue;
+                }
+                let view = a.view().unwrap();
+                let start = view.offset() + a.offset();
+                let len = a.count() * a.dimensions().multiplicity() * 4;
+                for c in blob[start..start + len].chunks_exact(4) {
+                    finite(f64::from(f32::from_le_bytes(c.try_into().unwrap())), &at);
+                }
+            }
+        }
+        "ply" => {
+            let parser = ply_rs::parser::Parser::<ply_rs::ply::DefaultElement>::new();
+            let ply = parser.read_ply(&mut bytes.as_slice()).unwrap();
+            for (element, rows) in &ply.payload {
+                for row in rows {
+                    for (key, p) in row {
+                        if let Property::Float(x) = p {
+                            finite(f64::from(*x), &format!("{element}.{key}"));
+                        }
+                    }
+                }
+            }
+        }
+        "vtk" => {
+            let halo = halo4d::import::read_vtk(&bytes).unwrap();
+            for p in &halo.mesh.positions {
+                p.iter().for_each(|&x| finite(x, "POINTS"));
+            }
+            for (field, values) in [("t", &halo.t), ("d_orig", &halo.d_orig)] {
+                let values = values.as_ref().expect("the halo's point data");
+                values.iter().for_each(|&x| finite(x, field));
+            }
+        }
+        "json" => {
+            fn walk(v: &serde_json::Value, at: &str, what: &str) {
+                match v {
+                    serde_json::Value::Null => assert!(
+                        at.ends_with("euler_characteristic"),
+                        "{what}: null (a non-finite number?) at {at}"
+                    ),
+                    serde_json::Value::Array(a) => {
+                        for (i, x) in a.iter().enumerate() {
+                            walk(x, &format!("{at}[{i}]"), what);
+                        }
+                    }
+                    serde_json::Value::Object(o) => {
+                        for (k, x) in o {
+                            walk(x, &format!("{at}.{k}"), what);
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            walk(
+                &serde_json::from_slice(&bytes).unwrap(),
+                "",
+                &what.to_string(),
+            );
+        }
+        "obj" => {
+            let text = String::from_utf8(bytes).unwrap();
+            for line in text.lines().filter(|l| l.starts_with("v ")) {
+                for x in line.split_whitespace().skip(1) {
+                    finite(x.parse().unwrap(), line);
+                }
+            }
+        }
+        "png" | "mtl" => {}
+        other => panic!("{what}: a file of unknown kind {other:?}"),
     }
 }
 
