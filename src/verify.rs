@@ -21,8 +21,9 @@
 //!   nearer sheet's halo has zero width at a corner of its triangle (collapsed where the
 //!   projection is singular or folds tighter than any halo fits: the halo vanishes there
 //!   by construction, as at a cross-cap, and is too thin around it for its t = 1/2 layer
-//!   to follow the triangle). Each ambiguous sample counts under its
-//!   first reason in that order ([`Ambiguous`]). Where a
+//!   to follow the triangle; such a sample is ambiguous only where the halo does not
+//!   explain it, and correct where it does). Each ambiguous sample counts under its first
+//!   reason in that order ([`Ambiguous`]). Where a
 //!   third sheet's halo hides the nearer sheet (near triple points) the sample counts as
 //!   `third_sheet`.
 //! - Away from the curves: at every surface vertex and triangle centroid, a hidden point must
@@ -98,8 +99,9 @@ pub struct Ambiguous {
     pub boundary: usize,
     /// The sheets' w differ by no more than w varies across their triangles.
     pub resolution: usize,
-    /// The nearer sheet's halo has zero width at a corner of its triangle (collapsed where
-    /// the projection is singular or folds tighter than any halo fits).
+    /// The halos do not explain the sample, and the nearer sheet's halo has zero width at a
+    /// corner of its triangle (collapsed where the projection is singular or folds tighter
+    /// than any halo fits).
     pub vanished_halo: usize,
 }
 
@@ -492,8 +494,6 @@ impl<'a> Index<'a> {
             Some(&mut reason.boundary)
         } else if dw <= spread(fn_).max(spread(ff)) {
             Some(&mut reason.resolution)
-        } else if halos.vanishes(fn_.surface, &ring_near) {
-            Some(&mut reason.vanished_halo)
         } else {
             None
         };
@@ -510,7 +510,10 @@ impl<'a> Index<'a> {
         let by_far = near_hiders
             .iter()
             .any(|h| halos.within(h.0, ff.surface, &ring_far));
-        if !far_hidden || by_far {
+        if (!far_hidden || by_far) && halos.vanishes(fn_.surface, &ring_near) {
+            v.ambiguous_reasons.vanished_halo += 1;
+            v.ambiguous += 1;
+        } else if !far_hidden || by_far {
             v.wrong += 1;
             if v.wrong_at.len() < EXAMPLES {
                 v.wrong_at.push(s.x.to_array());
