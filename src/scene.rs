@@ -5,6 +5,7 @@
 //! range; every error names the file and the field (`surfaces[0].surface.n`) and says what
 //! is allowed. No input makes the parser panic.
 
+use crate::error::shorten;
 use crate::halo::HaloParams;
 use crate::render::{CameraSettings, RenderSettings};
 use crate::sample::Sampling;
@@ -137,7 +138,7 @@ pub enum SceneError {
         source: std::io::Error,
     },
     /// The text is not a scene: bad JSON, a wrong type, an unknown key or surface type.
-    #[error("{file}:{line}:{column}: {field}: {message}")]
+    #[error("{file}:{line}:{column}: {}: {}", shorten(.field), shorten(.message))]
     Syntax {
         /// The file.
         file: String,
@@ -151,7 +152,7 @@ pub enum SceneError {
         column: usize,
     },
     /// A value is out of range or inconsistent.
-    #[error("{file}: {field}: {message}")]
+    #[error("{file}: {}: {}", shorten(.field), shorten(.message))]
     Invalid {
         /// The file.
         file: String,

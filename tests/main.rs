@@ -5,6 +5,7 @@ mod cli;
 mod common;
 mod curves_export;
 mod export;
+mod fuzz;
 mod halo;
 mod halo_export;
 mod intersect;

@@ -129,6 +129,16 @@ const BROKEN: &[(&str, &[&str])] = &[
     ),
     ("empty.json", &["EOF"]),
     ("delta-t-out-of-range.json", &["halo.delta_t", "[0, 1)"]),
+    // Found by fuzzing (tests/fuzz.rs), which also wants their messages short.
+    (
+        "long-unknown-variant.json",
+        &["sampling.method", "unknown variant", "adaptive"],
+    ),
+    ("long-name.json", &["name", "not a usable name"]),
+    (
+        "long-wide-characters.json",
+        &["surfaces[0].surface", "invalid type"],
+    ),
     (
         "projective-plane-too-coarse.json",
         &["sampling", "projective_plane needs at least 4 x 6 cells"],

@@ -22,6 +22,7 @@ pub use glb::{read_glb, read_scene_glb};
 pub use vtk::read_vtk;
 
 use crate::check::TetMesh;
+use crate::error::shorten;
 use crate::intersect::{self, Curves, Sheet};
 use crate::render::CameraSettings;
 use crate::verify::{self, HaloInput, Verification};
@@ -168,22 +169,22 @@ pub enum ImportError {
     #[error("cannot read the file: {0}")]
     Io(#[from] std::io::Error),
     /// The file name says neither `.glb` nor `.vtk`.
-    #[error("unknown file type `{0}`: give a .glb or a .vtk file written by halo4d build")]
+    #[error("unknown file type `{}`: give a .glb or a .vtk file written by halo4d build", shorten(.0))]
     UnknownType(String),
     /// The bytes are not a well-formed `.glb`.
-    #[error("not a valid .glb: {0}")]
+    #[error("not a valid .glb: {}", shorten(.0))]
     Glb(String),
     /// The bytes are not a well-formed legacy VTK file.
-    #[error("not a valid legacy VTK file: {0}")]
+    #[error("not a valid legacy VTK file: {}", shorten(.0))]
     Vtk(String),
     /// The file is well formed but carries no halo in halo4d's layout.
-    #[error("{0}")]
+    #[error("{}", shorten(.0))]
     NoHalo(String),
     /// The file is well formed but carries no surface in halo4d's layout.
-    #[error("{0}")]
+    #[error("{}", shorten(.0))]
     NoSurface(String),
     /// A surface's data break the layout: an index out of range, a non-finite coordinate, ...
-    #[error("surface `{name}`: {message}")]
+    #[error("surface `{}`: {}", shorten(.name), shorten(.message))]
     BadSurface {
         /// The surface.
         name: String,
@@ -193,7 +194,9 @@ pub enum ImportError {
     /// A halo mesh whose extras name tetrahedra that the file does not hold as halo4d
     /// writes them: an accessor that another program re-used for something else.
     #[error(
-        "this file has no tetrahedra for {mesh} (a program that re-saved it may have dropped them): {why}"
+        "this file has no tetrahedra for {} (a program that re-saved it may have dropped them): {}",
+        shorten(.mesh),
+        shorten(.why)
     )]
     NoTetrahedra {
         /// The halo mesh.
@@ -202,7 +205,7 @@ pub enum ImportError {
         why: String,
     },
     /// A halo's data break the layout: an index out of range, a non-finite coordinate, ...
-    #[error("halo `{name}`: {message}")]
+    #[error("halo `{}`: {}", shorten(.name), shorten(.message))]
     BadHalo {
         /// The halo.
         name: String,
