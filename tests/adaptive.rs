@@ -203,6 +203,42 @@ fn the_budget_stops_refinement_with_a_valid_incomplete_mesh() {
 }
 
 #[test]
+fn refinement_stops_at_the_shortest_edge_the_files_resolve() {
+    // The 9-twist-spun trefoil is so tangled that the chordal error does not shrink with the
+    // triangles somewhere: refinement used to pile 600,000 triangles onto points that f32
+    // cannot tell apart, and the curves then found billions of candidate pairs. It stops at
+    // edges of MIN_EDGE of the extent, reports the mesh incomplete, and stays small.
+    let s = Surface::TwistSpunTrefoil(TwistSpunTrefoil {
+        scale: 0.4,
+        twists: 9,
+    });
+    let tol = 1e-3 * bounding_diagonal(&s);
+    let out = sample_adaptive(&s, tol, 2_000_000);
+    assert!(!out.complete && out.failing > 0);
+    assert!(
+        out.mesh.triangles.len() < 200_000,
+        "{}",
+        out.mesh.triangles.len()
+    );
+    let stats = out.mesh.validate();
+    assert!(
+        stats.is_manifold() && stats.euler_characteristic == 2,
+        "{stats:?}"
+    );
+    // No two vertices of a triangle share an f32 position.
+    let coincident = out
+        .mesh
+        .triangles
+        .iter()
+        .filter(|t| {
+            let p = t.map(|v| out.mesh.positions[v as usize].as_vec4());
+            p[0] == p[1] || p[1] == p[2] || p[2] == p[0]
+        })
+        .count();
+    assert_eq!(coincident, 0);
+}
+
+#[test]
 fn parallel_refinement_is_deterministic() {
     let s = Surface::Fermat(Fermat { n: 3, y_range: 1.5 });
     let tol = 3e-4 * bounding_diagonal(&s);

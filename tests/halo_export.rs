@@ -733,6 +733,13 @@ fn malformed_vtk_files_are_clear_errors() {
             e.len()
         );
     }
+    let rho = format!("rho 1 1 double\n{}\n", halo.params.rho.unwrap());
+    for bad in ["nan", "inf", "-inf"] {
+        vtk_fails(
+            replace(&rho, &format!("rho 1 1 double\n{bad}\n")).as_bytes(),
+            &["FIELD value rho", "not a finite number"],
+        );
+    }
     vtk_fails(
         replace("UNSTRUCTURED_GRID", "POLYDATA").as_bytes(),
         &["POLYDATA", "UNSTRUCTURED_GRID"],

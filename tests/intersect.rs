@@ -170,6 +170,9 @@ fn the_bvh_finds_the_events_all_pairs_find() {
 
 #[test]
 fn every_fixture_at_low_resolution_agrees_with_all_pairs() {
+    // The exact tests take the candidate pairs in batches as the broad phase finds them;
+    // all pairs of the larger fixtures fill many batches.
+    let mut most = 0;
     for path in fixture_scenes() {
         let scene = Scene::load(&path).unwrap();
         let projected: Vec<_> = scene
@@ -196,7 +199,9 @@ fn every_fixture_at_low_resolution_agrees_with_all_pairs() {
             "{}",
             path.display()
         );
+        most = most.max(s.candidate_pairs);
     }
+    assert!(most > 4 << 20, "{most} pairs at most");
 }
 
 /// A closed octahedron with corners at `centre` +- `r` along the axes.

@@ -8,6 +8,7 @@
 use super::{FileParams, ImportError, ImportedHalo};
 use crate::check::TetMesh;
 use crate::convention::file_order;
+use crate::error::shorten;
 use std::collections::HashMap;
 
 type Result<T> = std::result::Result<T, ImportError>;
@@ -28,7 +29,7 @@ pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
         .ok_or_else(|| {
             err(format!(
                 "wrong magic: the first line must be `# vtk DataFile Version x.x`, found {:?}",
-                truncate(&magic)
+                shorten(&magic)
             ))
         })?;
     let major: u32 = version
@@ -36,7 +37,7 @@ pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
         .split('.')
         .next()
         .and_then(|m| m.parse().ok())
-        .ok_or_else(|| err(format!("unreadable file version {:?}", truncate(version))))?;
+        .ok_or_else(|| err(format!("unreadable file version {:?}", shorten(version))))?;
     let title = c
         .line()
         .ok_or_else(|| err("truncated after the first line".into()))?;
@@ -46,7 +47,7 @@ pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
         Some(l) => {
             return Err(err(format!(
                 "the third line must be ASCII or BINARY, found {:?}",
-                truncate(&l)
+                shorten(&l)
             )));
         }
         None => return Err(err("truncated: the file ends before ASCII or BINARY".into())),
@@ -61,14 +62,14 @@ pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
             if !kind.eq_ignore_ascii_case("UNSTRUCTURED_GRID") {
                 return Err(err(format!(
                     "the dataset is {}; halos are UNSTRUCTURED_GRID",
-                    truncate(kind)
+                    shorten(kind)
                 )));
             }
         }
         other => {
             return Err(err(format!(
                 "expected `DATASET UNSTRUCTURED_GRID`, found {:?}",
-                truncate(&other.map(|w| w.join(" ")).unwrap_or("end of file".into()))
+                shorten(&other.map(|w| w.join(" ")).unwrap_or("end of file".into()))
             )));
         }
     }
@@ -96,6 +97,13 @@ pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
             "surface_vertices must be a non-negative integer, found {n}"
         )));
     }
+    for key in ["rho", "delta_d", "delta_t"] {
+        if let Some(v) = field(key).filter(|v| !v.is_finite()) {
+            return Err(err(format!(
+                "the FIELD value {key} is {v}, not a finite number"
+            )));
+        }
+    }
     ImportedHalo {
         name,
         mesh: TetMesh {
@@ -114,14 +122,6 @@ pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
         },
     }
     .validate()
-}
-
-/// At most 60 characters of `s` (then `...`), for error messages.
-fn truncate(s: &str) -> String {
-    match s.char_indices().nth(60) {
-        Some((at, _)) => format!("{}...", &s[..at]),
-        None => s.to_string(),
-    }
 }
 
 /// A position in the file's bytes.
@@ -184,7 +184,7 @@ impl Type {
             other => {
                 return Err(err(format!(
                     "data type `{}` is not a number type this reader knows",
-                    truncate(other)
+                    shorten(other)
                 )));
             }
         })
@@ -246,7 +246,7 @@ struct Reader<'a> {
 fn count(word: Option<&String>, what: &str) -> Result<usize> {
     let word = word.ok_or_else(|| err(format!("{what}: a count is missing")))?;
     word.parse()
-        .map_err(|_| err(format!("{what}: {:?} is not a count", truncate(word))))
+        .map_err(|_| err(format!("{what}: {:?} is not a count", shorten(word))))
 }
 
 impl Reader<'_> {
@@ -285,7 +285,7 @@ impl Reader<'_> {
                 out.push(value.ok_or_else(|| {
                     err(format!(
                         "{what}: value {k} is {:?}, not a number of the declared type",
-                        truncate(&text)
+                        shorten(&text)
                     ))
                 })?);
             }
@@ -449,7 +449,7 @@ impl Reader<'_> {
                 }
                 other => Err(err(format!(
                     "CELLS: expected `{name} <type>`, found {:?}",
-                    truncate(&other.map(|w| w.join(" ")).unwrap_or("end of file".into()))
+                    shorten(&other.map(|w| w.join(" ")).unwrap_or("end of file".into()))
                 ))),
             }
         };
@@ -492,7 +492,7 @@ impl Reader<'_> {
             let [name, components, tuples, ty] = &line[..] else {
                 return Err(err(format!(
                     "FIELD: expected `name components tuples type`, found {:?}",
-                    truncate(&line.join(" "))
+                    shorten(&line.join(" "))
                 )));
             };
             let what = format!("FIELD array {name}");
@@ -525,7 +525,7 @@ impl Reader<'_> {
             Attach::Dataset => {
                 return Err(err(format!(
                     "unknown section `{}` (expected POINTS, CELLS, CELL_TYPES, FIELD, POINT_DATA or CELL_DATA)",
-                    truncate(&words[0])
+                    shorten(&words[0])
                 )));
             }
         };
@@ -589,7 +589,7 @@ impl Reader<'_> {
             _ => {
                 return Err(err(format!(
                     "unknown section `{}` in the point or cell data",
-                    truncate(&words[0])
+                    shorten(&words[0])
                 )));
             }
         }

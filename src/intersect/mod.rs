@@ -188,8 +188,10 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
     let proper = |t: &[u32; 3]| t[0] != t[1] && t[1] != t[2] && t[2] != t[0];
     report.degenerate_triangles = soup.tris.iter().filter(|t| !proper(t)).count();
 
-    // About eight touching pairs per triangle on a fine mesh: reserved, not grown.
-    let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(8 * soup.tris.len());
+    // Candidate pairs go to the exact tests in batches as the broad phase finds them: the
+    // memory they take is bounded however many there are (slivers and many-twist knots
+    // give thousands per triangle).
+    let mut exact = Exact::new(&soup);
     match broad_phase {
         BroadPhase::Bvh => {
             let boxes: Vec<_> = soup
@@ -218,7 +220,7 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
             let t = Instant::now();
             let mut test = |a: u32, b: u32| {
                 if boxes[a as usize].intersect_aabb(&boxes[b as usize]) {
-                    pairs.push((a.min(b), a.max(b)));
+                    exact.push(a.min(b), a.max(b));
                 }
             };
             for g in groups.windows(2) {
@@ -235,30 +237,31 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
                     }
                 }
             });
-            report.traverse_ms = ms(t);
+            exact.flush();
+            report.traverse_ms = ms(t) - exact.ms;
         }
         BroadPhase::AllPairs => {
             let ok: Vec<u32> = (0..soup.tris.len() as u32)
                 .filter(|&t| proper(&soup.tris[t as usize]))
                 .collect();
             for (i, &a) in ok.iter().enumerate() {
-                pairs.extend(ok[i + 1..].iter().map(|&b| (a, b)));
+                for &b in &ok[i + 1..] {
+                    exact.push(a, b);
+                }
             }
+            exact.flush();
         }
     }
-    report.candidate_pairs = pairs.len();
-
-    let t = Instant::now();
-    let mut segments: Vec<Segment> = Vec::new();
-    for &(a, b) in &pairs {
-        match soup.pair(a, b) {
-            Pair::Apart => {}
-            Pair::Cross(s) => segments.push(s),
-            Pair::Inconsistent(..) => report.unresolved += 1,
-        }
-    }
-    drop(pairs);
-    report.exact_ms = ms(t);
+    let Exact {
+        candidates,
+        segments,
+        inconsistent,
+        ms: exact_ms,
+        ..
+    } = exact;
+    report.candidate_pairs = candidates;
+    report.unresolved += inconsistent;
+    report.exact_ms = exact_ms;
     report.segments = segments.len();
 
     let t = Instant::now();
@@ -313,6 +316,55 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
     report.chain_ms = ms(t);
     report.ms = ms(start);
     Curves { curves, report }
+}
+
+/// The exact tests of candidate pairs, run a batch at a time.
+struct Exact<'a> {
+    soup: &'a Soup,
+    batch: Vec<(u32, u32)>,
+    candidates: usize,
+    segments: Vec<Segment>,
+    /// Pairs whose predicates disagreed.
+    inconsistent: usize,
+    /// Milliseconds in the tests.
+    ms: f64,
+}
+
+impl<'a> Exact<'a> {
+    /// Candidate pairs held before they are tested: 8 MB.
+    const BATCH: usize = 1 << 20;
+
+    fn new(soup: &'a Soup) -> Self {
+        Exact {
+            soup,
+            batch: Vec::with_capacity(Self::BATCH.min(8 * soup.tris.len())),
+            candidates: 0,
+            segments: Vec::new(),
+            inconsistent: 0,
+            ms: 0.0,
+        }
+    }
+
+    fn push(&mut self, a: u32, b: u32) {
+        self.batch.push((a, b));
+        if self.batch.len() == Self::BATCH {
+            self.flush();
+        }
+    }
+
+    fn flush(&mut self) {
+        let t = Instant::now();
+        self.candidates += self.batch.len();
+        for &(a, b) in &self.batch {
+            match self.soup.pair(a, b) {
+                Pair::Apart => {}
+                Pair::Cross(s) => self.segments.push(s),
+                Pair::Inconsistent(..) => self.inconsistent += 1,
+            }
+        }
+        self.batch.clear();
+        self.ms += ms(t);
+    }
 }
 
 /// Runs of up to four consecutive triangles that share a vertex with the run's first (as

@@ -51,7 +51,8 @@ pub struct AdaptiveMesh {
     /// The mesh.
     pub mesh: Mesh4,
     /// Whether every triangle met the tolerance (false when the triangle budget stopped the
-    /// refinement, or an edge became too short to split in floating point).
+    /// refinement, or an edge became too short to split: in floating point, or below
+    /// [`MIN_EDGE`] of the surface's extent).
     pub complete: bool,
     /// Triangles that still failed the tolerance when refinement stopped.
     pub failing: usize,
@@ -357,10 +358,20 @@ pub fn sample_adaptive(surface: &Surface, tolerance: f64, max_triangles: usize) 
     }
 }
 
+/// The shortest edge the sampler splits, as a share of the surface's extent (the diagonal
+/// of the 4D box of its starting grids). f32, which the files store, resolves about 6e-8 of
+/// it, and the later stages need distinct points: at a singular point of a surface, where
+/// the chordal error does not shrink with the triangles (a many-twist knot's tangle), the
+/// refinement would otherwise pile hundreds of thousands of triangles onto one f32 point.
+/// Such triangles stay failing, and the sampling is reported incomplete.
+pub const MIN_EDGE: f64 = 1e-6;
+
 /// What a patch needs to refine itself.
 struct Context<'a> {
     surface: &'a Surface,
     tolerance: f64,
+    /// Edges shorter than this (4D) are not split: [`MIN_EDGE`] of the extent.
+    min_edge: f64,
     /// Triangles of all patches together, and the most allowed.
     triangles: &'a AtomicUsize,
     max_triangles: usize,
@@ -411,9 +422,14 @@ impl Patch {
                 continue;
             }
             let t = tri.map(|h| h.index());
-            let Verdict::Split(edges) = self.check(cx.surface, patch, cx.tolerance, t) else {
+            let Verdict::Split(mut edges) = self.check(cx.surface, patch, cx.tolerance, t) else {
                 continue;
             };
+            edges.retain(|&k| (self.p[t[k]] - self.p[t[(k + 1) % 3]]).length() >= cx.min_edge);
+            if edges.is_empty() {
+                self.stuck += 1;
+                continue;
+            }
             // Reserve what the splits can add: per edge, two triangles here and, for a side
             // point, four on the sides glued to it (inserted after this round).
             let reserve = 6 * edges.len();
@@ -627,9 +643,18 @@ impl<'a> Sampler<'a> {
     /// points cross the seams, which queues the triangles they split on the other side.
     fn refine(&mut self, max_triangles: usize) -> bool {
         let triangles = AtomicUsize::new(self.triangles());
+        let (lo, hi) = self
+            .patches
+            .iter()
+            .flat_map(|p| &p.p)
+            .fold((DVec4::INFINITY, DVec4::NEG_INFINITY), |(lo, hi), &q| {
+                (lo.min(q), hi.max(q))
+            });
+        let extent = (hi - lo).length();
         let cx = Context {
             surface: self.surface,
             tolerance: self.tolerance,
+            min_edge: MIN_EDGE * if extent.is_finite() { extent } else { 0.0 },
             triangles: &triangles,
             max_triangles,
         };
