@@ -16,6 +16,7 @@ pub mod export;
 pub mod halo;
 pub mod import;
 pub mod intersect;
+pub mod memory;
 pub mod pipeline;
 pub mod render;
 pub mod sample;

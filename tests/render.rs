@@ -591,3 +591,43 @@ fn in_the_patches_of_paper_000_fig_1_the_nearer_patch_is_drawn_at_each_crossing(
     }
     assert!(checked >= 20, "{checked} crossings checked");
 }
+
+#[test]
+fn a_picture_beyond_the_memory_limit_is_refused_before_it_allocates() {
+    // The estimate counts the hits per ray on a grid of rays, so slices mode at 1024 x 1024
+    // (hundreds of megabytes of per-sample hits) is refused under a limit of 10 MB, exact
+    // mode is not, and a limit that is not a number is an error naming the variable.
+    let dir = tempfile::tempdir().unwrap();
+    let run = |limit: &str, mode: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_halo4d"))
+            .args([
+                "render", "--width", "1024", "--height", "1024", "--mode", mode,
+            ])
+            .args(["--out", "p.png"])
+            .env("HALO4D_MAX_MEMORY", limit)
+            .current_dir(dir.path())
+            .output()
+            .unwrap()
+    };
+    let out = run("0.01", "slices");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    for words in [
+        "the picture would need about",
+        "HALO4D_MAX_MEMORY",
+        "render.mode exact",
+    ] {
+        assert!(err.contains(words), "{words}: {err}");
+    }
+    assert!(!dir.path().join("p.png").exists());
+    let out = run("abc", "exact");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("HALO4D_MAX_MEMORY must be a number"), "{err}");
+    let out = run("0.3", "exact");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.path().join("p.png").exists());
+}

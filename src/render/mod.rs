@@ -340,6 +340,25 @@ pub enum RenderError {
     /// Nothing to draw.
     #[error("the scene has no triangles to render")]
     Empty,
+    /// The picture would need more memory than the limit ([`crate::memory`]).
+    #[error(
+        "the picture would need about {:.2} GB ({what}), more than the limit of {:.2} GB ({source_of_limit}); lower render.width and render.height or render.samples, or use render.mode exact, which needs no per-sample store",
+        needed / crate::memory::GB,
+        limit / crate::memory::GB
+    )]
+    Memory {
+        /// Estimated bytes.
+        needed: f64,
+        /// What the estimate counts.
+        what: String,
+        /// The limit in bytes.
+        limit: f64,
+        /// Where the limit comes from.
+        source_of_limit: &'static str,
+    },
+    /// The memory limit is set wrong.
+    #[error("{0}")]
+    MemoryLimit(String),
 }
 
 /// One surface as the renderer reads it.
@@ -429,6 +448,7 @@ pub fn render_with_depth(
     };
     let mut depth = Vec::new();
     let (w, h) = (settings.width, settings.height);
+    scene.check_memory(&Camera::new(camera, bounds, w, h, eyes[0])?, eyes.len())?;
     let mut rgb = vec![0u8; 3 * (w as usize * eyes.len()) * h as usize];
     for (e, &offset) in eyes.iter().enumerate() {
         let cam = Camera::new(camera, bounds, w, h, offset)?;
@@ -678,6 +698,50 @@ impl<'a> Scene<'a> {
             radius: (hi - lo).length() * 0.5,
             background: DVec3::from(settings.background),
         }
+    }
+
+    /// Estimates the memory of the picture before anything is allocated, and refuses it
+    /// above [`crate::memory::limit`]. Per pixel: the image and its distances (48 bytes). In
+    /// `slices` mode also every hit of every sample ([`slices::Probe`]) with its verdict,
+    /// and a slice image per thread; the hits per ray are counted on a grid of up to
+    /// 64 x 64 rays through the picture.
+    fn check_memory(&self, cam: &Camera, eyes: usize) -> Result<(), RenderError> {
+        let s = self.settings;
+        let pixels = f64::from(s.width) * f64::from(s.height);
+        let mut needed = pixels * (48.0 + 3.0 * eyes as f64);
+        let mut what = format!("{} x {} pixels", s.width, s.height);
+        if s.mode == RenderMode::Slices && self.halos.is_some() {
+            let grid = 64.min(s.width).min(s.height);
+            let mut hits = Vec::new();
+            let mut total = 0usize;
+            for j in 0..grid {
+                for i in 0..grid {
+                    let x = 2.0 * (f64::from(i) + 0.5) / f64::from(grid) - 1.0;
+                    let y = 2.0 * (f64::from(j) + 0.5) / f64::from(grid) - 1.0;
+                    let (origin, dir) = cam.ray(x, y);
+                    self.trace(origin, dir, &mut hits);
+                    total += hits.len();
+                }
+            }
+            let per_ray = total as f64 / f64::from(grid * grid);
+            let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
+            let probe = (std::mem::size_of::<slices::Probe>() + 1) as f64;
+            needed += pixels * (f64::from(s.samples) * per_ray * probe + 4.0 + 16.0 * threads);
+            what = format!(
+                "{what} x {} samples x {per_ray:.1} surfaces per ray, kept for the slices",
+                s.samples
+            );
+        }
+        let (limit, source_of_limit) = crate::memory::limit().map_err(RenderError::MemoryLimit)?;
+        if needed > limit {
+            return Err(RenderError::Memory {
+                needed,
+                what,
+                limit,
+                source_of_limit,
+            });
+        }
+        Ok(())
     }
 
     /// The sample points of pixel (x, y) in [-1, 1]^2 (y up), and which is its centre's.

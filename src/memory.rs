@@ -1,0 +1,36 @@
+//! The memory a command may use, and the check that stages make before they allocate what
+//! grows with their input (today the renderer's per-sample hits of `slices` mode; the
+//! intersection stage streams its candidate pairs instead).
+//!
+//! The limit is `HALO4D_MAX_MEMORY` (gigabytes) when set, else three quarters of this
+//! machine's memory (`MemTotal` of `/proc/meminfo`), else 16 GB where that cannot be read.
+
+/// Bytes in a gigabyte, as the limit and the messages count them.
+pub const GB: f64 = 1e9;
+
+/// The limit in bytes, and where it comes from (for messages).
+pub fn limit() -> Result<(f64, &'static str), String> {
+    if let Ok(text) = std::env::var("HALO4D_MAX_MEMORY") {
+        return match text.trim().parse::<f64>() {
+            Ok(gb) if gb.is_finite() && gb > 0.0 => Ok((gb * GB, "HALO4D_MAX_MEMORY")),
+            _ => Err(format!(
+                "HALO4D_MAX_MEMORY must be a number of gigabytes greater than 0, got {text:?}"
+            )),
+        };
+    }
+    let total = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
+        let line = m.lines().find(|l| l.starts_with("MemTotal:"))?;
+        let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+        Some(kb * 1e3)
+    });
+    Ok(match total {
+        Some(bytes) => (
+            0.75 * bytes,
+            "three quarters of this machine's memory; set HALO4D_MAX_MEMORY (GB) to change it",
+        ),
+        None => (
+            16.0 * GB,
+            "16 GB, this machine's memory being unknown; set HALO4D_MAX_MEMORY (GB) to change it",
+        ),
+    })
+}
