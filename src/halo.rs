@@ -74,14 +74,18 @@ impl Default for HaloParams {
     }
 }
 
+/// The smallest `rho`, a share of the scene's diagonal: f32, which the files store,
+/// resolves about 6e-8 of it, and the halo needs its two offsets apart.
+pub const MIN_RHO: f64 = 1e-6;
+
 impl HaloParams {
     /// Checks the numbers: `Err((field, message))` names the first bad one.
     pub fn check(&self) -> Result<(), (&'static str, String)> {
-        if !(self.rho.is_finite() && self.rho > 0.0 && self.rho < 0.5) {
+        if !(self.rho.is_finite() && self.rho >= MIN_RHO && self.rho < 0.5) {
             return Err((
                 "rho",
                 format!(
-                    "must be greater than 0 and less than 0.5 (a share of the scene's diagonal), got {}",
+                    "must be greater than 0: at least {MIN_RHO:e} (below that the two offsets round to one point in f32, which the files store), and less than 0.5 (a share of the scene's diagonal), got {:?}",
                     self.rho
                 ),
             ));

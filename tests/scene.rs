@@ -66,6 +66,7 @@ const BROKEN: &[(&str, &[&str])] = &[
     ("odd-resolution.json", &["sampling.u", "even number", "9"]),
     ("negative-rho.json", &["halo.rho", "greater than 0"]),
     ("zero-rho.json", &["halo.rho", "greater than 0"]),
+    ("rho-below-f32.json", &["halo.rho", "at least 1e-6", "f32"]),
     (
         "curve-radius-too-large.json",
         &["outputs.curve_radius", "at most 0.05", "0.5"],
