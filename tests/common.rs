@@ -65,11 +65,42 @@ impl Rng {
 
 /// Runs the `halo4d` binary with `args` in `dir`.
 pub fn halo4d(args: &[&str], dir: &Path) -> Output {
+    halo4d_with(args, dir, &[])
+}
+
+/// [`halo4d`] with environment variables set.
+pub fn halo4d_with(args: &[&str], dir: &Path, env: &[(&str, &str)]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_halo4d"))
         .args(args)
+        .envs(env.iter().copied())
         .current_dir(dir)
         .output()
         .expect("the halo4d binary runs")
+}
+
+/// A .glb of this JSON text (padded with spaces) followed by `bin_chunk` as it is (its
+/// header included, whatever it says), with a correct file header and JSON chunk header.
+pub fn pack_glb(json: &[u8], bin_chunk: &[u8]) -> Vec<u8> {
+    let mut json = json.to_vec();
+    json.resize(json.len().next_multiple_of(4), b' ');
+    let total = 20 + json.len() + bin_chunk.len();
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&json);
+    out.extend_from_slice(bin_chunk);
+    out
+}
+
+/// The .glb with its JSON chunk edited.
+pub fn with_json(glb: &[u8], edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let mut json: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    edit(&mut json);
+    pack_glb(&serde_json::to_vec(&json).unwrap(), &glb[20 + json_len..])
 }
 
 /// `out` failed on unreadable input (exit 2) with an `error: ` line containing `words`,

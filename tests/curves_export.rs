@@ -4,7 +4,9 @@
 //! surfaces and halos read back from its .glb; `halo4d check DIR` passes a build and catches
 //! faults planted in its .glb; unreadable folders are errors.
 
-use crate::common::{Rng, assert_unreadable, fixture, fixture_scenes, halo4d, hard_scenes};
+use crate::common::{
+    Rng, assert_unreadable, fixture, fixture_scenes, halo4d, hard_scenes, with_json,
+};
 use glam::DVec3;
 use halo4d::import::{ImportError, ImportedScene, read_scene_glb};
 use halo4d::intersect::Curves;
@@ -485,24 +487,6 @@ fn split(glb: &[u8]) -> (Value, usize) {
     let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
     let json = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
     (json, 20 + json_len + 8)
-}
-
-/// The .glb with its JSON chunk edited.
-fn with_json(glb: &[u8], edit: impl FnOnce(&mut Value)) -> Vec<u8> {
-    let (mut json, bin) = split(glb);
-    edit(&mut json);
-    let mut text = serde_json::to_vec(&json).unwrap();
-    text.resize(text.len().next_multiple_of(4), b' ');
-    let bin_chunk = &glb[bin - 8..];
-    let total = 20 + text.len() + bin_chunk.len();
-    let mut out = b"glTF".to_vec();
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(text.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&text);
-    out.extend_from_slice(bin_chunk);
-    out
 }
 
 /// Where in the .glb the values of attribute `attr` of the first mesh whose extras carry

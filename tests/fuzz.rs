@@ -33,7 +33,7 @@
 //! HALO4D_FUZZ_CASES=200000 cargo test --release --test main fuzz -- --ignored
 //! ```
 
-use crate::common::{fixture, fixture_scenes};
+use crate::common::{fixture, fixture_scenes, pack_glb};
 use halo4d::Scene;
 use halo4d::import::{ImportedHalo, ImportedScene, read_glb, read_scene_glb, read_vtk};
 use proptest::collection::vec;
@@ -1157,29 +1157,11 @@ fn glb_seed() -> &'static GlbSeed {
     })
 }
 
-/// Where the words of a packed .glb are.
-struct GlbLayout {
-    /// Offset of the BIN chunk's header.
-    bin_header: usize,
-}
-
-/// A .glb of this JSON (padded with spaces) and BIN chunk, with correct headers.
-fn pack(json: &[u8], bin_chunk: &[u8]) -> (Vec<u8>, GlbLayout) {
-    let mut json = json.to_vec();
-    json.resize(json.len().next_multiple_of(4), b' ');
-    let total = 20 + json.len() + bin_chunk.len();
-    let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&json);
-    out.extend_from_slice(bin_chunk);
-    let layout = GlbLayout {
-        bin_header: 20 + json.len(),
-    };
-    (out, layout)
+/// A .glb of this JSON and BIN chunk, and the offset of the BIN chunk's header.
+fn pack(json: &[u8], bin_chunk: &[u8]) -> (Vec<u8>, usize) {
+    let glb = pack_glb(json, bin_chunk);
+    let bin_header = glb.len() - bin_chunk.len();
+    (glb, bin_header)
 }
 
 /// A word of a packed .glb to change.
@@ -1232,14 +1214,14 @@ fn render_glb(case: &GlbCase) -> Vec<u8> {
     for op in &case.json_text {
         apply_text(&mut text, op);
     }
-    let (mut glb, layout) = pack(text.as_bytes(), &seed.bin_chunk);
+    let (mut glb, bin_header) = pack(text.as_bytes(), &seed.bin_chunk);
     for (place, word) in &case.words {
         let at = match *place {
             GlbWord::Header(k) => 4 * (k as usize % 5),
-            GlbWord::BinHeader(k) => layout.bin_header + 4 * (k as usize % 2),
+            GlbWord::BinHeader(k) => bin_header + 4 * (k as usize % 2),
             GlbWord::Bin(k) => {
-                let words = (glb.len() - layout.bin_header - 8) / 4;
-                layout.bin_header + 8 + 4 * (k as usize % words)
+                let words = (glb.len() - bin_header - 8) / 4;
+                bin_header + 8 + 4 * (k as usize % words)
             }
         };
         let old = get_word(&glb, at, 4, false);

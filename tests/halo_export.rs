@@ -2,7 +2,7 @@
 //! (by halo4d's readers and by the gltf crate) unchanged; faults planted in the files caught
 //! by `halo4d check`; malformed files rejected with errors, never panics.
 
-use crate::common::{Rng, assert_unreadable, fixture, fixture_scenes, halo4d};
+use crate::common::{Rng, assert_unreadable, fixture, fixture_scenes, halo4d, with_json};
 use glam::{DVec3, Vec3};
 use halo4d::Scene;
 use halo4d::check::check;
@@ -85,25 +85,6 @@ fn ascii_vtk(h: &ImportedHalo, with_layout: bool) -> String {
 fn bin_start(glb: &[u8]) -> usize {
     let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
     20 + json_len + 8
-}
-
-/// The .glb with its JSON chunk edited.
-fn with_json(glb: &[u8], edit: impl FnOnce(&mut Value)) -> Vec<u8> {
-    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
-    let mut json: Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
-    edit(&mut json);
-    let mut text = serde_json::to_vec(&json).unwrap();
-    text.resize(text.len().next_multiple_of(4), b' ');
-    let bin_chunk = &glb[20 + json_len..];
-    let total = 20 + text.len() + bin_chunk.len();
-    let mut out = b"glTF".to_vec();
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(text.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&text);
-    out.extend_from_slice(bin_chunk);
-    out
 }
 
 /// The JSON of the first halo mesh and its index.

@@ -1,7 +1,7 @@
 //! The CPU renderer: every fixture's picture, the crossing diagram probed at known places,
 //! determinism, and bad settings.
 
-use crate::common::{fixture, fixture_scenes, halo4d};
+use crate::common::{fixture, fixture_scenes, halo4d, halo4d_with};
 use glam::DVec3;
 use halo4d::Scene;
 use halo4d::render::camera::Camera;
@@ -599,15 +599,11 @@ fn a_picture_beyond_the_memory_limit_is_refused_before_it_allocates() {
     // mode is not, and a limit that is not a number is an error naming the variable.
     let dir = tempfile::tempdir().unwrap();
     let run = |limit: &str, mode: &str| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_halo4d"))
-            .args([
-                "render", "--width", "1024", "--height", "1024", "--mode", mode,
-            ])
-            .args(["--out", "p.png"])
-            .env("HALO4D_MAX_MEMORY", limit)
-            .current_dir(dir.path())
-            .output()
-            .unwrap()
+        let args = [
+            "render", "--width", "1024", "--height", "1024", "--mode", mode,
+        ];
+        let args = [&args[..], &["--out", "p.png"]].concat();
+        halo4d_with(&args, dir.path(), &[("HALO4D_MAX_MEMORY", limit)])
     };
     let out = run("0.01", "slices");
     let err = String::from_utf8_lossy(&out.stderr);
