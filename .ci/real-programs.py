@@ -138,8 +138,8 @@ def child_blender_import(path):
         mesh = obj.data
         if "halo" in extras:
             kind, names = "halo", ["_T", "_D", "_PATCH"]
-            # Every vertex a triangle uses is kept; the others may only be inserted vertices
-            # (inside the halo, after the 2n offsets), which Blender drops.
+            # Every vertex a triangle uses is kept; the others may only be surface or
+            # inserted vertices (inside the halo, after the 2n offsets), which Blender drops.
             used = np.unique(accessor(g, blob, prim.indices))
             tets = accessor(g, blob, extras["halo"]["tetrahedra"])
             n = extras["halo"]["surface_vertices"]

@@ -4,10 +4,12 @@
 //!
 //! Layout (the same in memory, in `.glb` and in `.vtk`): for a surface of n vertices, vertex
 //! i < n is the negative offset (t = 0) of surface vertex i, vertex n + i its positive offset
-//! (t = 1), and vertices from 2n on are inserted inside prisms. A surface vertex whose two
-//! offsets have identical coordinates is *collapsed*: both indices name one vertex. A prism
-//! may take either offset of each corner as its bottom (twisted prisms, where a
-//! non-orientable surface's offsets turn over).
+//! (t = 1), vertex 2n + i the surface vertex itself (t = 1/2), and vertices from 3n on are
+//! inserted inside prisms. A surface vertex whose two offsets have identical coordinates is
+//! *collapsed*: its three indices (the surface vertex's too, at the same point) name one
+//! vertex. A prism may take either offset of each corner as its bottom (twisted prisms, where
+//! a non-orientable surface's offsets turn over); the surface triangle cuts it in two
+//! layers.
 //!
 //! The checker reads the surface off the boundary: a boundary face whose three vertices are
 //! offsets of three different surface vertices is an offset face over that surface triangle.
@@ -17,22 +19,29 @@
 //!   the coordinates scaled as a whole by a power of two, so that the predicates neither
 //!   overflow nor underflow, and counted `undecidable` where no scaling can do that;
 //! - every face in one or two tetrahedra (`overshared_faces`);
-//! - every quad over a surface edge split along one of its diagonals, the same way from both
-//!   sides (`quad_mismatches`);
+//! - each half of every quad over a surface edge (offset edge to surface edge) split along
+//!   one of its diagonals, the same way from both sides (`quad_mismatches`);
 //! - every surface triangle has exactly two offset faces on the boundary, each vertex of one
 //!   the other offset of a vertex of the other (`missing_offset_faces`), and every other
 //!   boundary face is a side wall over an open edge of the surface
 //!   (`unexpected_boundary_faces`);
+//! - every surface triangle is itself a face between two tetrahedra, one of each layer
+//!   (`missing_surface_faces`): what puts every surface point inside its own halo with
+//!   t = 1/2;
 //! - the tetrahedra's volumes add up to the volume the boundary encloses (`volume_defect`).
 
 use serde::Serialize;
+
+/// Layers of prisms in the halo layout (see the module documentation), written into every
+/// file that carries a halo (`layers`) so that a reader never takes another layout for it.
+pub const LAYERS: u32 = 2;
 
 /// A tetrahedral mesh in the halo layout.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TetMesh {
     /// Vertex positions.
     pub positions: Vec<[f64; 3]>,
-    /// Surface vertices n: the first 2n vertices are the two offsets.
+    /// Surface vertices n: the first 3n vertices are the two offsets and the surface.
     pub surface_vertices: usize,
     /// Four vertex indices each.
     pub tets: Vec<[u32; 4]>,
@@ -65,6 +74,9 @@ pub struct CheckStats {
     pub missing_offset_faces: usize,
     /// Boundary faces that are neither offset triangles nor side walls over an open edge.
     pub unexpected_boundary_faces: usize,
+    /// Surface triangles (those with offset faces) that are not a face between two
+    /// tetrahedra.
+    pub missing_surface_faces: usize,
     /// Faces in exactly one tetrahedron.
     pub boundary_faces: usize,
     /// Faces in exactly two tetrahedra.
@@ -94,6 +106,7 @@ impl CheckStats {
             && self.quad_mismatches == 0
             && self.missing_offset_faces == 0
             && self.unexpected_boundary_faces == 0
+            && self.missing_surface_faces == 0
     }
 
     /// The verdict of `halo4d check` and of a build: the mesh conforms and has no inverted,
@@ -116,6 +129,7 @@ impl CheckStats {
             ("quad_mismatches", self.quad_mismatches),
             ("missing_offset_faces", self.missing_offset_faces),
             ("unexpected_boundary_faces", self.unexpected_boundary_faces),
+            ("missing_surface_faces", self.missing_surface_faces),
         ];
         counts
             .iter()
@@ -341,16 +355,23 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     let collapsed: Vec<bool> = (0..n)
         .map(|v| n + v < nv && positions[v] == positions[n + v])
         .collect();
-    // Collapsed vertices under one index; the offset of the same surface vertex on the other
-    // side (itself when collapsed); the surface vertex of an offset.
+    // Collapsed vertices under one index (a surface vertex at another point than its
+    // collapsed offsets keeps its own); the offset of the same surface vertex on the other
+    // side (itself when collapsed); the surface vertex of an offset or surface vertex; the
+    // surface vertex of surface vertex x.
     let canon = |i: u32| {
         let i = i as usize;
-        if (n..2 * n).contains(&i) && collapsed[i - n] {
-            (i - n) as u32
-        } else {
-            i as u32
-        }
+        let v = i % n.max(1);
+        let folded = match i {
+            _ if (n..2 * n).contains(&i) => collapsed[v],
+            _ if (2 * n..3 * n).contains(&i) => {
+                collapsed[v] && i < nv && positions[i] == positions[v]
+            }
+            _ => false,
+        };
+        if folded { v as u32 } else { i as u32 }
     };
+    let mid = |x: u32| canon(2 * n as u32 + x);
     let partner = |i: u32| {
         let i = i as usize;
         match i {
@@ -359,7 +380,8 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
             _ => (i - n) as u32,
         }
     };
-    let surface_vertex = |i: u32| ((i as usize) < 2 * n).then(|| (i as usize % n.max(1)) as u32);
+    let offset = |i: u32| (i as usize) < 2 * n;
+    let surface_vertex = |i: u32| ((i as usize) < 3 * n).then(|| (i as usize % n.max(1)) as u32);
 
     let tets: Vec<[u32; 4]> = mesh.tets.iter().map(|t| t.map(canon)).collect();
     let (scaled, volume_scale, tiny) = scaled(positions);
@@ -437,6 +459,9 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     }
     let count = |f: [u32; 3]| {
         let f = key(f);
+        if f[0] as usize >= nv {
+            return 0;
+        }
         let bucket = &keys[key_starts[f[0] as usize]..key_starts[f[0] as usize + 1]];
         bucket
             .iter()
@@ -463,7 +488,9 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
         // The divergence theorem, signed for that orientation.
         boundary_volume -= dot(a, cross(b, c)) / 6.0;
         match k.map(surface_vertex) {
-            [Some(x), Some(y), Some(z)] if x != y && y != z && x != z => {
+            [Some(x), Some(y), Some(z)]
+                if x != y && y != z && x != z && k.iter().all(|&i| offset(i)) =>
+            {
                 offset_faces.push((key([x, y, z]), k));
             }
             _ => others.push(k),
@@ -479,6 +506,9 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
         let opposite = group.len() == 2 && key(group[0].1.map(partner)) == group[1].1;
         if !opposite {
             s.missing_offset_faces += 1;
+        }
+        if count(group[0].0.map(mid)) != 2 {
+            s.missing_surface_faces += 1;
         }
         let face = group[0].1;
         for (i, j) in [(0, 1), (0, 2), (1, 2)] {
@@ -502,31 +532,41 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
             open.push([x, y]);
         }
         let (x1, y1) = (partner(x), partner(y));
-        let quad = match (x1 == x, y1 == y) {
-            (true, true) => continue,
-            (true, false) => count([x, y, y1]) == expected,
-            (false, true) => count([x, x1, y]) == expected,
-            (false, false) => {
-                // Split along a diagonal: the two faces on one of them, each used `expected`
-                // times, the other two unused. The diagonals cross sides where the perimeter
-                // runs straight; every prism over the edge must see the same perimeter.
-                let straight = group[0].1;
-                let agree = group.iter().all(|e| e.1 == straight);
-                let split = |a: u32, b: u32, c: u32, d: u32| {
-                    // Diagonal (a, b); the other diagonal (c, d).
-                    count([a, b, c]) == expected
-                        && count([a, b, d]) == expected
-                        && count([c, d, a]) == 0
-                        && count([c, d, b]) == 0
-                };
-                agree
-                    && if straight == Some(true) {
-                        split(x, y1, x1, y) || split(x1, y, x, y1)
-                    } else {
-                        split(x, y, x1, y1) || split(x1, y1, x, y)
-                    }
+        if x1 == x && y1 == y {
+            continue;
+        }
+        // Each half of the quad, from an offset edge (a, b) to the surface edge: split along
+        // a diagonal, the two faces on one of them each used `expected` times and the other
+        // two unused, or, with a collapsed end, one triangle used `expected` times. The offset
+        // edges join offsets on one side where the offset faces' edges do (else the halves
+        // cross sides, at a twist); every prism over the edge must see the same.
+        let straight = group[0].1;
+        let agree = group.iter().all(|e| e.1 == straight);
+        let split = |a: u32, b: u32, c: u32, d: u32| {
+            // Diagonal (a, b); the other diagonal (c, d).
+            count([a, b, c]) == expected
+                && count([a, b, d]) == expected
+                && count([c, d, a]) == 0
+                && count([c, d, b]) == 0
+        };
+        let half = |a: u32, b: u32| {
+            let (ma, mb) = (
+                mid(surface_vertex(a).unwrap_or(0)),
+                mid(surface_vertex(b).unwrap_or(0)),
+            );
+            match (ma == a, mb == b) {
+                (true, true) => true,
+                (true, false) => count([a, b, mb]) == expected,
+                (false, true) => count([a, b, ma]) == expected,
+                (false, false) => split(a, mb, b, ma) || split(b, ma, a, mb),
             }
         };
+        let quad = agree
+            && if straight == Some(false) {
+                half(x, y1) && half(x1, y)
+            } else {
+                half(x, y) && half(x1, y1)
+            };
         if !quad {
             s.quad_mismatches += 1;
         }
@@ -534,6 +574,7 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     for k in others {
         let wall = match k.map(surface_vertex) {
             [Some(a), Some(b), Some(c)] => {
+                // Over exactly two surface vertices, an open edge.
                 let mut e = [a, b, c];
                 e.sort_unstable();
                 let pair = if e[0] == e[1] {
@@ -541,7 +582,9 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
                 } else {
                     [e[0], e[1]]
                 };
-                pair[0] != pair[1] && open.binary_search(&pair).is_ok()
+                (e[0] == e[1] || e[1] == e[2])
+                    && pair[0] != pair[1]
+                    && open.binary_search(&pair).is_ok()
             }
             _ => false,
         };

@@ -2,8 +2,9 @@
 //!
 //! Takes: a projected surface (3D points, w-depths, unit normals from the view) and its
 //! triangles. Gives: a [`Halo`]: the two offset surfaces v ± rho n̂ (t = 0 on the negative
-//! side, 1 on the positive), each offset vertex keeping t and d_orig (its w-depth), and the
-//! tetrahedra of the prisms between them ([`crate::tets`]). Inside the halo the depth grows
+//! side, 1 on the positive) and the surface itself between them (t = 1/2), each vertex
+//! keeping t and d_orig (its w-depth), and the tetrahedra of the prisms between the offsets,
+//! in two layers that meet at the surface triangle ([`crate::tets`]). Inside the halo the depth grows
 //! as d_new = d_orig + max(0, |2t - 1| - delta_t) delta_d, evaluated after interpolating t
 //! and d_orig, so the halo carries those two and not d_new.
 //!
@@ -22,7 +23,8 @@
 //! prisms invert: with `fold: shrink` (the default) rho is halved at the corners of every
 //! inverted tetrahedron, re-examining only the prisms around them, until none is inverted;
 //! a vertex halved [`HALVINGS`] times collapses to 0. A collapsed vertex has both offsets at
-//! the surface point, with t = 0.5, and only the negative one's index is used. With
+//! the surface point, with t = 0.5, and only the negative one's index is used (for the
+//! surface vertex too). With
 //! `fold: report` rho stays as asked and the inverted tetrahedra are counted. Vertices are
 //! rounded to f32, what the files store, before they are checked.
 
@@ -42,8 +44,6 @@ pub struct HaloParams {
     /// Depth increment delta_d at the halo's outer surfaces (eq. 3), in w units.
     pub delta_d: f64,
     /// Dead zone delta_t in [0, 1) of |2t - 1| before the depth starts to grow (eq. 3).
-    /// It also bounds how fast rho may change between neighbours ([`grade`]): 0.3 lets rho
-    /// grow by 1.86 per edge away from where folding shrank it.
     pub delta_t: f64,
     /// How prisms are split into tetrahedra.
     pub split: Split,
@@ -109,15 +109,16 @@ impl HaloParams {
     }
 }
 
-/// A surface's halo: vertices (negative offsets, positive offsets, then inserted vertices)
-/// with t and d_orig, and tetrahedra.
+/// A surface's halo: vertices (negative offsets, positive offsets, the surface vertices, then
+/// inserted vertices) with t and d_orig, and tetrahedra.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Halo {
     /// Surface vertices n.
     pub surface_vertices: usize,
     /// Vertex positions.
     pub positions: Vec<DVec3>,
-    /// t of each vertex: 0 on the negative offset, 1 on the positive, 0.5 inside.
+    /// t of each vertex: 0 on the negative offset, 1 on the positive, 0.5 on the surface;
+    /// an inserted vertex has the mean t of its layer's corners.
     pub t: Vec<f64>,
     /// w-depth of the surface point each vertex came from.
     pub d_orig: Vec<f64>,
@@ -125,7 +126,7 @@ pub struct Halo {
     pub tets: Vec<[u32; 4]>,
     /// The half-width used at each surface vertex (rho, or less where it was shrunk).
     pub rho: Vec<f64>,
-    /// The surface triangle whose prism each inserted vertex (from 2n on) is in.
+    /// The surface triangle whose prism each inserted vertex (from 3n on) is in.
     pub inserted_in: Vec<u32>,
 }
 
@@ -406,60 +407,13 @@ fn frame(p: &Projected, triangles: &[[u32; 3]], stars: &Stars) -> Frame {
 /// Halvings of rho at a vertex before it collapses to zero.
 pub const HALVINGS: u32 = 10;
 
-/// How many times rho is graded (each followed by shrinking what grading inverted).
-const MAX_GRADINGS: usize = 8;
-
-/// The largest ratio of neighbouring half-widths. Inside a prism whose corners' rho differ
-/// by a ratio r, the surface triangle leaves the prism's mid-section: along a side quad
-/// split through a diagonal, the surface edge reaches |2t - 1| = (r - 1) / (r + 1). Keeping
-/// that within the dead zone delta_t of eq. 3 keeps the halo depth on the surface equal to
-/// d_orig, so a sheet crossing it is hidden however close it is in w.
-pub fn grade(delta_t: f64) -> f64 {
-    ((1.0 + delta_t) / (1.0 - delta_t)).clamp(1.05, 2.0)
-}
-
-/// Lowers rho where a neighbour's is more than `grade` times smaller (a Dijkstra sweep from
-/// the smallest, on the mesh's edges), leaving collapsed vertices (rho 0) out. Returns the
-/// vertices lowered.
-fn graded(rho: &mut [f64], stars: &Stars, triangles: &[[u32; 3]], grade: f64) -> Vec<u32> {
-    use std::cmp::Reverse;
-    use std::collections::BinaryHeap;
-    // Positive f64s order as their bits.
-    let mut heap: BinaryHeap<Reverse<(u64, u32)>> = rho
-        .iter()
-        .enumerate()
-        .filter(|&(_, &r)| r > 0.0)
-        .map(|(v, &r)| Reverse((r.to_bits(), v as u32)))
-        .collect();
-    let mut changed = Vec::new();
-    while let Some(Reverse((bits, v))) = heap.pop() {
-        if bits != rho[v as usize].to_bits() {
-            continue;
-        }
-        let limit = f64::from_bits(bits) * grade;
-        for &(t, _) in stars.of(v as usize) {
-            for &u in &triangles[t as usize] {
-                let r = &mut rho[u as usize];
-                if *r > limit {
-                    *r = limit;
-                    changed.push(u);
-                    heap.push(Reverse((limit.to_bits(), u)));
-                }
-            }
-        }
-    }
-    changed.sort_unstable();
-    changed.dedup();
-    changed
-}
-
 /// Rounds to f32, the precision of the exported files, so that the checked halo is the
 /// exported one.
 fn f32_exact(p: DVec3) -> DVec3 {
     p.as_vec3().as_dvec3()
 }
 
-/// The halo's offset vertices as rho changes, and which corners collapsed.
+/// The halo's offset and surface vertices as rho changes, and which corners collapsed.
 struct Offsets<'a> {
     projected: &'a Projected,
     dir: Vec<DVec3>,
@@ -494,27 +448,29 @@ impl Offsets<'_> {
     }
 }
 
-/// The surface vertices of prism `c`'s inverted or flat tetrahedra (exact orientation).
+/// The surface vertices of prism `c`'s inverted or flat tetrahedra (exact orientation), in
+/// either layer.
 fn inverted_corners(c: &Corners, forward: [bool; 3], positions: &[DVec3], out: &mut Vec<u32>) {
-    let n = (positions.len() / 2) as u32;
-    let v = c.vertices(n);
+    let n = (positions.len() / 3) as u32;
     let forward = c.effective(forward);
-    let centre = tets::cyclic(forward).then(|| tets::centre(v, positions));
-    let at = |i: u32| {
-        let p = if i == u32::MAX {
-            centre.unwrap_or_default()
-        } else {
-            positions[i as usize]
+    for v in c.layers(n) {
+        let centre = tets::cyclic(forward).then(|| tets::centre(v, positions));
+        let at = |i: u32| {
+            let p = if i == u32::MAX {
+                centre.unwrap_or_default()
+            } else {
+                positions[i as usize]
+            };
+            robust::Coord3D {
+                x: p.x,
+                y: p.y,
+                z: p.z,
+            }
         };
-        robust::Coord3D {
-            x: p.x,
-            y: p.y,
-            z: p.z,
-        }
-    };
-    for tet in tets::prism_tets(v, forward, u32::MAX) {
-        if robust::orient3d(at(tet[0]), at(tet[1]), at(tet[2]), at(tet[3])) <= 0.0 {
-            out.extend(tet.iter().filter(|&&i| i < 2 * n).map(|&i| i % n));
+        for tet in tets::prism_tets(v, forward, u32::MAX) {
+            if robust::orient3d(at(tet[0]), at(tet[1]), at(tet[2]), at(tet[3])) <= 0.0 {
+                out.extend(tet.iter().filter(|&&i| i < 3 * n).map(|&i| i % n));
+            }
         }
     }
 }
@@ -544,7 +500,7 @@ pub fn build_halo(
             })
             .collect(),
         dir: frame.dir,
-        positions: vec![DVec3::ZERO; 2 * n],
+        positions: [vec![DVec3::ZERO; 2 * n], projected.positions.clone()].concat(),
         collapsed: vec![false; n],
     };
     for v in 0..n {
@@ -559,11 +515,8 @@ pub fn build_halo(
 
     if shrink {
         // Halve rho at the corners of inverted tetrahedra, re-examining only the prisms
-        // around them, until none is left; a vertex halved HALVINGS times collapses. Then
-        // grade rho so neighbours differ by at most `grade`, and go on while grading
-        // inverts anything.
+        // around them, until none is left; a vertex halved HALVINGS times collapses.
         let floor = rho * 0.5f64.powi(HALVINGS as i32);
-        let grade = grade(params.delta_t);
         let mut bad = Vec::new();
         for (c, f) in corners.iter().zip(&forward) {
             inverted_corners(c, *f, &offsets.positions, &mut bad);
@@ -587,59 +540,45 @@ pub fn build_halo(
         // zero from the floor on), so the loop ends: every vertex can be lowered at most
         // HALVINGS + 1 times. A round that lowers nothing (every corner already collapsed:
         // the prism is as thin as it can be) ends it too, and the checker counts what is
-        // left. Grading comes after shrinking and never after the last shrink, which keeps
-        // the halo free of inversions at the price of a steeper grade there.
-        for grading in 0..=MAX_GRADINGS {
-            loop {
-                bad.sort_unstable();
-                bad.dedup();
-                bad.retain(|&v| offsets.rho[v as usize] > 0.0);
-                if bad.is_empty() {
-                    break;
-                }
-                for &v in &bad {
-                    let v = v as usize;
-                    offsets.rho[v] = if offsets.rho[v] > floor {
-                        0.5 * offsets.rho[v]
-                    } else {
-                        0.0
-                    };
-                    offsets.place(v);
-                }
-                let touched = std::mem::take(&mut bad);
-                reexamine(&touched, &offsets, &mut bad);
-            }
-            if grading == MAX_GRADINGS {
+        // left. No grading of rho between neighbours is needed: the surface triangle is a
+        // face of both layers, so however rho varies the surface keeps t = 1/2.
+        loop {
+            bad.sort_unstable();
+            bad.dedup();
+            bad.retain(|&v| offsets.rho[v as usize] > 0.0);
+            if bad.is_empty() {
                 break;
             }
-            let changed = graded(&mut offsets.rho, &stars, triangles, grade);
-            if changed.is_empty() {
-                break;
+            for &v in &bad {
+                let v = v as usize;
+                offsets.rho[v] = if offsets.rho[v] > floor {
+                    0.5 * offsets.rho[v]
+                } else {
+                    0.0
+                };
+                offsets.place(v);
             }
-            for &v in &changed {
-                offsets.place(v as usize);
-            }
-            reexamine(&changed, &offsets, &mut bad);
+            let touched = std::mem::take(&mut bad);
+            reexamine(&touched, &offsets, &mut bad);
         }
     }
     let tets = tets::emit(&corners, &forward, &offsets.positions, n, stats);
 
-    let mut t = vec![0.0; n];
-    t.extend(std::iter::repeat_n(1.0, n));
+    let mut t = [vec![0.0; n], vec![1.0; n], vec![0.5; n]].concat();
     for v in (0..n).filter(|&v| offsets.collapsed[v]) {
         (t[v], t[n + v]) = (0.5, 0.5);
     }
-    let mut d_orig = projected.w.clone();
-    d_orig.extend_from_slice(&projected.w);
-    for &tri in &tets.inserted_in {
+    let mut d_orig = projected.w.repeat(3);
+    for (&tri, over) in tets.inserted_in.iter().zip(&tets.inserted_over) {
+        // Means rounded to f32 like every value the files store.
+        let layer_t = over.iter().map(|&i| t[i as usize]).sum::<f64>() / 6.0;
         let corners = triangles[tri as usize];
-        t.push(0.5);
-        // Rounded to f32 like every value the files store.
         let mean = corners
             .iter()
             .map(|&i| projected.w[i as usize])
             .sum::<f64>()
             / 3.0;
+        t.push(layer_t as f32 as f64);
         d_orig.push(mean as f32 as f64);
     }
     let mut positions = offsets.positions;

@@ -1,11 +1,19 @@
 //! Prisms to tetrahedra: every triangle of a thickened surface is a prism between its two
-//! offsets, split into three tetrahedra so that neighbouring prisms agree on the diagonal of
-//! the quad they share.
+//! offsets, cut by the surface triangle itself into two layers (bottom to surface, surface
+//! to top), each split into three tetrahedra so that neighbouring prisms agree on the
+//! diagonal of the quads they share.
 //!
 //! Takes: the surface's triangles as [`Corners`] and the halo's vertices (offset vertex i of
-//! the negative side at index i, of the positive side at n + i). Gives: tetrahedra, oriented
-//! so that `robust::orient3d` is positive when the prism is not inverted, and vertices
-//! inserted inside prisms that no consistent split fits.
+//! the negative side at index i, of the positive side at n + i, the surface vertex itself at
+//! 2n + i). Gives: tetrahedra, oriented so that `robust::orient3d` is positive when the prism
+//! is not inverted, and vertices inserted inside layers that no consistent split fits.
+//!
+//! Why two layers: the surface triangle is then a face of the tetrahedra, so every surface
+//! point lies in its own prism's tetrahedra with t = 1/2 exactly. In one layer of three
+//! tetrahedra the mid-section of a prism whose corners' offset directions differ is not the
+//! triangle: its split quads bend across it, and a surface point can fall outside its own
+//! prism or get a t far from 1/2 (on the twist-spun knots, up to tens of crossings a halo
+//! failed to explain).
 //!
 //! A prism's bottom is the side its triangle's winding turns away from. At each corner that
 //! is the negative offset, unless the corner is *flipped* (its offset direction disagrees
@@ -13,11 +21,14 @@
 //! *collapsed* corner (rho shrunk to zero) is one vertex at the bottom and the top.
 //!
 //! A quad's diagonal runs from the bottom of one end of its surface edge to the top of the
-//! other: an orientation of the edge within the prism. A prism splits into three tetrahedra
-//! exactly when the orientations of its three edges are acyclic (a source p, a middle q and
+//! other: an orientation of the edge within the prism. Both layers take their prism's
+//! orientations, so each half of a quad is split parallel to the whole quad's diagonal and
+//! neighbours that agree on a quad agree on both its halves. A layer splits into three
+//! tetrahedra exactly when the orientations of its three edges are acyclic (a source p, a middle q and
 //! a sink r: tetrahedra {p0 q0 r0 r1}, {p0 q0 q1 r1}, {p0 p1 q1 r1}); the two cyclic patterns
-//! need a new vertex, here one at the prism's centre joined to its eight boundary triangles.
-//! Tetrahedra that repeat a collapsed corner are left out. Neighbours agree on a quad when
+//! need a new vertex, here one at the layer's centre joined to its eight boundary triangles.
+//! Tetrahedra that repeat a collapsed corner (whose offsets and surface vertex are one
+//! vertex) are left out. Neighbours agree on a quad when
 //! both split it through the same global vertex; "up" means through the negative offset of
 //! the edge's lower-index end. Three ways to choose ([`Split`]):
 //! - `global_order`: every quad up, i.e. through its lowest-index vertex. Acyclic
@@ -111,6 +122,25 @@ impl Corners {
         out
     }
 
+    /// The prism's two layers, bottom to surface and surface to top, each as global indices
+    /// of its bottom corners, then its top corners; a collapsed corner is one vertex, the
+    /// negative offset's index, in both.
+    pub fn layers(&self, n: u32) -> [[u32; 6]; 2] {
+        let v = self.vertices(n);
+        let mid = |i: usize| {
+            if self.collapsed[i] {
+                v[i]
+            } else {
+                2 * n + self.tri[i]
+            }
+        };
+        let m = [mid(0), mid(1), mid(2)];
+        [
+            [v[0], v[1], v[2], m[0], m[1], m[2]],
+            [m[0], m[1], m[2], v[3], v[4], v[5]],
+        ]
+    }
+
     /// Whether the quad over edge k, oriented `forward` in this prism, is split through the
     /// negative offset of the edge's lower-index end. Its own inverse: the orientation that
     /// splits the quad `up` is `self.up(k, up)`.
@@ -148,10 +178,12 @@ impl Corners {
 pub struct Tetrahedra {
     /// Four vertex indices each, into the halo's vertices followed by `inserted`.
     pub tets: Vec<[u32; 4]>,
-    /// Inserted vertices, each at the centre of a prism.
+    /// Inserted vertices, each at the centre of a layer of a prism.
     pub inserted: Vec<DVec3>,
     /// The triangle whose prism each inserted vertex is in.
     pub inserted_in: Vec<u32>,
+    /// The six vertices of the layer each inserted vertex is the centre of.
+    pub inserted_over: Vec<[u32; 6]>,
     /// What the split did.
     pub stats: SplitStats,
 }
@@ -325,13 +357,16 @@ pub fn prism_tets(v: [u32; 6], forward: [bool; 3], centre: u32) -> impl Iterator
 
 /// The tetrahedra of one plain prism over triangle `tri` of a surface of `n` vertices, given
 /// the orientation of its three edges (`forward[k]`: the quad over edge k is split from the
-/// bottom of corner k to the top of corner k + 1): three tetrahedra, or, for the two cyclic
-/// patterns, eight joined to the inserted vertex `centre`.
-pub fn prism(tri: [u32; 3], n: u32, forward: [bool; 3], centre: u32) -> Vec<[u32; 4]> {
-    prism_tets(Corners::plain(tri).vertices(n), forward, centre).collect()
+/// bottom of corner k to the top of corner k + 1): three tetrahedra in each layer, or, for
+/// the two cyclic patterns, eight joined to the inserted vertex `centres[layer]`.
+pub fn prism(tri: [u32; 3], n: u32, forward: [bool; 3], centres: [u32; 2]) -> Vec<[u32; 4]> {
+    let layers = Corners::plain(tri).layers(n);
+    (0..2)
+        .flat_map(|l| prism_tets(layers[l], forward, centres[l]))
+        .collect()
 }
 
-/// The centre of a prism with corners `v` (the inserted vertex of a cyclic pattern), rounded
+/// The centre of a layer with corners `v` (the inserted vertex of a cyclic pattern), rounded
 /// to f32 like every halo vertex.
 pub fn centre(v: [u32; 6], positions: &[DVec3]) -> DVec3 {
     let sum: DVec3 = v.iter().map(|&i| positions[i as usize]).sum();
@@ -453,8 +488,11 @@ pub fn plan(
         }
         Split::Quality => {
             let prism_quality = |t: usize, f: [bool; 3]| -> f64 {
-                let v = corners[t].vertices(n as u32);
-                prism_tets(v, corners[t].effective(f), u32::MAX)
+                let f = corners[t].effective(f);
+                corners[t]
+                    .layers(n as u32)
+                    .into_iter()
+                    .flat_map(|v| prism_tets(v, f, u32::MAX))
                     .map(|tet| {
                         let p = tet.map(|i| positions[i as usize]);
                         // Inverted is worst.
@@ -507,8 +545,9 @@ pub fn plan(
     (forward, stats)
 }
 
-/// The tetrahedra of every prism, with a vertex inserted at the centre of each prism whose
-/// pattern (in effect) is cyclic. `positions` are the halo's offset vertices.
+/// The tetrahedra of both layers of every prism, with a vertex inserted at the centre of each
+/// layer whose pattern (in effect) is cyclic. `positions` are the halo's offset and surface
+/// vertices.
 pub fn emit(
     corners: &[Corners],
     forward: &[[bool; 3]],
@@ -520,15 +559,17 @@ pub fn emit(
         stats,
         ..Tetrahedra::default()
     };
-    out.tets.reserve(3 * corners.len());
+    out.tets.reserve(6 * corners.len());
     for (t, c) in corners.iter().enumerate() {
-        let v = c.vertices(n as u32);
         let f = c.effective(forward[t]);
-        let centre_index = (positions.len() + out.inserted.len()) as u32;
-        out.tets.extend(prism_tets(v, f, centre_index));
-        if cyclic(f) {
-            out.inserted.push(centre(v, positions));
-            out.inserted_in.push(t as u32);
+        for v in c.layers(n as u32) {
+            let centre_index = (positions.len() + out.inserted.len()) as u32;
+            out.tets.extend(prism_tets(v, f, centre_index));
+            if cyclic(f) {
+                out.inserted.push(centre(v, positions));
+                out.inserted_in.push(t as u32);
+                out.inserted_over.push(v);
+            }
         }
     }
     out.stats.inserted_vertices = out.inserted.len();

@@ -41,7 +41,8 @@ use std::time::Instant;
 /// A halo as the verification reads it.
 #[derive(Clone, Copy, Debug)]
 pub struct HaloInput<'a> {
-    /// Vertex positions: offsets 0..n (t = 0), n..2n (t = 1), inserted vertices after.
+    /// Vertex positions: offsets 0..n (t = 0), n..2n (t = 1), the surface 2n..3n (t = 1/2),
+    /// inserted vertices after.
     pub positions: &'a [DVec3],
     /// t of each vertex.
     pub t: &'a [f64],
@@ -256,11 +257,11 @@ impl<'a> HaloIndex<'a> {
             let Some(h) = halo else { continue };
             let n = h.surface_vertices;
             // The surface vertices around each inserted vertex.
-            let mut sets: Vec<Vec<u32>> = vec![Vec::new(); h.positions.len().saturating_sub(2 * n)];
+            let mut sets: Vec<Vec<u32>> = vec![Vec::new(); h.positions.len().saturating_sub(3 * n)];
             for tet in h.tets {
-                for &k in tet.iter().filter(|&&k| k as usize >= 2 * n) {
-                    for &v in tet.iter().filter(|&&v| (v as usize) < 2 * n) {
-                        sets[k as usize - 2 * n].push(v % n as u32);
+                for &k in tet.iter().filter(|&&k| k as usize >= 3 * n) {
+                    for &v in tet.iter().filter(|&&v| (v as usize) < 3 * n) {
+                        sets[k as usize - 3 * n].push(v % n as u32);
                     }
                 }
             }
@@ -273,10 +274,10 @@ impl<'a> HaloIndex<'a> {
                 tets.push((s as u32, i as u32));
                 let mut vs: Vec<u32> = Vec::with_capacity(8);
                 for &k in tet {
-                    if (k as usize) < 2 * n {
+                    if (k as usize) < 3 * n {
                         vs.push(k % n as u32);
                     } else {
-                        vs.extend_from_slice(&sets[k as usize - 2 * n]);
+                        vs.extend_from_slice(&sets[k as usize - 3 * n]);
                     }
                 }
                 vs.sort_unstable();

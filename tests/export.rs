@@ -39,8 +39,8 @@ fn every_fixture_builds_and_reads_back() {
             assert!(c.valid(), "{what}");
             assert_eq!(p.halo_report.inverted, 0, "{what}");
             assert_eq!(p.halo_report.split_stats.mismatches_final, 0, "{what}");
-            // Three per prism, one fewer for each collapsed corner (rho 0), five more for
-            // each inserted vertex.
+            // Three per layer of a prism, one fewer in each layer for each collapsed corner
+            // (rho 0), five more for each inserted vertex.
             let collapsed_corners = p
                 .mesh
                 .triangles
@@ -49,8 +49,8 @@ fn every_fixture_builds_and_reads_back() {
                 .filter(|&&v| p.halo.rho[v as usize] == 0.0)
                 .count();
             assert_eq!(
-                c.tets + collapsed_corners,
-                3 * p.mesh.triangles.len() + 5 * p.halo_report.split_stats.inserted_vertices,
+                c.tets + 2 * collapsed_corners,
+                6 * p.mesh.triangles.len() + 5 * p.halo_report.split_stats.inserted_vertices,
                 "{what}"
             );
         }

@@ -486,6 +486,7 @@ const KEYS: &[&str] = &[
     "polylines",
     "tetrahedra",
     "surface_vertices",
+    "layers",
     "surface_mesh",
     "ribbons",
     "along",
@@ -1257,7 +1258,7 @@ fn halo_ok(h: &ImportedHalo) -> Result<(), String> {
     }
     if h.mesh
         .surface_vertices
-        .checked_mul(2)
+        .checked_mul(3)
         .is_none_or(|n| n > nv)
     {
         return bad(format!(
@@ -1461,7 +1462,7 @@ fn ascii_vtk(h: &ImportedHalo, version5: bool) -> String {
     let field = |s: &mut String| {
         let _ = write!(
             s,
-            "FIELD FieldData 4\nsurface_vertices 1 1 int\n{}\n",
+            "FIELD FieldData 5\nsurface_vertices 1 1 int\n{}\nlayers 1 1 int\n2\n",
             m.surface_vertices
         );
         for (name, value) in [
@@ -1577,6 +1578,7 @@ fn vtk_seeds() -> &'static VtkSeeds {
             (find(&format!("CELLS {nt} {}\n", 5 * nt)), 4, 5 * nt),
             (find(&format!("CELL_TYPES {nt}\n")), 4, nt),
             (find("surface_vertices 1 1 int\n"), 4, 1),
+            (find("layers 1 1 int\n"), 4, 1),
         ];
         for name in ["rho", "delta_d", "delta_t"] {
             blocks.push((find(&format!("{name} 1 1 double\n")), 8, 1));
@@ -1633,6 +1635,7 @@ const VTK_WORDS: &[&str] = &[
     "TEXTURE_COORDINATES",
     "COLOR_SCALARS",
     "surface_vertices",
+    "layers",
     "rho",
     "delta_d",
     "delta_t",
@@ -1698,6 +1701,7 @@ const VTK_LINES: &[&str] = &[
     "FIELD FieldData 1",
     "FIELD FieldData 0",
     "surface_vertices 1 1 int",
+    "layers 1 1 int",
     "rho 1 1 double",
     "0",
     "POINT_DATA 972",
@@ -2038,7 +2042,7 @@ const BROKEN_FILES: &[(&str, Reader, &[&str])] = &[
         Reader::Vtk,
         &["SCALARS", "LOOKUP_TABLE"],
     ),
-    ("long-title.vtk", Reader::Vtk, &["surface_vertices = 5"]),
+    ("long-title.vtk", Reader::Vtk, &["halo layout (`layers`)"]),
 ];
 
 #[test]

@@ -55,7 +55,7 @@ fn ascii_vtk(h: &ImportedHalo, with_layout: bool) -> String {
     );
     if with_layout {
         s += &format!(
-            "FIELD FieldData 2\nsurface_vertices 1 1 int\n{}\nrho 1 1 double\n{}\n",
+            "FIELD FieldData 3\nsurface_vertices 1 1 int\n{}\nlayers 1 1 int\n2\nrho 1 1 double\n{}\n",
             m.surface_vertices,
             h.params.rho.unwrap()
         );
@@ -230,10 +230,10 @@ fn the_glb_halo_is_plain_gltf_to_the_gltf_crate() {
         );
         let patch: Vec<f64> = (0..halo.positions.len())
             .map(|i| {
-                f64::from(if i < 2 * n {
+                f64::from(if i < 3 * n {
                     p.mesh.patch[i % n]
                 } else {
-                    p.mesh.triangle_patch[halo.inserted_in[i - 2 * n] as usize]
+                    p.mesh.triangle_patch[halo.inserted_in[i - 3 * n] as usize]
                 })
             })
             .collect();
@@ -282,6 +282,7 @@ fn the_glb_halo_is_plain_gltf_to_the_gltf_crate() {
         let extras: Value = serde_json::from_str(mesh.extras().as_ref().unwrap().get()).unwrap();
         let h = &extras["halo"];
         assert_eq!(h["surface_vertices"], n);
+        assert_eq!(h["layers"], 2);
         assert_eq!(h["rho"], p.halo_report.rho);
         assert_eq!(h["split"], scene.halo.split.name());
         let surface_mesh = gltf
@@ -610,9 +611,26 @@ fn malformed_glb_files_are_clear_errors() {
         }),
         &["no `surface_vertices`"],
     );
+    // A halo without its layout's marker (as earlier versions wrote them), or another one.
+    glb_fails(
+        &edited(&|j| {
+            halo_mesh(j)["extras"]["halo"]
+                .as_object_mut()
+                .unwrap()
+                .remove("layers");
+        }),
+        &[
+            "does not say its halo layout (`layers`)",
+            "build the scene again",
+        ],
+    );
+    glb_fails(
+        &edited(&|j| halo_mesh(j)["extras"]["halo"]["layers"] = 1.into()),
+        &["layers = 1", "2 layers of prisms"],
+    );
     glb_fails(
         &edited(&|j| halo_mesh(j)["extras"]["halo"]["surface_vertices"] = 100_000.into()),
-        &["surface_vertices = 100000", "offset vertices"],
+        &["surface_vertices = 100000", "offset and surface vertices"],
     );
     // Ten million tetrahedra claimed by a file of a hundred kilobytes.
     glb_fails(
@@ -799,6 +817,14 @@ fn malformed_vtk_files_are_clear_errors() {
     vtk_fails(
         replace(&layout, "surface_vertices 1 1 double\n4.5\n").as_bytes(),
         &["surface_vertices must be a non-negative integer"],
+    );
+    vtk_fails(
+        replace("layers 1 1 int\n2\n", "layers 1 1 int\n1\n").as_bytes(),
+        &["layers = 1", "2 layers of prisms"],
+    );
+    vtk_fails(
+        replace("layers 1 1 int\n2\n", "nothing 1 1 int\n2\n").as_bytes(),
+        &["does not say its halo layout (`layers`)"],
     );
     vtk_fails(
         ascii_vtk(&halo, false).as_bytes(),

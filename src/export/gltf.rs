@@ -13,8 +13,8 @@
 //!   glTF has no tetrahedron primitive: the tetrahedra are an UNSIGNED_INT SCALAR accessor of
 //!   4 indices each named `<surface>-halo tetrahedra`, in a buffer view without a target,
 //!   numbered by the halo mesh's extras `{"halo": {"tetrahedra": accessor, "surface_vertices":
-//!   n, "rho", "delta_d", "delta_t", "split", "surface_mesh": mesh}}` ([`crate::import`]
-//!   reads them back).
+//!   n, "layers": 2, "rho", "delta_d", "delta_t", "split", "surface_mesh": mesh}}` in the
+//!   layout of [`crate::check`] ([`crate::import`] reads them back).
 //!
 //! Then, when the scene has any, the intersection curves of all surfaces together in one mesh
 //! `curves` with its own node: [`super::tubes`] of the given radius as TRIANGLES with POSITION,
@@ -34,6 +34,7 @@
 
 use super::tubes::tubes;
 use super::{SurfaceData, curve_segments};
+use crate::check::LAYERS;
 use crate::convention::{file_order, to_gltf};
 use crate::halo::Halo;
 use crate::intersect::{CurvePoint, Curves};
@@ -267,17 +268,17 @@ fn vertex_normals(positions: &[DVec3], faces: &[[u32; 3]]) -> Vec<DVec3> {
     normals
 }
 
-/// The patch of each halo vertex: that of its surface vertex for the offsets, that of the
-/// triangle whose prism it is in for an inserted vertex.
+/// The patch of each halo vertex: that of its surface vertex for the offsets and the surface,
+/// that of the triangle whose prism it is in for an inserted vertex.
 fn halo_patches(s: &SurfaceData) -> Vec<f32> {
     let halo: &Halo = s.halo;
     let n = halo.surface_vertices;
     (0..halo.positions.len())
         .map(|i| {
-            if i < 2 * n {
+            if i < 3 * n {
                 s.mesh.patch[i % n] as f32
             } else {
-                s.mesh.triangle_patch[halo.inserted_in[i - 2 * n] as usize] as f32
+                s.mesh.triangle_patch[halo.inserted_in[i - 3 * n] as usize] as f32
             }
         })
         .collect()
@@ -462,6 +463,7 @@ fn halo_mesh(
         "halo": {
             "tetrahedra": tetrahedra.value(),
             "surface_vertices": halo.surface_vertices,
+            "layers": LAYERS,
             "rho": s.rho,
             "delta_d": s.halo_params.delta_d,
             "delta_t": s.halo_params.delta_t,

@@ -1,10 +1,10 @@
 //! Legacy VTK (`.vtk`, version 3.0, binary) of a halo's tetrahedra, for ParaView and meshio.
 //!
 //! One `UNSTRUCTURED_GRID` per halo: every halo vertex in the layout of [`crate::check`]
-//! (negative offsets, positive offsets, inserted vertices) as `double` POINTS, every
-//! tetrahedron as a cell of 4 ids and type 10 (`VTK_TETRA`) in VTK's orientation
-//! ([`file_order`]), the dataset's field data
-//! `surface_vertices` (int), `rho` (absolute), `delta_d` and `delta_t` (double), and the point
+//! (negative offsets, positive offsets, the surface, inserted vertices) as `double` POINTS,
+//! every tetrahedron as a cell of 4 ids and type 10 (`VTK_TETRA`) in VTK's orientation
+//! ([`file_order`]), the dataset's field data `surface_vertices` and `layers`
+//! ([`LAYERS`]) (int), `rho` (absolute), `delta_d` and `delta_t` (double), and the point
 //! scalars `t` and `d_orig` (double). Binary legacy VTK is big-endian; each binary block ends
 //! with a newline, as VTK's own writer does and meshio requires.
 //!
@@ -12,6 +12,7 @@
 //! takes it anywhere at the dataset level, but meshio files it as field data only there.
 
 use super::SurfaceData;
+use crate::check::LAYERS;
 use crate::convention::file_order;
 
 /// Builds the `.vtk` bytes of one surface's halo. The title line is
@@ -48,8 +49,10 @@ pub fn to_vtk(surface: &SurfaceData, scene_name: &str) -> Vec<u8> {
     for _ in 0..tets {
         out.extend_from_slice(&10i32.to_be_bytes());
     }
-    text(&mut out, "\nFIELD FieldData 4\nsurface_vertices 1 1 int\n");
+    text(&mut out, "\nFIELD FieldData 5\nsurface_vertices 1 1 int\n");
     out.extend_from_slice(&(halo.surface_vertices as i32).to_be_bytes());
+    text(&mut out, "\nlayers 1 1 int\n");
+    out.extend_from_slice(&(LAYERS as i32).to_be_bytes());
     let params = surface.halo_params;
     for (name, value) in [
         ("rho", surface.rho),

@@ -727,6 +727,7 @@ impl<'a> Doc<'a> {
                     .get("surface_mesh")
                     .and_then(Value::as_u64)
                     .and_then(|m| usize::try_from(m).ok()),
+                layers: number("layers"),
             },
         })
     }

@@ -21,7 +21,7 @@ mod vtk;
 pub use glb::{read_glb, read_scene_glb};
 pub use vtk::read_vtk;
 
-use crate::check::TetMesh;
+use crate::check::{LAYERS, TetMesh};
 use crate::error::shorten;
 use crate::intersect::{self, Curves, Sheet};
 use crate::render::CameraSettings;
@@ -160,6 +160,8 @@ pub struct FileParams {
     pub split: Option<String>,
     /// Index of the surface's own mesh (`.glb` only).
     pub surface_mesh: Option<usize>,
+    /// Layers of prisms the halo's layout has ([`crate::check::LAYERS`]).
+    pub layers: Option<f64>,
 }
 
 /// Why a file could not be read as halos.
@@ -234,8 +236,9 @@ pub fn read(path: &Path) -> Result<Vec<ImportedHalo>, ImportError> {
 }
 
 impl ImportedHalo {
-    /// Checks what the checker takes for granted: finite values, at least the 2n offset
-    /// vertices, indices in range, one t and d_orig per vertex.
+    /// Checks what the checker takes for granted: the layout of [`crate::check`] (its number
+    /// of layers), finite values, at least the 3n offset and surface vertices, indices in
+    /// range, one t and d_orig per vertex.
     fn validate(self) -> Result<Self, ImportError> {
         let bad = |message: String| ImportError::BadHalo {
             name: self.name.clone(),
@@ -253,11 +256,26 @@ impl ImportedHalo {
                 "vertex {i} has a non-finite coordinate ({x}, {y}, {z})"
             )));
         }
+        match self.params.layers {
+            Some(l) if l == LAYERS as f64 => {}
+            Some(l) => {
+                return Err(bad(format!(
+                    "layers = {l}, but halo4d {} reads halos of {LAYERS} layers of prisms (offsets, then the surface itself); build the scene again with this halo4d",
+                    env!("CARGO_PKG_VERSION")
+                )));
+            }
+            None => {
+                return Err(bad(format!(
+                    "the file does not say its halo layout (`layers`): an earlier halo4d wrote it, with one layer of prisms and no surface vertices among the halo's; build the scene again with halo4d {}",
+                    env!("CARGO_PKG_VERSION")
+                )));
+            }
+        }
         let n = self.mesh.surface_vertices;
-        if n.checked_mul(2).is_none_or(|two_n| two_n > nv) {
+        if n.checked_mul(3).is_none_or(|three_n| three_n > nv) {
             return Err(bad(format!(
-                "surface_vertices = {n} needs the 2n = {} offset vertices, but the halo has {nv} vertices",
-                n.saturating_mul(2)
+                "surface_vertices = {n} needs the 3n = {} offset and surface vertices, but the halo has {nv} vertices",
+                n.saturating_mul(3)
             )));
         }
         for (k, tet) in self.mesh.tets.iter().enumerate() {

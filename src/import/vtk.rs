@@ -119,6 +119,7 @@ pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
             delta_t: field("delta_t"),
             split: None,
             surface_mesh: None,
+            layers: field("layers"),
         },
     }
     .validate()
