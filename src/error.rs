@@ -67,7 +67,9 @@ pub enum Error {
         source: BehindEye,
     },
     /// The scene's numbers are finite but put its geometry where the files' f32 or the exact
-    /// predicates cannot follow (too large or too small).
+    /// predicates cannot follow (too large or too small), or so many triangles that the
+    /// stages from the halos on would need more memory than the limit
+    /// ([`crate::memory::limit`]).
     #[error("scene `{}`: {message}", shorten(.scene))]
     Scale {
         /// The scene.

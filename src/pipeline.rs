@@ -461,6 +461,23 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
         });
     }
     let rho = scene.halo.rho * diagonal;
+    let triangles: usize = projections.iter().map(|p| p.2.triangles.len()).sum();
+    let needed = triangles as f64 * crate::memory::BUILD_BYTES_PER_TRIANGLE;
+    let (limit, source_of_limit) = crate::memory::limit().map_err(|message| Error::Scale {
+        scene: scene.name.clone(),
+        message,
+    })?;
+    if needed > limit {
+        return Err(Error::Scale {
+            scene: scene.name.clone(),
+            message: format!(
+                "the halos, curves and verification of {triangles} triangles would need about {:.2} GB ({} bytes per triangle), more than the limit of {:.2} GB ({source_of_limit}); sample fewer triangles (sampling.tolerance, sampling.max_triangles or a coarser grid)",
+                needed / crate::memory::GB,
+                crate::memory::BUILD_BYTES_PER_TRIANGLE,
+                limit / crate::memory::GB
+            ),
+        });
+    }
     for (name, entry, mesh, stats, report, projected) in projections {
         bar.set_message(format!("halo of {name}"));
         let start = Instant::now();

@@ -20,9 +20,9 @@
 //!   split quads leave the boundary edge itself just inside or just outside), or where the
 //!   nearer sheet's halo has zero width at a corner of its triangle (collapsed where the
 //!   projection is singular or folds tighter than any halo fits: the halo vanishes there
-//!   by construction, as at a cross-cap, and is too thin around it for its t = 1/2 layer
-//!   to follow the triangle; such a sample is ambiguous only where the halo does not
-//!   explain it, and correct where it does). Each ambiguous sample counts under its first
+//!   by construction, as at a cross-cap, and with all three corners collapsed the prism has
+//!   no tetrahedron at all; such a sample is ambiguous only where the halo does not explain
+//!   it, and correct where it does). Each ambiguous sample counts under its first
 //!   reason in that order ([`Ambiguous`]). Where a
 //!   third sheet's halo hides the nearer sheet (near triple points) the sample counts as
 //!   `third_sheet`.

@@ -595,7 +595,7 @@ fn in_the_patches_of_paper_000_fig_1_the_nearer_patch_is_drawn_at_each_crossing(
 #[test]
 fn a_picture_beyond_the_memory_limit_is_refused_before_it_allocates() {
     // The estimate counts the hits per ray on a grid of rays, so slices mode at 1024 x 1024
-    // (hundreds of megabytes of per-sample hits) is refused under a limit of 10 MB, exact
+    // (hundreds of megabytes of per-sample hits) is refused under a limit of 100 MB, exact
     // mode is not, and a limit that is not a number is an error naming the variable.
     let dir = tempfile::tempdir().unwrap();
     let run = |limit: &str, mode: &str| {
@@ -605,7 +605,7 @@ fn a_picture_beyond_the_memory_limit_is_refused_before_it_allocates() {
         let args = [&args[..], &["--out", "p.png"]].concat();
         halo4d_with(&args, dir.path(), &[("HALO4D_MAX_MEMORY", limit)])
     };
-    let out = run("0.01", "slices");
+    let out = run("0.1", "slices");
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "{err}");
     for words in [
