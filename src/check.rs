@@ -355,10 +355,11 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     let collapsed: Vec<bool> = (0..n)
         .map(|v| n + v < nv && positions[v] == positions[n + v])
         .collect();
-    // Collapsed vertices under one index (a surface vertex at another point than its
-    // collapsed offsets keeps its own); the offset of the same surface vertex on the other
-    // side (itself when collapsed); the surface vertex of an offset or surface vertex; the
-    // surface vertex of surface vertex x.
+    // `canon`: collapsed vertices under one index, the negative offset's (a surface vertex
+    // at another point than its collapsed offsets keeps its own); `mid`: surface vertex x's
+    // own vertex (2n + x) under that index; `partner`: the offset of the same surface vertex
+    // on the other side (itself when collapsed); `surface_vertex`: the surface vertex an
+    // offset or surface vertex stands for.
     let canon = |i: u32| {
         let i = i as usize;
         let v = i % n.max(1);

@@ -4,9 +4,9 @@
 //! triangles. Gives: a [`Halo`]: the two offset surfaces v ± rho n̂ (t = 0 on the negative
 //! side, 1 on the positive) and the surface itself between them (t = 1/2), each vertex
 //! keeping t and d_orig (its w-depth), and the tetrahedra of the prisms between the offsets,
-//! in two layers that meet at the surface triangle ([`crate::tets`]). Inside the halo the depth grows
-//! as d_new = d_orig + max(0, |2t - 1| - delta_t) delta_d, evaluated after interpolating t
-//! and d_orig, so the halo carries those two and not d_new.
+//! in two layers that meet at the surface triangle ([`crate::tets`]). Inside the halo the
+//! depth grows as d_new = d_orig + max(0, |2t - 1| - delta_t) delta_d, evaluated after
+//! interpolating t and d_orig, so the halo carries those two and not d_new.
 //!
 //! The offset direction d of a vertex is the view's normal n̂ (eq. 1: the normalized cross
 //! product of the projected tangents) where every triangle around the vertex faces it by a

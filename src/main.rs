@@ -255,6 +255,10 @@ fn main() -> ExitCode {
                         t.render,
                         t.total
                     );
+                    eprintln!(
+                        "memory: about {:.2} GB estimated from the halos on, limit {:.2} GB",
+                        report.memory.estimate_gb, report.memory.limit_gb
+                    );
                     for f in &report.files {
                         println!("{}", out.join(f).display());
                     }

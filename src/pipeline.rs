@@ -56,6 +56,19 @@ pub struct Built {
     /// The diagonal of the projected scene's bounding box, of which `halo.rho` and
     /// `outputs.curve_radius` are shares, at least [`MIN_EXTENT`].
     pub diagonal: f64,
+    /// The memory the stages from the halos on were estimated to need, and the limit.
+    pub memory: MemoryReport,
+}
+
+/// `report.json`'s `memory`: what the stages from the halos on were estimated to need
+/// ([`crate::memory::BUILD_BYTES_PER_TRIANGLE`] per triangle) against the limit
+/// ([`crate::memory::limit`]), in GB. The picture is estimated on its own when it is made.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct MemoryReport {
+    /// Estimated peak of the stages from the halos on.
+    pub estimate_gb: f64,
+    /// The limit a build refuses to go beyond.
+    pub limit_gb: f64,
 }
 
 impl Built {
@@ -370,6 +383,8 @@ pub struct Report {
     pub halo_verification: Verification,
     /// Milliseconds per stage.
     pub timings_ms: Timings,
+    /// Memory estimated before the halos, against the limit.
+    pub memory: MemoryReport,
     /// Warnings, also printed on stderr.
     pub warnings: Vec<String>,
     /// Whether the build is verified: [`Built::failures`] found nothing.
@@ -512,6 +527,10 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
     Ok(Built {
         surfaces: products,
         diagonal,
+        memory: MemoryReport {
+            estimate_gb: needed / crate::memory::GB,
+            limit_gb: limit / crate::memory::GB,
+        },
         curves,
         verification,
         timings,
@@ -615,6 +634,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
         curves: built.curves.report.clone(),
         halo_verification: built.verification.clone(),
         timings_ms: timings,
+        memory: built.memory,
         warnings: products
             .iter()
             .filter_map(|p| p.sampling.warning(&p.name))

@@ -24,13 +24,13 @@
 //! other: an orientation of the edge within the prism. Both layers take their prism's
 //! orientations, so each half of a quad is split parallel to the whole quad's diagonal and
 //! neighbours that agree on a quad agree on both its halves. A layer splits into three
-//! tetrahedra exactly when the orientations of its three edges are acyclic (a source p, a middle q and
-//! a sink r: tetrahedra {p0 q0 r0 r1}, {p0 q0 q1 r1}, {p0 p1 q1 r1}); the two cyclic patterns
-//! need a new vertex, here one at the layer's centre joined to its eight boundary triangles.
-//! Tetrahedra that repeat a collapsed corner (whose offsets and surface vertex are one
-//! vertex) are left out. Neighbours agree on a quad when
-//! both split it through the same global vertex; "up" means through the negative offset of
-//! the edge's lower-index end. Three ways to choose ([`Split`]):
+//! tetrahedra exactly when the orientations of its three edges are acyclic (a source p, a
+//! middle q and a sink r: tetrahedra {p0 q0 r0 r1}, {p0 q0 q1 r1}, {p0 p1 q1 r1}); the two
+//! cyclic patterns need a new vertex, here one at the layer's centre joined to its eight
+//! boundary triangles. Tetrahedra that repeat a collapsed corner (whose offsets and surface
+//! vertex are one vertex) are left out. Neighbours agree on a quad when both split it
+//! through the same global vertex; "up" means through the negative offset of the edge's
+//! lower-index end. Three ways to choose ([`Split`]):
 //! - `global_order`: every quad up, i.e. through its lowest-index vertex. Acyclic
 //!   everywhere (the prism's lowest vertex is a source or a sink), conforming, blind to
 //!   geometry.
