@@ -146,8 +146,13 @@ def child_blender_import(path):
             unused = np.setdiff1d(np.arange(len(positions)), used)
             if unused.size and unused.min() < 2 * n:
                 problems.append(f"{m.name}: offset vertex {unused.min()} is on no triangle")
-            if np.setdiff1d(unused, tets).size:
-                problems.append(f"{m.name}: vertices on neither a triangle nor a tetrahedron")
+            # A collapsed surface vertex v has its three vertices v, n + v and 2n + v at one
+            # point, and the tetrahedra name it by v: its 2n + v is on neither.
+            loose = np.setdiff1d(unused, tets)
+            collapsed = (loose >= 2 * n) & (loose < 3 * n)
+            collapsed[collapsed] = (positions[loose[collapsed]] == positions[loose[collapsed] - 2 * n]).all(axis=1)
+            if (~collapsed).any():
+                problems.append(f"{m.name}: vertices on neither a triangle nor a tetrahedron, the first {loose[~collapsed][0]}")
             keep = len(used)
         elif "surface" in extras:
             kind, names, keep = "surface", ["_W", "_U", "_V", "_PATCH"], len(positions)
