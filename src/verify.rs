@@ -81,9 +81,11 @@ pub struct Verification {
     pub hidden_samples: usize,
     /// Of those, hidden where no sheet is within rho.
     pub spurious_hidden_samples: usize,
-    /// Where the first wrong curve samples are (up to 8).
+    /// Where the first wrong curve samples are (up to 8 distinct points: events that
+    /// symbolic perturbation tells apart can share one point, as where the flat torus's
+    /// curves pass through mesh vertices).
     pub wrong_at: Vec<[f64; 3]>,
-    /// Where the first spurious samples are (up to 8).
+    /// Where the first spurious samples are (up to 8 distinct points).
     pub spurious_at: Vec<[f64; 3]>,
     /// Milliseconds.
     pub ms: f64,
@@ -215,13 +217,21 @@ fn parallel<T: Sync>(items: &[T], f: impl Fn(&[T]) -> Verification + Sync) -> Ve
         (&mut v.wrong_at, b.wrong_at),
         (&mut v.spurious_at, b.spurious_at),
     ] {
-        to.extend(from);
-        to.truncate(EXAMPLES);
+        for x in from {
+            example(to, x);
+        }
     }
     v
 }
 
 const EXAMPLES: usize = 8;
+
+/// Adds `x` to a list of examples unless it is full or has `x` already.
+fn example(list: &mut Vec<[f64; 3]>, x: [f64; 3]) {
+    if list.len() < EXAMPLES && !list.contains(&x) {
+        list.push(x);
+    }
+}
 
 struct CurveSample {
     x: DVec3,
@@ -521,9 +531,7 @@ impl<'a> Index<'a> {
             v.ambiguous += 1;
         } else if !far_hidden || by_far {
             v.wrong += 1;
-            if v.wrong_at.len() < EXAMPLES {
-                v.wrong_at.push(s.x.to_array());
-            }
+            example(&mut v.wrong_at, s.x.to_array());
         } else if !near_hiders.is_empty() {
             v.third_sheet += 1;
         } else {
@@ -567,9 +575,7 @@ impl<'a> Index<'a> {
             v.hidden_samples += 1;
         } else {
             v.spurious_hidden_samples += 1;
-            if v.spurious_at.len() < EXAMPLES {
-                v.spurious_at.push(x.to_array());
-            }
+            example(&mut v.spurious_at, x.to_array());
         }
     }
 }
