@@ -24,9 +24,8 @@
 //! inverted tetrahedron, re-examining only the prisms around them, until none is inverted;
 //! a vertex halved [`HALVINGS`] times collapses to 0. A collapsed vertex has both offsets at
 //! the surface point, with t = 0.5, and only the negative one's index is used (for the
-//! surface vertex too). With
-//! `fold: report` rho stays as asked and the inverted tetrahedra are counted. Vertices are
-//! rounded to f32, what the files store, before they are checked.
+//! surface vertex too). With `fold: report` rho stays as asked and the inverted tetrahedra
+//! are counted. Vertices are rounded to f32, what the files store, before they are checked.
 
 use crate::check::{CheckStats, TetMesh, check};
 use crate::tets::{self, Corners, Split, SplitStats};
