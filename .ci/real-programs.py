@@ -138,8 +138,9 @@ def child_blender_import(path):
         mesh = obj.data
         if "halo" in extras:
             kind, names = "halo", ["_T", "_D", "_PATCH"]
-            # Every vertex a triangle uses is kept; the others may only be surface or
-            # inserted vertices (inside the halo, after the 2n offsets), which Blender drops.
+            # Every vertex a triangle uses is kept, in order; the others may only be surface
+            # or inserted vertices (inside the halo, after the 2n offsets, though the surface
+            # vertices of an open edge are on its side wall), which Blender drops.
             used = np.unique(accessor(g, blob, prim.indices))
             tets = accessor(g, blob, extras["halo"]["tetrahedra"])
             n = extras["halo"]["surface_vertices"]
@@ -153,26 +154,27 @@ def child_blender_import(path):
             collapsed[collapsed] = (positions[loose[collapsed]] == positions[loose[collapsed] - 2 * n]).all(axis=1)
             if (~collapsed).any():
                 problems.append(f"{m.name}: vertices on neither a triangle nor a tetrahedron, the first {loose[~collapsed][0]}")
-            keep = len(used)
+            kept = used
         elif "surface" in extras:
-            kind, names, keep = "surface", ["_W", "_U", "_V", "_PATCH"], len(positions)
+            kind, names, kept = "surface", ["_W", "_U", "_V", "_PATCH"], np.arange(len(positions))
         elif "curves" in extras:
-            kind, names, keep = "curves", ["_DW", "_CURVE", "_W"], len(positions)
+            kind, names, kept = "curves", ["_DW", "_CURVE", "_W"], np.arange(len(positions))
         else:
             problems.append(f"mesh {m.name}: neither surface, halo nor curves")
             continue
+        keep = len(kept)
         if len(mesh.vertices) != keep:
             problems.append(
                 f"{kind} {m.name}: Blender has {len(mesh.vertices)} vertices, expected {keep}"
             )
             continue
-        if not np.array_equal(blender_positions(mesh), positions[:keep]):
+        if not np.array_equal(blender_positions(mesh), positions[kept]):
             problems.append(f"{kind} {m.name}: Blender's positions differ from the file's")
         for name in names:
             values = mesh_attribute(mesh, name)
             if values is None:
                 problems.append(f"{kind} {m.name}: Blender has no float point attribute {name}")
-            elif not np.array_equal(values, accessor(g, blob, attrs.__dict__[name])[:keep]):
+            elif not np.array_equal(values, accessor(g, blob, attrs.__dict__[name])[kept]):
                 problems.append(f"{kind} {m.name}: {name} differs from the file's")
         if len(mesh.polygons) != len(accessor(g, blob, prim.indices)) // 3:
             problems.append(f"{kind} {m.name}: Blender has {len(mesh.polygons)} faces")
