@@ -259,9 +259,9 @@ pub struct HaloIndex<'a> {
 impl<'a> HaloIndex<'a> {
     /// Indexes the tetrahedra of `halos` (one per surface, `None` for none).
     pub fn new(halos: &'a [Option<HaloInput<'a>>]) -> Self {
+        let mut boxes = Vec::new();
         let mut tets = Vec::new();
         let mut over = Vec::new();
-        let mut boxes = Vec::new();
         for (s, halo) in halos.iter().enumerate() {
             let Some(h) = halo else { continue };
             let n = h.surface_vertices;
@@ -274,10 +274,6 @@ impl<'a> HaloIndex<'a> {
                     }
                 }
             }
-            for set in &mut sets {
-                set.sort_unstable();
-                set.dedup();
-            }
             for (i, tet) in h.tets.iter().enumerate() {
                 let p = tet.map(|v| h.positions[v as usize]);
                 boxes.push(broad::outward(
@@ -285,23 +281,21 @@ impl<'a> HaloIndex<'a> {
                     p[0].max(p[1]).max(p[2]).max(p[3]),
                 ));
                 tets.push((s as u32, i as u32));
-                let mut vs = [u32::MAX; 6];
-                let mut len = 0;
-                let mut add = |v: u32| {
-                    if !vs[..len].contains(&v) && len < vs.len() {
-                        vs[len] = v;
-                        len += 1;
-                    }
-                };
+                let mut vs: Vec<u32> = Vec::with_capacity(8);
                 for &k in tet {
                     if (k as usize) < 3 * n {
-                        add(k % n as u32);
+                        vs.push(k % n as u32);
                     } else {
-                        sets[k as usize - 3 * n].iter().for_each(|&v| add(v));
+                        vs.extend_from_slice(&sets[k as usize - 3 * n]);
                     }
                 }
-                vs[..len].sort_unstable();
-                over.push(vs);
+                vs.sort_unstable();
+                vs.dedup();
+                let mut padded = [u32::MAX; 6];
+                for (slot, v) in padded.iter_mut().zip(vs) {
+                    *slot = v;
+                }
+                over.push(padded);
             }
         }
         HaloIndex {
