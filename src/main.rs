@@ -232,14 +232,14 @@ fn main() -> ExitCode {
                         c.count, c.closed, c.open, c.points, c.triple_points, c.unresolved
                     );
                     eprintln!(
-                        "halo verification: {} curve samples: {} correct, {} wrong, {} ambiguous, {} third sheet; {} surface samples: {} hidden, {} spurious",
+                        "halo verification: {} curve samples: {} correct, {} wrong, {} ambiguous, {} third sheet; {} surface samples, {} far tetrahedra, {} spurious",
                         v.curve_samples,
                         v.correct,
                         v.wrong,
                         v.ambiguous,
                         v.third_sheet,
                         v.surface_samples,
-                        v.hidden_samples,
+                        v.far_tetrahedra,
                         v.spurious_hidden_samples
                     );
                     let t = report.timings_ms;
@@ -495,11 +495,11 @@ fn check_dir(dir: &Path) -> ExitCode {
         ("ambiguous", v.ambiguous),
         ("  branch_point", v.ambiguous_reasons.branch_point),
         ("  boundary", v.ambiguous_reasons.boundary),
-        ("  resolution", v.ambiguous_reasons.resolution),
         ("  vanished_halo", v.ambiguous_reasons.vanished_halo),
+        ("  resolution", v.ambiguous_reasons.resolution),
         ("third_sheet", v.third_sheet),
         ("surface_samples", v.surface_samples),
-        ("hidden_samples", v.hidden_samples),
+        ("far_tetrahedra", v.far_tetrahedra),
         ("spurious_hidden_samples", v.spurious_hidden_samples),
     ];
     let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);

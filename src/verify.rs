@@ -33,8 +33,10 @@
 
 use crate::intersect::broad;
 use crate::intersect::sos::orient3d;
-use crate::intersect::{Curves, Face, Sheet};
+use crate::intersect::{Curves, End, Face, Sheet};
 use glam::DVec3;
+use obvhs::aabb::Aabb;
+use rayon::prelude::*;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -65,11 +67,12 @@ pub struct Verification {
     pub curve_samples: usize,
     /// Far sheet hidden by the near sheet's halo, near sheet not hidden.
     pub correct: usize,
-    /// Far sheet not hidden by the near sheet's halo, or near sheet hidden by the far's.
+    /// Far sheet not hidden by the near sheet's halo, or near sheet hidden by the far's,
+    /// where nothing below excuses it.
     pub wrong: usize,
-    /// The sheets' w differ by no more than the mesh resolves there, the sample is at a
-    /// branch point or on the nearer sheet's boundary, or the nearer sheet's halo vanishes
-    /// there.
+    /// Samples the halos do not explain, within [`BRANCH_REACH`] halo widths of a curve's
+    /// end at a branch point or a boundary, where the nearer sheet's halo vanished, or
+    /// where the mesh does not separate the two sheets.
     pub ambiguous: usize,
     /// The ambiguous samples by reason.
     pub ambiguous_reasons: Ambiguous,
@@ -77,9 +80,10 @@ pub struct Verification {
     pub third_sheet: usize,
     /// Samples away from the curves: surface vertices and triangle centroids.
     pub surface_samples: usize,
-    /// Of those, hidden within rho of the sheet whose halo hides them.
-    pub hidden_samples: usize,
-    /// Of those, hidden where no sheet is within rho.
+    /// Halo tetrahedra reaching farther than rho from the surface points they were built
+    /// over; only these can hide a surface sample spuriously, and only these are searched.
+    pub far_tetrahedra: usize,
+    /// Surface samples hidden by such a tetrahedron where no sheet is within rho.
     pub spurious_hidden_samples: usize,
     /// Where the first wrong curve samples are (up to 8 distinct points: events that
     /// symbolic perturbation tells apart can share one point, as where the flat torus's
@@ -91,55 +95,124 @@ pub struct Verification {
     pub ms: f64,
 }
 
-/// Why curve samples are ambiguous, one reason per sample (the first that applies, in the
-/// order of the fields).
+/// Why curve samples the halos do not explain are ambiguous, one reason per sample (the
+/// first that applies, in the order of the fields).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Ambiguous {
-    /// The two triangles are within two rings of each other on one surface: a branch point
-    /// (a cross-cap), where the halo must vanish.
+    /// Within [`BRANCH_REACH`] halo widths of a curve's end at a branch point (a cross-cap),
+    /// where the two sheets are one surface folded over and the halo must vanish.
     pub branch_point: usize,
-    /// The nearer sheet's triangle is on its mesh's boundary, where its halo ends in a wall.
+    /// Within [`BRANCH_REACH`] halo widths of a curve's end at a mesh boundary, where the
+    /// nearer sheet's halo ends in a side wall.
     pub boundary: usize,
-    /// The sheets' w differ by no more than w varies across their triangles.
-    pub resolution: usize,
-    /// The halos do not explain the sample, and the nearer sheet's halo has zero width at a
-    /// corner of its triangle (collapsed where the projection is singular or folds tighter
-    /// than any halo fits).
+    /// The nearer sheet's halo has zero width at a corner of its triangle (collapsed where
+    /// the projection is singular or folds tighter than any halo fits).
     pub vanished_halo: usize,
+    /// The mesh does not separate the sheets there: their triangles are within two rings of
+    /// each other on one surface, or their w differ by no more than w varies across the
+    /// triangles. Only coarse meshes leave such samples; refining removes them.
+    pub resolution: usize,
 }
 
-impl Ambiguous {
-    fn add(&mut self, other: &Ambiguous) {
-        self.branch_point += other.branch_point;
-        self.boundary += other.boundary;
-        self.resolution += other.resolution;
-        self.vanished_halo += other.vanished_halo;
+/// How far from a branch point or a boundary end, in widths of the nearer sheet's halo
+/// (its largest half-width rho), a sample the halos do not explain is ambiguous rather
+/// than wrong. At a branch point the two sheets are one surface folded over; `fold:
+/// shrink` narrows the halo to zero there, and a sheet's own halo never hides it, so up
+/// to rho from the fold on either sheet (2 rho in all) the gap is the fold's, not the
+/// crossing's. On every fixture the farthest such sample is 1.27 rho away, and on fine
+/// meshes they all come within a few triangles.
+pub const BRANCH_REACH: f64 = 2.0;
+
+impl Verification {
+    /// Adds `other`'s counts, and its examples after this one's.
+    fn add(mut self, other: Verification) -> Verification {
+        self.curve_samples += other.curve_samples;
+        self.correct += other.correct;
+        self.wrong += other.wrong;
+        self.ambiguous += other.ambiguous;
+        let (a, b) = (&mut self.ambiguous_reasons, &other.ambiguous_reasons);
+        a.branch_point += b.branch_point;
+        a.boundary += b.boundary;
+        a.vanished_halo += b.vanished_halo;
+        a.resolution += b.resolution;
+        self.third_sheet += other.third_sheet;
+        self.surface_samples += other.surface_samples;
+        self.spurious_hidden_samples += other.spurious_hidden_samples;
+        for (to, from) in [
+            (&mut self.wrong_at, other.wrong_at),
+            (&mut self.spurious_at, other.spurious_at),
+        ] {
+            for x in from {
+                example(to, x);
+            }
+        }
+        self
     }
 }
 
 /// Verifies `halos` (one per sheet, `None` for a sheet without one) against `curves`.
+///
+/// Linear in the input: the curve samples are tested against the tetrahedra of the prisms
+/// whose boxes hold a curve sample, found by one pass over the triangles; the surface
+/// samples only against the tetrahedra that reach farther than rho from their sheet
+/// (none, in a sound halo), because a tetrahedron whose corners are all within rho of the
+/// surface points it is built over lies within rho of them everywhere (the distance to a
+/// convex set is convex).
 pub fn verify(sheets: &[Sheet], halos: &[Option<HaloInput>], curves: &Curves) -> Verification {
     let start = Instant::now();
-    let index = Index::new(sheets, halos);
     let scale = sheets
         .iter()
         .flat_map(|s| s.positions.iter())
         .fold(0.0f64, |m, p| m.max(p.abs().max_element()));
     let tolerance = 1e-6 * scale.max(f64::MIN_POSITIVE);
+    let samples = curve_samples(curves);
+    let points: Vec<DVec3> = samples.iter().map(|s| s.x).collect();
+    let index = Index::new(sheets, halos, curves, &points);
+    let mut out = samples
+        .par_iter()
+        .fold(Verification::default, |mut v, s| {
+            index.classify_curve_sample(s, &mut v);
+            v
+        })
+        .reduce(Verification::default, Verification::add);
 
-    let mut curve_samples: Vec<CurveSample> = Vec::new();
+    let far = far_tetrahedra(sheets, halos, tolerance);
+    out.far_tetrahedra = far.iter().map(Vec::len).sum();
+    out.surface_samples = sheets
+        .iter()
+        .map(|s| s.triangles.len() + used_vertices(s).count())
+        .sum();
+    if out.far_tetrahedra > 0 {
+        let far_index = HaloIndex::with(halos, |s, i| far[s].binary_search(&i).is_ok());
+        let surface = surface_samples(sheets)
+            .par_iter()
+            .fold(Verification::default, |mut v, &(x, w, face)| {
+                index.classify_surface_sample(&far_index, x, w, face, tolerance, &mut v);
+                v
+            })
+            .reduce(Verification::default, Verification::add);
+        out.spurious_hidden_samples = surface.spurious_hidden_samples;
+        out.spurious_at = surface.spurious_at;
+    }
+    out.ms = start.elapsed().as_secs_f64() * 1e3;
+    out
+}
+
+/// Each curve's events and the midpoints of its segments.
+fn curve_samples(curves: &Curves) -> Vec<CurveSample> {
+    let mut out = Vec::new();
     for c in &curves.curves {
         let n = c.points.len();
         let segments = if c.closed { n } else { n.saturating_sub(1) };
         for (k, p) in c.points.iter().enumerate() {
-            curve_samples.push(CurveSample {
+            out.push(CurveSample {
                 x: p.position,
                 w: p.w,
                 faces: p.faces,
             });
             if k < segments {
                 let q = &c.points[(k + 1) % n];
-                curve_samples.push(CurveSample {
+                out.push(CurveSample {
                     x: (p.position + q.position) * 0.5,
                     w: [(p.w[0] + q.w[0]) * 0.5, (p.w[1] + q.w[1]) * 0.5],
                     faces: p.faces,
@@ -147,81 +220,111 @@ pub fn verify(sheets: &[Sheet], halos: &[Option<HaloInput>], curves: &Curves) ->
             }
         }
     }
-    let mut surface_samples: Vec<(DVec3, f64, Face)> = Vec::new();
-    for (s, sheet) in sheets.iter().enumerate() {
-        for (t, tri) in sheet.triangles.iter().enumerate() {
-            let face = Face {
-                surface: s as u32,
-                triangle: t as u32,
-            };
-            let p = tri.map(|v| sheet.positions[v as usize]);
-            let w = tri.map(|v| sheet.w[v as usize]);
-            surface_samples.push(((p[0] + p[1] + p[2]) / 3.0, (w[0] + w[1] + w[2]) / 3.0, face));
-        }
-        // Each vertex once, with the first triangle that has it.
-        let mut seen = vec![false; sheet.positions.len()];
-        for (t, tri) in sheet.triangles.iter().enumerate() {
-            for &v in tri {
-                if !std::mem::replace(&mut seen[v as usize], true) {
-                    let face = Face {
-                        surface: s as u32,
-                        triangle: t as u32,
-                    };
-                    surface_samples.push((sheet.positions[v as usize], sheet.w[v as usize], face));
-                }
-            }
-        }
-    }
-
-    let mut out = parallel(&curve_samples, |chunk| {
-        let mut v = Verification::default();
-        for s in chunk {
-            index.classify_curve_sample(s, &mut v);
-        }
-        v
-    });
-    let surface = parallel(&surface_samples, |chunk| {
-        let mut v = Verification::default();
-        for &(x, w, face) in chunk {
-            index.classify_surface_sample(x, w, face, tolerance, &mut v);
-        }
-        v
-    });
-    out.surface_samples = surface.surface_samples;
-    out.hidden_samples = surface.hidden_samples;
-    out.spurious_hidden_samples = surface.spurious_hidden_samples;
-    out.spurious_at = surface.spurious_at;
-    out.ms = start.elapsed().as_secs_f64() * 1e3;
     out
 }
 
-/// Runs `f` on two halves of `items` on two threads and adds up the counts.
-fn parallel<T: Sync>(items: &[T], f: impl Fn(&[T]) -> Verification + Sync) -> Verification {
-    let mid = items.len() / 2;
-    let (a, b) = std::thread::scope(|scope| {
-        let first = scope.spawn(|| f(&items[..mid]));
-        let second = f(&items[mid..]);
-        (first.join().expect("verification thread"), second)
-    });
-    let mut v = a;
-    v.curve_samples += b.curve_samples;
-    v.correct += b.correct;
-    v.wrong += b.wrong;
-    v.ambiguous += b.ambiguous;
-    v.ambiguous_reasons.add(&b.ambiguous_reasons);
-    v.third_sheet += b.third_sheet;
-    v.surface_samples += b.surface_samples;
-    v.hidden_samples += b.hidden_samples;
-    v.spurious_hidden_samples += b.spurious_hidden_samples;
-    for (to, from) in [
-        (&mut v.wrong_at, b.wrong_at),
-        (&mut v.spurious_at, b.spurious_at),
-    ] {
-        for x in from {
-            example(to, x);
+/// The vertices some triangle of `sheet` uses, each once, with the first triangle that
+/// has it.
+fn used_vertices<'a>(sheet: &'a Sheet) -> impl Iterator<Item = (u32, u32)> + 'a {
+    let mut seen = vec![false; sheet.positions.len()];
+    sheet
+        .triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(t, tri)| tri.map(|v| (v, t as u32)))
+        .filter(move |&(v, _)| !std::mem::replace(&mut seen[v as usize], true))
+}
+
+/// Every triangle centroid and used vertex of every sheet, with its depth and triangle.
+fn surface_samples(sheets: &[Sheet]) -> Vec<(DVec3, f64, Face)> {
+    let mut out = Vec::new();
+    for (s, sheet) in sheets.iter().enumerate() {
+        let face = |t: u32| Face {
+            surface: s as u32,
+            triangle: t,
+        };
+        for (t, tri) in sheet.triangles.iter().enumerate() {
+            let p = tri.map(|v| sheet.positions[v as usize]);
+            let w = tri.map(|v| sheet.w[v as usize]);
+            let centroid = (p[0] + p[1] + p[2]) / 3.0;
+            out.push((centroid, (w[0] + w[1] + w[2]) / 3.0, face(t as u32)));
+        }
+        for (v, t) in used_vertices(sheet) {
+            out.push((sheet.positions[v as usize], sheet.w[v as usize], face(t)));
         }
     }
-    v
+    out
+}
+
+/// Per surface, the tetrahedra (sorted) with a corner farther from the surface points it
+/// stands for than the largest half-width rho among them, plus `tolerance`. An offset
+/// vertex stands for its own surface point, an inserted vertex for the surface points of
+/// the tetrahedra around it (measured to their hull). Every point of any other
+/// tetrahedron is within its rho of the hull of the surface points it is built over.
+fn far_tetrahedra(sheets: &[Sheet], halos: &[Option<HaloInput>], tolerance: f64) -> Vec<Vec<u32>> {
+    sheets
+        .iter()
+        .zip(halos)
+        .map(|(sheet, halo)| {
+            let Some(h) = halo else { return Vec::new() };
+            let n = h.surface_vertices;
+            let half_width = |v: usize| (h.positions[v + n] - h.positions[v]).length() * 0.5;
+            let inserted = inserted_sets(h);
+            // Per halo vertex: (distance to what it stands for, largest rho there).
+            let reach: Vec<(f64, f64)> = (0..h.positions.len())
+                .into_par_iter()
+                .map(|k| {
+                    if k < 3 * n {
+                        let v = k % n;
+                        (
+                            (h.positions[k] - sheet.positions[v]).length(),
+                            half_width(v),
+                        )
+                    } else {
+                        let set = &inserted[k - 3 * n];
+                        let points: Vec<DVec3> =
+                            set.iter().map(|&v| sheet.positions[v as usize]).collect();
+                        let rho = set
+                            .iter()
+                            .map(|&v| half_width(v as usize))
+                            .fold(0.0, f64::max);
+                        (distance_to_hull(h.positions[k], &points), rho)
+                    }
+                })
+                .collect();
+            h.tets
+                .par_iter()
+                .enumerate()
+                .filter(|(_, tet)| {
+                    let (d, rho) = tet.iter().fold((0.0f64, 0.0f64), |(d, rho), &k| {
+                        let r = reach[k as usize];
+                        (d.max(r.0), rho.max(r.1))
+                    });
+                    d > rho + tolerance
+                })
+                .map(|(i, _)| i as u32)
+                .collect()
+        })
+        .collect()
+}
+
+/// The surface vertices (mod n, sorted, distinct) of the tetrahedra around each inserted
+/// vertex of `h`.
+fn inserted_sets(h: &HaloInput) -> Vec<Vec<u32>> {
+    let n = h.surface_vertices;
+    let mut sets: Vec<Vec<u32>> = vec![Vec::new(); h.positions.len().saturating_sub(3 * n)];
+    for tet in h.tets {
+        for &k in tet.iter().filter(|&&k| k as usize >= 3 * n) {
+            for &v in tet.iter().filter(|&&v| (v as usize) < 3 * n) {
+                sets[k as usize - 3 * n].push(v % n as u32);
+            }
+        }
+    }
+    for set in &mut sets {
+        set.sort_unstable();
+        set.dedup();
+    }
+    sets
 }
 
 const EXAMPLES: usize = 8;
@@ -259,43 +362,52 @@ pub struct HaloIndex<'a> {
 impl<'a> HaloIndex<'a> {
     /// Indexes the tetrahedra of `halos` (one per surface, `None` for none).
     pub fn new(halos: &'a [Option<HaloInput<'a>>]) -> Self {
+        Self::with(halos, |_, _| true)
+    }
+
+    /// Indexes the tetrahedra `i` of each surface `s` with `keep(s, i)`.
+    pub(crate) fn with(
+        halos: &'a [Option<HaloInput<'a>>],
+        keep: impl Fn(usize, u32) -> bool + Sync,
+    ) -> Self {
         let mut boxes = Vec::new();
         let mut tets = Vec::new();
         let mut over = Vec::new();
         for (s, halo) in halos.iter().enumerate() {
             let Some(h) = halo else { continue };
-            let n = h.surface_vertices;
-            // The surface vertices around each inserted vertex.
-            let mut sets: Vec<Vec<u32>> = vec![Vec::new(); h.positions.len().saturating_sub(3 * n)];
-            for tet in h.tets {
-                for &k in tet.iter().filter(|&&k| k as usize >= 3 * n) {
-                    for &v in tet.iter().filter(|&&v| (v as usize) < 3 * n) {
-                        sets[k as usize - 3 * n].push(v % n as u32);
+            let n = h.surface_vertices as u32;
+            let inserted = inserted_sets(h);
+            let kept: Vec<(u32, Aabb, [u32; 6])> = (0..h.tets.len() as u32)
+                .into_par_iter()
+                .filter(|&i| keep(s, i))
+                .map(|i| {
+                    let tet = h.tets[i as usize];
+                    let p = tet.map(|v| h.positions[v as usize]);
+                    let aabb = broad::outward(
+                        p[0].min(p[1]).min(p[2]).min(p[3]),
+                        p[0].max(p[1]).max(p[2]).max(p[3]),
+                    );
+                    let mut vs: Vec<u32> = Vec::with_capacity(8);
+                    for &k in &tet {
+                        if k < 3 * n {
+                            vs.push(k % n);
+                        } else {
+                            vs.extend_from_slice(&inserted[(k - 3 * n) as usize]);
+                        }
                     }
-                }
-            }
-            for (i, tet) in h.tets.iter().enumerate() {
-                let p = tet.map(|v| h.positions[v as usize]);
-                boxes.push(broad::outward(
-                    p[0].min(p[1]).min(p[2]).min(p[3]),
-                    p[0].max(p[1]).max(p[2]).max(p[3]),
-                ));
-                tets.push((s as u32, i as u32));
-                let mut vs: Vec<u32> = Vec::with_capacity(8);
-                for &k in tet {
-                    if (k as usize) < 3 * n {
-                        vs.push(k % n as u32);
-                    } else {
-                        vs.extend_from_slice(&sets[k as usize - 3 * n]);
+                    vs.sort_unstable();
+                    vs.dedup();
+                    let mut padded = [u32::MAX; 6];
+                    for (slot, v) in padded.iter_mut().zip(vs) {
+                        *slot = v;
                     }
-                }
-                vs.sort_unstable();
-                vs.dedup();
-                let mut padded = [u32::MAX; 6];
-                for (slot, v) in padded.iter_mut().zip(vs) {
-                    *slot = v;
-                }
-                over.push(padded);
+                    (i, aabb, padded)
+                })
+                .collect();
+            for (i, aabb, vs) in kept {
+                boxes.push(aabb);
+                tets.push((s as u32, i));
+                over.push(vs);
             }
         }
         HaloIndex {
@@ -420,40 +532,74 @@ impl<'a> HaloIndex<'a> {
 /// What the classification needs of each surface, with the halos' index.
 struct Index<'a> {
     sheets: &'a [Sheet<'a>],
+    /// The tetrahedra whose boxes hold a curve sample.
     halos: HaloIndex<'a>,
     /// Per surface: the triangles around each vertex (CSR).
     vertex_tris: Vec<(Vec<u32>, Vec<u32>)>,
-    /// Per surface: whether each triangle has an edge on the mesh boundary.
-    at_boundary: Vec<Vec<bool>>,
+    /// Per surface: its halo's largest half-width rho (0 without a halo).
+    rho: Vec<f64>,
+    /// Where curves end at a branch point.
+    branch_points: Vec<DVec3>,
+    /// Where curves end at a mesh boundary.
+    boundary_ends: Vec<DVec3>,
 }
 
 impl<'a> Index<'a> {
-    fn new(sheets: &'a [Sheet<'a>], halos: &'a [Option<HaloInput<'a>>]) -> Self {
-        let vertex_tris: Vec<_> = sheets.iter().map(vertex_triangles).collect();
-        let at_boundary = sheets
-            .iter()
-            .zip(&vertex_tris)
-            .map(|(s, (starts, tris))| {
-                s.triangles
+    /// The index for the curve samples at `points`.
+    fn new(
+        sheets: &'a [Sheet<'a>],
+        halos: &'a [Option<HaloInput<'a>>],
+        curves: &Curves,
+        points: &[DVec3],
+    ) -> Self {
+        let boxes: Vec<Aabb> = points.iter().map(|&x| broad::outward(x, x)).collect();
+        let samples = broad::build(&boxes, 4);
+        // Whether the box of tetrahedron i of surface s holds a curve sample.
+        let near_curve = |s: usize, i: u32| {
+            let h = halos[s].as_ref().expect("a tetrahedron of a halo");
+            let p = h.tets[i as usize].map(|v| h.positions[v as usize]);
+            let aabb = broad::outward(
+                p[0].min(p[1]).min(p[2]).min(p[3]),
+                p[0].max(p[1]).max(p[2]).max(p[3]),
+            );
+            let mut found = false;
+            samples.aabb_traverse(aabb, |bvh, node| {
+                let node = &bvh.nodes[node as usize];
+                let first = node.first_index as usize;
+                found = bvh.primitive_indices[first..first + node.prim_count as usize]
                     .iter()
-                    .map(|t| {
-                        (0..3).any(|k| {
-                            let (a, b) = (t[k], t[(k + 1) % 3]);
-                            tris[starts[a as usize] as usize..starts[a as usize + 1] as usize]
-                                .iter()
-                                .filter(|&&o| s.triangles[o as usize].contains(&b))
-                                .count()
-                                == 1
-                        })
-                    })
-                    .collect()
+                    .any(|&k| aabb.contains_point(boxes[k as usize].min));
+                !found
+            });
+            found
+        };
+        let rho = halos
+            .iter()
+            .map(|h| {
+                h.as_ref().map_or(0.0, |h| {
+                    let n = h.surface_vertices;
+                    (0..n)
+                        .into_par_iter()
+                        .map(|v| (h.positions[v + n] - h.positions[v]).length() * 0.5)
+                        .reduce(|| 0.0, f64::max)
+                })
             })
             .collect();
+        let ends = |kind: End| {
+            curves
+                .curves
+                .iter()
+                .flat_map(|c| [(c.ends[0], c.points.first()), (c.ends[1], c.points.last())])
+                .filter_map(|(end, p)| p.filter(|_| end == kind).map(|p| p.position))
+                .collect()
+        };
         Index {
             sheets,
-            halos: HaloIndex::new(halos),
-            vertex_tris,
-            at_boundary,
+            halos: HaloIndex::with(halos, near_curve),
+            vertex_tris: sheets.iter().map(vertex_triangles).collect(),
+            rho,
+            branch_points: ends(End::BranchPoint),
+            boundary_ends: ends(End::Boundary),
         }
     }
 
@@ -484,34 +630,15 @@ impl<'a> Index<'a> {
         })
     }
 
+    /// Classifies a curve sample: by the halos first, then, where they do not explain it,
+    /// by the first reason that excuses it ([`Ambiguous`]), else `wrong`.
     fn classify_curve_sample(&self, s: &CurveSample, v: &mut Verification) {
         v.curve_samples += 1;
         let near = usize::from(s.w[1] < s.w[0]);
         let far = 1 - near;
         let (fn_, ff) = (s.faces[near], s.faces[far]);
         let (ring_near, ring_far) = (self.vertices(fn_), self.vertices(ff));
-        let spread = |f: Face| {
-            let sheet = &self.sheets[f.surface as usize];
-            let w = sheet.triangles[f.triangle as usize].map(|k| sheet.w[k as usize]);
-            w[0].max(w[1]).max(w[2]) - w[0].min(w[1]).min(w[2])
-        };
-        let dw = s.w[far] - s.w[near];
         let halos = &self.halos;
-        let reason = &mut v.ambiguous_reasons;
-        let counter = if self.close(fn_, ff) {
-            Some(&mut reason.branch_point)
-        } else if self.at_boundary[fn_.surface as usize][fn_.triangle as usize] {
-            Some(&mut reason.boundary)
-        } else if dw <= spread(fn_).max(spread(ff)) {
-            Some(&mut reason.resolution)
-        } else {
-            None
-        };
-        if let Some(counter) = counter {
-            *counter += 1;
-            v.ambiguous += 1;
-            return;
-        }
         let far_hidden = halos
             .hiders(s.x, s.w[far], (ff.surface, &ring_far))
             .into_iter()
@@ -520,54 +647,66 @@ impl<'a> Index<'a> {
         let by_far = near_hiders
             .iter()
             .any(|h| halos.within(h.0, ff.surface, &ring_far));
-        if (!far_hidden || by_far) && halos.vanishes(fn_.surface, &ring_near) {
-            v.ambiguous_reasons.vanished_halo += 1;
-            v.ambiguous += 1;
-        } else if !far_hidden || by_far {
+        if far_hidden && !by_far {
+            if near_hiders.is_empty() {
+                v.correct += 1;
+            } else {
+                v.third_sheet += 1;
+            }
+            return;
+        }
+        let reach = BRANCH_REACH * self.rho[fn_.surface as usize];
+        let within = |ends: &[DVec3]| ends.iter().any(|e| e.distance(s.x) <= reach);
+        let spread = |f: Face| {
+            let sheet = &self.sheets[f.surface as usize];
+            let w = sheet.triangles[f.triangle as usize].map(|k| sheet.w[k as usize]);
+            w[0].max(w[1]).max(w[2]) - w[0].min(w[1]).min(w[2])
+        };
+        let reasons = &mut v.ambiguous_reasons;
+        let reason = if within(&self.branch_points) {
+            &mut reasons.branch_point
+        } else if within(&self.boundary_ends) {
+            &mut reasons.boundary
+        } else if halos.vanishes(fn_.surface, &ring_near) {
+            &mut reasons.vanished_halo
+        } else if self.close(fn_, ff) || s.w[far] - s.w[near] <= spread(fn_).max(spread(ff)) {
+            &mut reasons.resolution
+        } else {
             v.wrong += 1;
             example(&mut v.wrong_at, s.x.to_array());
-        } else if !near_hiders.is_empty() {
-            v.third_sheet += 1;
-        } else {
-            v.correct += 1;
-        }
+            return;
+        };
+        *reason += 1;
+        v.ambiguous += 1;
     }
 
+    /// Classifies a surface sample against `far`, the tetrahedra that reach farther than
+    /// rho from their sheet: spurious where one of them hides it and no sheet is near.
     fn classify_surface_sample(
         &self,
+        far: &HaloIndex,
         x: DVec3,
         w: f64,
         face: Face,
         tolerance: f64,
         v: &mut Verification,
     ) {
-        v.surface_samples += 1;
         let ring = self.vertices(face);
-        let halos = &self.halos;
-        let hiders = halos.hiders(x, w, (face.surface, &ring));
-        if hiders.is_empty() {
-            return;
-        }
-        let near_its_sheet = hiders.iter().all(|h| {
-            let surface = halos.tets[h.0 as usize].0 as usize;
+        let spurious = far.hiders(x, w, (face.surface, &ring)).iter().any(|h| {
+            let surface = far.tets[h.0 as usize].0 as usize;
             let sheet = &self.sheets[surface];
-            let halo = halos.halos[surface].as_ref().expect("tet of a halo");
+            let halo = far.halos[surface].as_ref().expect("tet of a halo");
             let n = halo.surface_vertices;
-            let rho = halos
+            let rho = far
                 .over(h.0)
                 .map(|k| {
                     (halo.positions[k as usize + n] - halo.positions[k as usize]).length() * 0.5
                 })
                 .fold(0.0, f64::max);
-            let points: Vec<DVec3> = halos
-                .over(h.0)
-                .map(|k| sheet.positions[k as usize])
-                .collect();
-            distance_to_hull(x, &points) <= rho + tolerance
+            let points: Vec<DVec3> = far.over(h.0).map(|k| sheet.positions[k as usize]).collect();
+            distance_to_hull(x, &points) > rho + tolerance
         });
-        if near_its_sheet {
-            v.hidden_samples += 1;
-        } else {
+        if spurious {
             v.spurious_hidden_samples += 1;
             example(&mut v.spurious_at, x.to_array());
         }
@@ -640,4 +779,95 @@ fn triangle_distance(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
         .iter()
         .all(|&(p, q)| (q - p).cross(foot - p).dot(n) >= 0.0);
     if inside { (x - foot).length() } else { edges }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sample::Sampling;
+    use crate::scene::Scene;
+    use std::collections::HashSet;
+
+    /// The flat torus fixture on a 48 x 48 grid: its sheets, halos and curves.
+    fn flat_torus() -> (crate::Built, Scene) {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/fixtures/scenes/flat-torus.json"
+        );
+        let mut scene = Scene::load(std::path::Path::new(path)).unwrap();
+        scene.sampling = Sampling::Uniform { u: 48, v: 48 };
+        (crate::run(&scene, true).unwrap(), scene)
+    }
+
+    #[test]
+    fn the_tetrahedra_near_the_curves_hold_every_curve_sample() {
+        // Brute force: every tetrahedron of every halo that contains a curve sample (exact
+        // orient3d, boundary included) is among those the curve samples are tested against.
+        let (built, scene) = flat_torus();
+        let sheets = built.sheets();
+        let halos = crate::pipeline::halo_inputs(&built.surfaces, &scene.halo);
+        let points: Vec<DVec3> = curve_samples(&built.curves).iter().map(|s| s.x).collect();
+        let index = Index::new(&sheets, &halos, &built.curves, &points);
+        let kept: HashSet<(u32, u32)> = index.halos.tets.iter().copied().collect();
+        let all = HaloIndex::new(&halos);
+        assert!(
+            kept.len() * 10 < all.len(),
+            "{} of {}",
+            kept.len(),
+            all.len()
+        );
+        let mut containing = 0;
+        for &x in &points {
+            for g in 0..all.len() as u32 {
+                if all.depth_at(g, x).is_some() {
+                    containing += 1;
+                    assert!(kept.contains(&all.tets[g as usize]), "{x} in {g}");
+                }
+            }
+        }
+        assert!(containing > points.len(), "{containing}");
+    }
+
+    #[test]
+    fn searching_only_the_far_tetrahedra_finds_every_spurious_sample() {
+        // A sound halo has no far tetrahedron; moved off its surface, every spurious sample
+        // that a search over all tetrahedra finds, the search over the far ones finds too.
+        let (mut built, scene) = flat_torus();
+        let scale = 1.0; // the flat torus's largest coordinate
+        let sheets = built.sheets();
+        let halos = crate::pipeline::halo_inputs(&built.surfaces, &scene.halo);
+        assert!(far_tetrahedra(&sheets, &halos, 1e-6 * scale)[0].is_empty());
+        drop(halos);
+        let n = built.surfaces[0].mesh.positions.len();
+        let halo = &mut built.surfaces[0].halo;
+        for (k, p) in halo.positions.iter_mut().enumerate() {
+            // The halo over a quarter of the surface moved 0.1 along z, and all of it made
+            // shallow in w.
+            if k % n < n / 4 {
+                p.z += 0.1;
+            }
+        }
+        for d in &mut halo.d_orig {
+            *d -= 10.0;
+        }
+        let sheets = built.sheets();
+        let halos = crate::pipeline::halo_inputs(&built.surfaces, &scene.halo);
+        let far = far_tetrahedra(&sheets, &halos, 1e-6 * scale);
+        assert!(!far[0].is_empty() && far[0].len() < halos[0].unwrap().tets.len());
+        let points: Vec<DVec3> = Vec::new();
+        let index = Index::new(&sheets, &halos, &built.curves, &points);
+        let count = |search: &HaloIndex| {
+            let mut v = Verification::default();
+            for (x, w, face) in surface_samples(&sheets) {
+                index.classify_surface_sample(search, x, w, face, 1e-6 * scale, &mut v);
+            }
+            v.spurious_hidden_samples
+        };
+        let all = count(&HaloIndex::new(&halos));
+        let fast = count(&HaloIndex::with(&halos, |s, i| {
+            far[s].binary_search(&i).is_ok()
+        }));
+        assert!(all > 0);
+        assert_eq!(fast, all);
+    }
 }
