@@ -30,6 +30,7 @@
 //!   t = 1/2;
 //! - the tetrahedra's volumes add up to the volume the boundary encloses (`volume_defect`).
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// Layers of prisms in the halo layout (see the module documentation), written into every
@@ -216,6 +217,10 @@ struct Partial {
     faces: Vec<([u32; 3], u32)>,
 }
 
+/// Tetrahedra per parallel task of the checker: a fixed number, so that the volume (summed
+/// task after task) comes out the same on any number of threads.
+const CHECK_RUN: usize = 1 << 14;
+
 /// How far below the largest coordinate (as a factor) a coordinate may be for
 /// `robust::orient3d` to stay exact: its determinants multiply three coordinate differences,
 /// and with every coordinate scaled into [2^-266, 1) those stay above f64's smallest normal
@@ -299,7 +304,7 @@ fn examine(tets: &[[u32; 4]], positions: &[[f64; 3]], tiny: &[bool]) -> Partial 
 fn bucket_sort<T: Ord + Copy + Default + Send>(
     items: Vec<T>,
     vertices: usize,
-    first: impl Fn(&T) -> u32,
+    first: impl Fn(&T) -> u32 + Sync,
 ) -> Vec<T> {
     let mut starts = vec![0usize; vertices + 1];
     for item in &items {
@@ -315,35 +320,10 @@ fn bucket_sort<T: Ord + Copy + Default + Send>(
         out[*slot] = item;
         *slot += 1;
     }
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |t| t.get())
-        .min(8);
-    let share = out.len().div_ceil(threads).max(1);
-    std::thread::scope(|scope| {
-        let mut rest: &mut [T] = &mut out;
-        let mut offset = 0;
-        let mut bucket = 0;
-        while !rest.is_empty() {
-            // Cut at the first bucket boundary past an even share.
-            while bucket < vertices && starts[bucket] < offset + share {
-                bucket += 1;
-            }
-            let end = starts[bucket].max(offset + 1).min(offset + rest.len());
-            let (part, tail) = std::mem::take(&mut rest).split_at_mut(end - offset);
-            let bounds: Vec<usize> = starts
-                .iter()
-                .map(|&x| x.clamp(offset, end) - offset)
-                .collect();
-            scope.spawn(move || {
-                for w in bounds.windows(2) {
-                    if w[1] > w[0] + 1 {
-                        part[w[0]..w[1]].sort_unstable();
-                    }
-                }
-            });
-            (rest, offset) = (tail, end);
-        }
-    });
+    // Every bucket (a run of one first vertex) sorted on its own, the buckets shared
+    // among the cores.
+    out.par_chunk_by_mut(|a, b| first(a) == first(b))
+        .for_each(|bucket| bucket.sort_unstable());
     out
 }
 
@@ -387,20 +367,12 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     let tets: Vec<[u32; 4]> = mesh.tets.iter().map(|t| t.map(canon)).collect();
     let (scaled, volume_scale, tiny) = scaled(positions);
     let (positions, tiny) = (&scaled, &tiny);
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |t| t.get())
-        .min(8);
-    let chunk = tets.len().div_ceil(threads).max(1);
-    let partials: Vec<Partial> = std::thread::scope(|scope| {
-        let handles: Vec<_> = tets
-            .chunks(chunk)
-            .map(|part| scope.spawn(move || examine(part, positions, tiny)))
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().expect("checker thread"))
-            .collect()
-    });
+    // Runs of CHECK_RUN tetrahedra on the cores, summed in order: the volume's rounding
+    // depends on the runs only, not on the number of threads.
+    let partials: Vec<Partial> = tets
+        .par_chunks(CHECK_RUN)
+        .map(|part| examine(part, positions, tiny))
+        .collect();
     let mut s = CheckStats {
         vertices: nv,
         tets: mesh.tets.len(),

@@ -31,6 +31,7 @@ use crate::check::{CheckStats, TetMesh, check};
 use crate::tets::{self, Corners, Split, SplitStats};
 use crate::view::Projected;
 use glam::DVec3;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -256,6 +257,10 @@ fn reversed_in_star(star: &[(u32, u8)], triangles: &[[u32; 3]], scratch: &mut Sc
     }
 }
 
+/// Vertices per parallel task in [`frame`]: enough to make a task's bookkeeping
+/// negligible, few enough to share a mesh of some thousands of vertices among the cores.
+const FRAME_RUN: usize = 1024;
+
 /// A run of vertices' share of a [`Frame`]: directions, singular flags and, along their
 /// stars, which triangles are reversed.
 #[derive(Default)]
@@ -358,34 +363,21 @@ fn frame(p: &Projected, triangles: &[[u32; 3]], stars: &Stars) -> Frame {
         let dir = if wide_margin > margin { wide } else { normal };
         (dir, wide_margin.max(margin) <= 0.0)
     };
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |t| t.get())
-        .min(8);
-    let share = n.div_ceil(threads).max(1);
-    // Each thread's vertices, joined in vertex order.
-    let parts: Vec<FramePart> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..n)
-            .step_by(share)
-            .map(|first| {
-                let vertex = &vertex;
-                scope.spawn(move || {
-                    let mut scratch = Scratch::default();
-                    let mut part = FramePart::default();
-                    for v in first..(first + share).min(n) {
-                        let (dir, singular) = vertex(v, &mut scratch);
-                        part.dir.push(dir);
-                        part.singular.push(singular);
-                        part.reversed.extend_from_slice(&scratch.reversed);
-                    }
-                    part
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().expect("frame thread"))
-            .collect()
-    });
+    // Runs of FRAME_RUN vertices, each with its scratch buffers, joined in vertex order.
+    let parts: Vec<FramePart> = (0..n)
+        .into_par_iter()
+        .step_by(FRAME_RUN)
+        .map_init(Scratch::default, |scratch, first| {
+            let mut part = FramePart::default();
+            for v in first..(first + FRAME_RUN).min(n) {
+                let (dir, singular) = vertex(v, scratch);
+                part.dir.push(dir);
+                part.singular.push(singular);
+                part.reversed.extend_from_slice(&scratch.reversed);
+            }
+            part
+        })
+        .collect();
     let mut frame = Frame {
         dir: Vec::with_capacity(n),
         flip: vec![[false; 3]; triangles.len()],

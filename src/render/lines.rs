@@ -64,6 +64,7 @@
 //! pixel). Along a single line whose width changes slowly the band is exact.
 
 use glam::DVec2;
+use rayon::prelude::*;
 use rustfft::num_complex::Complex;
 use rustfft::{Fft, FftPlanner};
 use std::sync::Arc;
@@ -88,8 +89,9 @@ const PAD_SIGMAS: f64 = 3.0;
 /// Plans (lengths and sigmas) a [`Broadener`] keeps before forgetting the oldest.
 const KEPT_PLANS: usize = 8;
 
-/// Below this many samples in a pass, threads cost more than they save.
-const THREADED_SAMPLES: usize = 1 << 16;
+/// The fewest samples worth a parallel task of their own: below, handing the work to
+/// another thread costs more than it saves.
+const TASK_SAMPLES: usize = 1 << 16;
 
 /// Why a mask could not be made, drawn into or broadened. All are bad input.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -604,63 +606,64 @@ impl Plan {
 }
 
 /// Blurs in place each line (`len` samples) of `p` and of `q`, line i of `q` travelling with
-/// line i of `p` as the imaginary part of one transform; `q` may hold one line fewer.
+/// line i of `p` as the imaginary part of one transform; `q` may hold one line fewer. Runs
+/// of lines on the cores, each thread with its own FFT buffers.
 fn blur_lines(p: &mut [f32], q: &mut [f32], len: usize, plan: &Plan) {
-    let lines = p.len() / len;
-    let threads = threads_for(p.len() + q.len());
-    let share = lines.div_ceil(threads).max(1) * len;
-    if threads == 1 {
-        blur_chunk(p, q, len, plan);
-        return;
-    }
-    std::thread::scope(|scope| {
-        let (mut p, mut q) = (p, q);
-        while !p.is_empty() {
-            let (p_part, p_rest) = p.split_at_mut(share.min(p.len()));
-            let (q_part, q_rest) = q.split_at_mut(share.min(q.len()));
-            scope.spawn(move || blur_chunk(p_part, q_part, len, plan));
-            (p, q) = (p_rest, q_rest);
-        }
-    });
+    let zero = Complex::new(0.0, 0.0);
+    // Line i of `q`, or none for the last line of `p` where `q` is one line short (`zip`
+    // drops the `None` when it is not).
+    let q_lines = q
+        .par_chunks_exact_mut(len)
+        .map(Some)
+        .chain(rayon::iter::once(None));
+    p.par_chunks_exact_mut(len)
+        .zip(q_lines)
+        .with_min_len(lines_per_task(len))
+        .for_each_init(
+            || (vec![zero; plan.len], vec![zero; plan.scratch_len]),
+            |(buffer, scratch), (p_line, q_line)| blur_line(p_line, q_line, plan, buffer, scratch),
+        );
 }
 
-/// [`blur_lines`] on one thread.
-fn blur_chunk(p: &mut [f32], q: &mut [f32], len: usize, plan: &Plan) {
+/// [`blur_lines`] on one line of `p` and its partner in `q`, with the FFT's `buffer` and
+/// `scratch`.
+fn blur_line(
+    p_line: &mut [f32],
+    q_line: Option<&mut [f32]>,
+    plan: &Plan,
+    buffer: &mut [Complex<f32>],
+    scratch: &mut [Complex<f32>],
+) {
     let zero = Complex::new(0.0, 0.0);
-    let mut buffer = vec![zero; plan.len];
-    let mut scratch = vec![zero; plan.scratch_len];
-    let mut q_lines = q.chunks_exact_mut(len);
-    for p_line in p.chunks_exact_mut(len) {
-        let q_line = q_lines.next();
-        let empty = |l: &[f32]| l.iter().all(|&v| v == 0.0);
-        if empty(p_line) && q_line.as_deref().is_none_or(empty) {
-            continue;
-        }
-        match q_line.as_deref() {
-            Some(q_line) => {
-                for ((b, &re), &im) in buffer.iter_mut().zip(p_line.iter()).zip(q_line) {
-                    *b = Complex::new(re, im);
-                }
-            }
-            None => {
-                for (b, &re) in buffer.iter_mut().zip(p_line.iter()) {
-                    *b = Complex::new(re, 0.0);
-                }
+    let len = p_line.len();
+    let empty = |l: &[f32]| l.iter().all(|&v| v == 0.0);
+    if empty(p_line) && q_line.as_deref().is_none_or(empty) {
+        return;
+    }
+    match q_line.as_deref() {
+        Some(q_line) => {
+            for ((b, &re), &im) in buffer.iter_mut().zip(p_line.iter()).zip(q_line) {
+                *b = Complex::new(re, im);
             }
         }
-        buffer[len..].fill(zero);
-        plan.forward.process_with_scratch(&mut buffer, &mut scratch);
-        for (b, &k) in buffer.iter_mut().zip(&plan.spectrum) {
-            *b *= k;
-        }
-        plan.inverse.process_with_scratch(&mut buffer, &mut scratch);
-        for (v, b) in p_line.iter_mut().zip(&buffer) {
-            *v = b.re;
-        }
-        if let Some(q_line) = q_line {
-            for (v, b) in q_line.iter_mut().zip(&buffer) {
-                *v = b.im;
+        None => {
+            for (b, &re) in buffer.iter_mut().zip(p_line.iter()) {
+                *b = Complex::new(re, 0.0);
             }
+        }
+    }
+    buffer[len..].fill(zero);
+    plan.forward.process_with_scratch(buffer, scratch);
+    for (b, &k) in buffer.iter_mut().zip(&plan.spectrum) {
+        *b *= k;
+    }
+    plan.inverse.process_with_scratch(buffer, scratch);
+    for (v, b) in p_line.iter_mut().zip(buffer.iter()) {
+        *v = b.re;
+    }
+    if let Some(q_line) = q_line {
+        for (v, b) in q_line.iter_mut().zip(buffer.iter()) {
+            *v = b.im;
         }
     }
 }
@@ -690,32 +693,17 @@ fn transpose(src: &[f32], w: usize, h: usize, dst: &mut Vec<f32>) {
 }
 
 /// Runs `f(first_line, lines)` on consecutive runs of the lines (`len` samples each) of
-/// `data`, on several threads when there is enough to do.
+/// `data`, the runs on the cores.
 fn for_line_chunks(data: &mut [f32], len: usize, f: impl Fn(usize, &mut [f32]) + Sync) {
-    let lines = data.len() / len;
-    let threads = threads_for(data.len());
-    if threads == 1 {
-        f(0, data);
-        return;
-    }
-    let share = lines.div_ceil(threads);
-    std::thread::scope(|scope| {
-        for (i, chunk) in data.chunks_mut(share * len).enumerate() {
-            let f = &f;
-            scope.spawn(move || f(i * share, chunk));
-        }
-    });
+    let lines = lines_per_task(len);
+    data.par_chunks_mut(lines * len)
+        .enumerate()
+        .for_each(|(i, chunk)| f(i * lines, chunk));
 }
 
-/// Threads worth starting for a pass over `samples` samples.
-fn threads_for(samples: usize) -> usize {
-    if samples < THREADED_SAMPLES {
-        1
-    } else {
-        std::thread::available_parallelism()
-            .map_or(1, |t| t.get())
-            .min(8)
-    }
+/// Lines of `len` samples worth a parallel task: at least [`TASK_SAMPLES`] samples.
+fn lines_per_task(len: usize) -> usize {
+    TASK_SAMPLES.div_ceil(len)
 }
 
 /// The smallest length at least `n` whose only prime factors are 2, 3 and 5.

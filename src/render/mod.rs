@@ -23,6 +23,7 @@ use crate::intersect::Curves;
 use crate::verify::{HaloIndex, HaloInput};
 use camera::Camera;
 use glam::DVec3;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use trace::{Hit, TraceSurface, Tracer};
 
@@ -724,7 +725,7 @@ impl<'a> Scene<'a> {
                 }
             }
             let per_ray = total as f64 / f64::from(grid * grid);
-            let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
+            let threads = rayon::current_num_threads() as f64;
             let probe = (std::mem::size_of::<slices::Probe>() + 1) as f64;
             needed += pixels * (f64::from(s.samples) * per_ray * probe + 4.0 + 16.0 * threads);
             what = format!(
@@ -784,45 +785,34 @@ impl<'a> Scene<'a> {
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
         let mut rgb = vec![DVec3::ZERO; w * h];
         let mut front = vec![f64::INFINITY; w * h];
-        let threads = std::thread::available_parallelism()
-            .map_or(1, |n| n.get())
-            .min(h.max(1));
-        let rows_per = h.div_ceil(threads);
-        let hidden = &hidden;
-        std::thread::scope(|scope| {
-            for (band, (rgb, front)) in rgb
-                .chunks_mut(rows_per * w)
-                .zip(front.chunks_mut(rows_per * w))
-                .enumerate()
-            {
-                scope.spawn(move || {
-                    let mut hits = Vec::new();
-                    for (i, (c, f)) in rgb.iter_mut().zip(front.iter_mut()).enumerate() {
-                        let pixel = band * rows_per * w + i;
-                        let (x, y) = (pixel % w, pixel / w);
-                        let mut sum = DVec3::ZERO;
-                        let mut count = 0;
-                        let mut numbered = 0;
-                        for (sx, sy, centre) in self.samples(x, y) {
-                            let (origin, dir) = cam.ray(sx, sy);
-                            self.trace(origin, dir, &mut hits);
-                            let base = numbered;
-                            numbered += hits.len();
-                            let (colour, first) =
-                                self.shade(cam, origin, dir, &hits, |k, hit, x, wd| {
-                                    hidden(pixel, base + k, hit, x, wd)
-                                });
-                            sum += colour;
-                            count += 1;
-                            if centre {
-                                *f = first;
-                            }
+        // Row by row on the cores, each thread with its own hit buffer.
+        rgb.par_chunks_mut(w)
+            .zip(front.par_chunks_mut(w))
+            .enumerate()
+            .for_each_init(Vec::new, |hits, (y, (rgb, front))| {
+                for (x, (c, f)) in rgb.iter_mut().zip(front.iter_mut()).enumerate() {
+                    let pixel = y * w + x;
+                    let mut sum = DVec3::ZERO;
+                    let mut count = 0;
+                    let mut numbered = 0;
+                    for (sx, sy, centre) in self.samples(x, y) {
+                        let (origin, dir) = cam.ray(sx, sy);
+                        self.trace(origin, dir, hits);
+                        let base = numbered;
+                        numbered += hits.len();
+                        let (colour, first) =
+                            self.shade(cam, origin, dir, hits, |k, hit, x, wd| {
+                                hidden(pixel, base + k, hit, x, wd)
+                            });
+                        sum += colour;
+                        count += 1;
+                        if centre {
+                            *f = first;
                         }
-                        *c = sum / count as f64;
                     }
-                });
-            }
-        });
+                    *c = sum / count as f64;
+                }
+            });
         View { rgb, front }
     }
 
@@ -851,59 +841,44 @@ impl<'a> Scene<'a> {
     /// are hidden, then the samples are composited.
     fn view_slices(&self, cam: &Camera, index: &HaloIndex) -> View {
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
-        // Per pixel, its hits over all its samples, in sample order; rows in bands on the
+        // Per pixel, its hits over all its samples, in sample order; row by row on the
         // cores, joined in order.
-        let threads = std::thread::available_parallelism()
-            .map_or(1, |n| n.get())
-            .min(h.max(1));
-        let rows_per = h.div_ceil(threads);
-        let bands: Vec<(Vec<u32>, Vec<slices::Probe>)> = std::thread::scope(|scope| {
-            let handles: Vec<_> = (0..threads)
-                .map(|band| {
-                    scope.spawn(move || {
-                        let mut counts = Vec::new();
-                        let mut probes = Vec::new();
-                        let mut hits = Vec::new();
-                        let rows = (band * rows_per).min(h)..((band + 1) * rows_per).min(h);
-                        for pixel in rows.start * w..rows.end * w {
-                            let before = probes.len();
-                            for (sx, sy, _) in self.samples(pixel % w, pixel / w) {
-                                let (origin, dir) = cam.ray(sx, sy);
-                                self.trace(origin, dir, &mut hits);
-                                for hit in &hits {
-                                    let surf = &self.input.surfaces[hit.surface as usize];
-                                    let tri = surf.triangles[hit.triangle as usize];
-                                    probes.push(slices::Probe {
-                                        pixel: pixel as u32,
-                                        x: origin + dir * hit.t,
-                                        w: (0..3)
-                                            .map(|i| hit.bary[i] * surf.w[tri[i] as usize])
-                                            .sum(),
-                                        surface: hit.surface,
-                                        triangle: tri,
-                                    });
-                                }
-                            }
-                            counts.push((probes.len() - before) as u32);
+        let rows: Vec<(Vec<u32>, Vec<slices::Probe>)> = (0..h)
+            .into_par_iter()
+            .map_init(Vec::new, |hits, y| {
+                let mut counts = Vec::with_capacity(w);
+                let mut probes = Vec::new();
+                for pixel in y * w..(y + 1) * w {
+                    let before = probes.len();
+                    for (sx, sy, _) in self.samples(pixel % w, y) {
+                        let (origin, dir) = cam.ray(sx, sy);
+                        self.trace(origin, dir, hits);
+                        for hit in hits.iter() {
+                            let surf = &self.input.surfaces[hit.surface as usize];
+                            let tri = surf.triangles[hit.triangle as usize];
+                            probes.push(slices::Probe {
+                                pixel: pixel as u32,
+                                x: origin + dir * hit.t,
+                                w: (0..3).map(|i| hit.bary[i] * surf.w[tri[i] as usize]).sum(),
+                                surface: hit.surface,
+                                triangle: tri,
+                            });
                         }
-                        (counts, probes)
-                    })
-                })
-                .collect();
-            handles
-                .into_iter()
-                .map(|t| t.join().expect("render thread"))
-                .collect()
-        });
+                    }
+                    counts.push((probes.len() - before) as u32);
+                }
+                (counts, probes)
+            })
+            .collect();
         let mut starts = vec![0u32; w * h + 1];
         let mut probes = Vec::new();
         let mut pixel = 0;
-        for (counts, band) in bands {
+        for (counts, row) in rows {
             for c in counts {
                 starts[pixel + 1] = starts[pixel] + c;
                 pixel += 1;
             }
-            probes.extend(band);
+            probes.extend(row);
         }
         let depth = (self.centre - cam.eye).dot(cam.forward);
         let hidden = slices::hidden(

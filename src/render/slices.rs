@@ -9,6 +9,7 @@
 use super::camera::Camera;
 use crate::verify::HaloIndex;
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// A hit to test: its pixel, position, w and triangle.
 #[derive(Clone, Copy, Debug)]
@@ -24,6 +25,10 @@ pub struct Probe {
     /// The hit triangle's vertices.
     pub triangle: [u32; 3],
 }
+
+/// The most runs of consecutive slices [`hidden`] sweeps in parallel: each run starts by
+/// scanning every tetrahedron for those its first slice cuts.
+const SLICE_RUNS: usize = 32;
 
 /// Which probes are hidden by the halos, with `slices` planes, for an image of `width` x
 /// `height` through `cam`; the planes span depths `[near, far]` along the view direction.
@@ -81,65 +86,59 @@ pub fn hidden(
     }
 
     let (w, h) = (width as usize, height as usize);
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |t| t.get())
-        .min(n);
-    let per = n.div_ceil(threads);
+    // Runs of `per` consecutive slices, each swept with one slice image and one active set;
+    // the runs depend on the number of slices only, not on the number of threads (the order
+    // of the active set decides ties in the image).
+    let per = n.div_ceil(SLICE_RUNS);
     let mut out = vec![false; probes.len()];
-    let hidden_lists: Vec<Vec<u32>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..threads)
-            .map(|th| {
-                let (spans, starting, tet_start, by_slice, probe_start) =
-                    (&spans, &starting, &tet_start, &by_slice, &probe_start);
-                scope.spawn(move || {
-                    let mut image = vec![(f64::INFINITY, u32::MAX); w * h];
-                    let mut active: Vec<u32> = Vec::new();
-                    let mut hidden = Vec::new();
-                    let (k0, k1) = (th * per, ((th + 1) * per).min(n));
-                    for k in k0..k1 {
-                        // Active tetrahedra: those whose span holds k. Start from every span
-                        // beginning at or before k0 on the first slice of this thread.
-                        if k == k0 {
-                            active = spans
+    let hidden_lists: Vec<Vec<u32>> = (0..n)
+        .into_par_iter()
+        .step_by(per)
+        .map_init(
+            || (vec![(f64::INFINITY, u32::MAX); w * h], Vec::new()),
+            |(image, active), k0| {
+                let mut hidden = Vec::new();
+                for k in k0..(k0 + per).min(n) {
+                    // Active tetrahedra: those whose span holds k. Start from every span
+                    // beginning at or before k0 on the first slice of the run.
+                    if k == k0 {
+                        active.clear();
+                        active.extend(
+                            spans
                                 .iter()
                                 .enumerate()
                                 .filter(|(_, s)| s.0 as usize <= k && s.1 as usize >= k)
-                                .map(|(i, _)| i as u32)
-                                .collect();
-                        } else {
-                            active.retain(|&i| spans[i as usize].1 as usize >= k);
-                            active.extend_from_slice(
-                                &starting[tet_start[k] as usize..tet_start[k + 1] as usize],
-                            );
-                        }
-                        let probes_here =
-                            &by_slice[probe_start[k] as usize..probe_start[k + 1] as usize];
-                        if probes_here.is_empty() {
-                            continue;
-                        }
-                        image.fill((f64::INFINITY, u32::MAX));
-                        let plane = near + (k as f64 + 0.5) * step;
-                        for &i in &active {
-                            let g = spans[i as usize].2;
-                            cut(index, g, cam, plane, (width, height), &mut image);
-                        }
-                        for &pi in probes_here {
-                            let p = &probes[pi as usize];
-                            let (d, g) = image[p.pixel as usize];
-                            if d < p.w && !index.within(g, p.surface, &p.triangle) {
-                                hidden.push(pi);
-                            }
+                                .map(|(i, _)| i as u32),
+                        );
+                    } else {
+                        active.retain(|&i| spans[i as usize].1 as usize >= k);
+                        active.extend_from_slice(
+                            &starting[tet_start[k] as usize..tet_start[k + 1] as usize],
+                        );
+                    }
+                    let probes_here =
+                        &by_slice[probe_start[k] as usize..probe_start[k + 1] as usize];
+                    if probes_here.is_empty() {
+                        continue;
+                    }
+                    image.fill((f64::INFINITY, u32::MAX));
+                    let plane = near + (k as f64 + 0.5) * step;
+                    for &i in active.iter() {
+                        let g = spans[i as usize].2;
+                        cut(index, g, cam, plane, (width, height), image);
+                    }
+                    for &pi in probes_here {
+                        let p = &probes[pi as usize];
+                        let (d, g) = image[p.pixel as usize];
+                        if d < p.w && !index.within(g, p.surface, &p.triangle) {
+                            hidden.push(pi);
                         }
                     }
-                    hidden
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().expect("slice thread"))
-            .collect()
-    });
+                }
+                hidden
+            },
+        )
+        .collect();
     for list in hidden_lists {
         for i in list {
             out[i as usize] = true;

@@ -10,6 +10,7 @@
 use super::Mesh4;
 use crate::surfaces::Surface;
 use glam::DVec4;
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// Barycentric coordinates of the points where every triangle is compared with the surface:
@@ -55,6 +56,10 @@ impl Audit {
     }
 }
 
+/// Triangles per parallel task of the audit: a fixed number, so that the sum of squares
+/// (added task after task) comes out the same on any number of threads.
+const AUDIT_RUN: usize = 1024;
+
 /// Partial sums of one slice of triangles.
 #[derive(Default)]
 struct Partial {
@@ -70,22 +75,12 @@ struct Partial {
 /// every core of the machine.
 pub fn audit(surface: &Surface, mesh: &Mesh4) -> Audit {
     let n = mesh.triangles.len();
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |t| t.get())
-        .clamp(1, 16);
-    let chunk = n.div_ceil(threads).max(1024);
-    let partials: Vec<Partial> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..n)
-            .step_by(chunk)
-            .map(|start| {
-                scope.spawn(move || audit_range(surface, mesh, start..(start + chunk).min(n)))
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().expect("audit thread panicked"))
-            .collect()
-    });
+    // Runs of AUDIT_RUN triangles on the cores, summed in order.
+    let partials: Vec<Partial> = (0..n)
+        .into_par_iter()
+        .step_by(AUDIT_RUN)
+        .map(|start| audit_range(surface, mesh, start..(start + AUDIT_RUN).min(n)))
+        .collect();
     let mut total = Partial::default();
     for p in partials {
         if total.worst.is_none() || p.max > total.max {
