@@ -173,6 +173,23 @@ pub struct HaloReport {
     pub check: CheckStats,
     /// Milliseconds: thickening, splitting, fixing and checking.
     pub ms: f64,
+    /// Where the milliseconds went.
+    pub stage_ms: HaloStages,
+}
+
+/// Milliseconds per step of the halo stage.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct HaloStages {
+    /// Offset directions (eq. 1 and the widest direction where it fails) and offsets.
+    pub directions: f64,
+    /// Planning the split (edge orientations, Dompierre's rule).
+    pub plan: f64,
+    /// Shrinking rho where tetrahedra invert.
+    pub shrink: f64,
+    /// Emitting the tetrahedra, t and d_orig.
+    pub split: f64,
+    /// The independent checker.
+    pub check: f64,
 }
 
 /// The triangles around each vertex, as (triangle, corner); flat, vertex after vertex.
@@ -475,6 +492,14 @@ pub fn build_halo(
     params: &HaloParams,
 ) -> (Halo, HaloReport) {
     let start = Instant::now();
+    let mut stage_ms = HaloStages::default();
+    let mut lap = {
+        let mut last = Instant::now();
+        move |to: &mut f64| {
+            *to = last.elapsed().as_secs_f64() * 1e3;
+            last = Instant::now();
+        }
+    };
     let n = projected.positions.len();
     let stars = Stars::new(n, triangles);
     let frame = frame(projected, triangles, &stars);
@@ -502,7 +527,9 @@ pub fn build_halo(
         .zip(&frame.flip)
         .map(|(&tri, &flip)| offsets.corners(tri, flip))
         .collect();
+    lap(&mut stage_ms.directions);
     let (forward, stats) = tets::plan(&corners, &offsets.positions, n, params.split);
+    lap(&mut stage_ms.plan);
 
     if shrink {
         // Halve rho at the corners of inverted tetrahedra, re-examining only the prisms
@@ -553,6 +580,7 @@ pub fn build_halo(
             reexamine(&touched, &offsets, &mut bad);
         }
     }
+    lap(&mut stage_ms.shrink);
     let tets = tets::emit(&corners, &forward, &offsets.positions, n, stats);
 
     let mut t = [vec![0.0; n], vec![1.0; n], vec![0.5; n]].concat();
@@ -583,7 +611,9 @@ pub fn build_halo(
         rho: offsets.rho,
         inserted_in: tets.inserted_in,
     };
+    lap(&mut stage_ms.split);
     let checked = check(&halo.tet_mesh());
+    lap(&mut stage_ms.check);
     let report = HaloReport {
         split: params.split.name(),
         prisms: triangles.len(),
@@ -602,6 +632,7 @@ pub fn build_halo(
         min_dihedral_deg: checked.min_dihedral_deg,
         check: checked,
         ms: start.elapsed().as_secs_f64() * 1e3,
+        stage_ms,
     };
     (halo, report)
 }

@@ -76,6 +76,10 @@ pub struct Verification {
     pub ambiguous: usize,
     /// The ambiguous samples by reason.
     pub ambiguous_reasons: Ambiguous,
+    /// The farthest that a sample excused as `branch_point` or `boundary` lies from the
+    /// curve end that excuses it, in halo widths rho (at most [`BRANCH_REACH`]; 0 when
+    /// there is none): how far from the ends the halos fail to explain the curves.
+    pub ambiguous_reach: f64,
     /// The near sheet hidden by a third sheet's halo (near triple points).
     pub third_sheet: usize,
     /// Samples away from the curves: surface vertices and triangle centroids.
@@ -135,6 +139,7 @@ impl Verification {
         a.boundary += b.boundary;
         a.vanished_halo += b.vanished_halo;
         a.resolution += b.resolution;
+        self.ambiguous_reach = self.ambiguous_reach.max(other.ambiguous_reach);
         self.third_sheet += other.third_sheet;
         self.surface_samples += other.surface_samples;
         self.spurious_hidden_samples += other.spurious_hidden_samples;
@@ -655,22 +660,32 @@ impl<'a> Index<'a> {
             }
             return;
         }
-        let reach = BRANCH_REACH * self.rho[fn_.surface as usize];
-        let within = |ends: &[DVec3]| ends.iter().any(|e| e.distance(s.x) <= reach);
+        let rho = self.rho[fn_.surface as usize];
+        // Whether the sample is within reach of one of `ends`; if so, how far in rho.
+        let mut within = |ends: &[DVec3]| {
+            let nearest = ends
+                .iter()
+                .map(|e| e.distance(s.x))
+                .fold(f64::INFINITY, f64::min);
+            let inside = nearest <= BRANCH_REACH * rho;
+            if inside && rho > 0.0 {
+                v.ambiguous_reach = v.ambiguous_reach.max(nearest / rho);
+            }
+            inside
+        };
         let spread = |f: Face| {
             let sheet = &self.sheets[f.surface as usize];
             let w = sheet.triangles[f.triangle as usize].map(|k| sheet.w[k as usize]);
             w[0].max(w[1]).max(w[2]) - w[0].min(w[1]).min(w[2])
         };
-        let reasons = &mut v.ambiguous_reasons;
         let reason = if within(&self.branch_points) {
-            &mut reasons.branch_point
+            &mut v.ambiguous_reasons.branch_point
         } else if within(&self.boundary_ends) {
-            &mut reasons.boundary
+            &mut v.ambiguous_reasons.boundary
         } else if halos.vanishes(fn_.surface, &ring_near) {
-            &mut reasons.vanished_halo
+            &mut v.ambiguous_reasons.vanished_halo
         } else if self.close(fn_, ff) || s.w[far] - s.w[near] <= spread(fn_).max(spread(ff)) {
-            &mut reasons.resolution
+            &mut v.ambiguous_reasons.resolution
         } else {
             v.wrong += 1;
             example(&mut v.wrong_at, s.x.to_array());
