@@ -209,14 +209,6 @@ fn key(mut f: [u32; 3]) -> [u32; 3] {
     f
 }
 
-/// What one pass over a share of the tetrahedra finds.
-#[derive(Default)]
-struct Partial {
-    stats: CheckStats,
-    /// (face, the vertex opposite it) for every face of every non-degenerate tetrahedron.
-    faces: Vec<([u32; 3], u32)>,
-}
-
 /// Tetrahedra per parallel task of the checker: a fixed number, so that the volume (summed
 /// task after task) comes out the same on any number of threads.
 const CHECK_RUN: usize = 1 << 14;
@@ -251,26 +243,32 @@ fn scaled(positions: &[[f64; 3]]) -> (Vec<[f64; 3]>, f64, Vec<bool>) {
     (out, 2f64.powi(3 * e), tiny)
 }
 
-/// Orientation, volume, angle and faces of `tets[range]` (indices already canonical), on
-/// positions [`scaled`], with which vertices are too small to decide.
-fn examine(tets: &[[u32; 4]], positions: &[[f64; 3]], tiny: &[bool]) -> Partial {
-    let mut out = Partial {
-        stats: CheckStats {
-            min_volume: f64::INFINITY,
-            max_volume: f64::NEG_INFINITY,
-            min_dihedral_deg: 180.0,
-            ..CheckStats::default()
-        },
-        faces: Vec::with_capacity(4 * tets.len()),
+/// A face (sorted vertex triple) with the vertex opposite it in its tetrahedron.
+type Face = ([u32; 3], u32);
+
+/// Orientation, volume and angle of `tets` (indices already canonical), on positions
+/// [`scaled`], with which vertices are too small to decide; writes each tetrahedron's four
+/// faces into `faces` (a degenerate one's as four faces past the last vertex).
+fn examine(
+    tets: &[[u32; 4]],
+    faces: &mut [Face],
+    positions: &[[f64; 3]],
+    tiny: &[bool],
+) -> CheckStats {
+    let mut s = CheckStats {
+        min_volume: f64::INFINITY,
+        max_volume: f64::NEG_INFINITY,
+        min_dihedral_deg: 180.0,
+        ..CheckStats::default()
     };
-    let s = &mut out.stats;
     let nv = positions.len();
     let mut dihedral_cosine = -1.0f64;
-    for tet in tets {
+    for (tet, out) in tets.iter().zip(faces.chunks_exact_mut(4)) {
         let mut sorted = *tet;
         sorted.sort_unstable();
         if sorted.windows(2).any(|w| w[0] == w[1]) || sorted[3] as usize >= nv {
             s.degenerate += 1;
+            out.fill(([nv as u32; 3], 0));
             continue;
         }
         let p = tet.map(|i| positions[i as usize]);
@@ -288,7 +286,7 @@ fn examine(tets: &[[u32; 4]], positions: &[[f64; 3]], tiny: &[bool]) -> Partial 
         s.max_volume = s.max_volume.max(v);
         dihedral_cosine = dihedral_cosine.max(smallest_dihedral_cosine(p));
         let [a, b, c, d] = sorted;
-        out.faces.extend([
+        out.copy_from_slice(&[
             ([b, c, d], a),
             ([a, c, d], b),
             ([a, b, d], c),
@@ -296,7 +294,7 @@ fn examine(tets: &[[u32; 4]], positions: &[[f64; 3]], tiny: &[bool]) -> Partial 
         ]);
     }
     s.min_dihedral_deg = dihedral_cosine.clamp(-1.0, 1.0).acos().to_degrees();
-    out
+    s
 }
 
 /// Sorts `items` whose first sort field is a vertex index below `vertices`: a counting sort
@@ -364,14 +362,16 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     let offset = |i: u32| (i as usize) < 2 * n;
     let surface_vertex = |i: u32| ((i as usize) < 3 * n).then(|| (i as usize % n.max(1)) as u32);
 
-    let tets: Vec<[u32; 4]> = mesh.tets.iter().map(|t| t.map(canon)).collect();
+    let tets: Vec<[u32; 4]> = mesh.tets.par_iter().map(|t| t.map(canon)).collect();
     let (scaled, volume_scale, tiny) = scaled(positions);
     let (positions, tiny) = (&scaled, &tiny);
     // Runs of CHECK_RUN tetrahedra on the cores, summed in order: the volume's rounding
     // depends on the runs only, not on the number of threads.
-    let partials: Vec<Partial> = tets
+    let mut faces: Vec<Face> = vec![([0; 3], 0); 4 * tets.len()];
+    let partials: Vec<CheckStats> = tets
         .par_chunks(CHECK_RUN)
-        .map(|part| examine(part, positions, tiny))
+        .zip(faces.par_chunks_mut(4 * CHECK_RUN))
+        .map(|(part, faces)| examine(part, faces, positions, tiny))
         .collect();
     let mut s = CheckStats {
         vertices: nv,
@@ -382,9 +382,7 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
         min_dihedral_deg: 180.0,
         ..CheckStats::default()
     };
-    let mut faces = Vec::with_capacity(partials.iter().map(|p| p.faces.len()).sum());
-    for p in partials {
-        let q = p.stats;
+    for q in partials {
         s.degenerate += q.degenerate;
         s.inverted += q.inverted;
         s.flat += q.flat;
@@ -393,12 +391,13 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
         s.min_volume = s.min_volume.min(q.min_volume);
         s.max_volume = s.max_volume.max(q.max_volume);
         s.min_dihedral_deg = s.min_dihedral_deg.min(q.min_dihedral_deg);
-        faces.extend(p.faces);
     }
     if s.tets == s.degenerate {
         (s.min_volume, s.max_volume, s.min_dihedral_deg) = (0.0, 0.0, 0.0);
     }
-    let faces = bucket_sort(faces, nv, |f| f.0[0]);
+    // The degenerate tetrahedra's faces, past the last vertex, sort last: dropped.
+    let mut faces = bucket_sort(faces, nv + 1, |f| f.0[0]);
+    faces.truncate(4 * (s.tets - s.degenerate));
 
     // Distinct faces with their use counts; boundary faces with their tetrahedron.
     let mut keys: Vec<[u32; 3]> = Vec::with_capacity(faces.len() / 2 + 1);
