@@ -142,7 +142,7 @@ impl Halo {
 }
 
 /// What `report.json` says of a halo.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Default, Serialize)]
 pub struct HaloReport {
     /// The split used.
     pub split: &'static str,

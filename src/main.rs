@@ -226,22 +226,29 @@ fn main() -> ExitCode {
                             s.name, s.vertices, s.triangles, s.mesh.euler_characteristic
                         );
                     }
-                    let (c, v) = (&report.curves, &report.halo_verification);
-                    eprintln!(
-                        "curves: {} ({} closed, {} open), {} points, {} triple points, {} unresolved",
-                        c.count, c.closed, c.open, c.points, c.triple_points, c.unresolved
-                    );
-                    eprintln!(
-                        "halo verification: {} curve samples: {} correct, {} wrong, {} ambiguous, {} third sheet; {} surface samples, {} far tetrahedra, {} spurious",
-                        v.curve_samples,
-                        v.correct,
-                        v.wrong,
-                        v.ambiguous,
-                        v.third_sheet,
-                        v.surface_samples,
-                        v.far_tetrahedra,
-                        v.spurious_hidden_samples
-                    );
+                    match &report.curves {
+                        Some(c) => eprintln!(
+                            "curves: {} ({} closed, {} open), {} points, {} triple points, {} unresolved",
+                            c.count, c.closed, c.open, c.points, c.triple_points, c.unresolved
+                        ),
+                        None => eprintln!("curves: not computed (no output uses them)"),
+                    }
+                    match &report.halo_verification {
+                        Some(v) => eprintln!(
+                            "halo verification: {} curve samples: {} correct, {} wrong, {} ambiguous, {} third sheet; {} surface samples, {} far tetrahedra, {} spurious",
+                            v.curve_samples,
+                            v.correct,
+                            v.wrong,
+                            v.ambiguous,
+                            v.third_sheet,
+                            v.surface_samples,
+                            v.far_tetrahedra,
+                            v.spurious_hidden_samples
+                        ),
+                        None => eprintln!(
+                            "halo verification: not run (no halo file written; `outputs.verify: true` asks for it)"
+                        ),
+                    }
                     let t = report.timings_ms;
                     eprintln!(
                         "sample {:.1} ms, audit {:.1} ms, view {:.1} ms, halo {:.1} ms, curves {:.1} ms, verify {:.1} ms, export {:.1} ms, render {:.1} ms, total {:.1} ms",

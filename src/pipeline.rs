@@ -58,6 +58,35 @@ pub struct Built {
     pub diagonal: f64,
     /// The memory the stages from the halos on were estimated to need, and the limit.
     pub memory: MemoryReport,
+    /// Which stages after the projection ran.
+    pub stages: Stages,
+}
+
+/// Which stages after the projection a build runs: those whose products an output the
+/// scene asks for uses (`report.json`'s `stages`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Stages {
+    /// Halos: for `glb`, `vtk`, a `png` whose `render.halos` is on, and the verification.
+    pub halos: bool,
+    /// Intersection curves: for `glb`, `ply` (`-curves.ply`), a `png` whose
+    /// `render.curves` is on, and the verification.
+    pub curves: bool,
+    /// The halos checked against the curves: whenever a halo file is written, and where
+    /// `outputs.verify` asks for it.
+    pub verify: bool,
+}
+
+impl Stages {
+    /// The stages `scene`'s outputs need.
+    pub fn of(scene: &Scene) -> Stages {
+        let o = &scene.outputs;
+        let verify = o.verify.unwrap_or(o.glb || o.vtk);
+        Stages {
+            halos: verify || o.glb || o.vtk || (o.png && scene.render.halos),
+            curves: verify || o.glb || o.ply || (o.png && scene.render.curves),
+            verify,
+        }
+    }
 }
 
 /// `report.json`'s `memory`: what the stages from the halos on were estimated to need
@@ -78,7 +107,7 @@ impl Built {
     /// hidden surface sample.
     pub fn failures(&self) -> Vec<String> {
         let mut out = Vec::new();
-        for p in &self.surfaces {
+        for p in self.surfaces.iter().filter(|_| self.stages.halos) {
             let check = &p.halo_report.check;
             if p.halo.tets.is_empty() {
                 out.push(format!("{}: no halo (no tetrahedron)", p.name));
@@ -364,8 +393,8 @@ pub struct SurfaceReport {
     pub bounds_3d: Option<Bounds>,
     /// Range of w-depth after the view.
     pub w_range: Option<[f64; 2]>,
-    /// The halo.
-    pub halo: HaloReport,
+    /// The halo (null when no output needs one).
+    pub halo: Option<HaloReport>,
 }
 
 /// `report.json`.
@@ -377,17 +406,20 @@ pub struct Report {
     pub scene_name: String,
     /// Per surface.
     pub surfaces: Vec<SurfaceReport>,
-    /// The intersection curves of all surfaces together.
-    pub curves: CurvesReport,
-    /// The halos checked against the curves.
-    pub halo_verification: Verification,
+    /// Which stages after the projection ran (those the outputs need).
+    pub stages: Stages,
+    /// The intersection curves of all surfaces together (null when not computed).
+    pub curves: Option<CurvesReport>,
+    /// The halos checked against the curves (null when not verified).
+    pub halo_verification: Option<Verification>,
     /// Milliseconds per stage.
     pub timings_ms: Timings,
     /// Memory estimated before the halos, against the limit.
     pub memory: MemoryReport,
     /// Warnings, also printed on stderr.
     pub warnings: Vec<String>,
-    /// Whether the build is verified: [`Built::failures`] found nothing.
+    /// Whether the build is verified: [`Built::failures`] found nothing in the stages that
+    /// ran.
     pub verified: bool,
     /// What [`Built::failures`] found.
     pub failures: Vec<String>,
@@ -476,8 +508,13 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
         });
     }
     let rho = scene.halo.rho * diagonal;
+    let stages = Stages::of(scene);
     let triangles: usize = projections.iter().map(|p| p.2.triangles.len()).sum();
-    let needed = triangles as f64 * crate::memory::BUILD_BYTES_PER_TRIANGLE;
+    let needed = if stages.halos || stages.curves {
+        triangles as f64 * crate::memory::BUILD_BYTES_PER_TRIANGLE
+    } else {
+        0.0
+    };
     let (limit, source_of_limit) = crate::memory::limit().map_err(|message| Error::Scale {
         scene: scene.name.clone(),
         message,
@@ -494,10 +531,15 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
         });
     }
     for (name, entry, mesh, stats, report, projected) in projections {
-        bar.set_message(format!("halo of {name}"));
-        let start = Instant::now();
-        let (halo, halo_report) = build_halo(&projected, &mesh.triangles, rho, &scene.halo);
-        timings.halo += ms(start);
+        let (halo, halo_report) = if stages.halos {
+            bar.set_message(format!("halo of {name}"));
+            let start = Instant::now();
+            let built = build_halo(&projected, &mesh.triangles, rho, &scene.halo);
+            timings.halo += ms(start);
+            built
+        } else {
+            Default::default()
+        };
         bar.inc(1);
         products.push(SurfaceProduct {
             name,
@@ -510,19 +552,25 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
             halo_report,
         });
     }
-    bar.set_message("intersection curves");
-    let start = Instant::now();
-    let curves = intersect::curves(&sheets(&products));
-    timings.curves = ms(start);
+    let mut curves = Curves::default();
+    if stages.curves {
+        bar.set_message("intersection curves");
+        let start = Instant::now();
+        curves = intersect::curves(&sheets(&products));
+        timings.curves = ms(start);
+    }
     bar.inc(1);
-    bar.set_message("verifying halos");
-    let start = Instant::now();
-    let verification = verify::verify(
-        &sheets(&products),
-        &halo_inputs(&products, &scene.halo),
-        &curves,
-    );
-    timings.verify = ms(start);
+    let mut verification = Verification::default();
+    if stages.verify {
+        bar.set_message("verifying halos");
+        let start = Instant::now();
+        verification = verify::verify(
+            &sheets(&products),
+            &halo_inputs(&products, &scene.halo),
+            &curves,
+        );
+        timings.verify = ms(start);
+    }
     bar.finish_and_clear();
     Ok(Built {
         surfaces: products,
@@ -534,6 +582,7 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
         curves,
         verification,
         timings,
+        stages,
     })
 }
 
@@ -630,9 +679,13 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     let report = Report {
         halo4d: env!("CARGO_PKG_VERSION"),
         scene_name: scene.name.clone(),
-        surfaces: products.iter().map(surface_report).collect(),
-        curves: built.curves.report.clone(),
-        halo_verification: built.verification.clone(),
+        surfaces: products
+            .iter()
+            .map(|p| surface_report(p, built.stages.halos))
+            .collect(),
+        stages: built.stages,
+        curves: built.stages.curves.then(|| built.curves.report.clone()),
+        halo_verification: built.stages.verify.then(|| built.verification.clone()),
         timings_ms: timings,
         memory: built.memory,
         warnings: products
@@ -663,7 +716,7 @@ fn staged_error(e: export::StagedError) -> Error {
     }
 }
 
-fn surface_report(p: &SurfaceProduct) -> SurfaceReport {
+fn surface_report(p: &SurfaceProduct, halo: bool) -> SurfaceReport {
     SurfaceReport {
         name: p.name.clone(),
         type_name: p.surface.type_name().to_string(),
@@ -682,6 +735,6 @@ fn surface_report(p: &SurfaceProduct) -> SurfaceReport {
             max: hi.to_array().to_vec(),
         }),
         w_range: p.projected.w_range(),
-        halo: p.halo_report.clone(),
+        halo: halo.then(|| p.halo_report.clone()),
     }
 }

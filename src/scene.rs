@@ -83,6 +83,11 @@ pub struct Outputs {
     pub report: bool,
     /// `<name>.png`: the picture of the `render` settings through the `camera`.
     pub png: bool,
+    /// Whether the halos are checked against the intersection curves. Always when a halo
+    /// file is written (`glb`, `vtk`; the default then), and on request without one (the
+    /// verdict in `report.json` and the exit status).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verify: Option<bool>,
     /// Radius of the intersection curves' tubes in `<name>.glb`, a share of the projected
     /// scene's diagonal (as `halo.rho`).
     pub curve_radius: f64,
@@ -98,6 +103,12 @@ pub const CURVE_RADIUS: f64 = 0.004;
 impl Outputs {
     /// Checks the numbers: `Err((field, message))` names the first bad one.
     pub fn check(&self) -> Result<(), (&'static str, String)> {
+        if self.verify == Some(false) && (self.glb || self.vtk) {
+            return Err((
+                "verify",
+                "halo files (glb, vtk) are always verified; remove `verify: false`, or set `glb` and `vtk` to false".into(),
+            ));
+        }
         if !(self.curve_radius.is_finite() && self.curve_radius > 0.0 && self.curve_radius <= 0.05)
         {
             return Err((
@@ -122,6 +133,7 @@ impl Default for Outputs {
             report: true,
             png: true,
             curve_radius: CURVE_RADIUS,
+            verify: None,
         }
     }
 }

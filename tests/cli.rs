@@ -476,3 +476,75 @@ fn a_build_beyond_the_memory_limit_is_refused_before_the_halos_and_writes_nothin
     );
     assert!(dir.path().join("out").join("report.json").exists());
 }
+
+#[test]
+fn a_build_runs_only_the_stages_its_outputs_need() {
+    let dir = tempfile::tempdir().unwrap();
+    let build = |name: &str, outputs: &str| {
+        let file = patches_scene(dir.path(), name, &format!(r#"{{"outputs": {outputs}}}"#));
+        let out = halo4d(&["build", "--quiet", &file, "--out", name], dir.path());
+        (out, dir.path().join(name))
+    };
+    let report = |folder: &std::path::Path| -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(folder.join("report.json")).unwrap()).unwrap()
+    };
+    let stages = |r: &serde_json::Value| {
+        let s = &r["stages"];
+        [&s["halos"], &s["curves"], &s["verify"]].map(|b| b.as_bool().unwrap())
+    };
+    let none = r#"{"glb": false, "ply": false, "vtk": false, "png": false, "report": true"#;
+
+    // Surfaces for MeshLab: the curves for `-curves.ply`, no halo, no verification.
+    let (out, folder) = build("ply", &format!(r#"{none}, "ply": true}}"#));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r = report(&folder);
+    assert_eq!(stages(&r), [false, true, false], "{r}");
+    assert!(r["halo_verification"].is_null() && r["surfaces"][0]["halo"].is_null());
+    assert!(r["curves"]["count"].as_u64().unwrap() > 0);
+    assert_eq!(
+        (
+            r["timings_ms"]["halo"].as_f64(),
+            r["timings_ms"]["verify"].as_f64()
+        ),
+        (Some(0.0), Some(0.0))
+    );
+    let names: Vec<String> = folder_names(&folder);
+    assert_eq!(names, ["patches-curves.ply", "patches.ply", "report.json"]);
+
+    // Only the report: nothing after the projection.
+    let (out, folder) = build("bare", &format!("{none}}}"));
+    assert!(out.status.success());
+    let r = report(&folder);
+    assert_eq!(stages(&r), [false, false, false], "{r}");
+    assert!(r["curves"].is_null());
+
+    // The verification asked for without a halo file: its verdict in the report.
+    let (out, folder) = build("verify", &format!(r#"{none}, "verify": true}}"#));
+    assert!(out.status.success());
+    let r = report(&folder);
+    assert_eq!(stages(&r), [true, true, true], "{r}");
+    assert!(
+        r["halo_verification"]["correct"].as_u64().unwrap() > 0,
+        "{r}"
+    );
+    assert_eq!(r["halo_verification"]["wrong"], 0);
+    assert_eq!(folder_names(&folder), ["report.json"]);
+
+    // Halo files are never written unverified.
+    let (out, folder) = build("no", r#"{"glb": true, "verify": false}"#);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("outputs.verify") && err.contains("always verified"),
+        "{err}"
+    );
+    assert!(!folder.exists());
+}
+
+fn folder_names(dir: &std::path::Path) -> Vec<String> {
+    folder(dir).into_iter().map(|(name, _)| name).collect()
+}
