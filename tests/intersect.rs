@@ -610,3 +610,44 @@ fn the_verdict_does_not_depend_on_the_resolution() {
         assert_eq!(unresolved, 0, "{name}");
     }
 }
+
+#[test]
+fn planted_faults_are_caught_at_a_million_triangles() {
+    // The oblique flat torus on a 708 x 708 grid (1,002,528 triangles, 6 million
+    // tetrahedra): sound, then each fault planted in its halo and caught.
+    let mut scene = Scene::load(&fixture("scenes/flat-torus.json")).unwrap();
+    scene.sampling = Sampling::Uniform { u: 708, v: 708 };
+    let mut built = halo4d::run(&scene, true).unwrap();
+    assert_eq!(built.surfaces[0].mesh.triangles.len(), 1_002_528);
+    let v = verify(&built, &scene);
+    assert_eq!(
+        (v.wrong, v.spurious_hidden_samples, v.far_tetrahedra),
+        (0, 0, 0),
+        "{v:?}"
+    );
+    assert!(v.correct > 6000, "{v:?}");
+    // d_orig raised past every w: no halo hides anything.
+    let halo = &mut built.surfaces[0].halo;
+    for d in &mut halo.d_orig {
+        *d += 10.0;
+    }
+    let raised = verify(&built, &scene);
+    assert!(raised.wrong > v.correct / 2, "{raised:?}");
+    assert_eq!(raised.correct + raised.third_sheet, 0, "{raised:?}");
+    // Moved off its surface (0.1 along z) and made shallow: it hides what it no longer
+    // surrounds.
+    let halo = &mut built.surfaces[0].halo;
+    for d in &mut halo.d_orig {
+        *d -= 20.0;
+    }
+    for p in &mut halo.positions {
+        p.z += 0.1;
+    }
+    let moved = verify(&built, &scene);
+    assert_eq!(
+        moved.far_tetrahedra,
+        built.surfaces[0].halo.tets.len(),
+        "{moved:?}"
+    );
+    assert!(moved.spurious_hidden_samples > 0, "{moved:?}");
+}
