@@ -42,6 +42,7 @@ use glam::{DVec3, Vec3};
 use gltf_json as json;
 use json::validation::Checked::Valid;
 use json::validation::USize64;
+use rayon::prelude::*;
 use serde_json::value::to_raw_value;
 
 /// Base colours of the surfaces' materials, in turn.
@@ -196,16 +197,20 @@ fn boundary_faces(positions: &[DVec3], tets: &[[u32; 4]]) -> Vec<[u32; 3]> {
     const FACES: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
     // One u128 per face use: the sorted vertex triple above, the use (tetrahedron, face) below,
     // so that sorting groups the uses of each face.
-    let mut uses: Vec<u128> = Vec::with_capacity(tets.len() * 4);
-    for (k, tet) in tets.iter().enumerate() {
-        for (f, face) in FACES.iter().enumerate() {
-            let mut key = face.map(|i| tet[i]);
-            key.sort_unstable();
-            let high = (u128::from(key[0]) << 64) | (u128::from(key[1]) << 32) | u128::from(key[2]);
-            uses.push((high << 32) | (k as u128 * 4 + f as u128));
-        }
-    }
-    uses.sort_unstable();
+    let mut uses: Vec<u128> = tets
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(k, tet)| {
+            FACES.iter().enumerate().map(move |(f, face)| {
+                let mut key = face.map(|i| tet[i]);
+                key.sort_unstable();
+                let high =
+                    (u128::from(key[0]) << 64) | (u128::from(key[1]) << 32) | u128::from(key[2]);
+                (high << 32) | (k as u128 * 4 + f as u128)
+            })
+        })
+        .collect();
+    uses.par_sort_unstable();
     let c = |i: u32| {
         let p = positions[i as usize];
         robust::Coord3D {
