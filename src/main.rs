@@ -263,8 +263,14 @@ fn main() -> ExitCode {
                         t.total
                     );
                     eprintln!(
-                        "memory: about {:.2} GB estimated from the halos on, limit {:.2} GB",
-                        report.memory.estimate_gb, report.memory.limit_gb
+                        "memory: about {:.2} GB estimated from the halos on, limit {:.2} GB{}",
+                        report.memory.estimate_gb,
+                        report.memory.limit_gb,
+                        report
+                            .memory
+                            .peak_gb
+                            .map(|gb| format!(", peak {gb:.2} GB"))
+                            .unwrap_or_default()
                     );
                     for f in &report.files {
                         println!("{}", out.join(f).display());

@@ -43,3 +43,12 @@ pub fn limit() -> Result<(f64, &'static str), String> {
         ),
     })
 }
+
+/// This process's peak resident memory so far in bytes (`VmHWM` of `/proc/self/status`;
+/// `None` where that cannot be read).
+pub fn peak_resident() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1e3)
+}

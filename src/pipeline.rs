@@ -98,6 +98,9 @@ pub struct MemoryReport {
     pub estimate_gb: f64,
     /// The limit a build refuses to go beyond.
     pub limit_gb: f64,
+    /// The process's peak resident memory when the files were made (null where the system
+    /// does not say).
+    pub peak_gb: Option<f64>,
 }
 
 impl Built {
@@ -578,6 +581,7 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
         memory: MemoryReport {
             estimate_gb: needed / crate::memory::GB,
             limit_gb: limit / crate::memory::GB,
+            peak_gb: None,
         },
         curves,
         verification,
@@ -687,7 +691,10 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
         curves: built.stages.curves.then(|| built.curves.report.clone()),
         halo_verification: built.stages.verify.then(|| built.verification.clone()),
         timings_ms: timings,
-        memory: built.memory,
+        memory: MemoryReport {
+            peak_gb: crate::memory::peak_resident().map(|b| b / crate::memory::GB),
+            ..built.memory
+        },
         warnings: products
             .iter()
             .filter_map(|p| p.sampling.warning(&p.name))
