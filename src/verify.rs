@@ -508,6 +508,18 @@ impl<'a> HaloIndex<'a> {
         out
     }
 
+    /// The tetrahedra containing `x` with their halo depth there.
+    fn containing(&self, x: DVec3) -> Vec<(u32, f64)> {
+        let mut out = Vec::new();
+        self.visit(x, |g| {
+            if let Some(depth) = self.depth_at(g, x) {
+                out.push((g, depth));
+            }
+            true
+        });
+        out
+    }
+
     /// Halo depth (eq. 3) at `x` if tetrahedron `g` contains it (boundary included).
     fn depth_at(&self, g: u32, x: DVec3) -> Option<f64> {
         let (surface, tet) = self.tets[g as usize];
@@ -644,14 +656,23 @@ impl<'a> Index<'a> {
         let (fn_, ff) = (s.faces[near], s.faces[far]);
         let (ring_near, ring_far) = (self.vertices(fn_), self.vertices(ff));
         let halos = &self.halos;
-        let far_hidden = halos
-            .hiders(s.x, s.w[far], (ff.surface, &ring_far))
-            .into_iter()
-            .any(|h| halos.within(h.0, fn_.surface, &ring_near));
-        let near_hiders = halos.hiders(s.x, s.w[near], (fn_.surface, &ring_near));
+        // One search answers both sheets: the far sheet is hidden by the near sheet's halo
+        // (not its own) where the depth is below its w, the near sheet by any halo but its
+        // own where the depth is below its (smaller) w.
+        let containing = halos.containing(s.x);
+        let far_hidden = containing.iter().any(|&(g, depth)| {
+            depth < s.w[far]
+                && !halos.within(g, ff.surface, &ring_far)
+                && halos.within(g, fn_.surface, &ring_near)
+        });
+        let near_hiders: Vec<u32> = containing
+            .iter()
+            .filter(|&&(g, depth)| depth < s.w[near] && !halos.within(g, fn_.surface, &ring_near))
+            .map(|&(g, _)| g)
+            .collect();
         let by_far = near_hiders
             .iter()
-            .any(|h| halos.within(h.0, ff.surface, &ring_far));
+            .any(|&g| halos.within(g, ff.surface, &ring_far));
         if far_hidden && !by_far {
             if near_hiders.is_empty() {
                 v.correct += 1;
