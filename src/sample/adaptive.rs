@@ -38,6 +38,7 @@
 use super::{AUDIT_POINTS, Classes, Mesh4};
 use crate::surfaces::{Domain, Side, SideRule, Surface};
 use glam::DVec4;
+use rayon::prelude::*;
 use spade::handles::FixedVertexHandle;
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 use std::collections::{BTreeSet, HashMap, VecDeque};
@@ -658,33 +659,16 @@ impl<'a> Sampler<'a> {
             triangles: &triangles,
             max_triangles,
         };
-        let threads = std::thread::available_parallelism()
-            .map_or(1, |t| t.get())
-            .clamp(1, 16);
-        let chunk = self.patches.len().div_ceil(threads).max(1);
         loop {
-            let within_budget = std::thread::scope(|scope| {
-                let handles: Vec<_> = self
-                    .patches
-                    .chunks_mut(chunk)
-                    .enumerate()
-                    .map(|(c, patches)| {
-                        let cx = &cx;
-                        scope.spawn(move || {
-                            patches
-                                .iter_mut()
-                                .enumerate()
-                                .all(|(i, p)| p.refine(c * chunk + i, cx))
-                        })
-                    })
-                    .collect();
-                // Join every thread before looking at the verdicts.
-                let done: Vec<bool> = handles
-                    .into_iter()
-                    .map(|h| h.join().expect("refinement thread panicked"))
-                    .collect();
-                done.into_iter().all(|d| d)
-            });
+            // Every patch refines on its own; all finish their round before the verdicts
+            // are read.
+            let done: Vec<bool> = self
+                .patches
+                .par_iter_mut()
+                .enumerate()
+                .map(|(i, p)| p.refine(i, &cx))
+                .collect();
+            let within_budget = done.into_iter().all(|d| d);
             // The seams conform even when the budget stopped the round.
             self.exchange();
             if !within_budget {
