@@ -105,7 +105,7 @@ pub struct MemoryReport {
 
 impl Built {
     /// The build's verdict: what keeps it from being verified, empty when it is. Every
-    /// surface has a halo that passes the checker ([`CheckStats::passes`]), every curve is
+    /// surface has a halo that passes the checker ([`crate::check::CheckStats::passes`]), every curve is
     /// resolved, and the halos' verification found no wrong curve sample and no spurious
     /// hidden surface sample.
     pub fn failures(&self) -> Vec<String> {

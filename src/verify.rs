@@ -12,24 +12,20 @@
 //!
 //! - Along every curve (at each event and each segment's midpoint) the sheet farther in w
 //!   must be hidden by the halo of the nearer sheet, and the nearer sheet must not be hidden
-//!   by the farther's (`correct`, else `wrong`). A sample is `ambiguous` where the two
-//!   sheets' w differ by no more than w varies across their triangles there (what the mesh
-//!   resolves), where the two triangles are within two rings of each other on one surface
-//!   (a branch point, as at a cross-cap, where the halo must vanish), where the nearer
-//!   sheet's triangle is on its mesh's boundary (where its halo ends in a side wall, whose
-//!   split quads leave the boundary edge itself just inside or just outside), or where the
-//!   nearer sheet's halo has zero width at a corner of its triangle (collapsed where the
-//!   projection is singular or folds tighter than any halo fits: the halo vanishes there
-//!   by construction, as at a cross-cap, and with all three corners collapsed the prism has
-//!   no tetrahedron at all; such a sample is ambiguous only where the halo does not explain
-//!   it, and correct where it does). Each ambiguous sample counts under its first
-//!   reason in that order ([`Ambiguous`]). Where a
-//!   third sheet's halo hides the nearer sheet (near triple points) the sample counts as
-//!   `third_sheet`.
-//! - Away from the curves: at every surface vertex and triangle centroid, a hidden point must
-//!   be within rho of the sheet whose halo hides it (the distance to the surface points the
-//!   tetrahedron was built over, against the largest half-width there); a point hidden with
-//!   no such sheet near is `spurious`.
+//!   by the farther's (`correct`; `third_sheet` where a third sheet's halo also hides the
+//!   nearer one, near triple points). A sample the halos do not explain is `wrong` unless a
+//!   reason excuses it as `ambiguous`, the first that applies in the order of
+//!   [`Ambiguous`]: within [`BRANCH_REACH`] halo widths of a curve's end at a branch point
+//!   or at a boundary, where the nearer sheet's halo vanished at a corner of its triangle,
+//!   or where the mesh does not separate the sheets. The reaches are geometry (the halo's
+//!   width), not the mesh's size, so the verdict does not depend on the resolution.
+//! - Away from the curves: no point of a sheet may be hidden by a tetrahedron farther than
+//!   rho from the surface points it was built over (`spurious`, counted at every surface
+//!   vertex and triangle centroid). Checked per tetrahedron corner (`far_tetrahedra`),
+//!   which covers every point of the halo; only the tetrahedra that fail are searched.
+//!
+//! Linear in the input: no index over all tetrahedra is built; the curve samples see only
+//! the tetrahedra whose boxes hold one.
 
 use crate::intersect::broad;
 use crate::intersect::sos::orient3d;
@@ -332,6 +328,15 @@ fn inserted_sets(h: &HaloInput) -> Vec<Vec<u32>> {
     sets
 }
 
+/// The f32 box around tetrahedron `i` of `h` (rounded outward).
+fn tet_box(h: &HaloInput, i: u32) -> Aabb {
+    let p = h.tets[i as usize].map(|v| h.positions[v as usize]);
+    broad::outward(
+        p[0].min(p[1]).min(p[2]).min(p[3]),
+        p[0].max(p[1]).max(p[2]).max(p[3]),
+    )
+}
+
 const EXAMPLES: usize = 8;
 
 /// Adds `x` to a list of examples unless it is full or has `x` already.
@@ -387,11 +392,7 @@ impl<'a> HaloIndex<'a> {
                 .filter(|&i| keep(s, i))
                 .map(|i| {
                     let tet = h.tets[i as usize];
-                    let p = tet.map(|v| h.positions[v as usize]);
-                    let aabb = broad::outward(
-                        p[0].min(p[1]).min(p[2]).min(p[3]),
-                        p[0].max(p[1]).max(p[2]).max(p[3]),
-                    );
+                    let aabb = tet_box(h, i);
                     let mut vs: Vec<u32> = Vec::with_capacity(8);
                     for &k in &tet {
                         if k < 3 * n {
@@ -573,12 +574,7 @@ impl<'a> Index<'a> {
         let samples = broad::build(&boxes, 4);
         // Whether the box of tetrahedron i of surface s holds a curve sample.
         let near_curve = |s: usize, i: u32| {
-            let h = halos[s].as_ref().expect("a tetrahedron of a halo");
-            let p = h.tets[i as usize].map(|v| h.positions[v as usize]);
-            let aabb = broad::outward(
-                p[0].min(p[1]).min(p[2]).min(p[3]),
-                p[0].max(p[1]).max(p[2]).max(p[3]),
-            );
+            let aabb = tet_box(halos[s].as_ref().expect("a tetrahedron of a halo"), i);
             let mut found = false;
             samples.aabb_traverse(aabb, |bvh, node| {
                 let node = &bvh.nodes[node as usize];
