@@ -128,7 +128,10 @@ fn render_sweep(scene: &Scene, slices: &[u32], out: &Path, quiet: bool) -> ExitC
         eprintln!("error: --slices: every count must be 1 to 4096, got {bad}");
         return ExitCode::FAILURE;
     }
-    let built = match halo4d::run(scene, quiet) {
+    // The stages a picture needs, whatever files the scene writes.
+    let mut picture = scene.clone();
+    picture.outputs.png = true;
+    let built = match halo4d::run(&picture, quiet) {
         Ok(b) => b,
         Err(e) => return fail(&e),
     };
@@ -332,6 +335,8 @@ fn main() -> ExitCode {
                     .join(&scene.name)
                     .join(format!("{}.png", scene.name))
             });
+            // The stages a picture needs, whatever files the scene writes.
+            scene.outputs.png = true;
             let built = match halo4d::run(&scene, quiet) {
                 Ok(b) => b,
                 Err(e) => return fail(&e),

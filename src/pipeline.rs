@@ -104,10 +104,10 @@ pub struct MemoryReport {
 }
 
 impl Built {
-    /// The build's verdict: what keeps it from being verified, empty when it is. Every
-    /// surface has a halo that passes the checker ([`crate::check::CheckStats::passes`]), every curve is
-    /// resolved, and the halos' verification found no wrong curve sample and no spurious
-    /// hidden surface sample.
+    /// The build's verdict: what keeps it from being verified, empty when it is. Of the
+    /// stages that ran: every surface has a halo that passes the checker
+    /// ([`crate::check::CheckStats::passes`]), every curve is resolved, and the halos'
+    /// verification found no wrong curve sample and no spurious hidden surface sample.
     pub fn failures(&self) -> Vec<String> {
         let mut out = Vec::new();
         for p in self.surfaces.iter().filter(|_| self.stages.halos) {

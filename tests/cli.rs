@@ -545,6 +545,37 @@ fn a_build_runs_only_the_stages_its_outputs_need() {
     assert!(!folder.exists());
 }
 
+#[test]
+fn a_picture_gets_its_halos_whatever_files_the_scene_writes() {
+    // `halo4d render` makes a picture, so it runs the stages a picture needs even for a
+    // scene that writes only its report: the same PNG as with every output.
+    let dir = tempfile::tempdir().unwrap();
+    let small = r#""render": {"width": 96, "height": 96, "samples": 1}"#;
+    let mut pictures = Vec::new();
+    for (name, outputs) in [
+        ("all", "{}"),
+        (
+            "report",
+            r#"{"glb": false, "ply": false, "vtk": false, "png": false}"#,
+        ),
+    ] {
+        let file = patches_scene(
+            dir.path(),
+            name,
+            &format!(r#"{{"outputs": {outputs}, {small}}}"#),
+        );
+        let png = format!("{name}.png");
+        let out = halo4d(&["render", &file, "--out", &png, "--quiet"], dir.path());
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        pictures.push(std::fs::read(dir.path().join(png)).unwrap());
+    }
+    assert_eq!(pictures[0], pictures[1]);
+}
+
 fn folder_names(dir: &std::path::Path) -> Vec<String> {
     folder(dir).into_iter().map(|(name, _)| name).collect()
 }
