@@ -56,6 +56,14 @@ pub struct HaloInput<'a> {
     pub delta_t: f64,
 }
 
+impl HaloInput<'_> {
+    /// Surface vertex v's half-width rho: half the distance between its two offsets.
+    fn half_width(&self, v: usize) -> f64 {
+        let n = self.surface_vertices;
+        (self.positions[v + n] - self.positions[v]).length() * 0.5
+    }
+}
+
 /// `report.json`'s `halo_verification`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Verification {
@@ -269,7 +277,6 @@ fn far_tetrahedra(sheets: &[Sheet], halos: &[Option<HaloInput>], tolerance: f64)
         .map(|(sheet, halo)| {
             let Some(h) = halo else { return Vec::new() };
             let n = h.surface_vertices;
-            let half_width = |v: usize| (h.positions[v + n] - h.positions[v]).length() * 0.5;
             let inserted = inserted_sets(h);
             // Per halo vertex: (distance to what it stands for, largest rho there).
             let reach: Vec<(f64, f64)> = (0..h.positions.len())
@@ -279,7 +286,7 @@ fn far_tetrahedra(sheets: &[Sheet], halos: &[Option<HaloInput>], tolerance: f64)
                         let v = k % n;
                         (
                             (h.positions[k] - sheet.positions[v]).length(),
-                            half_width(v),
+                            h.half_width(v),
                         )
                     } else {
                         let set = &inserted[k - 3 * n];
@@ -287,7 +294,7 @@ fn far_tetrahedra(sheets: &[Sheet], halos: &[Option<HaloInput>], tolerance: f64)
                             set.iter().map(|&v| sheet.positions[v as usize]).collect();
                         let rho = set
                             .iter()
-                            .map(|&v| half_width(v as usize))
+                            .map(|&v| h.half_width(v as usize))
                             .fold(0.0, f64::max);
                         (distance_to_hull(h.positions[k], &points), rho)
                     }
@@ -590,10 +597,9 @@ impl<'a> Index<'a> {
             .iter()
             .map(|h| {
                 h.as_ref().map_or(0.0, |h| {
-                    let n = h.surface_vertices;
-                    (0..n)
+                    (0..h.surface_vertices)
                         .into_par_iter()
-                        .map(|v| (h.positions[v + n] - h.positions[v]).length() * 0.5)
+                        .map(|v| h.half_width(v))
                         .reduce(|| 0.0, f64::max)
                 })
             })
@@ -728,12 +734,9 @@ impl<'a> Index<'a> {
             let surface = far.tets[h.0 as usize].0 as usize;
             let sheet = &self.sheets[surface];
             let halo = far.halos[surface].as_ref().expect("tet of a halo");
-            let n = halo.surface_vertices;
             let rho = far
                 .over(h.0)
-                .map(|k| {
-                    (halo.positions[k as usize + n] - halo.positions[k as usize]).length() * 0.5
-                })
+                .map(|k| halo.half_width(k as usize))
                 .fold(0.0, f64::max);
             let points: Vec<DVec3> = far.over(h.0).map(|k| sheet.positions[k as usize]).collect();
             distance_to_hull(x, &points) > rho + tolerance
