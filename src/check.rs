@@ -223,19 +223,28 @@ pub const SAFE_RANGE: f64 = 1e80;
 /// into [0.5, 1) (exact: every orientation is kept, and `robust::orient3d` cannot overflow),
 /// the factor that scales volumes back, and which vertices have a coordinate too small for
 /// the predicates to stay exact ([`SAFE_RANGE`]).
-fn scaled(positions: &[[f64; 3]]) -> (Vec<[f64; 3]>, f64, Vec<bool>) {
+fn scaled<P: Copy + Into<[f64; 3]> + Sync>(positions: &[P]) -> (Vec<[f64; 3]>, f64, Vec<bool>) {
     let largest = positions
-        .iter()
-        .flatten()
-        .fold(0.0f64, |m, x| m.max(x.abs()));
+        .par_iter()
+        .map(|&p| {
+            Into::<[f64; 3]>::into(p)
+                .map(f64::abs)
+                .into_iter()
+                .fold(0.0, f64::max)
+        })
+        .reduce(|| 0.0, f64::max);
     if !(largest.is_finite() && largest > 0.0) {
-        return (positions.to_vec(), 1.0, vec![false; positions.len()]);
+        let out = positions.iter().map(|&p| p.into()).collect();
+        return (out, 1.0, vec![false; positions.len()]);
     }
     // 2^-e with largest = m 2^e, m in [0.5, 1); in two steps, each a normal power of two.
     let e = largest.log2().floor() as i32 + 1;
     let (a, b) = (-e / 2, -e - (-e / 2));
     let scale = |x: f64| x * 2f64.powi(a) * 2f64.powi(b);
-    let out: Vec<[f64; 3]> = positions.iter().map(|p| p.map(scale)).collect();
+    let out: Vec<[f64; 3]> = positions
+        .par_iter()
+        .map(|&p| Into::<[f64; 3]>::into(p).map(scale))
+        .collect();
     let tiny = out
         .iter()
         .map(|p| p.iter().any(|&x| x != 0.0 && x.abs() * SAFE_RANGE < 1.0))
@@ -246,33 +255,48 @@ fn scaled(positions: &[[f64; 3]]) -> (Vec<[f64; 3]>, f64, Vec<bool>) {
 /// A face (sorted vertex triple) with the vertex opposite it in its tetrahedron.
 type Face = ([u32; 3], u32);
 
-/// Orientation, volume and angle of `tets` (indices already canonical), on positions
-/// [`scaled`], with which vertices are too small to decide; writes each tetrahedron's four
-/// faces into `faces` (a degenerate one's as four faces past the last vertex).
-fn examine(
-    tets: &[[u32; 4]],
-    faces: &mut [Face],
-    positions: &[[f64; 3]],
-    tiny: &[bool],
-) -> CheckStats {
+/// What stands for a degenerate tetrahedron among the sorted ones: no vertex index can be
+/// this large (a mesh of 2^32 vertices would need 96 GiB of positions).
+const DEGENERATE: [u32; 4] = [u32::MAX; 4];
+
+/// A tetrahedron's vertices in increasing order and whether that order is an odd
+/// permutation of the given one (its orientation turned over); [`DEGENERATE`] when it
+/// repeats a vertex or names one past the last of `vertices`.
+fn sorted_tet(tet: [u32; 4], vertices: usize) -> ([u32; 4], bool) {
+    let (mut s, mut odd) = (tet, false);
+    // A sorting network for four, each exchange one transposition.
+    for (i, j) in [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)] {
+        if s[i] > s[j] {
+            s.swap(i, j);
+            odd = !odd;
+        }
+    }
+    if s[0] < s[1] && s[1] < s[2] && s[2] < s[3] && (s[3] as usize) < vertices {
+        (s, odd)
+    } else {
+        (DEGENERATE, false)
+    }
+}
+
+/// Orientation, volume and angle of `tets` (sorted, with their parities), on positions
+/// [`scaled`], with which vertices are too small to decide.
+fn examine(tets: &[[u32; 4]], odd: &[bool], positions: &[[f64; 3]], tiny: &[bool]) -> CheckStats {
     let mut s = CheckStats {
         min_volume: f64::INFINITY,
         max_volume: f64::NEG_INFINITY,
         min_dihedral_deg: 180.0,
         ..CheckStats::default()
     };
-    let nv = positions.len();
     let mut dihedral_cosine = -1.0f64;
-    for (tet, out) in tets.iter().zip(faces.chunks_exact_mut(4)) {
-        let mut sorted = *tet;
-        sorted.sort_unstable();
-        if sorted.windows(2).any(|w| w[0] == w[1]) || sorted[3] as usize >= nv {
+    for (tet, &odd) in tets.iter().zip(odd) {
+        if *tet == DEGENERATE {
             s.degenerate += 1;
-            out.fill(([nv as u32; 3], 0));
             continue;
         }
+        let sign = if odd { -1.0 } else { 1.0 };
         let p = tet.map(|i| positions[i as usize]);
-        let o = robust::orient3d(c3(p[0]), c3(p[1]), c3(p[2]), c3(p[3]));
+        // Exact, so its sign turns over exactly with the vertex order.
+        let o = sign * robust::orient3d(c3(p[0]), c3(p[1]), c3(p[2]), c3(p[3]));
         if tet.iter().any(|&i| tiny[i as usize]) {
             s.undecidable += 1;
         } else if o < 0.0 {
@@ -280,18 +304,11 @@ fn examine(
         } else if o == 0.0 {
             s.flat += 1;
         }
-        let v = volume(p);
+        let v = sign * volume(p);
         s.volume += v.abs();
         s.min_volume = s.min_volume.min(v);
         s.max_volume = s.max_volume.max(v);
         dihedral_cosine = dihedral_cosine.max(smallest_dihedral_cosine(p));
-        let [a, b, c, d] = sorted;
-        out.copy_from_slice(&[
-            ([b, c, d], a),
-            ([a, c, d], b),
-            ([a, b, d], c),
-            ([a, b, c], d),
-        ]);
     }
     s.min_dihedral_deg = dihedral_cosine.clamp(-1.0, 1.0).acos().to_degrees();
     s
@@ -325,14 +342,112 @@ fn bucket_sort<T: Ord + Copy + Default + Send>(
     out
 }
 
+/// The tetrahedra that can hold a face whose smallest vertex is v: those whose smallest or
+/// second smallest vertex is v, each listed under v by its other three vertices in
+/// increasing order (every tetrahedron is listed twice, degenerate ones never). A face is
+/// found by its smallest vertex among a few entries side by side in memory, with no list of
+/// all faces (at a million triangles that list would be 24 million faces, sorted).
+struct Incidence {
+    starts: Vec<usize>,
+    others: Vec<[u32; 3]>,
+}
+
+impl Incidence {
+    /// From sorted tetrahedra.
+    fn new(tets: &[[u32; 4]], vertices: usize) -> Self {
+        let mut starts = vec![0usize; vertices + 1];
+        for t in tets.iter().filter(|&t| *t != DEGENERATE) {
+            starts[t[0] as usize + 1] += 1;
+            starts[t[1] as usize + 1] += 1;
+        }
+        for i in 0..vertices {
+            starts[i + 1] += starts[i];
+        }
+        let mut fill = starts.clone();
+        let mut others = vec![[0u32; 3]; starts[vertices]];
+        for &[a, b, c, d] in tets.iter().filter(|&t| *t != DEGENERATE) {
+            for (v, rest) in [(a, [b, c, d]), (b, [a, c, d])] {
+                others[fill[v as usize]] = rest;
+                fill[v as usize] += 1;
+            }
+        }
+        Incidence { starts, others }
+    }
+
+    fn at(&self, v: u32) -> &[[u32; 3]] {
+        &self.others[self.starts[v as usize]..self.starts[v as usize + 1]]
+    }
+
+    /// How many tetrahedra hold face f.
+    fn count(&self, f: [u32; 3]) -> usize {
+        let f = key(f);
+        if f[0] as usize + 1 >= self.starts.len() {
+            return 0;
+        }
+        self.at(f[0])
+            .iter()
+            .filter(|e| e.contains(&f[1]) && e.contains(&f[2]))
+            .count()
+    }
+}
+
+/// Vertices per parallel task of the face count: a fixed number, so that the boundary faces
+/// come out in the same order on any number of threads.
+const FACE_RUN: usize = 1 << 12;
+
+/// The faces whose smallest vertex is in `vertices`, grouped: counts of interior and
+/// overshared faces and of repeated tetrahedra, and the boundary faces (in increasing order)
+/// with the vertex opposite each.
+fn faces_from(vertices: std::ops::Range<usize>, incidence: &Incidence) -> (CheckStats, Vec<Face>) {
+    let mut s = CheckStats::default();
+    let mut boundary = Vec::new();
+    let mut faces: Vec<Face> = Vec::new();
+    for v in vertices {
+        let v = v as u32;
+        faces.clear();
+        for &[a, b, c] in incidence.at(v) {
+            if a > v {
+                faces.extend([([v, b, c], a), ([v, a, c], b), ([v, a, b], c)]);
+            } else {
+                faces.push(([v, b, c], a));
+            }
+        }
+        faces.sort_unstable();
+        for group in faces.chunk_by(|a, b| a.0 == b.0) {
+            let k = group[0].0;
+            // A repeated tetrahedron repeats every face with the same opposite vertex; count
+            // it once, at the face opposite its largest vertex.
+            for (i, &(_, o)) in group.iter().enumerate() {
+                if o > k[2] && group[..i].iter().any(|&(_, other)| other == o) {
+                    s.duplicate_tets += 1;
+                }
+            }
+            match group.len() {
+                1 => boundary.push(group[0]),
+                2 => s.interior_faces += 1,
+                _ => s.overshared_faces += 1,
+            }
+        }
+    }
+    (s, boundary)
+}
+
 /// Checks a tetrahedral halo (see the module documentation).
 pub fn check(mesh: &TetMesh) -> CheckStats {
-    let n = mesh.surface_vertices;
-    let nv = mesh.positions.len();
-    let positions = &mesh.positions;
-    let collapsed: Vec<bool> = (0..n)
-        .map(|v| n + v < nv && positions[v] == positions[n + v])
-        .collect();
+    check_parts(&mesh.positions, mesh.surface_vertices, &mesh.tets)
+}
+
+/// [`check`] on borrowed parts: vertex positions, the number n of surface vertices and the
+/// tetrahedra (what [`TetMesh`] holds), so that a halo is checked without a copy of it.
+pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
+    positions: &[P],
+    surface_vertices: usize,
+    tets: &[[u32; 4]],
+) -> CheckStats {
+    let n = surface_vertices;
+    let nv = positions.len();
+    let at = |i: usize| -> [f64; 3] { positions[i].into() };
+    let collapsed: Vec<bool> = (0..n).map(|v| n + v < nv && at(v) == at(n + v)).collect();
     // `canon`: collapsed vertices under one index, the negative offset's (a surface vertex
     // at another point than its collapsed offsets keeps its own); `mid`: surface vertex x's
     // own vertex (2n + x) under that index; `partner`: the offset of the same surface vertex
@@ -340,14 +455,11 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     // offset or surface vertex stands for.
     let canon = |i: u32| {
         let i = i as usize;
-        let v = i % n.max(1);
-        let folded = match i {
-            _ if (n..2 * n).contains(&i) => collapsed[v],
-            _ if (2 * n..3 * n).contains(&i) => {
-                collapsed[v] && i < nv && positions[i] == positions[v]
-            }
-            _ => false,
-        };
+        if i < n || i >= 3 * n {
+            return i as u32;
+        }
+        let v = if i < 2 * n { i - n } else { i - 2 * n };
+        let folded = collapsed[v] && (i < 2 * n || (i < nv && at(i) == at(v)));
         if folded { v as u32 } else { i as u32 }
     };
     let mid = |x: u32| canon(2 * n as u32 + x);
@@ -362,20 +474,25 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     let offset = |i: u32| (i as usize) < 2 * n;
     let surface_vertex = |i: u32| ((i as usize) < 3 * n).then(|| (i as usize % n.max(1)) as u32);
 
-    let tets: Vec<[u32; 4]> = mesh.tets.par_iter().map(|t| t.map(canon)).collect();
+    // Every tetrahedron under canonical indices, sorted, with its parity.
+    let tet_count = tets.len();
+    let (tets, odd): (Vec<[u32; 4]>, Vec<bool>) = tets
+        .par_iter()
+        .map(|t| sorted_tet(t.map(canon), nv))
+        .unzip();
     let (scaled, volume_scale, tiny) = scaled(positions);
     let (positions, tiny) = (&scaled, &tiny);
     // Runs of CHECK_RUN tetrahedra on the cores, summed in order: the volume's rounding
     // depends on the runs only, not on the number of threads.
-    let mut faces: Vec<Face> = vec![([0; 3], 0); 4 * tets.len()];
     let partials: Vec<CheckStats> = tets
         .par_chunks(CHECK_RUN)
-        .zip(faces.par_chunks_mut(4 * CHECK_RUN))
-        .map(|(part, faces)| examine(part, faces, positions, tiny))
+        .zip(odd.par_chunks(CHECK_RUN))
+        .map(|(part, odd)| examine(part, odd, positions, tiny))
         .collect();
+    drop(odd);
     let mut s = CheckStats {
         vertices: nv,
-        tets: mesh.tets.len(),
+        tets: tet_count,
         collapsed_vertices: collapsed.iter().filter(|&&c| c).count(),
         min_volume: f64::INFINITY,
         max_volume: f64::NEG_INFINITY,
@@ -395,175 +512,169 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     if s.tets == s.degenerate {
         (s.min_volume, s.max_volume, s.min_dihedral_deg) = (0.0, 0.0, 0.0);
     }
-    // The degenerate tetrahedra's faces, past the last vertex, sort last: dropped.
-    let mut faces = bucket_sort(faces, nv + 1, |f| f.0[0]);
-    faces.truncate(4 * (s.tets - s.degenerate));
 
-    // Distinct faces with their use counts; boundary faces with their tetrahedron.
-    let mut keys: Vec<[u32; 3]> = Vec::with_capacity(faces.len() / 2 + 1);
-    let mut counts: Vec<u32> = Vec::with_capacity(faces.len() / 2 + 1);
-    let mut boundary: Vec<([u32; 3], u32)> = Vec::new();
-    for group in faces.chunk_by(|a, b| a.0 == b.0) {
-        let k = group[0].0;
-        // A repeated tetrahedron repeats every face with the same opposite vertex; count it
-        // once, at the face opposite its largest vertex.
-        for (i, &(_, o)) in group.iter().enumerate() {
-            if o > k[2] && group[..i].iter().any(|&(_, other)| other == o) {
-                s.duplicate_tets += 1;
-            }
-        }
-        match group.len() {
-            1 => boundary.push(group[0]),
-            2 => s.interior_faces += 1,
-            _ => s.overshared_faces += 1,
-        }
-        keys.push(k);
-        counts.push(group.len() as u32);
+    // Every face counted at its smallest vertex; boundary faces kept with their
+    // tetrahedron's fourth vertex, in increasing order.
+    let incidence = Incidence::new(&tets, nv);
+    drop(tets);
+    let runs: Vec<(CheckStats, Vec<Face>)> = (0..nv.div_ceil(FACE_RUN))
+        .into_par_iter()
+        .map(|r| faces_from(r * FACE_RUN..nv.min((r + 1) * FACE_RUN), &incidence))
+        .collect();
+    let mut boundary: Vec<Face> = Vec::with_capacity(runs.iter().map(|r| r.1.len()).sum());
+    for (q, faces) in runs {
+        s.duplicate_tets += q.duplicate_tets;
+        s.interior_faces += q.interior_faces;
+        s.overshared_faces += q.overshared_faces;
+        boundary.extend(faces);
     }
     s.boundary_faces = boundary.len();
-    // Where each first vertex's distinct faces start in `keys`.
-    let mut key_starts = vec![0usize; nv + 1];
-    for k in &keys {
-        key_starts[k[0] as usize + 1] += 1;
-    }
-    for i in 0..nv {
-        key_starts[i + 1] += key_starts[i];
-    }
-    let count = |f: [u32; 3]| {
-        let f = key(f);
-        if f[0] as usize >= nv {
-            return 0;
-        }
-        let bucket = &keys[key_starts[f[0] as usize]..key_starts[f[0] as usize + 1]];
-        bucket
-            .iter()
-            .position(|&k| k == f)
-            .map_or(0, |i| counts[key_starts[f[0] as usize] + i])
-    };
+    let count = |f: [u32; 3]| incidence.count(f);
     // Whether two offsets lie on the same side (both negative or both positive).
     let same_side = |a: u32, b: u32| (a < n as u32) == (b < n as u32);
 
     // Offset faces (three offsets of three surface vertices) by surface triangle; the other
-    // boundary faces to classify once the open edges are known.
-    let mut offset_faces: Vec<([u32; 3], [u32; 3])> = Vec::new();
-    let mut others: Vec<[u32; 3]> = Vec::new();
-    let mut boundary_volume = 0.0;
-    for &(k, o) in &boundary {
-        // Turned so that the opposite vertex lies above it: outward, clockwise seen from
-        // outside.
-        let mut f = k;
-        let [pa, pb, pc, po] = [k[0], k[1], k[2], o].map(|i| c3(positions[i as usize]));
-        if robust::orient3d(pa, pb, pc, po) > 0.0 {
-            f.swap(1, 2);
-        }
-        let [a, b, c] = f.map(|i| positions[i as usize]);
-        // The divergence theorem, signed for that orientation.
-        boundary_volume -= dot(a, cross(b, c)) / 6.0;
-        match k.map(surface_vertex) {
-            [Some(x), Some(y), Some(z)]
-                if x != y && y != z && x != z && k.iter().all(|&i| offset(i)) =>
-            {
-                offset_faces.push((key([x, y, z]), k));
+    // boundary faces to classify once the open edges are known. In runs of a fixed size,
+    // the boundary's volume summed in order.
+    let sorted_boundary: Vec<(f64, Vec<([u32; 3], [u32; 3])>, Vec<[u32; 3]>)> = boundary
+        .par_chunks(CHECK_RUN)
+        .map(|part| {
+            let (mut volume, mut offset_faces, mut others) = (0.0, Vec::new(), Vec::new());
+            for &(k, o) in part {
+                // Turned so that the opposite vertex lies above it: outward, clockwise seen
+                // from outside.
+                let mut f = k;
+                let [pa, pb, pc, po] = [k[0], k[1], k[2], o].map(|i| c3(positions[i as usize]));
+                if robust::orient3d(pa, pb, pc, po) > 0.0 {
+                    f.swap(1, 2);
+                }
+                let [a, b, c] = f.map(|i| positions[i as usize]);
+                // The divergence theorem, signed for that orientation.
+                volume -= dot(a, cross(b, c)) / 6.0;
+                match k.map(surface_vertex) {
+                    [Some(x), Some(y), Some(z)]
+                        if x != y && y != z && x != z && k.iter().all(|&i| offset(i)) =>
+                    {
+                        offset_faces.push((key([x, y, z]), k));
+                    }
+                    _ => others.push(k),
+                }
             }
-            _ => others.push(k),
-        }
+            (volume, offset_faces, others)
+        })
+        .collect();
+    drop(boundary);
+    let (mut offset_faces, mut others) = (Vec::new(), Vec::new());
+    for (volume, o, k) in sorted_boundary {
+        s.boundary_volume += volume;
+        offset_faces.extend(o);
+        others.extend(k);
     }
-    s.boundary_volume = boundary_volume;
     let offset_faces = bucket_sort(offset_faces, n, |f| f.0[0]);
     // Surface edges, each with the side pairing of the offset face's edge over it: `true`
     // when that edge joins two offsets on the same side (its quad's perimeter runs
     // straight, so the diagonals cross sides), `None` at a collapsed end.
-    let mut edges: Vec<([u32; 2], Option<bool>)> = Vec::new();
-    for group in offset_faces.chunk_by(|a, b| a.0 == b.0) {
-        let opposite = group.len() == 2 && key(group[0].1.map(partner)) == group[1].1;
-        if !opposite {
-            s.missing_offset_faces += 1;
-        }
-        if count(group[0].0.map(mid)) != 2 {
-            s.missing_surface_faces += 1;
-        }
-        let face = group[0].1;
-        for (i, j) in [(0, 1), (0, 2), (1, 2)] {
-            let (a, b) = (face[i], face[j]);
-            let (x, y) = (
-                surface_vertex(a).unwrap_or(0),
-                surface_vertex(b).unwrap_or(0),
-            );
-            let straight = (partner(a) != a && partner(b) != b).then(|| same_side(a, b));
-            edges.push(([x.min(y), x.max(y)], straight));
-        }
+    type Edge = ([u32; 2], Option<bool>);
+    let triangles: Vec<(bool, bool, [Edge; 3])> = offset_faces
+        .par_chunk_by(|a, b| a.0 == b.0)
+        .map(|group| {
+            let opposite = group.len() == 2 && key(group[0].1.map(partner)) == group[1].1;
+            let face = group[0].1;
+            let edges = [(0, 1), (0, 2), (1, 2)].map(|(i, j)| {
+                let (a, b) = (face[i], face[j]);
+                let (x, y) = (
+                    surface_vertex(a).unwrap_or(0),
+                    surface_vertex(b).unwrap_or(0),
+                );
+                let straight = (partner(a) != a && partner(b) != b).then(|| same_side(a, b));
+                ([x.min(y), x.max(y)], straight)
+            });
+            (!opposite, count(group[0].0.map(mid)) != 2, edges)
+        })
+        .collect();
+    drop(offset_faces);
+    let mut edges: Vec<Edge> = Vec::with_capacity(3 * triangles.len());
+    for (missing_offset, missing_surface, e) in triangles {
+        s.missing_offset_faces += missing_offset as usize;
+        s.missing_surface_faces += missing_surface as usize;
+        edges.extend(e);
     }
     let edges = bucket_sort(edges, n, |e| e.0[0]);
 
-    // Quads over surface edges; the edges used by one surface triangle are open.
-    let mut open: Vec<[u32; 2]> = Vec::new();
-    for group in edges.chunk_by(|a, b| a.0 == b.0) {
-        let [x, y] = group[0].0;
-        let expected = if group.len() >= 2 { 2 } else { 1 };
-        if group.len() == 1 {
-            open.push([x, y]);
-        }
-        let (x1, y1) = (partner(x), partner(y));
-        if x1 == x && y1 == y {
-            continue;
-        }
-        // Each half of the quad, from an offset edge (a, b) to the surface edge: split along
-        // a diagonal, the two faces on one of them each used `expected` times and the other
-        // two unused, or, with a collapsed end, one triangle used `expected` times. The offset
-        // edges join offsets on one side where the offset faces' edges do (else the halves
-        // cross sides, at a twist); every prism over the edge must see the same.
-        let straight = group[0].1;
-        let agree = group.iter().all(|e| e.1 == straight);
-        let split = |a: u32, b: u32, c: u32, d: u32| {
-            // Diagonal (a, b); the other diagonal (c, d).
-            count([a, b, c]) == expected
-                && count([a, b, d]) == expected
-                && count([c, d, a]) == 0
-                && count([c, d, b]) == 0
-        };
-        let half = |a: u32, b: u32| {
-            let (ma, mb) = (
-                mid(surface_vertex(a).unwrap_or(0)),
-                mid(surface_vertex(b).unwrap_or(0)),
-            );
-            match (ma == a, mb == b) {
-                (true, true) => true,
-                (true, false) => count([a, b, mb]) == expected,
-                (false, true) => count([a, b, ma]) == expected,
-                (false, false) => split(a, mb, b, ma) || split(b, ma, a, mb),
+    // Quads over surface edges (whether each is split right); the edges used by one
+    // surface triangle are open.
+    let quads: Vec<(bool, Option<[u32; 2]>)> = edges
+        .par_chunk_by(|a, b| a.0 == b.0)
+        .map(|group| {
+            let [x, y] = group[0].0;
+            let expected = if group.len() >= 2 { 2 } else { 1 };
+            let open = (group.len() == 1).then_some([x, y]);
+            let (x1, y1) = (partner(x), partner(y));
+            if x1 == x && y1 == y {
+                return (true, open);
             }
-        };
-        let quad = agree
-            && if straight == Some(false) {
-                half(x, y1) && half(x1, y)
-            } else {
-                half(x, y) && half(x1, y1)
+            // Each half of the quad, from an offset edge (a, b) to the surface edge: split
+            // along a diagonal, the two faces on one of them each used `expected` times and
+            // the other two unused, or, with a collapsed end, one triangle used `expected`
+            // times. The offset edges join offsets on one side where the offset faces' edges
+            // do (else the halves cross sides, at a twist); every prism over the edge must
+            // see the same.
+            let straight = group[0].1;
+            let agree = group.iter().all(|e| e.1 == straight);
+            let split = |a: u32, b: u32, c: u32, d: u32| {
+                // Diagonal (a, b); the other diagonal (c, d).
+                count([a, b, c]) == expected
+                    && count([a, b, d]) == expected
+                    && count([c, d, a]) == 0
+                    && count([c, d, b]) == 0
             };
-        if !quad {
-            s.quad_mismatches += 1;
-        }
-    }
-    for k in others {
-        let wall = match k.map(surface_vertex) {
-            [Some(a), Some(b), Some(c)] => {
-                // Over exactly two surface vertices, an open edge.
-                let mut e = [a, b, c];
-                e.sort_unstable();
-                let pair = if e[0] == e[1] {
-                    [e[0], e[2]]
+            let half = |a: u32, b: u32| {
+                let (ma, mb) = (
+                    mid(surface_vertex(a).unwrap_or(0)),
+                    mid(surface_vertex(b).unwrap_or(0)),
+                );
+                match (ma == a, mb == b) {
+                    (true, true) => true,
+                    (true, false) => count([a, b, mb]) == expected,
+                    (false, true) => count([a, b, ma]) == expected,
+                    (false, false) => split(a, mb, b, ma) || split(b, ma, a, mb),
+                }
+            };
+            let quad = agree
+                && if straight == Some(false) {
+                    half(x, y1) && half(x1, y)
                 } else {
-                    [e[0], e[1]]
+                    half(x, y) && half(x1, y1)
                 };
-                (e[0] == e[1] || e[1] == e[2])
-                    && pair[0] != pair[1]
-                    && open.binary_search(&pair).is_ok()
-            }
-            _ => false,
-        };
-        if !wall {
-            s.unexpected_boundary_faces += 1;
-        }
-    }
+            (quad, open)
+        })
+        .collect();
+    drop(edges);
+    s.quad_mismatches = quads.iter().filter(|q| !q.0).count();
+    let open: Vec<[u32; 2]> = quads.into_iter().filter_map(|q| q.1).collect();
+    s.unexpected_boundary_faces = others
+        .par_iter()
+        .filter(|k| {
+            let wall = match k.map(surface_vertex) {
+                [Some(a), Some(b), Some(c)] => {
+                    // Over exactly two surface vertices, an open edge.
+                    let mut e = [a, b, c];
+                    e.sort_unstable();
+                    let pair = if e[0] == e[1] {
+                        [e[0], e[2]]
+                    } else {
+                        [e[0], e[1]]
+                    };
+                    (e[0] == e[1] || e[1] == e[2])
+                        && pair[0] != pair[1]
+                        && open.binary_search(&pair).is_ok()
+                }
+                _ => false,
+            };
+            !wall
+        })
+        .count();
+    let boundary_volume = s.boundary_volume;
     s.volume_defect = if boundary_volume.abs() > 0.0 {
         (s.volume - boundary_volume).abs() / boundary_volume.abs()
     } else if s.volume == 0.0 {

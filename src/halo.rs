@@ -27,7 +27,7 @@
 //! surface vertex too). With `fold: report` rho stays as asked and the inverted tetrahedra
 //! are counted. Vertices are rounded to f32, what the files store, before they are checked.
 
-use crate::check::{CheckStats, TetMesh, check};
+use crate::check::{CheckStats, TetMesh, check_parts};
 use crate::tets::{self, Corners, Split, SplitStats};
 use crate::view::Projected;
 use glam::DVec3;
@@ -612,7 +612,7 @@ pub fn build_halo(
         inserted_in: tets.inserted_in,
     };
     lap(&mut stage_ms.split);
-    let checked = check(&halo.tet_mesh());
+    let checked = check_parts(&halo.positions, n, &halo.tets);
     lap(&mut stage_ms.check);
     let report = HaloReport {
         split: params.split.name(),
