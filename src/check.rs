@@ -255,6 +255,10 @@ fn scaled<P: Copy + Into<[f64; 3]> + Sync>(positions: &[P]) -> (Vec<[f64; 3]>, f
 /// A face (sorted vertex triple) with the vertex opposite it in its tetrahedron.
 type Face = ([u32; 3], u32);
 
+/// A boundary face over a surface triangle: the triangle's surface vertices (sorted) and the
+/// face's own vertices.
+type OffsetFace = ([u32; 3], [u32; 3]);
+
 /// What stands for a degenerate tetrahedron among the sorted ones: no vertex index can be
 /// this large (a mesh of 2^32 vertices would need 96 GiB of positions).
 const DEGENERATE: [u32; 4] = [u32::MAX; 4];
@@ -536,7 +540,7 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
     // Offset faces (three offsets of three surface vertices) by surface triangle; the other
     // boundary faces to classify once the open edges are known. In runs of a fixed size,
     // the boundary's volume summed in order.
-    let sorted_boundary: Vec<(f64, Vec<([u32; 3], [u32; 3])>, Vec<[u32; 3]>)> = boundary
+    let classified: Vec<(f64, Vec<OffsetFace>, Vec<[u32; 3]>)> = boundary
         .par_chunks(CHECK_RUN)
         .map(|part| {
             let (mut volume, mut offset_faces, mut others) = (0.0, Vec::new(), Vec::new());
@@ -565,7 +569,7 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
         .collect();
     drop(boundary);
     let (mut offset_faces, mut others) = (Vec::new(), Vec::new());
-    for (volume, o, k) in sorted_boundary {
+    for (volume, o, k) in classified {
         s.boundary_volume += volume;
         offset_faces.extend(o);
         others.extend(k);
