@@ -270,6 +270,10 @@ pub struct SamplingReport {
     /// Whether the sampler met its tolerance everywhere (false when its triangle budget
     /// stopped it).
     pub complete: bool,
+    /// When the budget stopped adaptive sampling: the audited max error of a uniform grid
+    /// of about as many triangles ([`sample::uniform_error`]), to compare `max_error` with.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub uniform_max_error: Option<f64>,
     /// Milliseconds spent sampling.
     pub ms: f64,
     /// Milliseconds spent auditing.
@@ -278,6 +282,7 @@ pub struct SamplingReport {
 
 impl SamplingReport {
     fn new(
+        surface: &Surface,
         sampling: &Sampling,
         sampled: &sample::Sampled,
         audit: &Audit,
@@ -301,6 +306,8 @@ impl SamplingReport {
             max_error_relative: max_rel,
             rms_error_relative: rms_rel,
             complete: sampled.complete,
+            uniform_max_error: (!sampled.complete)
+                .then(|| sample::uniform_error(surface, sampled.mesh.triangles.len())),
             ms,
             audit_ms,
         }
@@ -312,12 +319,13 @@ impl SamplingReport {
             return None;
         }
         Some(format!(
-            "surface `{surface}`: the triangle budget (max_triangles = {}) stopped refinement at {} triangles before every triangle met the tolerance {:.3e}; the audited max error is {:.3e} ({:.3e} of the diagonal). Raise max_triangles or the tolerance.",
+            "surface `{surface}`: the triangle budget (max_triangles = {}) stopped refinement at {} triangles before every triangle met the tolerance {:.3e}; the audited max error is {:.3e} ({:.3e} of the diagonal; a uniform grid of as many triangles: {:.3e}). Raise max_triangles or the tolerance.",
             self.max_triangles.unwrap_or(0),
             self.triangles,
             self.tolerance.unwrap_or(f64::NAN),
             self.max_error,
             self.max_error_relative,
+            self.uniform_max_error.unwrap_or(f64::NAN),
         ))
     }
 }
@@ -468,7 +476,14 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
         let audited = audit(&entry.surface, &sampled.mesh);
         let audit_ms = ms(start);
         timings.audit += audit_ms;
-        let report = SamplingReport::new(sampling, &sampled, &audited, sample_ms, audit_ms);
+        let report = SamplingReport::new(
+            &entry.surface,
+            sampling,
+            &sampled,
+            &audited,
+            sample_ms,
+            audit_ms,
+        );
         if let Some(w) = report.warning(&name) {
             bar.suspend(|| eprintln!("warning: {w}"));
         }

@@ -23,8 +23,16 @@
 //! the chordal error), or, when only interior points fail, the longest edge in the warped
 //! plane. A midpoint that encroaches on a side segment (lies in the circle on it as a
 //! diameter) splits that segment instead, as in Ruppert's refinement, so no sliver forms
-//! against a side. The new point's triangles join the queue. Patches refine in parallel;
-//! between rounds every new side point is inserted on the sides glued to it, so seams
+//! against a side. The new point's triangles join the queue.
+//!
+//! The queue is worst first: a failing triangle waits on the level of its largest error,
+//! counted in factors of 4 above the tolerance (what halving its edges gains), and the
+//! refinement goes down the levels in rounds. So when the triangle budget stops it, every
+//! triangle left is within a factor of about 4 of the best error the budget allows, not
+//! fine in one place and coarse in another. Patches refine in parallel, each within a share
+//! of the budget in proportion to its failing triangles (the mesh does not depend on the
+//! number of threads); between rounds every new side point is inserted on the sides glued
+//! to it, so seams
 //! conform: side points are dyadic fractions of the side (the starting grids have powers of
 //! two of cells, and splits halve), and the glue maps (σ ↦ offset ± σ with offsets that are
 //! multiples of 1/2) send them to dyadic fractions exactly. At the end the patches are
@@ -39,10 +47,9 @@ use super::{AUDIT_POINTS, Classes, Mesh4};
 use crate::surfaces::{Domain, Side, SideRule, Surface};
 use glam::DVec4;
 use rayon::prelude::*;
-use spade::handles::FixedVertexHandle;
+use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 use std::collections::{BTreeSet, HashMap, VecDeque};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
@@ -74,8 +81,10 @@ struct Patch {
     /// The side coordinates of the points on each side (as bits: non-negative floats sort
     /// like their bits).
     sides: [BTreeSet<u64>; 4],
-    /// Triangles to check.
-    queue: VecDeque<[FixedVertexHandle; 3]>,
+    /// New triangles, to check.
+    pending: Vec<Face>,
+    /// Triangles to refine, by [`level`]: on each level first in, first out.
+    queue: Vec<VecDeque<Queued>>,
     /// New side points whose images on glued sides are still to be inserted.
     outbox: Vec<(Side, f64)>,
     /// Edges too short to split in floating point, or points spade refused.
@@ -88,15 +97,22 @@ impl Patch {
         [lerp(self.domain.u, st[0]), lerp(self.domain.v, st[1])]
     }
 
-    /// Inserts a point; returns its vertex and whether it is new.
+    /// Inserts a point, searching for its place from `near` when given (refinement jumps
+    /// from the worst triangle to the next worst: a search from the last point inserted
+    /// would walk across the patch); returns its vertex and whether it is new.
     fn insert(
         &mut self,
         surface: &Surface,
         patch: usize,
         st: [f64; 2],
+        near: Option<FixedVertexHandle>,
     ) -> Option<(FixedVertexHandle, bool)> {
         let pos = self.warp.apply(st);
-        let h = self.cdt.insert(pos).ok()?;
+        let h = match near {
+            Some(hint) => self.cdt.insert_with_hint(pos, hint),
+            None => self.cdt.insert(pos),
+        }
+        .ok()?;
         if h.index() < self.st.len() {
             return Some((h, false));
         }
@@ -341,8 +357,46 @@ fn grid_cells(x: f64, min: usize) -> usize {
 /// The verdict on one triangle.
 enum Verdict {
     Pass,
-    /// Split the edges from corner k to corner k + 1, for each listed k.
-    Split(Vec<usize>),
+    /// Split the edges from corner k to corner k + 1, for each listed k; `score` is the
+    /// triangle's largest error at the audit points (infinite for a folded triangle).
+    Split {
+        edges: Vec<usize>,
+        score: f64,
+    },
+}
+
+/// A triangle in the refinement's queue. A triangle made by a split is queued unchecked on
+/// its parent's level, behind the triangles already there, and checked only when it comes
+/// first: most are split away by their neighbours' refinement before, and never need the
+/// check.
+#[derive(Clone, Copy)]
+struct Queued {
+    face: Face,
+    /// Whether the triangle failed its check (else it is still to check).
+    checked: bool,
+    /// Which edges to split (when checked), bit k for the edge from corner k.
+    edges: u8,
+}
+
+/// A triangle of a patch's triangulation: the face that held it and its corners (the face
+/// holds another triangle once a split has changed it).
+type Face = (FixedFaceHandle<InnerTag>, [FixedVertexHandle; 3]);
+
+/// Levels of the refinement's queue.
+const LEVELS: usize = 64;
+
+/// The queue level of a triangle whose largest error is `score`: 0 when it passes, else the
+/// number of factors of 4 (what halving a triangle's edges gains on its chordal error) by
+/// which the score exceeds the tolerance, rounded up; the top level for a folded triangle
+/// (an infinite score).
+fn level(score: f64, tolerance: f64) -> usize {
+    if score <= tolerance {
+        0
+    } else if !score.is_finite() {
+        LEVELS - 1
+    } else {
+        ((score / tolerance).log(4.0).ceil() as usize).clamp(1, LEVELS - 2)
+    }
 }
 
 /// Samples `surface` so that every triangle lies within `tolerance` (an absolute length in
@@ -373,24 +427,63 @@ struct Context<'a> {
     tolerance: f64,
     /// Edges shorter than this (4D) are not split: [`MIN_EDGE`] of the extent.
     min_edge: f64,
-    /// Triangles of all patches together, and the most allowed.
-    triangles: &'a AtomicUsize,
-    max_triangles: usize,
 }
 
 impl Patch {
     fn queue_around(&mut self, h: FixedVertexHandle) {
         for e in self.cdt.vertex(h).out_edges() {
             if let Some(f) = e.face().as_inner() {
-                self.queue.push_back(f.vertices().map(|v| v.fix()));
+                self.pending.push((f.fix(), f.vertices().map(|v| v.fix())));
             }
         }
     }
 
+    /// Checks the new triangles and queues those that fail.
+    fn settle(&mut self, surface: &Surface, patch: usize, tolerance: f64) {
+        let pending = std::mem::take(&mut self.pending);
+        for &face in &pending {
+            if self.alive(face) {
+                self.queue_checked(surface, patch, tolerance, face);
+            }
+        }
+        self.pending = pending;
+        self.pending.clear();
+    }
+
+    /// Checks a triangle and queues it on its level when it fails.
+    fn queue_checked(&mut self, surface: &Surface, patch: usize, tolerance: f64, face: Face) {
+        let t = face.1.map(|h| h.index());
+        if let Verdict::Split { edges, score } = self.check(surface, patch, tolerance, t) {
+            self.queue[level(score, tolerance)].push_back(Queued {
+                face,
+                checked: true,
+                edges: edges.iter().fold(0, |m, &k| m | 1 << k),
+            });
+        }
+    }
+
+    /// Triangles queued above level `floor`.
+    fn work(&self, floor: usize) -> usize {
+        self.queue[floor + 1..].iter().map(VecDeque::len).sum()
+    }
+
+    /// Whether the triangle is still one of the triangulation's: its face still has its
+    /// corners (in some rotation).
+    fn alive(&self, (face, [a, b, c]): Face) -> bool {
+        let now = self.cdt.face(face).vertices().map(|v| v.fix());
+        now == [a, b, c] || now == [b, c, a] || now == [c, a, b]
+    }
+
     /// Inserts a point and queues its triangles; records it in the outbox when it is a new
     /// side point, for the sides glued to it. Returns whether the point is new.
-    fn add(&mut self, surface: &Surface, patch: usize, st: [f64; 2]) -> bool {
-        match self.insert(surface, patch, st) {
+    fn add(
+        &mut self,
+        surface: &Surface,
+        patch: usize,
+        st: [f64; 2],
+        near: Option<FixedVertexHandle>,
+    ) -> bool {
+        match self.insert(surface, patch, st, near) {
             Some((h, true)) => {
                 self.queue_around(h);
                 self.outbox.extend(sides_of_point(st));
@@ -411,32 +504,55 @@ impl Patch {
         }
     }
 
-    /// Refines this patch until its queue is empty (true) or the budget is reached (false).
-    fn refine(&mut self, patch: usize, cx: &Context) -> bool {
-        while let Some(tri) = self.queue.pop_front() {
-            let alive = self
-                .cdt
-                .get_edge_from_neighbors(tri[0], tri[1])
-                .and_then(|e| e.opposite_vertex())
-                .is_some_and(|v| v.fix() == tri[2]);
-            if !alive {
-                continue;
+    /// Refines this patch, worst level first, until no triangle is queued above level
+    /// `floor` (true) or the next split could take it past `share` more triangles (false).
+    fn refine(&mut self, patch: usize, cx: &Context, floor: usize, share: usize) -> bool {
+        let mut used = 0usize;
+        // The level worked on: nothing is queued above it again (new triangles go on it or
+        // below), so it only goes down.
+        let mut at = LEVELS - 1;
+        loop {
+            while at > floor && self.queue[at].is_empty() {
+                at -= 1;
             }
-            let t = tri.map(|h| h.index());
-            let Verdict::Split(mut edges) = self.check(cx.surface, patch, cx.tolerance, t) else {
+            if at == floor {
+                return true;
+            }
+            let Some(mut q) = self.queue[at].pop_front() else {
                 continue;
             };
+            let (t, tri) = (q.face.1.map(|h| h.index()), q.face.1);
+            if !self.alive(q.face) {
+                continue;
+            }
+            if !q.checked {
+                let Verdict::Split { edges, score } =
+                    self.check(cx.surface, patch, cx.tolerance, t)
+                else {
+                    continue;
+                };
+                let real = level(score, cx.tolerance);
+                q = Queued {
+                    face: q.face,
+                    checked: true,
+                    edges: edges.iter().fold(0, |m, &k| m | 1 << k),
+                };
+                if real < at {
+                    self.queue[real].push_back(q);
+                    continue;
+                }
+            }
+            let mut edges: Vec<usize> = (0..3).filter(|k| q.edges & 1 << k != 0).collect();
             edges.retain(|&k| (self.p[t[k]] - self.p[t[(k + 1) % 3]]).length() >= cx.min_edge);
             if edges.is_empty() {
                 self.stuck += 1;
                 continue;
             }
-            // Reserve what the splits can add: per edge, two triangles here and, for a side
-            // point, four on the sides glued to it (inserted after this round).
+            // What the splits can add: per edge, two triangles here and, for a side point,
+            // four on the sides glued to it (inserted after this round).
             let reserve = 6 * edges.len();
-            if cx.triangles.fetch_add(reserve, Ordering::Relaxed) + reserve > cx.max_triangles {
-                cx.triangles.fetch_sub(reserve, Ordering::Relaxed);
-                self.queue.push_front(tri);
+            if used + reserve > share {
+                self.queue[at].push_front(q);
                 return false;
             }
             let (faces, sent) = (self.cdt.num_inner_faces(), self.outbox.len());
@@ -444,24 +560,32 @@ impl Patch {
                 .iter()
                 .map(|&k| (self.st[t[k]], self.st[t[(k + 1) % 3]]))
                 .collect();
-            let mut added = false;
             for (a, b) in ends {
-                added |= self.split(cx.surface, patch, a, b);
+                self.split(cx.surface, patch, a, b, tri[0]);
             }
-            let used = self.cdt.num_inner_faces() - faces + 4 * (self.outbox.len() - sent);
-            cx.triangles
-                .fetch_sub(reserve.saturating_sub(used), Ordering::Relaxed);
+            used += self.cdt.num_inner_faces() - faces + 4 * (self.outbox.len() - sent);
             // A split elsewhere (an encroached side) may leave this triangle standing.
-            if added {
-                self.queue.push_back(tri);
+            self.pending.push(q.face);
+            for face in self.pending.drain(..) {
+                self.queue[at].push_back(Queued {
+                    face,
+                    checked: false,
+                    edges: 0,
+                });
             }
         }
-        true
     }
 
     /// Splits the edge from `sa` to `sb` (normalized parameters) at its midpoint, or the
     /// side segment that midpoint encroaches on. Returns whether a point was added.
-    fn split(&mut self, surface: &Surface, patch: usize, sa: [f64; 2], sb: [f64; 2]) -> bool {
+    fn split(
+        &mut self,
+        surface: &Surface,
+        patch: usize,
+        sa: [f64; 2],
+        sb: [f64; 2],
+        near: FixedVertexHandle,
+    ) -> bool {
         let mid = [(sa[0] + sb[0]) / 2.0, (sa[1] + sb[1]) / 2.0];
         if mid == sa || mid == sb {
             self.stuck += 1;
@@ -474,7 +598,7 @@ impl Patch {
         } else {
             mid
         };
-        self.add(surface, patch, at)
+        self.add(surface, patch, at, Some(near))
     }
 
     /// Tests a triangle at the audit's edge and interior points.
@@ -508,20 +632,21 @@ impl Patch {
         if worst <= tolerance && !folded {
             return Verdict::Pass;
         }
+        let score = if folded { f64::INFINITY } else { worst };
         // The curvature term of each edge's chordal error, from the centroid's Hessian.
         let c = [
             (uv[0][0] + uv[1][0] + uv[2][0]) / 3.0,
             (uv[0][1] + uv[1][1] + uv[2][1]) / 3.0,
         ];
         let e = surface.eval(patch, c[0], c[1]);
-        let mut score = [0.0f64; 3];
+        let mut edge_score = [0.0f64; 3];
         let mut longest = (0.0f64, 0usize);
         for k in 0..3 {
             let (a, b) = (uv[k], uv[(k + 1) % 3]);
             let (du, dv) = (b[0] - a[0], b[1] - a[1]);
             let predicted =
                 (e.duu * (du * du) + e.duv * (2.0 * du * dv) + e.dvv * (dv * dv)).length() / 8.0;
-            score[k] = edge_error[k].max(if predicted.is_finite() {
+            edge_score[k] = edge_error[k].max(if predicted.is_finite() {
                 predicted
             } else {
                 0.0
@@ -536,17 +661,16 @@ impl Patch {
             }
         }
         let over: Vec<usize> = (0..3)
-            .filter(|&k| score[k] > tolerance && !folded)
+            .filter(|&k| edge_score[k] > tolerance && !folded)
             .collect();
-        match over.len() {
-            0 => Verdict::Split(vec![longest.1]),
+        let edges = match over.len() {
+            0 => vec![longest.1],
             // Every edge too long: split all three (a 1-to-4 refinement, one check for
             // what single splits would take two levels of checks to reach).
-            3 => Verdict::Split(over),
-            _ => Verdict::Split(vec![
-                (0..3).fold(0, |m, k| if score[k] > score[m] { k } else { m }),
-            ]),
-        }
+            3 => over,
+            _ => vec![(0..3).fold(0, |m, k| if edge_score[k] > edge_score[m] { k } else { m })],
+        };
+        Verdict::Split { edges, score }
     }
 }
 
@@ -578,7 +702,8 @@ impl<'a> Sampler<'a> {
                 p: Vec::new(),
                 pole,
                 sides: Default::default(),
-                queue: VecDeque::new(),
+                pending: Vec::new(),
+                queue: vec![VecDeque::new(); LEVELS],
                 outbox: Vec::new(),
                 stuck: 0,
             };
@@ -586,7 +711,7 @@ impl<'a> Sampler<'a> {
             for (j, row) in handles.iter_mut().enumerate() {
                 for (i, h) in row.iter_mut().enumerate() {
                     let st = [i as f64 / nu as f64, j as f64 / nv as f64];
-                    *h = p.insert(surface, patch, st).map(|(h, _)| h);
+                    *h = p.insert(surface, patch, st, None).map(|(h, _)| h);
                     p.outbox.extend(sides_of_point(st));
                 }
             }
@@ -603,9 +728,9 @@ impl<'a> Sampler<'a> {
             let faces: Vec<_> = p
                 .cdt
                 .inner_faces()
-                .map(|f| f.vertices().map(|v| v.fix()))
+                .map(|f| (f.fix(), f.vertices().map(|v| v.fix())))
                 .collect();
-            p.queue.extend(faces);
+            p.pending.extend(faces);
             patches.push(p);
         }
         let mut sampler = Sampler {
@@ -632,18 +757,28 @@ impl<'a> Sampler<'a> {
         }
         while let Some((patch, side, sigma)) = work.pop() {
             let p = &mut self.patches[patch];
-            if p.add(self.surface, patch, side_st(side, sigma)) {
+            if p.add(self.surface, patch, side_st(side, sigma), None) {
                 work.extend(glued_images(&p.domain, side, sigma));
             }
             p.outbox.clear();
         }
+        let (surface, tolerance) = (self.surface, self.tolerance);
+        self.patches
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(i, p)| p.settle(surface, i, tolerance));
     }
 
     /// Refines until every triangle passes (true), or the budget or floating point stops it
-    /// (false). Rounds: every patch refines on its own, in parallel; then the new side
-    /// points cross the seams, which queues the triangles they split on the other side.
+    /// (false). Worst first, in rounds: each round refines every triangle queued above a
+    /// floor level, one level (a factor 4 of error) lower than the round before, down to
+    /// the tolerance; so when the budget stops the refinement, the worst triangle left is as
+    /// good as the budget allows, within that factor. In a round every patch refines on its
+    /// own, in parallel, within a share of the budget left in proportion to its work above
+    /// the floor; then the new side points cross the seams, which queues the triangles they
+    /// split on the other side. The shares, not the threads' timing, decide where the budget
+    /// goes: the mesh is the same on any number of threads.
     fn refine(&mut self, max_triangles: usize) -> bool {
-        let triangles = AtomicUsize::new(self.triangles());
         let (lo, hi) = self
             .patches
             .iter()
@@ -656,27 +791,43 @@ impl<'a> Sampler<'a> {
             surface: self.surface,
             tolerance: self.tolerance,
             min_edge: MIN_EDGE * if extent.is_finite() { extent } else { 0.0 },
-            triangles: &triangles,
-            max_triangles,
         };
+        // Below the highest level of a finite error (folded triangles, on the top level,
+        // are above every floor).
+        let mut floor = self
+            .patches
+            .iter()
+            .filter_map(|p| (1..LEVELS - 1).rev().find(|&l| !p.queue[l].is_empty()))
+            .max()
+            .unwrap_or(1)
+            - 1;
         loop {
-            // Every patch refines on its own; all finish their round before the verdicts
-            // are read.
+            let work: Vec<usize> = self.patches.iter().map(|p| p.work(floor)).collect();
+            let total: usize = work.iter().sum();
+            if total == 0 {
+                if floor == 0 {
+                    return self.patches.iter().all(|p| p.stuck == 0);
+                }
+                floor -= 1;
+                continue;
+            }
+            let before = self.triangles();
+            let left = max_triangles.saturating_sub(before) as u128;
             let done: Vec<bool> = self
                 .patches
                 .par_iter_mut()
+                .zip(work)
                 .enumerate()
-                .map(|(i, p)| p.refine(i, &cx))
+                .map(|(i, (p, w))| {
+                    let share = (left * w as u128 / total as u128) as usize;
+                    p.refine(i, &cx, floor, share)
+                })
                 .collect();
-            let within_budget = done.into_iter().all(|d| d);
             // The seams conform even when the budget stopped the round.
             self.exchange();
-            if !within_budget {
+            if !done.into_iter().all(|d| d) && self.triangles() == before {
+                // The budget left is too small for any split.
                 return false;
-            }
-            triangles.store(self.triangles(), Ordering::Relaxed);
-            if self.patches.iter().all(|p| p.queue.is_empty()) {
-                return self.patches.iter().all(|p| p.stuck == 0);
             }
         }
     }
@@ -693,7 +844,7 @@ impl<'a> Sampler<'a> {
                         let t = f.vertices().map(|v| v.fix().index());
                         matches!(
                             p.check(self.surface, patch, self.tolerance, t),
-                            Verdict::Split(_)
+                            Verdict::Split { .. }
                         )
                     })
                     .count()

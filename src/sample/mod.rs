@@ -196,6 +196,16 @@ pub fn sample(surface: &Surface, sampling: &Sampling) -> Sampled {
     }
 }
 
+/// The audited max error of a uniform grid of about `triangles` triangles over the whole
+/// surface (square grids of an even number of cells on every patch, at least the surface's
+/// smallest grid): what budget-stopped adaptive sampling is compared with.
+pub fn uniform_error(surface: &Surface, triangles: usize) -> f64 {
+    let [min_u, min_v] = surface.min_cells();
+    let side = (triangles as f64 / (2 * surface.patch_count().max(1)) as f64).sqrt();
+    let even = |min: usize| ((side / 2.0).round() as usize * 2).clamp(min.max(4), 4096);
+    audit(surface, &sample_uniform(surface, even(min_u), even(min_v))).max_error
+}
+
 /// The diagonal of the surface's bounding box in R^4, from its points on a 64 x 64 grid of
 /// every patch: the length that relative tolerances and errors refer to.
 pub fn bounding_diagonal(surface: &Surface) -> f64 {
