@@ -436,6 +436,37 @@ fn faces_from(vertices: std::ops::Range<usize>, incidence: &Incidence) -> (Check
     (s, boundary)
 }
 
+/// Every face of sorted tetrahedra counted at its smallest vertex: the incidence, the counts
+/// of interior and overshared faces and repeated tetrahedra, and the boundary faces in
+/// increasing order, each with its tetrahedron's fourth vertex.
+fn face_uses(tets: &[[u32; 4]], vertices: usize) -> (Incidence, CheckStats, Vec<Face>) {
+    let incidence = Incidence::new(tets, vertices);
+    let runs: Vec<(CheckStats, Vec<Face>)> = (0..vertices.div_ceil(FACE_RUN))
+        .into_par_iter()
+        .map(|r| faces_from(r * FACE_RUN..vertices.min((r + 1) * FACE_RUN), &incidence))
+        .collect();
+    let mut s = CheckStats::default();
+    let mut boundary: Vec<Face> = Vec::with_capacity(runs.iter().map(|r| r.1.len()).sum());
+    for (q, faces) in runs {
+        s.duplicate_tets += q.duplicate_tets;
+        s.interior_faces += q.interior_faces;
+        s.overshared_faces += q.overshared_faces;
+        boundary.extend(faces);
+    }
+    (incidence, s, boundary)
+}
+
+/// The faces of `tets` that belong to exactly one of them (degenerate tetrahedra left out),
+/// each as its sorted vertex triple with the fourth vertex of its tetrahedron, in increasing
+/// order: what an exporter draws of a tetrahedral mesh, found as the checker finds it.
+pub fn boundary_faces(tets: &[[u32; 4]], vertices: usize) -> Vec<([u32; 3], u32)> {
+    let sorted: Vec<[u32; 4]> = tets
+        .par_iter()
+        .map(|&t| sorted_tet(t, vertices).0)
+        .collect();
+    face_uses(&sorted, vertices).2
+}
+
 /// Checks a tetrahedral halo (see the module documentation).
 pub fn check(mesh: &TetMesh) -> CheckStats {
     check_parts(&mesh.positions, mesh.surface_vertices, &mesh.tets)
@@ -519,19 +550,11 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
 
     // Every face counted at its smallest vertex; boundary faces kept with their
     // tetrahedron's fourth vertex, in increasing order.
-    let incidence = Incidence::new(&tets, nv);
+    let (incidence, faces, boundary) = face_uses(&tets, nv);
     drop(tets);
-    let runs: Vec<(CheckStats, Vec<Face>)> = (0..nv.div_ceil(FACE_RUN))
-        .into_par_iter()
-        .map(|r| faces_from(r * FACE_RUN..nv.min((r + 1) * FACE_RUN), &incidence))
-        .collect();
-    let mut boundary: Vec<Face> = Vec::with_capacity(runs.iter().map(|r| r.1.len()).sum());
-    for (q, faces) in runs {
-        s.duplicate_tets += q.duplicate_tets;
-        s.interior_faces += q.interior_faces;
-        s.overshared_faces += q.overshared_faces;
-        boundary.extend(faces);
-    }
+    s.duplicate_tets = faces.duplicate_tets;
+    s.interior_faces = faces.interior_faces;
+    s.overshared_faces = faces.overshared_faces;
     s.boundary_faces = boundary.len();
     let count = |f: [u32; 3]| incidence.count(f);
     // Whether two offsets lie on the same side (both negative or both positive).

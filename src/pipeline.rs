@@ -17,6 +17,7 @@ use crate::verify::{self, HaloInput, Verification};
 use crate::view::{MAX_COORDINATE, MIN_EXTENT, Projected};
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
 use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
@@ -619,48 +620,59 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     let export_start = Instant::now();
     // Every file under a temporary name until all were made: a failure leaves the folder
     // as it was.
-    let mut staged = export::Staged::new(out_dir).map_err(staged_error)?;
+    let staged = export::Staged::new(out_dir).map_err(staged_error)?;
     let data: Vec<SurfaceData> = products.iter().map(|p| p.data(&scene.halo)).collect();
-    let mut write = |file: String, bytes: &[u8]| -> Result<String, Error> {
+    let write = |file: String, bytes: &[u8]| -> Result<String, Error> {
         staged.write(file, bytes).map_err(staged_error)
     };
-    let mut files = Vec::new();
     let name = &scene.name;
     let failures = built.failures();
+    // The files are made on the cores side by side, each written as it is made (a halo's
+    // `.vtk` streamed, with no copy in memory); the report lists them in this order.
+    type Job<'a> = Box<dyn FnOnce() -> Result<Vec<String>, Error> + Send + 'a>;
+    let mut jobs: Vec<Job> = Vec::new();
     if scene.outputs.glb {
-        let scene_json = serde_json::to_value(scene).map_err(|e| Error::Internal {
-            stage: "export",
-            message: e.to_string(),
-        })?;
-        let asset = serde_json::json!({
-            "scene": scene_json,
-            "verified": failures.is_empty(),
-            "failures": failures,
-        });
-        let glb = export::to_glb(
-            &data,
-            &built.curves,
-            scene.outputs.curve_radius * built.diagonal,
-            &asset,
-        )
-        .map_err(|message| Error::Internal {
-            stage: "export",
-            message,
-        })?;
-        files.push(write(format!("{name}.glb"), &glb)?);
+        jobs.push(Box::new(|| {
+            let scene_json = serde_json::to_value(scene).map_err(|e| Error::Internal {
+                stage: "export",
+                message: e.to_string(),
+            })?;
+            let asset = serde_json::json!({
+                "scene": scene_json,
+                "verified": failures.is_empty(),
+                "failures": failures,
+            });
+            let glb = export::to_glb(
+                &data,
+                &built.curves,
+                scene.outputs.curve_radius * built.diagonal,
+                &asset,
+            )
+            .map_err(|message| Error::Internal {
+                stage: "export",
+                message,
+            })?;
+            Ok(vec![write(format!("{name}.glb"), &glb)?])
+        }));
     }
     if scene.outputs.ply {
-        files.push(write(format!("{name}.ply"), &export::to_ply(&data, name))?);
-        files.push(write(
-            format!("{name}-curves.ply"),
-            &export::to_curves_ply(&built.curves, name),
-        )?);
+        jobs.push(Box::new(|| {
+            Ok(vec![
+                write(format!("{name}.ply"), &export::to_ply(&data, name))?,
+                write(
+                    format!("{name}-curves.ply"),
+                    &export::to_curves_ply(&built.curves, name),
+                )?,
+            ])
+        }));
     }
     if scene.outputs.obj {
-        files.push(write(
-            format!("{name}.obj"),
-            export::to_obj(&data, name).as_bytes(),
-        )?);
+        jobs.push(Box::new(|| {
+            Ok(vec![write(
+                format!("{name}.obj"),
+                export::to_obj(&data, name).as_bytes(),
+            )?])
+        }));
     }
     if scene.outputs.vtk {
         for d in &data {
@@ -669,9 +681,17 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
             } else {
                 format!("{name}-{}-halo.vtk", d.name)
             };
-            files.push(write(file, &export::to_vtk(d, name))?);
+            let staged = &staged;
+            jobs.push(Box::new(move || {
+                let file = staged
+                    .stream(file, |w| export::write_vtk(w, d, name))
+                    .map_err(staged_error)?;
+                Ok(vec![file])
+            }));
         }
     }
+    let written: Result<Vec<Vec<String>>, Error> = jobs.into_par_iter().map(|job| job()).collect();
+    let mut files: Vec<String> = written?.into_iter().flatten().collect();
     timings.export = ms(export_start);
     if scene.outputs.png {
         let start = Instant::now();

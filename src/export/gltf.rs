@@ -188,29 +188,10 @@ impl Builder {
     }
 }
 
-/// The faces of exactly one tetrahedron, each turned outward (counter-clockwise seen from
-/// outside, glTF's front face) by the exact orientation of its tetrahedron, in a
-/// deterministic order.
+/// The faces of exactly one tetrahedron ([`crate::check::boundary_faces`]), each turned
+/// outward (counter-clockwise seen from outside, glTF's front face) by the exact orientation
+/// of its tetrahedron, in a deterministic order.
 fn boundary_faces(positions: &[DVec3], tets: &[[u32; 4]]) -> Vec<[u32; 3]> {
-    // Outward faces of a positive tetrahedron (a, b, c, d), opposite a, b, c and d:
-    // each ordering with the opposite vertex appended is an even permutation of (a, b, c, d).
-    const FACES: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
-    // One u128 per face use: the sorted vertex triple above, the use (tetrahedron, face) below,
-    // so that sorting groups the uses of each face.
-    let mut uses: Vec<u128> = tets
-        .par_iter()
-        .enumerate()
-        .flat_map_iter(|(k, tet)| {
-            FACES.iter().enumerate().map(move |(f, face)| {
-                let mut key = face.map(|i| tet[i]);
-                key.sort_unstable();
-                let high =
-                    (u128::from(key[0]) << 64) | (u128::from(key[1]) << 32) | u128::from(key[2]);
-                (high << 32) | (k as u128 * 4 + f as u128)
-            })
-        })
-        .collect();
-    uses.par_sort_unstable();
     let c = |i: u32| {
         let p = positions[i as usize];
         robust::Coord3D {
@@ -219,27 +200,18 @@ fn boundary_faces(positions: &[DVec3], tets: &[[u32; 4]]) -> Vec<[u32; 3]> {
             z: p.z,
         }
     };
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < uses.len() {
-        let mut j = i + 1;
-        while j < uses.len() && uses[j] >> 32 == uses[i] >> 32 {
-            j += 1;
-        }
-        if j == i + 1 {
-            let use_ = (uses[i] & 0xffff_ffff) as usize;
-            let tet = tets[use_ / 4];
-            let face = FACES[use_ % 4].map(|v| tet[v]);
-            let o = robust::orient3d(c(tet[0]), c(tet[1]), c(tet[2]), c(tet[3]));
-            out.push(if o < 0.0 {
-                [face[0], face[2], face[1]]
+    crate::check::boundary_faces(tets, positions.len())
+        .into_par_iter()
+        .map(|([a, b, c3], o)| {
+            // `orient3d` is negative where the fourth vertex lies above the face as given
+            // (counter-clockwise seen from the fourth vertex): inward, so turned over.
+            if robust::orient3d(c(a), c(b), c(c3), c(o)) < 0.0 {
+                [a, c3, b]
             } else {
-                face
-            });
-        }
-        i = j;
-    }
-    out
+                [a, b, c3]
+            }
+        })
+        .collect()
 }
 
 /// The halo's boundary faces as [`boundary_faces`] finds them, except that a top face (one

@@ -23,7 +23,7 @@ pub use gltf::{glb_container, to_glb};
 pub use obj::to_obj;
 pub use plot::{encode_png, render_speed_vs_error_png, speed_vs_error_png};
 pub use ply::{to_curves_ply, to_ply};
-pub use vtk::to_vtk;
+pub use vtk::write_vtk;
 
 mod staged;
 pub use staged::{LOCK, Staged, StagedError};
@@ -74,22 +74,30 @@ fn curve_segments(curves: &Curves) -> Vec<[u32; 2]> {
 
 /// Writes `bytes` to `path` through a temporary file in the same folder and a rename.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let tmp = write_partial(path, bytes)?;
+    let tmp = write_partial(path, |w| w.write_all(bytes))?;
     std::fs::rename(&tmp, path).inspect_err(|_| {
         let _ = std::fs::remove_file(&tmp);
     })
 }
 
-/// Writes `bytes`, synced, to the temporary name of `path` (`.<file name>.partial` in its
-/// folder) and returns that name; on failure removes what it wrote.
-fn write_partial(path: &Path, bytes: &[u8]) -> std::io::Result<std::path::PathBuf> {
+/// Writes what `fill` writes, buffered and synced, to the temporary name of `path`
+/// (`.<file name>.partial` in its folder) and returns that name; on failure removes what it
+/// wrote.
+fn write_partial(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> std::io::Result<std::path::PathBuf> {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     let tmp = path.with_file_name(format!(".{name}.partial"));
     std::fs::File::create(&tmp)
-        .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
+        .and_then(|f| {
+            let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
+            fill(&mut w)?;
+            w.into_inner().map_err(|e| e.into_error())?.sync_all()
+        })
         .inspect_err(|_| {
             let _ = std::fs::remove_file(&tmp);
         })?;

@@ -51,8 +51,9 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> StagedError + '_ {
 pub struct Staged {
     dir: PathBuf,
     lock: PathBuf,
-    /// (temporary, final) paths of the files written so far.
-    files: Vec<(PathBuf, PathBuf)>,
+    /// (temporary, final) paths of the files written so far (files may be written from
+    /// several threads at once).
+    files: std::sync::Mutex<Vec<(PathBuf, PathBuf)>>,
 }
 
 impl Staged {
@@ -71,21 +72,35 @@ impl Staged {
         taken.map(|()| Staged {
             dir: dir.to_path_buf(),
             lock,
-            files: Vec::new(),
+            files: Default::default(),
         })
     }
 
     /// Writes `bytes` as `file` in the folder under a temporary name; returns `file`.
-    pub fn write(&mut self, file: String, bytes: &[u8]) -> Result<String, StagedError> {
+    pub fn write(&self, file: String, bytes: &[u8]) -> Result<String, StagedError> {
+        self.stream(file, |w| w.write_all(bytes))
+    }
+
+    /// Writes `file` in the folder under a temporary name through `fill`, buffered, with
+    /// no copy of the whole file in memory; returns `file`.
+    pub fn stream(
+        &self,
+        file: String,
+        fill: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
+    ) -> Result<String, StagedError> {
         let path = self.dir.join(&file);
-        let tmp = super::write_partial(&path, bytes).map_err(io(&path))?;
-        self.files.push((tmp, path));
+        let tmp = super::write_partial(&path, fill).map_err(io(&path))?;
+        self.files
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push((tmp, path));
         Ok(file)
     }
 
     /// Moves every file written into place, then releases the lock.
     pub fn commit(mut self) -> Result<(), StagedError> {
-        for (tmp, path) in std::mem::take(&mut self.files) {
+        let files = std::mem::take(self.files.get_mut().unwrap_or_else(|e| e.into_inner()));
+        for (tmp, path) in files {
             std::fs::rename(&tmp, &path).map_err(io(&path))?;
         }
         Ok(())
@@ -95,7 +110,12 @@ impl Staged {
 impl Drop for Staged {
     /// Removes what was not committed, and the lock.
     fn drop(&mut self) {
-        for (tmp, _) in &self.files {
+        for (tmp, _) in self
+            .files
+            .get_mut()
+            .unwrap_or_else(|e| e.into_inner())
+            .iter()
+        {
             let _ = std::fs::remove_file(tmp);
         }
         let _ = std::fs::remove_file(&self.lock);

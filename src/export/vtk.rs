@@ -14,64 +14,61 @@
 use super::SurfaceData;
 use crate::check::LAYERS;
 use crate::convention::file_order;
+use std::io::{self, Write};
 
-/// Builds the `.vtk` bytes of one surface's halo. The title line is
+/// Writes the `.vtk` of one surface's halo to `out` as it goes (no copy of the file in
+/// memory; give it a buffered writer). The title line is
 /// `<surface>-halo: halo4d <version>, scene <scene_name>`.
-pub fn to_vtk(surface: &SurfaceData, scene_name: &str) -> Vec<u8> {
+pub fn write_vtk(out: &mut dyn Write, surface: &SurfaceData, scene_name: &str) -> io::Result<()> {
     let halo = surface.halo;
     let points = halo.positions.len();
     let tets = halo.tets.len();
-    let mut out = Vec::with_capacity(256 + points * 40 + tets * 24);
-    let text = |out: &mut Vec<u8>, s: &str| out.extend_from_slice(s.as_bytes());
-    text(
-        &mut out,
-        &format!(
-            "# vtk DataFile Version 3.0\n{}-halo: halo4d {}, scene {scene_name}\nBINARY\n\
-             DATASET UNSTRUCTURED_GRID\nPOINTS {points} double\n",
-            surface.name,
-            env!("CARGO_PKG_VERSION"),
-        ),
-    );
+    write!(
+        out,
+        "# vtk DataFile Version 3.0\n{}-halo: halo4d {}, scene {scene_name}\nBINARY\n\
+         DATASET UNSTRUCTURED_GRID\nPOINTS {points} double\n",
+        surface.name,
+        env!("CARGO_PKG_VERSION"),
+    )?;
     for p in &halo.positions {
         for x in p.to_array() {
-            out.extend_from_slice(&x.to_be_bytes());
+            out.write_all(&x.to_be_bytes())?;
         }
     }
     // Ids are 32-bit ints in legacy VTK; a scene's triangle limit keeps them far below 2^31.
-    text(&mut out, &format!("\nCELLS {tets} {}\n", 5 * tets));
+    write!(out, "\nCELLS {tets} {}\n", 5 * tets)?;
     for &tet in &halo.tets {
-        out.extend_from_slice(&4i32.to_be_bytes());
-        for i in file_order(tet) {
-            out.extend_from_slice(&(i as i32).to_be_bytes());
+        let mut cell = [0u8; 20];
+        cell[..4].copy_from_slice(&4i32.to_be_bytes());
+        for (k, i) in file_order(tet).into_iter().enumerate() {
+            cell[4 + 4 * k..8 + 4 * k].copy_from_slice(&(i as i32).to_be_bytes());
         }
+        out.write_all(&cell)?;
     }
-    text(&mut out, &format!("\nCELL_TYPES {tets}\n"));
+    write!(out, "\nCELL_TYPES {tets}\n")?;
     for _ in 0..tets {
-        out.extend_from_slice(&10i32.to_be_bytes());
+        out.write_all(&10i32.to_be_bytes())?;
     }
-    text(&mut out, "\nFIELD FieldData 5\nsurface_vertices 1 1 int\n");
-    out.extend_from_slice(&(halo.surface_vertices as i32).to_be_bytes());
-    text(&mut out, "\nlayers 1 1 int\n");
-    out.extend_from_slice(&(LAYERS as i32).to_be_bytes());
+    write!(out, "\nFIELD FieldData 5\nsurface_vertices 1 1 int\n")?;
+    out.write_all(&(halo.surface_vertices as i32).to_be_bytes())?;
+    write!(out, "\nlayers 1 1 int\n")?;
+    out.write_all(&(LAYERS as i32).to_be_bytes())?;
     let params = surface.halo_params;
     for (name, value) in [
         ("rho", surface.rho),
         ("delta_d", params.delta_d),
         ("delta_t", params.delta_t),
     ] {
-        text(&mut out, &format!("\n{name} 1 1 double\n"));
-        out.extend_from_slice(&value.to_be_bytes());
+        write!(out, "\n{name} 1 1 double\n")?;
+        out.write_all(&value.to_be_bytes())?;
     }
-    text(&mut out, &format!("\nPOINT_DATA {points}\n"));
+    write!(out, "\nPOINT_DATA {points}\n")?;
     for (name, values) in [("t", &halo.t), ("d_orig", &halo.d_orig)] {
-        text(
-            &mut out,
-            &format!("SCALARS {name} double 1\nLOOKUP_TABLE default\n"),
-        );
+        write!(out, "SCALARS {name} double 1\nLOOKUP_TABLE default\n")?;
         for x in values.iter() {
-            out.extend_from_slice(&x.to_be_bytes());
+            out.write_all(&x.to_be_bytes())?;
         }
-        out.push(b'\n');
+        out.write_all(b"\n")?;
     }
-    out
+    Ok(())
 }
