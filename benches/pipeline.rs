@@ -3,7 +3,7 @@
 //! the quartic Fermat.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use halo4d::export::{SurfaceData, to_glb, to_ply, to_vtk};
+use halo4d::export::{SurfaceData, to_glb, to_ply, write_vtk};
 use halo4d::halo::{HaloParams, build_halo};
 use halo4d::surfaces::{Fermat, SpunTrefoil};
 use halo4d::{Surface, View, sample_uniform};
@@ -58,7 +58,11 @@ fn stages(c: &mut Criterion) {
             b.iter(|| to_ply(black_box(&data), name))
         });
         c.bench_function(&format!("export_vtk/{name}/128"), |b| {
-            b.iter(|| to_vtk(black_box(&data[0]), name))
+            b.iter(|| {
+                let mut bytes = Vec::new();
+                write_vtk(&mut bytes, black_box(&data[0]), name).unwrap();
+                bytes
+            })
         });
     }
 }
