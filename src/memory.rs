@@ -11,11 +11,11 @@
 pub const GB: f64 = 1e9;
 
 /// Peak resident bytes per triangle of a build from the halos on (two layers of
-/// tetrahedra, the checker's faces, the curves, the verification's index, the files in
-/// memory), with a margin: measured 2.16 kB at 250,000 triangles and 2.03 kB at 1,000,000
-/// (`/usr/bin/time -v halo4d build` on the flat torus at uniform 354 x 354 and 708 x 708,
-/// without the picture).
-pub const BUILD_BYTES_PER_TRIANGLE: f64 = 2500.0;
+/// tetrahedra, the checker's incidence, the curves, the verification's index, the `.glb` in
+/// memory while the `.vtk` streams), with a margin: measured 920 bytes at 1,000,000 triangles
+/// and 830 at 4,000,000 (`report.json`'s `memory.peak_gb` of `cargo bench --bench scale`,
+/// the flat torus with glb, vtk, ply and report).
+pub const BUILD_BYTES_PER_TRIANGLE: f64 = 1100.0;
 
 /// The limit in bytes, and where it comes from (for messages).
 pub fn limit() -> Result<(f64, &'static str), String> {
