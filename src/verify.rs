@@ -534,14 +534,16 @@ impl<'a> HaloIndex<'a> {
         let h = self.halos[surface as usize].as_ref()?;
         let k = h.tets[tet as usize];
         let p = k.map(|v| h.positions[v as usize]);
-        let l = [
-            orient3d(x, p[1], p[2], p[3]),
-            orient3d(p[0], x, p[2], p[3]),
-            orient3d(p[0], p[1], x, p[3]),
-            orient3d(p[0], p[1], p[2], x),
-        ];
-        if l.iter().any(|&v| v < 0.0) {
-            return None;
+        // Each barycentric weight in turn, the search ending at the first negative one: most
+        // candidates (tetrahedra whose box holds x) do not hold it.
+        let mut l = [0.0; 4];
+        for (i, w) in l.iter_mut().enumerate() {
+            let mut q = p;
+            q[i] = x;
+            *w = orient3d(q[0], q[1], q[2], q[3]);
+            if *w < 0.0 {
+                return None;
+            }
         }
         let total: f64 = l.iter().sum();
         if total <= 0.0 {
