@@ -628,7 +628,8 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     let name = &scene.name;
     let failures = built.failures();
     // The files are made on the cores side by side, each written as it is made (a halo's
-    // `.vtk` streamed, with no copy in memory); the report lists them in this order.
+    // `.vtk` streamed, the `.glb`'s chunks written as they are, with no copy of the whole
+    // file in memory); the report lists them in this order.
     type Job<'a> = Box<dyn FnOnce() -> Result<Vec<String>, Error> + Send + 'a>;
     let mut jobs: Vec<Job> = Vec::new();
     if scene.outputs.glb {
@@ -642,7 +643,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
                 "verified": failures.is_empty(),
                 "failures": failures,
             });
-            let glb = export::to_glb(
+            let (text, bin) = export::glb_chunks(
                 &data,
                 &built.curves,
                 scene.outputs.curve_radius * built.diagonal,
@@ -652,7 +653,12 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
                 stage: "export",
                 message,
             })?;
-            Ok(vec![write(format!("{name}.glb"), &glb)?])
+            let file = staged
+                .stream(format!("{name}.glb"), |w| {
+                    export::write_glb_container(w, &text, &bin)
+                })
+                .map_err(staged_error)?;
+            Ok(vec![file])
         }));
     }
     if scene.outputs.ply {

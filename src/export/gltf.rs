@@ -44,6 +44,7 @@ use json::validation::Checked::Valid;
 use json::validation::USize64;
 use rayon::prelude::*;
 use serde_json::value::to_raw_value;
+use std::io::{self, Write};
 
 /// Base colours of the surfaces' materials, in turn.
 const PALETTE: [[f32; 4]; 6] = [
@@ -65,20 +66,22 @@ struct Builder {
 }
 
 impl Builder {
-    /// Appends a buffer view with `bytes`, aligned to 4 bytes; `target` is `None` for data
-    /// that no primitive reads (the tetrahedra).
+    /// Appends a buffer view of 4-byte `words` (little-endian), written straight into the
+    /// binary chunk; `target` is `None` for data that no primitive reads (the tetrahedra).
     fn view(
         &mut self,
-        bytes: &[u8],
+        words: impl ExactSizeIterator<Item = [u8; 4]>,
         target: Option<json::buffer::Target>,
     ) -> json::Index<json::buffer::View> {
         debug_assert_eq!(self.bin.len() % 4, 0);
         let offset = self.bin.len();
-        self.bin.extend_from_slice(bytes);
-        self.bin.resize(self.bin.len().next_multiple_of(4), 0);
+        self.bin.reserve(4 * words.len());
+        for w in words {
+            self.bin.extend_from_slice(&w);
+        }
         self.root.push(json::buffer::View {
             buffer: json::Index::new(0),
-            byte_length: USize64::from(bytes.len()),
+            byte_length: USize64::from(self.bin.len() - offset),
             byte_offset: Some(USize64::from(offset)),
             byte_stride: None,
             name: None,
@@ -100,8 +103,10 @@ impl Builder {
         } else {
             1
         };
-        let bytes: Vec<u8> = values.iter().flat_map(|x| x.to_le_bytes()).collect();
-        let view = self.view(&bytes, Some(json::buffer::Target::ArrayBuffer));
+        let view = self.view(
+            values.iter().map(|x| x.to_le_bytes()),
+            Some(json::buffer::Target::ArrayBuffer),
+        );
         let (min, max) = match minmax {
             Some((lo, hi)) => (Some(serde_json::json!(lo)), Some(serde_json::json!(hi))),
             None => (None, None),
@@ -167,8 +172,7 @@ impl Builder {
         target: Option<json::buffer::Target>,
         name: Option<String>,
     ) -> json::Index<json::Accessor> {
-        let bytes: Vec<u8> = indices.iter().flat_map(|i| i.to_le_bytes()).collect();
-        let view = self.view(&bytes, target);
+        let view = self.view(indices.iter().map(|i| i.to_le_bytes()), target);
         self.root.push(json::Accessor {
             buffer_view: Some(view),
             byte_offset: None,
@@ -263,14 +267,26 @@ fn halo_patches(s: &SurfaceData) -> Vec<f32> {
 
 /// Builds the `.glb` bytes for the surfaces, their halos and the scene's intersection
 /// `curves`, as tubes of `curve_radius` (absolute); `asset` goes into the asset's extras
-/// as `halo4d` (the build writes the scene as parsed and its verdict there). A halo without tetrahedra, and curves without a segment, get no mesh (glTF
-/// accessors cannot be empty).
+/// as `halo4d` (the build writes the scene as parsed and its verdict there). A halo without
+/// tetrahedra, and curves without a segment, get no mesh (glTF accessors cannot be empty).
 pub fn to_glb(
     surfaces: &[SurfaceData],
     curves: &Curves,
     curve_radius: f64,
     asset: &serde_json::Value,
 ) -> Result<Vec<u8>, String> {
+    let (text, bin) = glb_chunks(surfaces, curves, curve_radius, asset)?;
+    Ok(glb_container(text, bin))
+}
+
+/// The JSON and binary chunks of [`to_glb`]'s file, for [`write_glb_container`] to write
+/// without a copy of the whole file in memory.
+pub fn glb_chunks(
+    surfaces: &[SurfaceData],
+    curves: &Curves,
+    curve_radius: f64,
+    asset: &serde_json::Value,
+) -> Result<(Vec<u8>, Vec<u8>), String> {
     let extras = |v: serde_json::Value| to_raw_value(&v).map(Some).map_err(|e| e.to_string());
     let mut b = Builder {
         root: json::Root {
@@ -385,7 +401,7 @@ pub fn to_glb(
         extras: None,
     });
     let text = b.root.to_vec().map_err(|e| e.to_string())?;
-    Ok(glb_container(text, b.bin))
+    Ok((text, b.bin))
 }
 
 /// Appends the halo mesh of `s` (see the module documentation); `surface_mesh` is the
@@ -566,21 +582,31 @@ fn curves_mesh(
 
 /// Wraps JSON and binary chunks in the GLB container (header, JSON chunk padded with spaces,
 /// BIN chunk padded with zeros).
-pub fn glb_container(mut text: Vec<u8>, mut bin: Vec<u8>) -> Vec<u8> {
-    text.resize(text.len().next_multiple_of(4), b' ');
-    bin.resize(bin.len().next_multiple_of(4), 0);
-    let total = 12 + 8 + text.len() + 8 + bin.len();
-    let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(text.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&text);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin);
+pub fn glb_container(text: Vec<u8>, bin: Vec<u8>) -> Vec<u8> {
+    let mut out = Vec::with_capacity(28 + text.len() + bin.len() + 6);
+    write_glb_container(&mut out, &text, &bin).expect("writing into memory cannot fail");
     out
+}
+
+/// Writes [`glb_container`]'s bytes to `out`, the chunks as they are.
+pub fn write_glb_container(out: &mut dyn Write, text: &[u8], bin: &[u8]) -> io::Result<()> {
+    let (text_pad, bin_pad) = (
+        text.len().next_multiple_of(4) - text.len(),
+        bin.len().next_multiple_of(4) - bin.len(),
+    );
+    let (text_len, bin_len) = (text.len() + text_pad, bin.len() + bin_pad);
+    let total = 12 + 8 + text_len + 8 + bin_len;
+    out.write_all(b"glTF")?;
+    out.write_all(&2u32.to_le_bytes())?;
+    out.write_all(&(total as u32).to_le_bytes())?;
+    out.write_all(&(text_len as u32).to_le_bytes())?;
+    out.write_all(b"JSON")?;
+    out.write_all(text)?;
+    out.write_all(&b"   "[..text_pad])?;
+    out.write_all(&(bin_len as u32).to_le_bytes())?;
+    out.write_all(b"BIN\0")?;
+    out.write_all(bin)?;
+    out.write_all(&[0; 3][..bin_pad])
 }
 
 #[cfg(test)]
