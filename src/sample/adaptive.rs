@@ -560,12 +560,16 @@ impl Patch {
                 .iter()
                 .map(|&k| (self.st[t[k]], self.st[t[(k + 1) % 3]]))
                 .collect();
+            let mut added = false;
             for (a, b) in ends {
-                self.split(cx.surface, patch, a, b, tri[0]);
+                added |= self.split(cx.surface, patch, a, b, tri[0]);
             }
             used += self.cdt.num_inner_faces() - faces + 4 * (self.outbox.len() - sent);
-            // A split elsewhere (an encroached side) may leave this triangle standing.
-            self.pending.push(q.face);
+            // A split elsewhere (an encroached side) may leave this triangle standing; one
+            // that added no point is stuck, and counted so.
+            if added {
+                self.pending.push(q.face);
+            }
             for face in self.pending.drain(..) {
                 self.queue[at].push_back(Queued {
                     face,
