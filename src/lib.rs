@@ -30,7 +30,7 @@ pub mod view;
 pub mod viewer;
 
 pub use error::Error;
-pub use pipeline::{Built, Report, build, run, write};
+pub use pipeline::{Built, Report, build, run, run_for_picture, write};
 pub use sample::{Mesh4, MeshStats, Sampling, sample, sample_adaptive, sample_uniform};
 pub use scene::{Scene, SceneError};
 pub use surfaces::{Domain, Eval4, Surface, Topology};

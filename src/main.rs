@@ -128,10 +128,7 @@ fn render_sweep(scene: &Scene, slices: &[u32], out: &Path, quiet: bool) -> ExitC
         eprintln!("error: --slices: every count must be 1 to 4096, got {bad}");
         return ExitCode::FAILURE;
     }
-    // The stages a picture needs, whatever files the scene writes.
-    let mut picture = scene.clone();
-    picture.outputs.png = true;
-    let built = match halo4d::run(&picture, quiet) {
+    let built = match halo4d::run_for_picture(scene, quiet) {
         Ok(b) => b,
         Err(e) => return fail(&e),
     };
@@ -335,9 +332,7 @@ fn main() -> ExitCode {
                     .join(&scene.name)
                     .join(format!("{}.png", scene.name))
             });
-            // The stages a picture needs, whatever files the scene writes.
-            scene.outputs.png = true;
-            let built = match halo4d::run(&scene, quiet) {
+            let built = match halo4d::run_for_picture(&scene, quiet) {
                 Ok(b) => b,
                 Err(e) => return fail(&e),
             };

@@ -11,10 +11,10 @@
 pub const GB: f64 = 1e9;
 
 /// Peak resident bytes per triangle of a build from the halos on (two layers of
-/// tetrahedra, the checker's incidence, the curves, the verification's index, the `.glb` in
-/// memory while the `.vtk` streams), with a margin: measured 920 bytes at 1,000,000 triangles
-/// and 830 at 4,000,000 (`report.json`'s `memory.peak_gb` of `cargo bench --bench scale`,
-/// the flat torus with glb, vtk, ply and report).
+/// tetrahedra, the checker's incidence, the curves, the verification's index, the `.glb`'s
+/// chunks while the files stream), with a margin: measured 830 bytes at 1,000,000 triangles,
+/// 750 at 4,000,000 and 730 at 10,000,000 (`report.json`'s `memory.peak_gb` of `cargo bench
+/// --bench scale`, the flat torus with glb, vtk, ply and report).
 pub const BUILD_BYTES_PER_TRIANGLE: f64 = 1100.0;
 
 /// The limit in bytes, and where it comes from (for messages).

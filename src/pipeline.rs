@@ -80,11 +80,17 @@ pub struct Stages {
 impl Stages {
     /// The stages `scene`'s outputs need.
     pub fn of(scene: &Scene) -> Stages {
+        Stages::with_picture(scene, scene.outputs.png)
+    }
+
+    /// The stages `scene`'s outputs need, with a picture's when `picture` whatever the scene
+    /// says of `png`.
+    fn with_picture(scene: &Scene, picture: bool) -> Stages {
         let o = &scene.outputs;
         let verify = o.verify.unwrap_or(o.glb || o.vtk);
         Stages {
-            halos: verify || o.glb || o.vtk || (o.png && scene.render.halos),
-            curves: verify || o.glb || o.ply || (o.png && scene.render.curves),
+            halos: verify || o.glb || o.vtk || (picture && scene.render.halos),
+            curves: verify || o.glb || o.ply || (picture && scene.render.curves),
             verify,
         }
     }
@@ -277,16 +283,16 @@ pub struct SamplingReport {
     pub uniform_max_error: Option<f64>,
     /// Milliseconds spent sampling.
     pub ms: f64,
-    /// Milliseconds spent auditing.
+    /// Milliseconds spent auditing (with the uniform grid of `uniform_max_error`).
     pub audit_ms: f64,
 }
 
 impl SamplingReport {
     fn new(
-        surface: &Surface,
         sampling: &Sampling,
         sampled: &sample::Sampled,
         audit: &Audit,
+        uniform_max_error: Option<f64>,
         ms: f64,
         audit_ms: f64,
     ) -> Self {
@@ -307,8 +313,7 @@ impl SamplingReport {
             max_error_relative: max_rel,
             rms_error_relative: rms_rel,
             complete: sampled.complete,
-            uniform_max_error: (!sampled.complete)
-                .then(|| sample::uniform_error(surface, sampled.mesh.triangles.len())),
+            uniform_max_error,
             ms,
             audit_ms,
         }
@@ -459,8 +464,18 @@ fn progress(len: usize, quiet: bool) -> ProgressBar {
 }
 
 /// Samples, projects and thickens every surface of the scene, finds the intersection
-/// curves and verifies the halos against them.
+/// curves and verifies the halos against them: the stages its outputs need ([`Stages::of`]).
 pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
+    run_stages(scene, Stages::of(scene), quiet)
+}
+
+/// [`run`] with the stages a picture of the scene needs too, whatever files the scene
+/// writes: what `halo4d render` and `halo4d sweep --render` draw from.
+pub fn run_for_picture(scene: &Scene, quiet: bool) -> Result<Built, Error> {
+    run_stages(scene, Stages::with_picture(scene, true), quiet)
+}
+
+fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error> {
     let bar = progress(scene.surfaces.len() * 3 + 2, quiet);
     let mut timings = Timings::default();
     let mut products = Vec::with_capacity(scene.surfaces.len());
@@ -475,16 +490,14 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
         timings.sample += sample_ms;
         let start = Instant::now();
         let audited = audit(&entry.surface, &sampled.mesh);
+        // Stopped by its budget: the uniform grid of as many triangles to compare with,
+        // audited too (and timed with the audit).
+        let uniform = (!sampled.complete)
+            .then(|| sample::uniform_error(&entry.surface, sampled.mesh.triangles.len()));
         let audit_ms = ms(start);
         timings.audit += audit_ms;
-        let report = SamplingReport::new(
-            &entry.surface,
-            sampling,
-            &sampled,
-            &audited,
-            sample_ms,
-            audit_ms,
-        );
+        let report =
+            SamplingReport::new(sampling, &sampled, &audited, uniform, sample_ms, audit_ms);
         if let Some(w) = report.warning(&name) {
             bar.suspend(|| eprintln!("warning: {w}"));
         }
@@ -527,7 +540,6 @@ pub fn run(scene: &Scene, quiet: bool) -> Result<Built, Error> {
         });
     }
     let rho = scene.halo.rho * diagonal;
-    let stages = Stages::of(scene);
     let triangles: usize = projections.iter().map(|p| p.2.triangles.len()).sum();
     let needed = if stages.halos || stages.curves {
         triangles as f64 * crate::memory::BUILD_BYTES_PER_TRIANGLE
