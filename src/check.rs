@@ -30,6 +30,7 @@
 //!   t = 1/2;
 //! - the tetrahedra's volumes add up to the volume the boundary encloses (`volume_defect`).
 
+use crate::limits::VOLUME_DEFECT;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -110,15 +111,16 @@ impl CheckStats {
             && self.missing_surface_faces == 0
     }
 
-    /// The verdict of `halo4d check` and of a build: the mesh conforms and has no inverted,
-    /// flat or undecidable tetrahedron.
+    /// The verdict of a build and of `halo4d check`: the mesh conforms, has no inverted,
+    /// flat or undecidable tetrahedron, and its tetrahedra fill the volume its boundary
+    /// encloses to within [`crate::limits::VOLUME_DEFECT`].
     pub fn passes(&self) -> bool {
         self.failures().is_empty()
     }
 
     /// What keeps the mesh from passing ([`Self::passes`]): each non-zero failure count as
     /// `<count> <name>` (the conformity counts are [`Self::conforms`]'s, so a mesh that does
-    /// not conform always has one).
+    /// not conform always has one), and a volume defect above [`crate::limits::VOLUME_DEFECT`].
     pub fn failures(&self) -> Vec<String> {
         let counts = [
             ("inverted", self.inverted),
@@ -132,17 +134,25 @@ impl CheckStats {
             ("unexpected_boundary_faces", self.unexpected_boundary_faces),
             ("missing_surface_faces", self.missing_surface_faces),
         ];
-        counts
+        let mut out: Vec<String> = counts
             .iter()
             .filter(|(_, c)| *c > 0)
             .map(|(k, c)| format!("{c} {k}"))
-            .collect()
+            .collect();
+        // A NaN defect fails too.
+        if self.volume_defect.is_nan() || self.volume_defect > VOLUME_DEFECT {
+            out.push(format!(
+                "volume_defect {:.3e} (the tetrahedra overlap or leave gaps)",
+                self.volume_defect
+            ));
+        }
+        out
     }
 
-    /// Whether the mesh conforms, every tetrahedron is positive, and the tetrahedra fill
-    /// exactly the volume the boundary encloses (no overlap).
-    pub fn valid(&self) -> bool {
-        self.passes() && self.volume_defect <= 1e-9
+    /// The verdict as one line naming the mesh, `None` when it passes.
+    pub fn verdict(&self, name: &str) -> Option<String> {
+        let failures = self.failures();
+        (!failures.is_empty()).then(|| format!("{name}: {}", failures.join(", ")))
     }
 }
 

@@ -28,6 +28,7 @@
 //! are counted. Vertices are rounded to f32, what the files store, before they are checked.
 
 use crate::check::{CheckStats, TetMesh, check_parts};
+use crate::limits::FieldError;
 use crate::tets::{self, Corners, Split, SplitStats};
 use crate::view::Projected;
 use glam::DVec3;
@@ -79,10 +80,10 @@ impl Default for HaloParams {
 pub const MIN_RHO: f64 = 1e-6;
 
 impl HaloParams {
-    /// Checks the numbers: `Err((field, message))` names the first bad one.
-    pub fn check(&self) -> Result<(), (&'static str, String)> {
+    /// Checks the numbers: names the first bad field.
+    pub fn check(&self) -> Result<(), FieldError> {
         if !(self.rho.is_finite() && self.rho >= MIN_RHO && self.rho < 0.5) {
-            return Err((
+            return Err(FieldError::new(
                 "rho",
                 format!(
                     "must be greater than 0: at least {MIN_RHO:e} (below that the two offsets round to one point in f32, which the files store), and less than 0.5 (a share of the scene's diagonal), got {:?}",
@@ -91,7 +92,7 @@ impl HaloParams {
             ));
         }
         if !(self.delta_d.is_finite() && self.delta_d >= 0.0) {
-            return Err((
+            return Err(FieldError::new(
                 "delta_d",
                 format!(
                     "must be a finite number of at least 0, got {}",
@@ -100,7 +101,7 @@ impl HaloParams {
             ));
         }
         if !(self.delta_t.is_finite() && (0.0..1.0).contains(&self.delta_t)) {
-            return Err((
+            return Err(FieldError::new(
                 "delta_t",
                 format!("must be in [0, 1), got {}", self.delta_t),
             ));

@@ -6,14 +6,13 @@
 use crate::error::Error;
 use crate::export::{self, SurfaceData};
 use crate::halo::{Halo, HaloParams, HaloReport, build_halo};
-use crate::intersect::{self, Curves, CurvesReport, Sheet};
-use crate::render::{
-    self, CameraSettings, Picture, RenderError, RenderInput, RenderSettings, RenderSurface,
-};
+use crate::intersect::{self, Curves, CurvesReport};
+use crate::parts::{HaloPart, Parts, SurfacePart};
+use crate::render::{self, CameraSettings, Picture, RenderError, RenderSettings};
 use crate::sample::{self, Audit, Mesh4, MeshStats, Sampling, audit};
 use crate::scene::Scene;
 use crate::surfaces::{Surface, Topology};
-use crate::verify::{self, HaloInput, Verification};
+use crate::verify::{self, Verification};
 use crate::view::{MAX_COORDINATE, MIN_EXTENT, Projected};
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -118,68 +117,21 @@ impl Built {
     pub fn failures(&self) -> Vec<String> {
         let mut out = Vec::new();
         for p in self.surfaces.iter().filter(|_| self.stages.halos) {
-            let check = &p.halo_report.check;
             if p.halo.tets.is_empty() {
                 out.push(format!("{}: no halo (no tetrahedron)", p.name));
-            } else if !check.passes() {
-                out.push(format!("{}-halo: {}", p.name, check.failures().join(", ")));
+            } else {
+                out.extend(p.halo_report.check.verdict(&format!("{}-halo", p.name)));
             }
         }
-        let c = &self.curves.report;
-        if c.unresolved > 0 {
-            out.push(format!(
-                "curves: {} unresolved (more than two segments meet at a point)",
-                c.unresolved
-            ));
-        }
-        let v = &self.verification;
-        let first = |at: &[[f64; 3]]| {
-            at.first()
-                .map(|p| format!(" (the first at ({:.6}, {:.6}, {:.6}))", p[0], p[1], p[2]))
-                .unwrap_or_default()
-        };
-        if v.wrong > 0 {
-            out.push(format!(
-                "halo verification: {} of {} curve samples wrong{}",
-                v.wrong,
-                v.curve_samples,
-                first(&v.wrong_at)
-            ));
-        }
-        if v.spurious_hidden_samples > 0 {
-            out.push(format!(
-                "halo verification: {} of {} surface samples spuriously hidden{}",
-                v.spurious_hidden_samples,
-                v.surface_samples,
-                first(&v.spurious_at)
-            ));
-        }
+        out.extend(self.curves.report.failures());
+        out.extend(self.verification.failures());
         out
     }
 
-    /// The surfaces as the intersection stage reads them.
-    pub fn sheets(&self) -> Vec<Sheet<'_>> {
-        sheets(&self.surfaces)
-    }
-
-    /// The surfaces, halos (with the scene's `halo` parameters) and curves as the renderer
-    /// reads them.
-    pub fn render_parts(&self, halo: &HaloParams) -> RenderParts<'_> {
-        RenderParts {
-            surfaces: self
-                .surfaces
-                .iter()
-                .map(|p| RenderSurface {
-                    positions: &p.projected.positions,
-                    w: &p.projected.w,
-                    normals: &p.projected.normals,
-                    uv: &p.mesh.uv,
-                    triangles: &p.mesh.triangles,
-                })
-                .collect(),
-            halos: halo_inputs(&self.surfaces, halo),
-            curves: &self.curves,
-        }
+    /// What the build produced, as the verification, the renderer and the viewer read it;
+    /// `halo` are the scene's halo parameters.
+    pub fn parts<'a>(&'a self, halo: &HaloParams) -> Parts<'a> {
+        parts(&self.surfaces, halo, &self.curves)
     }
 
     /// The picture of the given settings (the scene's `render` and `camera`, usually).
@@ -189,61 +141,39 @@ impl Built {
         settings: &RenderSettings,
         camera: &CameraSettings,
     ) -> Result<Picture, RenderError> {
-        render::render(&self.render_parts(halo).input(), settings, camera)
+        render::render(&self.parts(halo), settings, camera)
     }
 }
 
-/// A build's surfaces, halos and curves as the renderer reads them ([`Built::render_parts`]).
-pub struct RenderParts<'a> {
-    /// The surfaces.
-    pub surfaces: Vec<RenderSurface<'a>>,
-    /// Their halos.
-    pub halos: Vec<Option<HaloInput<'a>>>,
-    /// The curves.
-    pub curves: &'a Curves,
-}
-
-impl RenderParts<'_> {
-    /// The renderer's input.
-    pub fn input(&self) -> RenderInput<'_> {
-        RenderInput {
-            surfaces: &self.surfaces,
-            halos: &self.halos,
-            curves: self.curves,
-        }
-    }
-}
-
-fn sheets(surfaces: &[SurfaceProduct]) -> Vec<Sheet<'_>> {
-    surfaces
-        .iter()
-        .map(|p| Sheet {
-            positions: &p.projected.positions,
-            w: &p.projected.w,
-            triangles: &p.mesh.triangles,
-        })
-        .collect()
-}
-
-/// The halos as the verification reads them.
-pub fn halo_inputs<'a>(
-    surfaces: &'a [SurfaceProduct],
-    params: &HaloParams,
-) -> Vec<Option<HaloInput<'a>>> {
-    surfaces
-        .iter()
-        .map(|p| {
-            (!p.halo.tets.is_empty()).then_some(HaloInput {
-                positions: &p.halo.positions,
-                t: &p.halo.t,
-                d_orig: &p.halo.d_orig,
-                tets: &p.halo.tets,
-                surface_vertices: p.halo.surface_vertices,
-                delta_d: params.delta_d,
-                delta_t: params.delta_t,
+/// The one place a build's products become the hand-off.
+fn parts<'a>(surfaces: &'a [SurfaceProduct], halo: &HaloParams, curves: &'a Curves) -> Parts<'a> {
+    Parts {
+        surfaces: surfaces
+            .iter()
+            .map(|p| SurfacePart {
+                positions: &p.projected.positions,
+                w: &p.projected.w,
+                normals: &p.projected.normals,
+                uv: Some(&p.mesh.uv),
+                triangles: &p.mesh.triangles,
             })
-        })
-        .collect()
+            .collect(),
+        halos: surfaces
+            .iter()
+            .map(|p| {
+                (!p.halo.tets.is_empty()).then_some(HaloPart {
+                    positions: &p.halo.positions,
+                    t: &p.halo.t,
+                    d_orig: &p.halo.d_orig,
+                    tets: &p.halo.tets,
+                    surface_vertices: p.halo.surface_vertices,
+                    delta_d: halo.delta_d,
+                    delta_t: halo.delta_t,
+                })
+            })
+            .collect(),
+        curves,
+    }
 }
 
 /// How a surface was sampled, and the audit of the mesh (`report.json`'s `sampling`).
@@ -446,6 +376,84 @@ pub struct Report {
     pub scene: Scene,
 }
 
+impl Report {
+    /// What `halo4d build` prints on stderr: per surface its mesh, the curves, the halo
+    /// verification, the timings and the memory, one line each.
+    pub fn summary(&self) -> String {
+        let mut out = String::new();
+        for s in &self.surfaces {
+            out += &format!(
+                "{:<24} {:>9} vertices {:>9} triangles  Euler characteristic {}\n",
+                s.name, s.vertices, s.triangles, s.mesh.euler_characteristic
+            );
+        }
+        match &self.curves {
+            Some(c) => out += &format!("{}\n", c.summary()),
+            None => out += "curves: not computed (no output uses them)\n",
+        }
+        match &self.halo_verification {
+            Some(v) => {
+                out += &format!(
+                    "halo verification: {} curve samples: {} correct, {} wrong, {} ambiguous, {} third sheet; {} surface samples, {} far tetrahedra, {} spurious\n",
+                    v.curve_samples,
+                    v.correct,
+                    v.wrong,
+                    v.ambiguous,
+                    v.third_sheet,
+                    v.surface_samples,
+                    v.far_tetrahedra,
+                    v.spurious_hidden_samples
+                )
+            }
+            None => {
+                out += "halo verification: not run (no halo file written; `outputs.verify: true` asks for it)\n"
+            }
+        }
+        let t = self.timings_ms;
+        out += &format!(
+            "sample {:.1} ms, audit {:.1} ms, view {:.1} ms, halo {:.1} ms, curves {:.1} ms, verify {:.1} ms, export {:.1} ms, render {:.1} ms, total {:.1} ms\n",
+            t.sample, t.audit, t.view, t.halo, t.curves, t.verify, t.export, t.render, t.total
+        );
+        out += &format!(
+            "memory: about {:.2} GB estimated from the halos on, limit {:.2} GB{}\n",
+            self.memory.estimate_gb,
+            self.memory.limit_gb,
+            self.memory
+                .peak_gb
+                .map(|gb| format!(", peak {gb:.2} GB"))
+                .unwrap_or_default()
+        );
+        out
+    }
+}
+
+/// Renders the scene's picture (the stages it needs, then its `render` and `camera`) and
+/// writes it to `out` as PNG, whole or not at all, making its folder when missing. Gives the
+/// picture and the milliseconds the rendering took.
+pub fn render_to(scene: &Scene, out: &Path, quiet: bool) -> Result<(Picture, f64), Error> {
+    let render_error = |source| Error::Render {
+        scene: scene.name.clone(),
+        source,
+    };
+    // The settings first: a bad one stops the command before the build.
+    (scene.render.check()).map_err(|e| render_error(RenderError::Setting(e.within("render"))))?;
+    let built = run_for_picture(scene, quiet)?;
+    let start = Instant::now();
+    let picture = built
+        .render(&scene.halo, &scene.render, &scene.camera)
+        .map_err(render_error)?;
+    let took = ms(start);
+    let write_error = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| Error::Write { path, source }
+    };
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(write_error(dir))?;
+    }
+    export::write_atomic(out, &picture.png()).map_err(write_error(out))?;
+    Ok((picture, took))
+}
+
 fn ms(since: Instant) -> f64 {
     since.elapsed().as_secs_f64() * 1e3
 }
@@ -587,7 +595,7 @@ fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error
     if stages.curves {
         bar.set_message("intersection curves");
         let start = Instant::now();
-        curves = intersect::curves(&sheets(&products));
+        curves = intersect::curves(&parts(&products, &scene.halo, &curves).sheets());
         timings.curves = ms(start);
     }
     bar.inc(1);
@@ -595,11 +603,7 @@ fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error
     if stages.verify {
         bar.set_message("verifying halos");
         let start = Instant::now();
-        verification = verify::verify(
-            &sheets(&products),
-            &halo_inputs(&products, &scene.halo),
-            &curves,
-        );
+        verification = verify::verify(&parts(&products, &scene.halo, &curves));
         timings.verify = ms(start);
     }
     bar.finish_and_clear();

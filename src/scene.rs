@@ -7,6 +7,7 @@
 
 use crate::error::shorten;
 use crate::halo::HaloParams;
+use crate::limits::{FieldError, NAME_LENGTH, SURFACES, TRIANGLES};
 use crate::render::{CameraSettings, RenderSettings};
 use crate::sample::Sampling;
 use crate::surfaces::Surface;
@@ -16,9 +17,6 @@ use std::path::Path;
 
 /// The scene built when none is given: a spun trefoil in an oblique 4D view.
 pub const DEFAULT_SCENE: &str = include_str!("../fixtures/scenes/default.json");
-
-/// The most triangles a scene may ask for, over all its surfaces.
-pub const MAX_TRIANGLES: usize = 20_000_000;
 
 /// A scene: what to build and what to write.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -101,17 +99,17 @@ pub struct Outputs {
 pub const CURVE_RADIUS: f64 = 0.004;
 
 impl Outputs {
-    /// Checks the numbers: `Err((field, message))` names the first bad one.
-    pub fn check(&self) -> Result<(), (&'static str, String)> {
+    /// Checks the numbers: names the first bad field.
+    pub fn check(&self) -> Result<(), FieldError> {
         if self.verify == Some(false) && (self.glb || self.vtk) {
-            return Err((
+            return Err(FieldError::new(
                 "verify",
-                "halo files (glb, vtk) are always verified; remove `verify: false`, or set `glb` and `vtk` to false".into(),
+                "halo files (glb, vtk) are always verified; remove `verify: false`, or set `glb` and `vtk` to false",
             ));
         }
         if !(self.curve_radius.is_finite() && self.curve_radius > 0.0 && self.curve_radius <= 0.05)
         {
-            return Err((
+            return Err(FieldError::new(
                 "curve_radius",
                 format!(
                     "must be greater than 0 and at most 0.05 (a share of the scene's diagonal), got {}",
@@ -212,7 +210,7 @@ impl Scene {
             .map_err(|e| syntax("(after the scene)".into(), e))?;
         scene
             .validate()
-            .map_err(|(field, message)| SceneError::Invalid {
+            .map_err(|FieldError { field, message }| SceneError::Invalid {
                 file: file.to_string(),
                 field,
                 message,
@@ -233,33 +231,36 @@ impl Scene {
         self.surfaces[i].sampling.as_ref().unwrap_or(&self.sampling)
     }
 
-    /// Checks every value; `Err((field, message))` names the first bad one.
-    pub fn validate(&self) -> Result<(), (String, String)> {
-        check_name(&self.name).map_err(|m| ("name".to_string(), m))?;
-        if self.surfaces.is_empty() || self.surfaces.len() > 64 {
-            return Err((
-                "surfaces".into(),
-                format!("must list 1 to 64 surfaces, got {}", self.surfaces.len()),
+    /// Checks every value; names the first bad field.
+    pub fn validate(&self) -> Result<(), FieldError> {
+        check_name(&self.name).map_err(|m| FieldError::new("name", m))?;
+        if !SURFACES.contains(&self.surfaces.len()) {
+            return Err(FieldError::new(
+                "surfaces",
+                format!(
+                    "must list {} to {} surfaces, got {}",
+                    SURFACES.start(),
+                    SURFACES.end(),
+                    self.surfaces.len()
+                ),
             ));
         }
-        self.sampling
-            .check()
-            .map_err(|(f, m)| (format!("sampling.{f}"), m))?;
+        self.sampling.check().map_err(|e| e.within("sampling"))?;
         let mut names = Vec::new();
         let mut triangles = 0usize;
         for (i, s) in self.surfaces.iter().enumerate() {
             s.surface
                 .check()
-                .map_err(|(f, m)| (format!("surfaces[{i}].surface.{f}"), m))?;
+                .map_err(|e| e.within(&format!("surfaces[{i}].surface")))?;
             if let Some(sampling) = &s.sampling {
                 sampling
                     .check()
-                    .map_err(|(f, m)| (format!("surfaces[{i}].sampling.{f}"), m))?;
+                    .map_err(|e| e.within(&format!("surfaces[{i}].sampling")))?;
             }
             let name = self.surface_name(i);
-            check_name(&name).map_err(|m| (format!("surfaces[{i}].name"), m))?;
+            check_name(&name).map_err(|m| FieldError::new(format!("surfaces[{i}].name"), m))?;
             if names.contains(&name) {
-                return Err((
+                return Err(FieldError::new(
                     format!("surfaces[{i}].name"),
                     format!(
                         "`{name}` is used by an earlier surface; give each surface a unique `name`"
@@ -276,7 +277,7 @@ impl Scene {
             if let Sampling::Uniform { u, v } = *sampling {
                 let [min_u, min_v] = s.surface.min_cells();
                 if u < min_u || v < min_v {
-                    return Err((
+                    return Err(FieldError::new(
                         field,
                         format!(
                             "{} needs at least {min_u} x {min_v} cells, got {u} x {v}",
@@ -291,36 +292,26 @@ impl Scene {
                     triangles.saturating_add(sampling.max_triangles(s.surface.patch_count()));
             }
         }
-        if triangles > MAX_TRIANGLES {
-            return Err((
-                "sampling".into(),
+        if triangles > *TRIANGLES.end() {
+            return Err(FieldError::new(
+                "sampling",
                 format!(
-                    "the scene's grids make {triangles} triangles, more than the limit of {MAX_TRIANGLES}; lower u and v"
+                    "the scene's grids make {triangles} triangles, more than the limit of {}; lower u and v",
+                    TRIANGLES.end()
                 ),
             ));
         }
-        self.view
-            .check()
-            .map_err(|(f, m)| (format!("view.{f}"), m))?;
-        self.halo
-            .check()
-            .map_err(|(f, m)| (format!("halo.{f}"), m))?;
-        self.camera
-            .check()
-            .map_err(|(f, m)| (format!("camera.{f}"), m))?;
-        self.render
-            .check()
-            .map_err(|(f, m)| (format!("render.{f}"), m))?;
-        self.outputs
-            .check()
-            .map_err(|(f, m)| (format!("outputs.{f}"), m))?;
+        self.view.check().map_err(|e| e.within("view"))?;
+        self.halo.check().map_err(|e| e.within("halo"))?;
+        self.camera.check().map_err(|e| e.within("camera"))?;
+        self.render.check().map_err(|e| e.within("render"))?;
+        self.outputs.check().map_err(|e| e.within("outputs"))?;
         Ok(())
     }
 }
 
 fn check_name(name: &str) -> Result<(), String> {
-    let ok = !name.is_empty()
-        && name.len() <= 64
+    let ok = NAME_LENGTH.contains(&name.len())
         && !name.starts_with('.')
         && name
             .chars()
@@ -329,7 +320,9 @@ fn check_name(name: &str) -> Result<(), String> {
         Ok(())
     } else {
         Err(format!(
-            "`{name}` is not a usable name: use 1 to 64 letters, digits, `-`, `_` or `.`, not starting with `.`"
+            "`{name}` is not a usable name: use {} to {} letters, digits, `-`, `_` or `.`, not starting with `.`",
+            NAME_LENGTH.start(),
+            NAME_LENGTH.end()
         ))
     }
 }

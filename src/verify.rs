@@ -1,7 +1,7 @@
 //! Halo verification: the intersection curves are the ground truth the halos must explain.
 //!
-//! Takes: the sheets (projected surfaces), their halos (tetrahedra with t and d_orig, in the
-//! layout of [`crate::check`]) and the curves of [`crate::intersect`]. Gives:
+//! Takes: [`Parts`]: the sheets (projected surfaces), their halos (tetrahedra with t and
+//! d_orig, in the layout of [`crate::check`]) and the curves of [`crate::intersect`]. Gives:
 //! [`Verification`], counts of samples classified as below. A point x of a sheet at depth w
 //! is *hidden* when it lies in a halo tetrahedron (exact `orient3d`, boundary included;
 //! found by an obvhs query over the tetrahedra) whose halo depth there (paper 000 eq. 3,
@@ -28,41 +28,13 @@
 //! the tetrahedra whose boxes hold one.
 
 use crate::intersect::broad;
-use crate::intersect::sos::orient3d;
 use crate::intersect::{Curves, End, Face, Sheet};
+use crate::parts::{HaloIndex, HaloPart, Parts, inserted_sets, tet_box};
 use glam::DVec3;
 use obvhs::aabb::Aabb;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::time::Instant;
-
-/// A halo as the verification reads it.
-#[derive(Clone, Copy, Debug)]
-pub struct HaloInput<'a> {
-    /// Vertex positions: offsets 0..n (t = 0), n..2n (t = 1), the surface 2n..3n (t = 1/2),
-    /// inserted vertices after.
-    pub positions: &'a [DVec3],
-    /// t of each vertex.
-    pub t: &'a [f64],
-    /// d_orig of each vertex.
-    pub d_orig: &'a [f64],
-    /// Positively oriented tetrahedra.
-    pub tets: &'a [[u32; 4]],
-    /// Surface vertices n.
-    pub surface_vertices: usize,
-    /// Depth increment delta_d of eq. 3.
-    pub delta_d: f64,
-    /// Dead zone delta_t of eq. 3.
-    pub delta_t: f64,
-}
-
-impl HaloInput<'_> {
-    /// Surface vertex v's half-width rho: half the distance between its two offsets.
-    fn half_width(&self, v: usize) -> f64 {
-        let n = self.surface_vertices;
-        (self.positions[v + n] - self.positions[v]).length() * 0.5
-    }
-}
 
 /// `report.json`'s `halo_verification`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -132,6 +104,55 @@ pub struct Ambiguous {
 pub const BRANCH_REACH: f64 = 2.0;
 
 impl Verification {
+    /// The verdict of a build and of `halo4d check DIR`: what the halos do not explain (a
+    /// wrong curve sample, a spuriously hidden surface sample), empty when they explain
+    /// everything.
+    pub fn failures(&self) -> Vec<String> {
+        let first = |at: &[[f64; 3]]| {
+            at.first()
+                .map(|p| format!(" (the first at ({:.6}, {:.6}, {:.6}))", p[0], p[1], p[2]))
+                .unwrap_or_default()
+        };
+        let mut out = Vec::new();
+        if self.wrong > 0 {
+            out.push(format!(
+                "halo verification: {} of {} curve samples wrong{}",
+                self.wrong,
+                self.curve_samples,
+                first(&self.wrong_at)
+            ));
+        }
+        if self.spurious_hidden_samples > 0 {
+            out.push(format!(
+                "halo verification: {} of {} surface samples spuriously hidden{}",
+                self.spurious_hidden_samples,
+                self.surface_samples,
+                first(&self.spurious_at)
+            ));
+        }
+        out
+    }
+
+    /// The counts as rows (name, count), the reasons of the ambiguous ones indented, in
+    /// the order `halo4d check DIR` prints them.
+    pub fn rows(&self) -> [(&'static str, usize); 12] {
+        let r = &self.ambiguous_reasons;
+        [
+            ("curve_samples", self.curve_samples),
+            ("correct", self.correct),
+            ("wrong", self.wrong),
+            ("ambiguous", self.ambiguous),
+            ("  branch_point", r.branch_point),
+            ("  boundary", r.boundary),
+            ("  vanished_halo", r.vanished_halo),
+            ("  resolution", r.resolution),
+            ("third_sheet", self.third_sheet),
+            ("surface_samples", self.surface_samples),
+            ("far_tetrahedra", self.far_tetrahedra),
+            ("spurious_hidden_samples", self.spurious_hidden_samples),
+        ]
+    }
+
     /// Adds `other`'s counts, and its examples after this one's.
     fn add(mut self, other: Verification) -> Verification {
         self.curve_samples += other.curve_samples;
@@ -167,8 +188,10 @@ impl Verification {
 /// (none, in a sound halo), because a tetrahedron whose corners are all within rho of the
 /// surface points it is built over lies within rho of them everywhere (the distance to a
 /// convex set is convex).
-pub fn verify(sheets: &[Sheet], halos: &[Option<HaloInput>], curves: &Curves) -> Verification {
+pub fn verify(parts: &Parts) -> Verification {
     let start = Instant::now();
+    let sheets = &parts.sheets();
+    let (halos, curves) = (&parts.halos, parts.curves);
     let scale = sheets
         .iter()
         .flat_map(|s| s.positions.iter())
@@ -270,7 +293,7 @@ fn surface_samples(sheets: &[Sheet]) -> Vec<(DVec3, f64, Face)> {
 /// vertex stands for its own surface point, an inserted vertex for the surface points of
 /// the tetrahedra around it (measured to their hull). Every point of any other
 /// tetrahedron is within its rho of the hull of the surface points it is built over.
-fn far_tetrahedra(sheets: &[Sheet], halos: &[Option<HaloInput>], tolerance: f64) -> Vec<Vec<u32>> {
+fn far_tetrahedra(sheets: &[Sheet], halos: &[Option<HaloPart>], tolerance: f64) -> Vec<Vec<u32>> {
     sheets
         .iter()
         .zip(halos)
@@ -316,34 +339,6 @@ fn far_tetrahedra(sheets: &[Sheet], halos: &[Option<HaloInput>], tolerance: f64)
         .collect()
 }
 
-/// The surface vertices (mod n, sorted, distinct) of the tetrahedra around each inserted
-/// vertex of `h`.
-fn inserted_sets(h: &HaloInput) -> Vec<Vec<u32>> {
-    let n = h.surface_vertices;
-    let mut sets: Vec<Vec<u32>> = vec![Vec::new(); h.positions.len().saturating_sub(3 * n)];
-    for tet in h.tets {
-        for &k in tet.iter().filter(|&&k| k as usize >= 3 * n) {
-            for &v in tet.iter().filter(|&&v| (v as usize) < 3 * n) {
-                sets[k as usize - 3 * n].push(v % n as u32);
-            }
-        }
-    }
-    for set in &mut sets {
-        set.sort_unstable();
-        set.dedup();
-    }
-    sets
-}
-
-/// The f32 box around tetrahedron `i` of `h` (rounded outward).
-fn tet_box(h: &HaloInput, i: u32) -> Aabb {
-    let p = h.tets[i as usize].map(|v| h.positions[v as usize]);
-    broad::outward(
-        p[0].min(p[1]).min(p[2]).min(p[3]),
-        p[0].max(p[1]).max(p[2]).max(p[3]),
-    )
-}
-
 const EXAMPLES: usize = 8;
 
 /// Adds `x` to a list of examples unless it is full or has `x` already.
@@ -357,203 +352,6 @@ struct CurveSample {
     x: DVec3,
     w: [f64; 2],
     faces: [Face; 2],
-}
-
-/// A tetrahedron (global index into [`HaloIndex`]) containing a point whose halo depth
-/// there is below the point's w.
-#[derive(Clone, Copy, Debug)]
-struct Hider(u32);
-
-/// The halo tetrahedra of several surfaces in one obvhs BVH, for the question the halo
-/// verification and the renderer's exact mode both ask: is this point of a sheet hidden?
-pub struct HaloIndex<'a> {
-    halos: &'a [Option<HaloInput<'a>>],
-    /// Global tetrahedron -> (surface, tet).
-    tets: Vec<(u32, u32)>,
-    /// Per global tetrahedron, the surface vertices it is built over (an inserted vertex
-    /// stands for those of the tetrahedra around it), sorted, padded with `u32::MAX`.
-    over: Vec<[u32; 6]>,
-    bvh: obvhs::bvh2::Bvh2,
-}
-
-impl<'a> HaloIndex<'a> {
-    /// Indexes the tetrahedra of `halos` (one per surface, `None` for none).
-    pub fn new(halos: &'a [Option<HaloInput<'a>>]) -> Self {
-        Self::with(halos, |_, _| true)
-    }
-
-    /// Indexes the tetrahedra `i` of each surface `s` with `keep(s, i)`.
-    pub(crate) fn with(
-        halos: &'a [Option<HaloInput<'a>>],
-        keep: impl Fn(usize, u32) -> bool + Sync,
-    ) -> Self {
-        let mut boxes = Vec::new();
-        let mut tets = Vec::new();
-        let mut over = Vec::new();
-        for (s, halo) in halos.iter().enumerate() {
-            let Some(h) = halo else { continue };
-            let n = h.surface_vertices as u32;
-            let inserted = inserted_sets(h);
-            let kept: Vec<(u32, Aabb, [u32; 6])> = (0..h.tets.len() as u32)
-                .into_par_iter()
-                .filter(|&i| keep(s, i))
-                .map(|i| {
-                    let tet = h.tets[i as usize];
-                    let aabb = tet_box(h, i);
-                    let mut vs: Vec<u32> = Vec::with_capacity(8);
-                    for &k in &tet {
-                        if k < 3 * n {
-                            vs.push(k % n);
-                        } else {
-                            vs.extend_from_slice(&inserted[(k - 3 * n) as usize]);
-                        }
-                    }
-                    vs.sort_unstable();
-                    vs.dedup();
-                    let mut padded = [u32::MAX; 6];
-                    for (slot, v) in padded.iter_mut().zip(vs) {
-                        *slot = v;
-                    }
-                    (i, aabb, padded)
-                })
-                .collect();
-            for (i, aabb, vs) in kept {
-                boxes.push(aabb);
-                tets.push((s as u32, i));
-                over.push(vs);
-            }
-        }
-        HaloIndex {
-            halos,
-            tets,
-            over,
-            bvh: broad::build(&boxes, 4),
-        }
-    }
-
-    /// Whether the point `x` of a triangle (with vertices `own`) of surface `surface`, at
-    /// depth `w`, is hidden: inside a tetrahedron whose halo depth there is below `w`,
-    /// other than those of the prisms of the triangles sharing a vertex with it.
-    pub fn hidden(&self, x: DVec3, w: f64, surface: u32, own: [u32; 3]) -> bool {
-        let mut hidden = false;
-        self.visit(x, |g| {
-            if !self.within(g, surface, &own) && self.depth_at(g, x).is_some_and(|depth| depth < w)
-            {
-                hidden = true;
-            }
-            !hidden
-        });
-        hidden
-    }
-
-    /// Whether the halo of `surface` has zero width at a vertex of `triangle` (its two
-    /// offsets coincide there: collapsed). False where the surface has no halo: then
-    /// nothing vanished, nothing was built.
-    fn vanishes(&self, surface: u32, triangle: &[u32; 3]) -> bool {
-        self.halos[surface as usize].as_ref().is_some_and(|h| {
-            let n = h.surface_vertices;
-            triangle
-                .iter()
-                .any(|&k| h.positions[k as usize] == h.positions[k as usize + n])
-        })
-    }
-
-    /// The number of tetrahedra.
-    pub(crate) fn len(&self) -> usize {
-        self.tets.len()
-    }
-
-    /// Tetrahedron `g`'s corners, t and d_orig at them, and its halo's (delta_t, delta_d).
-    pub(crate) fn tet(&self, g: u32) -> ([DVec3; 4], [f64; 4], [f64; 4], (f64, f64)) {
-        let (surface, tet) = self.tets[g as usize];
-        let h = self.halos[surface as usize]
-            .as_ref()
-            .expect("an indexed tetrahedron has a halo");
-        let k = h.tets[tet as usize];
-        (
-            k.map(|v| h.positions[v as usize]),
-            k.map(|v| h.t[v as usize]),
-            k.map(|v| h.d_orig[v as usize]),
-            (h.delta_t, h.delta_d),
-        )
-    }
-
-    /// Calls `f` with each tetrahedron whose box contains `x`, until it returns false.
-    fn visit(&self, x: DVec3, mut f: impl FnMut(u32) -> bool) {
-        self.bvh.aabb_traverse(broad::outward(x, x), |bvh, node| {
-            let node = &bvh.nodes[node as usize];
-            let first = node.first_index as usize;
-            bvh.primitive_indices[first..first + node.prim_count as usize]
-                .iter()
-                .all(|&g| f(g))
-        });
-    }
-
-    /// The surface vertices tetrahedron `g` is built over.
-    fn over(&self, g: u32) -> impl Iterator<Item = u32> + '_ {
-        self.over[g as usize]
-            .iter()
-            .copied()
-            .take_while(|&v| v != u32::MAX)
-    }
-
-    /// Whether tetrahedron `g` is over a vertex of `ring` on `surface` (with a triangle's
-    /// vertices: whether it belongs to the sheet's own halo there, which never hides it).
-    pub(crate) fn within(&self, g: u32, surface: u32, ring: &[u32]) -> bool {
-        self.tets[g as usize].0 == surface && self.over(g).any(|v| ring.contains(&v))
-    }
-
-    /// The tetrahedra containing `x` whose halo depth there is below `w`, except those of
-    /// `own` (its surface and ring).
-    fn hiders(&self, x: DVec3, w: f64, own: (u32, &[u32])) -> Vec<Hider> {
-        let mut out = Vec::new();
-        self.visit(x, |g| {
-            if !self.within(g, own.0, own.1) && self.depth_at(g, x).is_some_and(|depth| depth < w) {
-                out.push(Hider(g));
-            }
-            true
-        });
-        out
-    }
-
-    /// The tetrahedra containing `x` with their halo depth there.
-    fn containing(&self, x: DVec3) -> Vec<(u32, f64)> {
-        let mut out = Vec::new();
-        self.visit(x, |g| {
-            if let Some(depth) = self.depth_at(g, x) {
-                out.push((g, depth));
-            }
-            true
-        });
-        out
-    }
-
-    /// Halo depth (eq. 3) at `x` if tetrahedron `g` contains it (boundary included).
-    fn depth_at(&self, g: u32, x: DVec3) -> Option<f64> {
-        let (surface, tet) = self.tets[g as usize];
-        let h = self.halos[surface as usize].as_ref()?;
-        let k = h.tets[tet as usize];
-        let p = k.map(|v| h.positions[v as usize]);
-        // Each barycentric weight in turn, the search ending at the first negative one: most
-        // candidates (tetrahedra whose box holds x) do not hold it.
-        let mut l = [0.0; 4];
-        for (i, w) in l.iter_mut().enumerate() {
-            let mut q = p;
-            q[i] = x;
-            *w = orient3d(q[0], q[1], q[2], q[3]);
-            if *w < 0.0 {
-                return None;
-            }
-        }
-        let total: f64 = l.iter().sum();
-        if total <= 0.0 {
-            return None;
-        }
-        let interp = |f: &[f64]| (0..4).map(|i| l[i] * f[k[i] as usize]).sum::<f64>() / total;
-        let t = interp(h.t);
-        let d = interp(h.d_orig);
-        Some(d + ((2.0 * t - 1.0).abs() - h.delta_t).max(0.0) * h.delta_d)
-    }
 }
 
 /// What the classification needs of each surface, with the halos' index.
@@ -575,7 +373,7 @@ impl<'a> Index<'a> {
     /// The index for the curve samples at `points`.
     fn new(
         sheets: &'a [Sheet<'a>],
-        halos: &'a [Option<HaloInput<'a>>],
+        halos: &'a [Option<HaloPart<'a>>],
         curves: &Curves,
         points: &[DVec3],
     ) -> Self {
@@ -841,8 +639,8 @@ mod tests {
         // Brute force: every tetrahedron of every halo that contains a curve sample (exact
         // orient3d, boundary included) is among those the curve samples are tested against.
         let (built, scene) = flat_torus();
-        let sheets = built.sheets();
-        let halos = crate::pipeline::halo_inputs(&built.surfaces, &scene.halo);
+        let parts = built.parts(&scene.halo);
+        let (sheets, halos) = (parts.sheets(), parts.halos);
         let points: Vec<DVec3> = curve_samples(&built.curves).iter().map(|s| s.x).collect();
         let index = Index::new(&sheets, &halos, &built.curves, &points);
         let kept: HashSet<(u32, u32)> = index.halos.tets.iter().copied().collect();
@@ -871,10 +669,9 @@ mod tests {
         // that a search over all tetrahedra finds, the search over the far ones finds too.
         let (mut built, scene) = flat_torus();
         let scale = 1.0; // the flat torus's largest coordinate
-        let sheets = built.sheets();
-        let halos = crate::pipeline::halo_inputs(&built.surfaces, &scene.halo);
-        assert!(far_tetrahedra(&sheets, &halos, 1e-6 * scale)[0].is_empty());
-        drop(halos);
+        let parts = built.parts(&scene.halo);
+        assert!(far_tetrahedra(&parts.sheets(), &parts.halos, 1e-6 * scale)[0].is_empty());
+        drop(parts);
         let n = built.surfaces[0].mesh.positions.len();
         let halo = &mut built.surfaces[0].halo;
         for (k, p) in halo.positions.iter_mut().enumerate() {
@@ -887,8 +684,8 @@ mod tests {
         for d in &mut halo.d_orig {
             *d -= 10.0;
         }
-        let sheets = built.sheets();
-        let halos = crate::pipeline::halo_inputs(&built.surfaces, &scene.halo);
+        let parts = built.parts(&scene.halo);
+        let (sheets, halos) = (parts.sheets(), parts.halos);
         let far = far_tetrahedra(&sheets, &halos, 1e-6 * scale);
         assert!(!far[0].is_empty() && far[0].len() < halos[0].unwrap().tets.len());
         let points: Vec<DVec3> = Vec::new();

@@ -12,6 +12,7 @@
 //! the w-depth of a vertex is its w after rotation and translation: smaller is nearer the
 //! eye. A point at or behind the eye is an error, never a NaN.
 
+use crate::limits::FieldError;
 use crate::sample::Mesh4;
 use glam::{DMat4, DVec3, DVec4};
 use serde::{Deserialize, Serialize};
@@ -208,11 +209,11 @@ impl Projected {
 }
 
 impl View {
-    /// Checks the numbers: `Err((field, message))` names the first bad one.
-    pub fn check(&self) -> Result<(), (String, String)> {
+    /// Checks the numbers: names the first bad field.
+    pub fn check(&self) -> Result<(), FieldError> {
         for (name, deg) in self.rotation.planes() {
             if !deg.is_finite() {
-                return Err((
+                return Err(FieldError::new(
                     format!("rotation.{name}"),
                     format!("must be a finite angle in degrees, got {deg}"),
                 ));
@@ -220,7 +221,7 @@ impl View {
         }
         for (i, t) in self.translation.iter().enumerate() {
             if !t.is_finite() {
-                return Err((
+                return Err(FieldError::new(
                     format!("translation[{i}]"),
                     format!("must be finite, got {t}"),
                 ));
@@ -229,8 +230,8 @@ impl View {
         if let Projection::Perspective { eye_distance } = self.projection
             && !(eye_distance.is_finite() && eye_distance > 0.0)
         {
-            return Err((
-                "projection.eye_distance".into(),
+            return Err(FieldError::new(
+                "projection.eye_distance",
                 format!("must be a finite number greater than 0, got {eye_distance}"),
             ));
         }
@@ -280,15 +281,22 @@ impl View {
     }
 }
 
-fn vertex_normals(p: &Projected, triangles: &[[u32; 3]]) -> Vec<DVec3> {
-    let mut face_sum = vec![DVec3::ZERO; p.positions.len()];
+/// Per vertex, the sum of the normals of the triangles around it, each as long as twice the
+/// triangle's area: normalized, the area-weighted vertex normal of a mesh without tangents.
+pub fn area_normal_sums(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
+    let mut sums = vec![DVec3::ZERO; positions.len()];
     for t in triangles {
-        let [a, b, c] = t.map(|i| p.positions[i as usize]);
+        let [a, b, c] = t.map(|i| positions[i as usize]);
         let n = (b - a).cross(c - a);
-        for i in t {
-            face_sum[*i as usize] += n;
+        for &i in t {
+            sums[i as usize] += n;
         }
     }
+    sums
+}
+
+fn vertex_normals(p: &Projected, triangles: &[[u32; 3]]) -> Vec<DVec3> {
+    let face_sum = area_normal_sums(&p.positions, triangles);
     (0..p.positions.len())
         .map(|i| {
             let (tu, tv) = (p.tangent_u[i], p.tangent_v[i]);

@@ -180,7 +180,7 @@ fn sweep_writes_csv_and_plot_for_a_scene() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
-        err.contains("--max-triangles 64") && err.contains("`fermat`") && err.contains("512"),
+        err.contains("--max-triangles: 64") && err.contains("`fermat`") && err.contains("512"),
         "{err}"
     );
 }

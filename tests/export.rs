@@ -36,7 +36,7 @@ fn every_fixture_builds_and_reads_back() {
         for p in products {
             let c = p.halo_report.check;
             let what = format!("{name}/{}: {c:?}", p.name);
-            assert!(c.valid(), "{what}");
+            assert!(c.passes(), "{what}");
             assert_eq!(p.halo_report.inverted, 0, "{what}");
             assert_eq!(p.halo_report.split_stats.mismatches_final, 0, "{what}");
             // Three per layer of a prism, one fewer in each layer for each collapsed corner

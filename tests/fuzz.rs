@@ -1304,9 +1304,7 @@ fn scene_ok(s: &ImportedScene) -> Result<(), String> {
         }) {
             return bad(format!("with triangle {t:?} (for {nv} vertices)"));
         }
-        if let Some(normals) = &surface.normals
-            && (normals.len() != nv || normals.iter().any(|n| !n.is_finite()))
-        {
+        if surface.normals.len() != nv || surface.normals.iter().any(|n| !n.is_finite()) {
             return bad("with normals of the wrong count or not finite".into());
         }
         if let Some(halo) = &surface.halo {
@@ -1365,7 +1363,7 @@ fn check_glb(bytes: &[u8], tally: &Tally) -> Result<(), String> {
             // seed: it must not panic.
             if scene.surfaces != glb_seed().scene.surfaces {
                 tally.add("verified a changed scene");
-                let _ = scene.verify();
+                let _ = halo4d::inspect::verify_scene(scene);
             }
             // The scene's halos are the file's halos.
             let mut in_scene: Vec<&ImportedHalo> = scene

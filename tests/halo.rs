@@ -74,7 +74,7 @@ fn halo_of(projected: &Projected, triangles: &[[u32; 3]], split: Split) -> TetMe
 }
 
 fn assert_valid(stats: &CheckStats, what: &str) {
-    assert!(stats.valid(), "{what}: {stats:?}");
+    assert!(stats.passes(), "{what}: {stats:?}");
     assert_eq!(stats.quad_mismatches, 0, "{what}");
 }
 
@@ -193,7 +193,7 @@ fn the_checker_catches_each_planted_fault_as_its_own_kind() {
     bad.tets[5] = [tet[1], tet[0], tet[2], tet[3]];
     let s = check(&bad);
     assert_eq!((s.inverted, s.duplicate_tets), (1, 0), "{s:?}");
-    assert!(!s.valid());
+    assert!(!s.passes());
 
     // A face shared by three tetrahedra: a new vertex joined to an interior face.
     let mut bad = good.clone();
@@ -401,7 +401,7 @@ fn the_flat_torus_cross_caps_are_exactly_its_singular_vertices() {
         let cross_cap = s.sin().abs() < 1e-9 && t.sin().abs() < 1e-9;
         assert_eq!(rho == 0.0, cross_cap, "vertex {v} at ({s}, {t}), rho {rho}");
     }
-    assert!(r.check.valid(), "{r:?}");
+    assert!(r.check.passes(), "{r:?}");
 }
 
 #[test]
@@ -415,7 +415,7 @@ fn cross_caps_between_vertices_and_rho_beyond_the_curvature_stay_valid() {
         });
         let r = &products[0].halo_report;
         let what = format!("{u}x{u}, rho {rho}: {r:?}");
-        assert!(r.check.valid(), "{what}");
+        assert!(r.check.passes(), "{what}");
         assert_eq!(r.inverted, 0, "{what}");
         if rho > 0.1 {
             assert!(
@@ -445,7 +445,7 @@ fn the_poles_of_a_spun_knot_sampled_on_a_grid_get_a_valid_halo() {
         scene.sampling = Sampling::Uniform { u: 64, v: 48 };
     });
     let r = &products[0].halo_report;
-    assert!(r.check.valid(), "{r:?}");
+    assert!(r.check.passes(), "{r:?}");
     assert!(products[0].halo.positions.iter().all(|p| p.is_finite()));
 }
 
@@ -462,7 +462,7 @@ fn the_paper_split_fixes_every_fixture() {
             assert!(s.mismatches_initial > 0, "{what}");
             assert!(s.flips > 0, "{what}");
             assert_eq!(s.mismatches_final, 0, "{what}");
-            assert!(r.check.valid() && r.inverted == 0, "{what}");
+            assert!(r.check.passes() && r.inverted == 0, "{what}");
         }
     }
 }
@@ -473,7 +473,7 @@ fn the_checker_catches_faults_at_twisted_and_collapsed_prisms() {
     let mut rng = Rng(77);
     let (projected, triangles) = random_moebius(&mut rng, 16, 2);
     let (halo, report) = build_halo(&projected, &triangles, 0.05, &HaloParams::default());
-    assert!(check(&halo.tet_mesh()).valid() && report.collapsed_vertices == 0);
+    assert!(check(&halo.tet_mesh()).passes() && report.collapsed_vertices == 0);
     let n = halo.surface_vertices as u32;
     // Twisted prisms: their offset faces on the boundary mix the two sides.
     let mut uses = std::collections::HashMap::new();

@@ -457,11 +457,7 @@ fn flat_torus_build() -> halo4d::Built {
 }
 
 fn verify(built: &halo4d::Built, scene: &Scene) -> halo4d::verify::Verification {
-    halo4d::verify::verify(
-        &built.sheets(),
-        &halo4d::pipeline::halo_inputs(&built.surfaces, &scene.halo),
-        &built.curves,
-    )
+    halo4d::verify::verify(&built.parts(&scene.halo))
 }
 
 #[test]
@@ -526,7 +522,21 @@ fn empty_and_single_triangle_inputs_give_no_curves() {
     ] {
         let c = curves(&sheets);
         assert_eq!((c.report.count, c.report.unresolved), (0, 0));
-        let v = halo4d::verify::verify(&sheets, &vec![None; sheets.len()], &c);
+        let parts = halo4d::parts::Parts {
+            surfaces: sheets
+                .iter()
+                .map(|s| halo4d::parts::SurfacePart {
+                    positions: s.positions,
+                    w: s.w,
+                    normals: &[],
+                    uv: None,
+                    triangles: s.triangles,
+                })
+                .collect(),
+            halos: vec![None; sheets.len()],
+            curves: &c,
+        };
+        let v = halo4d::verify::verify(&parts);
         assert_eq!(
             (v.wrong, v.spurious_hidden_samples, v.far_tetrahedra),
             (0, 0, 0)

@@ -103,12 +103,12 @@ impl Torus {
 
     /// What the picture shows at image points, with halos or without.
     fn probe(&self, halos: bool, points: &[[f64; 2]]) -> Vec<Option<Seen>> {
-        let parts = self.built.render_parts(&self.scene.halo);
+        let parts = self.built.parts(&self.scene.halo);
         let settings = RenderSettings {
             halos,
             ..self.scene.render
         };
-        let input = parts.input();
+        let input = parts;
         let prober = Prober::new(&input, &settings, &self.scene.camera).unwrap();
         points.iter().map(|&p| prober.seen(p)).collect()
     }
@@ -120,8 +120,8 @@ fn along_a_crossing_the_sheet_nearer_in_w_is_drawn_and_the_farther_has_a_gap() {
     let cam = torus.camera();
     let (w, h) = (torus.scene.render.width, torus.scene.render.height);
     let products = &torus.built.surfaces;
-    let parts = torus.built.render_parts(&torus.scene.halo);
-    let input = parts.input();
+    let parts = torus.built.parts(&torus.scene.halo);
+    let input = parts;
     let with = torus.scene.render;
     let without = RenderSettings {
         halos: false,
@@ -401,8 +401,8 @@ fn the_drawn_curves_lie_on_the_computed_curves_at_the_width_asked_for() {
     scene.render.silhouettes = false;
     scene.render.line_width = 4.0;
     let built = halo4d::run(&scene, true).unwrap();
-    let parts = built.render_parts(&scene.halo);
-    let input = parts.input();
+    let parts = built.parts(&scene.halo);
+    let input = parts;
     let coverage = halo4d::render::line_coverage(&input, &scene.render, &scene.camera).unwrap();
     let cam = *Prober::new(&input, &scene.render, &scene.camera)
         .unwrap()
@@ -548,8 +548,8 @@ fn in_the_patches_of_paper_000_fig_1_the_nearer_patch_is_drawn_at_each_crossing(
     let mut scene = Scene::load(&fixture("scenes/patches.json")).unwrap();
     small(&mut scene);
     let built = halo4d::run(&scene, true).unwrap();
-    let parts = built.render_parts(&scene.halo);
-    let input = parts.input();
+    let parts = built.parts(&scene.halo);
+    let input = parts;
     let without = RenderSettings {
         halos: false,
         ..scene.render

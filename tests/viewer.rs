@@ -42,8 +42,8 @@ fn exact_distances(scene: &Scene, built: &halo4d::Built) -> Vec<f64> {
         mode: RenderMode::Exact,
         ..scene.render
     };
-    let parts = built.render_parts(&scene.halo);
-    render_with_depth(&parts.input(), &settings, &scene.camera)
+    let parts = built.parts(&scene.halo);
+    render_with_depth(&parts, &settings, &scene.camera)
         .unwrap()
         .1
 }
@@ -517,8 +517,8 @@ fn supersampling_draws_what_the_cpu_renderer_draws_with_as_many_samples() {
             mode: RenderMode::Exact,
             ..scene.render
         };
-        let parts = built.render_parts(&scene.halo);
-        render_with_depth(&parts.input(), &settings, &scene.camera).unwrap()
+        let parts = built.parts(&scene.halo);
+        render_with_depth(&parts, &settings, &scene.camera).unwrap()
     };
     let (reference, depth) = cpu(4);
     let gpu_at = |samples| {

@@ -1,6 +1,7 @@
 //! `halo4d-view`: the wgpu viewer of a scene's `.glb` (see `halo4d::viewer`).
 
 use clap::{Parser, ValueEnum};
+use halo4d::limits::FieldError;
 use halo4d::render::{CameraProjection, CameraSettings, Colormap};
 use halo4d::viewer::{self, Asset, Gpu, HaloMode, SLICE_COUNTS, ViewSettings, ViewerError};
 use std::path::PathBuf;
@@ -119,10 +120,10 @@ fn main() -> ExitCode {
 
 fn run(args: &Args) -> Result<(), ViewerError> {
     if args.headless && args.screenshot.is_none() && !args.bench && !args.compare {
-        return Err(ViewerError::Setting {
-            field: "--headless".into(),
-            message: "needs --screenshot OUT.png (or --bench, or --compare)".into(),
-        });
+        return Err(ViewerError::Setting(FieldError::new(
+            "--headless",
+            "needs --screenshot OUT.png (or --bench, or --compare)",
+        )));
     }
     let (scene, asset) = Asset::read(&args.file)?;
     if !asset.surfaces_without_halo.is_empty() {
@@ -203,10 +204,10 @@ fn run(args: &Args) -> Result<(), ViewerError> {
 
 fn bench(asset: &Asset, settings: &ViewSettings, frames: u32) -> Result<(), ViewerError> {
     if frames == 0 {
-        return Err(ViewerError::Setting {
-            field: "--frames".into(),
-            message: "must be at least 1".into(),
-        });
+        return Err(ViewerError::Setting(FieldError::new(
+            "--frames",
+            "must be at least 1",
+        )));
     }
     let gpu = Gpu::headless()?;
     println!(

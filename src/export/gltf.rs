@@ -38,6 +38,7 @@ use crate::check::LAYERS;
 use crate::convention::{file_order, to_gltf};
 use crate::halo::Halo;
 use crate::intersect::{CurvePoint, Curves};
+use crate::view::area_normal_sums;
 use glam::{DVec3, Vec3};
 use gltf_json as json;
 use json::validation::Checked::Valid;
@@ -237,18 +238,6 @@ fn halo_faces(halo: &Halo) -> Vec<[u32; 3]> {
 }
 
 /// Area-weighted normals of the vertices of `faces` (zero at a vertex that no face uses).
-fn vertex_normals(positions: &[DVec3], faces: &[[u32; 3]]) -> Vec<DVec3> {
-    let mut normals = vec![DVec3::ZERO; positions.len()];
-    for f in faces {
-        let [a, b, c] = f.map(|i| positions[i as usize]);
-        let n = (b - a).cross(c - a);
-        for &i in f {
-            normals[i as usize] += n;
-        }
-    }
-    normals
-}
-
 /// The patch of each halo vertex: that of its surface vertex for the offsets and the surface,
 /// that of the triangle whose prism it is in for an inserted vertex.
 fn halo_patches(s: &SurfaceData) -> Vec<f32> {
@@ -418,7 +407,7 @@ fn halo_mesh(
     let name = format!("{}-halo", s.name);
     let scalar = |values: &[f64]| values.iter().map(|&x| x as f32).collect::<Vec<f32>>();
     let faces = halo_faces(halo);
-    let normals = vertex_normals(&halo.positions, &faces);
+    let normals = area_normal_sums(&halo.positions, &faces);
     let attributes = [
         (Semantic::Positions, b.positions(&halo.positions)),
         (Semantic::Normals, b.normals(&normals)),

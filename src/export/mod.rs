@@ -14,14 +14,12 @@
 
 mod gltf;
 mod obj;
-mod plot;
 mod ply;
 mod tubes;
 mod vtk;
 
 pub use gltf::{glb_chunks, glb_container, to_glb, write_glb_container};
 pub use obj::to_obj;
-pub use plot::{encode_png, render_speed_vs_error_png, speed_vs_error_png};
 pub use ply::{to_curves_ply, to_ply};
 pub use vtk::write_vtk;
 

@@ -6,6 +6,7 @@ use super::{
 };
 use crate::check::TetMesh;
 use crate::convention::{file_order, from_gltf};
+use crate::view::area_normal_sums;
 use glam::DVec3;
 use serde_json::Value;
 
@@ -472,7 +473,7 @@ impl<'a> Doc<'a> {
         let attribute = |key: &str| -> Result<u64> {
             index(attributes, key, &format!("{what} attributes"), None)
         };
-        let normals: Option<Vec<DVec3>> = match attributes.get("NORMAL") {
+        let file_normals: Option<Vec<DVec3>> = match attributes.get("NORMAL") {
             None => None,
             Some(_) => Some(self.vec3s(attribute("NORMAL")?)?),
         };
@@ -494,7 +495,7 @@ impl<'a> Doc<'a> {
         if let Some(k) = w.iter().position(|x| !x.is_finite()) {
             return Err(bad(format!("_W of vertex {k} is not finite ({})", w[k])));
         }
-        if let Some(normals) = &normals {
+        if let Some(normals) = &file_normals {
             if normals.len() != nv {
                 return Err(bad(format!(
                     "NORMAL has {} values for {nv} positions",
@@ -527,6 +528,12 @@ impl<'a> Doc<'a> {
                 )));
             }
         }
+        let normals = file_normals.unwrap_or_else(|| {
+            area_normal_sums(&positions, &triangles)
+                .into_iter()
+                .map(|n| n.normalize_or_zero())
+                .collect()
+        });
         Ok(ImportedSurface {
             name,
             mesh: i,

@@ -6,8 +6,8 @@
 //! binary, file version 2.0 to 5.1). Gives: [`ImportedHalo`]s, each a [`TetMesh`] in the
 //! halo layout of [`crate::check`] with its name, per-vertex t and d_orig and parameters;
 //! from a scene's `.glb` also its surfaces ([`read_scene_glb`]: positions, w-depth and
-//! triangles, each with its halo, and the curves' polylines), from which [`ImportedScene::verify`] recomputes the
-//! intersection curves and verifies the halos against them.
+//! triangles, each with its halo, and the curves' polylines), which [`ImportedScene::parts`] hands on as the
+//! verification and the renderer read a build.
 //! Guarantees: malformed input (truncated, wrong magic, bad JSON, references out of range,
 //! counts that disagree, non-finite coordinates) is an [`ImportError`] that names the
 //! problem, never a panic; a count claimed in a file is checked against the bytes actually
@@ -23,9 +23,9 @@ pub use vtk::read_vtk;
 
 use crate::check::{LAYERS, TetMesh};
 use crate::error::shorten;
-use crate::intersect::{self, Curves, Sheet};
+use crate::intersect::Curves;
+use crate::parts::{HaloPart, Parts, SurfacePart};
 use crate::render::CameraSettings;
-use crate::verify::{self, HaloInput, Verification};
 use glam::DVec3;
 use std::path::Path;
 
@@ -57,8 +57,9 @@ pub struct ImportedSurface {
     pub w: Vec<f64>,
     /// Triangles, none of which repeats a vertex.
     pub triangles: Vec<[u32; 3]>,
-    /// Unit normal of each vertex (`NORMAL`), when the file has them.
-    pub normals: Option<Vec<DVec3>>,
+    /// Unit normal of each vertex: the file's `NORMAL`, or where it has none, the normalized
+    /// sum of the area-weighted normals of the triangles around the vertex.
+    pub normals: Vec<DVec3>,
     /// Its halo, when the file has one: with t, d_orig, delta_d and delta_t, and as many
     /// surface vertices as the surface has vertices.
     pub halo: Option<ImportedHalo>,
@@ -91,59 +92,41 @@ pub struct ImportedCurves {
 }
 
 impl ImportedScene {
-    /// The surfaces as the intersection stage reads them.
-    pub fn sheets(&self) -> Vec<Sheet<'_>> {
-        self.surfaces
-            .iter()
-            .map(|s| Sheet {
-                positions: &s.positions,
-                w: &s.w,
-                triangles: &s.triangles,
-            })
-            .collect()
-    }
-
-    /// Recomputes the intersection curves of the surfaces ([`intersect::curves`]) and
-    /// verifies the halos against them ([`verify::verify`]). Takes the scene as
-    /// [`read_scene_glb`] returns it; a halo without tetrahedra, t, d_orig, delta_d or
-    /// delta_t counts as none.
-    pub fn verify(&self) -> (Curves, Verification) {
-        let sheets = self.sheets();
-        let curves = intersect::curves(&sheets);
-        let verification = self.with_halos(|halos| verify::verify(&sheets, halos, &curves));
-        (curves, verification)
-    }
-
-    /// Calls `f` with the halos as the verification and the renderer read them (one per
-    /// surface; a halo without tetrahedra, t, d_orig, delta_d or delta_t counts as none).
-    pub fn with_halos<R>(&self, f: impl FnOnce(&[Option<HaloInput>]) -> R) -> R {
-        let positions: Vec<Vec<DVec3>> = self
-            .surfaces
-            .iter()
-            .map(|s| {
-                s.halo.as_ref().map_or_else(Vec::new, |h| {
-                    h.mesh.positions.iter().map(|&p| DVec3::from(p)).collect()
+    /// The scene as the verification, the renderer and the viewer read it, with `curves`
+    /// (recomputed from [`Parts::sheets`], as `halo4d check DIR` does, or none). A halo
+    /// without tetrahedra, t, d_orig, delta_d or delta_t counts as none; a surface has no
+    /// (u, v).
+    pub fn parts<'a>(&'a self, curves: &'a Curves) -> Parts<'a> {
+        Parts {
+            surfaces: self
+                .surfaces
+                .iter()
+                .map(|s| SurfacePart {
+                    positions: &s.positions,
+                    w: &s.w,
+                    normals: &s.normals,
+                    uv: None,
+                    triangles: &s.triangles,
                 })
-            })
-            .collect();
-        let halos: Vec<Option<HaloInput>> = self
-            .surfaces
-            .iter()
-            .zip(&positions)
-            .map(|(s, positions)| {
-                let h = s.halo.as_ref().filter(|h| !h.mesh.tets.is_empty())?;
-                Some(HaloInput {
-                    positions,
-                    t: h.t.as_deref()?,
-                    d_orig: h.d_orig.as_deref()?,
-                    tets: &h.mesh.tets,
-                    surface_vertices: h.mesh.surface_vertices,
-                    delta_d: h.params.delta_d?,
-                    delta_t: h.params.delta_t?,
+                .collect(),
+            halos: self
+                .surfaces
+                .iter()
+                .map(|s| {
+                    let h = s.halo.as_ref().filter(|h| !h.mesh.tets.is_empty())?;
+                    Some(HaloPart {
+                        positions: bytemuck::cast_slice(&h.mesh.positions),
+                        t: h.t.as_deref()?,
+                        d_orig: h.d_orig.as_deref()?,
+                        tets: &h.mesh.tets,
+                        surface_vertices: h.mesh.surface_vertices,
+                        delta_d: h.params.delta_d?,
+                        delta_t: h.params.delta_t?,
+                    })
                 })
-            })
-            .collect();
-        f(&halos)
+                .collect(),
+            curves,
+        }
     }
 }
 

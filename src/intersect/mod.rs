@@ -164,6 +164,28 @@ pub struct CurvesReport {
     pub chain_ms: f64,
 }
 
+impl CurvesReport {
+    /// The verdict of a build and of `halo4d check DIR` on the curves the halos are
+    /// verified against: nothing unresolved.
+    pub fn failures(&self) -> Vec<String> {
+        if self.unresolved == 0 {
+            return Vec::new();
+        }
+        vec![format!(
+            "curves: {} unresolved (more than two segments meet at a point)",
+            self.unresolved
+        )]
+    }
+
+    /// The one-line summary `halo4d build` and `halo4d check DIR` print.
+    pub fn summary(&self) -> String {
+        format!(
+            "curves: {} ({} closed, {} open), {} points, {} triple points, {} unresolved",
+            self.count, self.closed, self.open, self.points, self.triple_points, self.unresolved
+        )
+    }
+}
+
 /// The curves and what they cost.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Curves {

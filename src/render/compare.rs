@@ -1,9 +1,8 @@
 //! Speed against error of the multi-slice mode: for several slice counts, the render time
 //! and how far the picture is from the exact mode's.
 
-use super::{
-    CameraSettings, RenderError, RenderInput, RenderMode, RenderSettings, render_with_depth,
-};
+use super::{CameraSettings, RenderError, RenderMode, RenderSettings, render_with_depth};
+use crate::parts::Parts;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -26,7 +25,7 @@ pub struct Comparison {
 /// The exact render first, then the slice mode with each of `slices`, all with `settings`
 /// otherwise; `progress` hears of each.
 pub fn compare(
-    input: &RenderInput,
+    input: &Parts,
     settings: &RenderSettings,
     camera: &CameraSettings,
     slices: &[u32],

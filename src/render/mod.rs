@@ -19,8 +19,8 @@ pub mod shade;
 pub mod slices;
 pub mod trace;
 
-use crate::intersect::Curves;
-use crate::verify::{HaloIndex, HaloInput};
+use crate::limits::FieldError;
+use crate::parts::{HaloIndex, Parts};
 use camera::Camera;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -68,7 +68,7 @@ impl Default for CameraSettings {
 }
 
 /// How halos hide sheets in a picture.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum RenderMode {
     /// Each hit asks the tetrahedra whether it is hidden (the reference).
@@ -199,26 +199,29 @@ impl Default for RenderSettings {
 pub const MAX_SIDE: u32 = 8192;
 
 impl RenderSettings {
-    /// Checks the numbers: `Err((field, message))` names the first bad one.
-    pub fn check(&self) -> Result<(), (&'static str, String)> {
+    /// Checks the numbers: names the first bad field.
+    pub fn check(&self) -> Result<(), FieldError> {
         let side = |v: u32| (1..=MAX_SIDE).contains(&v);
         if !side(self.width) {
-            return Err((
+            return Err(FieldError::new(
                 "width",
                 format!("must be 1 to {MAX_SIDE} pixels, got {}", self.width),
             ));
         }
         if !side(self.height) {
-            return Err((
+            return Err(FieldError::new(
                 "height",
                 format!("must be 1 to {MAX_SIDE} pixels, got {}", self.height),
             ));
         }
         if !(1..=4096).contains(&self.slices) {
-            return Err(("slices", format!("must be 1 to 4096, got {}", self.slices)));
+            return Err(FieldError::new(
+                "slices",
+                format!("must be 1 to 4096, got {}", self.slices),
+            ));
         }
         if ![1, 4, 9, 16].contains(&self.samples) {
-            return Err((
+            return Err(FieldError::new(
                 "samples",
                 format!(
                     "must be 1, 4, 9 or 16 (a square grid), got {}",
@@ -228,7 +231,7 @@ impl RenderSettings {
         }
         let unit = |v: f64| v.is_finite() && v > 0.0 && v <= 1.0;
         if !unit(self.opacity) {
-            return Err((
+            return Err(FieldError::new(
                 "opacity",
                 format!("must be in (0, 1], got {}", self.opacity),
             ));
@@ -236,22 +239,31 @@ impl RenderSettings {
         if let Some(o) = self.opacity_far
             && !unit(o)
         {
-            return Err(("opacity_far", format!("must be in (0, 1], got {o}")));
+            return Err(FieldError::new(
+                "opacity_far",
+                format!("must be in (0, 1], got {o}"),
+            ));
         }
         if let Some(h) = self.hither
             && !(h.is_finite() && h >= 0.0)
         {
-            return Err(("hither", format!("must be a distance >= 0, got {h}")));
+            return Err(FieldError::new(
+                "hither",
+                format!("must be a distance >= 0, got {h}"),
+            ));
         }
         if let Some(r) = self.ribbons {
             if !(r.count.is_finite() && r.count > 0.0 && r.count <= 1e4) {
-                return Err((
+                return Err(FieldError::new(
                     "ribbons.count",
                     format!("must be in (0, 10000], got {}", r.count),
                 ));
             }
             if !(r.gap.is_finite() && r.gap > 0.0 && r.gap < 1.0) {
-                return Err(("ribbons.gap", format!("must be in (0, 1), got {}", r.gap)));
+                return Err(FieldError::new(
+                    "ribbons.gap",
+                    format!("must be in (0, 1), got {}", r.gap),
+                ));
             }
         }
         let side = self.width.min(self.height);
@@ -263,7 +275,7 @@ impl RenderSettings {
             if let Some(w) = w
                 && !(w.is_finite() && w >= 0.5 && w <= max_width)
             {
-                return Err((
+                return Err(FieldError::new(
                     field,
                     format!(
                         "must be 0.5 to {max_width} pixels (at most a quarter of the picture's smaller side, {side} pixels, or 0.5), got {w}: make the lines thinner or the picture larger"
@@ -272,7 +284,7 @@ impl RenderSettings {
             }
         }
         if !(self.eye_separation.is_finite() && (0.0..=30.0).contains(&self.eye_separation)) {
-            return Err((
+            return Err(FieldError::new(
                 "eye_separation",
                 format!("must be 0 to 30 degrees, got {}", self.eye_separation),
             ));
@@ -282,7 +294,7 @@ impl RenderSettings {
             .iter()
             .any(|c| !(c.is_finite() && (0.0..=1.0).contains(c)))
         {
-            return Err((
+            return Err(FieldError::new(
                 "background",
                 format!("must be three numbers in [0, 1], got {:?}", self.background),
             ));
@@ -292,19 +304,22 @@ impl RenderSettings {
 }
 
 impl CameraSettings {
-    /// Checks the numbers: `Err((field, message))` names the first bad one.
-    pub fn check(&self) -> Result<(), (&'static str, String)> {
+    /// Checks the numbers: names the first bad field.
+    pub fn check(&self) -> Result<(), FieldError> {
         if !self.azimuth.is_finite() {
-            return Err(("azimuth", format!("must be finite, got {}", self.azimuth)));
+            return Err(FieldError::new(
+                "azimuth",
+                format!("must be finite, got {}", self.azimuth),
+            ));
         }
         if !(self.elevation.is_finite() && (-89.0..=89.0).contains(&self.elevation)) {
-            return Err((
+            return Err(FieldError::new(
                 "elevation",
                 format!("must be -89 to 89 degrees, got {}", self.elevation),
             ));
         }
         if !(self.distance.is_finite() && self.distance > 0.0 && self.distance <= 1e4) {
-            return Err((
+            return Err(FieldError::new(
                 "distance",
                 format!(
                     "must be in (0, 10000] (units of half the scene's diagonal), got {}",
@@ -313,7 +328,10 @@ impl CameraSettings {
             ));
         }
         if !(self.fov.is_finite() && self.fov > 1.0 && self.fov < 170.0) {
-            return Err(("fov", format!("must be 1 to 170 degrees, got {}", self.fov)));
+            return Err(FieldError::new(
+                "fov",
+                format!("must be 1 to 170 degrees, got {}", self.fov),
+            ));
         }
         Ok(())
     }
@@ -323,13 +341,8 @@ impl CameraSettings {
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
     /// A setting is out of range.
-    #[error("render.{field}: {message}")]
-    Setting {
-        /// The setting.
-        field: String,
-        /// What is wrong.
-        message: String,
-    },
+    #[error("{0}")]
+    Setting(FieldError),
     /// An orthographic eye inside the scene sees nothing sensible.
     #[error(
         "camera.distance: the eye at {distance} half-diagonals is inside the scene's bounding box; an orthographic camera must be outside it (raise camera.distance above 1)"
@@ -360,32 +373,6 @@ pub enum RenderError {
     /// The memory limit is set wrong.
     #[error("{0}")]
     MemoryLimit(String),
-}
-
-/// One surface as the renderer reads it.
-#[derive(Clone, Copy, Debug)]
-pub struct RenderSurface<'a> {
-    /// Vertex positions.
-    pub positions: &'a [DVec3],
-    /// w-depth of each vertex.
-    pub w: &'a [f64],
-    /// Unit normal of each vertex (for shading).
-    pub normals: &'a [DVec3],
-    /// Surface parameters (u, v) of each vertex (for ribbons).
-    pub uv: &'a [[f64; 2]],
-    /// Triangles.
-    pub triangles: &'a [[u32; 3]],
-}
-
-/// What a picture is made of.
-#[derive(Clone, Copy, Debug)]
-pub struct RenderInput<'a> {
-    /// The surfaces.
-    pub surfaces: &'a [RenderSurface<'a>],
-    /// Their halos (one per surface).
-    pub halos: &'a [Option<HaloInput<'a>>],
-    /// The intersection curves.
-    pub curves: &'a Curves,
 }
 
 /// An RGB picture, 8 bits per channel, row-major from the top.
@@ -425,7 +412,7 @@ struct View {
 
 /// Renders a picture.
 pub fn render(
-    input: &RenderInput,
+    input: &Parts,
     settings: &RenderSettings,
     camera: &CameraSettings,
 ) -> Result<Picture, RenderError> {
@@ -436,7 +423,7 @@ pub fn render(
 /// halos leave visible along the pixel's centre sample (infinite where none), which tells
 /// where two renders disagree on what is hidden.
 pub fn render_with_depth(
-    input: &RenderInput,
+    input: &Parts,
     settings: &RenderSettings,
     camera: &CameraSettings,
 ) -> Result<(Picture, Vec<f64>), RenderError> {
@@ -488,7 +475,7 @@ pub fn render_with_depth(
 /// The coverage in [0, 1] of the lines (curves and silhouettes, as the settings ask) in the
 /// first eye's image, row-major; all zero when there are none.
 pub fn line_coverage(
-    input: &RenderInput,
+    input: &Parts,
     settings: &RenderSettings,
     camera: &CameraSettings,
 ) -> Result<Vec<f32>, RenderError> {
@@ -522,7 +509,7 @@ pub struct Seen {
 /// Probes a picture: what the ray through an image point sees first that the halos do not
 /// hide (with the exact test), as [`render`] decides it for the first eye.
 pub struct Prober<'a> {
-    input: &'a RenderInput<'a>,
+    input: &'a Parts<'a>,
     scene: Scene<'a>,
     cam: Camera,
 }
@@ -530,7 +517,7 @@ pub struct Prober<'a> {
 impl<'a> Prober<'a> {
     /// Indexes the scene for probing.
     pub fn new(
-        input: &'a RenderInput<'a>,
+        input: &'a Parts<'a>,
         settings: &'a RenderSettings,
         camera: &CameraSettings,
     ) -> Result<Self, RenderError> {
@@ -589,18 +576,16 @@ fn first_eye(settings: &RenderSettings) -> f64 {
 
 /// Checks the settings and indexes the scene.
 fn prepare<'a>(
-    input: &'a RenderInput<'a>,
+    input: &'a Parts<'a>,
     settings: &'a RenderSettings,
     camera: &CameraSettings,
 ) -> Result<((DVec3, DVec3), Scene<'a>), RenderError> {
-    settings.check().map_err(|(f, m)| RenderError::Setting {
-        field: f.into(),
-        message: m,
-    })?;
-    camera.check().map_err(|(f, m)| RenderError::Setting {
-        field: format!("camera.{f}"),
-        message: m,
-    })?;
+    settings
+        .check()
+        .map_err(|e| RenderError::Setting(e.within("render")))?;
+    camera
+        .check()
+        .map_err(|e| RenderError::Setting(e.within("camera")))?;
     let bounds = triangle_bounds(input.surfaces.iter().map(|s| (s.positions, s.triangles)))
         .ok_or(RenderError::Empty)?;
     Ok((bounds, Scene::new(input, settings, bounds)))
@@ -658,7 +643,7 @@ fn to_srgb8(c: f64) -> u8 {
 
 /// What every ray of one render shares.
 struct Scene<'a> {
-    input: &'a RenderInput<'a>,
+    input: &'a Parts<'a>,
     settings: &'a RenderSettings,
     tracer: Tracer<'a>,
     halos: Option<HaloIndex<'a>>,
@@ -669,11 +654,7 @@ struct Scene<'a> {
 }
 
 impl<'a> Scene<'a> {
-    fn new(
-        input: &'a RenderInput<'a>,
-        settings: &'a RenderSettings,
-        (lo, hi): (DVec3, DVec3),
-    ) -> Self {
+    fn new(input: &'a Parts<'a>, settings: &'a RenderSettings, (lo, hi): (DVec3, DVec3)) -> Self {
         let trace = input
             .surfaces
             .iter()
@@ -693,7 +674,7 @@ impl<'a> Scene<'a> {
             input,
             settings,
             tracer: Tracer::new(trace, (hi - lo).length()),
-            halos: settings.halos.then(|| HaloIndex::new(input.halos)),
+            halos: settings.halos.then(|| HaloIndex::new(&input.halos)),
             w_range,
             centre: (lo + hi) * 0.5,
             radius: (hi - lo).length() * 0.5,
@@ -828,10 +809,10 @@ impl<'a> Scene<'a> {
             };
             hits.retain(|hit| {
                 let surf = &self.input.surfaces[hit.surface as usize];
+                // A surface read from a file without its parameters has no ribbons.
+                let Some(uv) = surf.uv else { return true };
                 let tri = surf.triangles[hit.triangle as usize];
-                let param: f64 = (0..3)
-                    .map(|i| hit.bary[i] * surf.uv[tri[i] as usize][k])
-                    .sum();
+                let param: f64 = (0..3).map(|i| hit.bary[i] * uv[tri[i] as usize][k]).sum();
                 (param * r.count).rem_euclid(1.0) >= r.gap
             });
         }

@@ -4,6 +4,7 @@
 use super::camera::Camera;
 use super::lines::{Broadener, Coverage, Mask};
 use super::{RenderError, Scene};
+use crate::limits::FieldError;
 use glam::{DVec2, DVec3};
 
 /// The colour of the lines (linear RGB).
@@ -127,7 +128,7 @@ impl Scene<'_> {
     /// ray lies in the surface's tangent plane (paper 001 section 5.2).
     fn silhouette_edges(&self, cam: &Camera) -> Vec<[DVec3; 2]> {
         let mut out = Vec::new();
-        for surf in self.input.surfaces {
+        for surf in &self.input.surfaces {
             let facing: Vec<bool> = surf
                 .triangles
                 .iter()
@@ -155,10 +156,7 @@ impl Scene<'_> {
 }
 
 fn line_error(e: super::lines::LinesError) -> RenderError {
-    RenderError::Setting {
-        field: "line_width".into(),
-        message: e.to_string(),
-    }
+    RenderError::Setting(FieldError::new("render.line_width", e.to_string()))
 }
 
 /// The flag of an interior edge whose two triangles' windings agree.

@@ -7,7 +7,7 @@
 //! falls as N grows.
 
 use super::camera::Camera;
-use crate::verify::HaloIndex;
+use crate::parts::HaloIndex;
 use glam::DVec3;
 use rayon::prelude::*;
 

@@ -22,6 +22,7 @@ pub use adaptive::{AdaptiveMesh, MIN_EDGE, metric_aspect, sample_adaptive};
 pub use audit::{AUDIT_POINTS, Audit, audit};
 pub use uniform::sample_uniform;
 
+use crate::limits::{FieldError, GRID_CELLS, RELATIVE_TOLERANCE, TRIANGLES};
 use crate::surfaces::{Eval4, Surface};
 use glam::DVec4;
 use serde::{Deserialize, Serialize};
@@ -95,8 +96,8 @@ impl Sampling {
         }
     }
 
-    /// Checks the settings: `Err((field, message))` names the first bad one.
-    pub fn check(&self) -> Result<(), (&'static str, String)> {
+    /// Checks the settings: names the first bad field.
+    pub fn check(&self) -> Result<(), FieldError> {
         match *self {
             Sampling::Adaptive {
                 tolerance,
@@ -104,35 +105,38 @@ impl Sampling {
                 max_triangles,
             } => {
                 if tolerance.is_some() && absolute_tolerance.is_some() {
-                    return Err((
+                    return Err(FieldError::new(
                         "absolute_tolerance",
-                        "give either `tolerance` (relative to the bounding diagonal) or `absolute_tolerance`, not both".into(),
+                        "give either `tolerance` (relative to the bounding diagonal) or `absolute_tolerance`, not both",
                     ));
                 }
                 if let Some(t) = tolerance
-                    && !(1e-9..=0.5).contains(&t)
+                    && !RELATIVE_TOLERANCE.contains(&t)
                 {
-                    return Err((
+                    return Err(FieldError::new(
                         "tolerance",
                         format!(
-                            "must be from 1e-9 to 0.5 (a share of the 4D bounding diagonal), got {t}"
+                            "must be from {:?} to {:?} (a share of the 4D bounding diagonal), got {t}",
+                            RELATIVE_TOLERANCE.start(),
+                            RELATIVE_TOLERANCE.end()
                         ),
                     ));
                 }
                 if let Some(a) = absolute_tolerance
                     && !(a.is_finite() && a > 0.0)
                 {
-                    return Err((
+                    return Err(FieldError::new(
                         "absolute_tolerance",
                         format!("must be a finite length greater than 0, got {a}"),
                     ));
                 }
-                if !(64..=crate::scene::MAX_TRIANGLES).contains(&max_triangles) {
-                    return Err((
+                if !TRIANGLES.contains(&max_triangles) {
+                    return Err(FieldError::new(
                         "max_triangles",
                         format!(
-                            "must be from 64 to {}, got {max_triangles}",
-                            crate::scene::MAX_TRIANGLES
+                            "must be from {} to {}, got {max_triangles}",
+                            TRIANGLES.start(),
+                            TRIANGLES.end()
                         ),
                     ));
                 }
@@ -140,11 +144,13 @@ impl Sampling {
             }
             Sampling::Uniform { u, v } => {
                 for (field, n) in [("u", u), ("v", v)] {
-                    if !(2..=4096).contains(&n) || n % 2 != 0 {
-                        return Err((
+                    if !GRID_CELLS.contains(&n) || n % 2 != 0 {
+                        return Err(FieldError::new(
                             field,
                             format!(
-                                "must be an even number of cells from 2 to 4096 (seams glued at half a side need a node there), got {n}"
+                                "must be an even number of cells from {} to {} (seams glued at half a side need a node there), got {n}",
+                                GRID_CELLS.start(),
+                                GRID_CELLS.end()
                             ),
                         ));
                     }
@@ -202,7 +208,8 @@ pub fn sample(surface: &Surface, sampling: &Sampling) -> Sampled {
 pub fn uniform_error(surface: &Surface, triangles: usize) -> f64 {
     let [min_u, min_v] = surface.min_cells();
     let side = (triangles as f64 / (2 * surface.patch_count().max(1)) as f64).sqrt();
-    let even = |min: usize| ((side / 2.0).round() as usize * 2).clamp(min.max(4), 4096);
+    let even =
+        |min: usize| ((side / 2.0).round() as usize * 2).clamp(min.max(4), *GRID_CELLS.end());
     audit(surface, &sample_uniform(surface, even(min_u), even(min_v))).max_error
 }
 

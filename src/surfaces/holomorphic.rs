@@ -6,6 +6,7 @@
 //! ∂vv f = -f''.
 
 use super::{Domain, Eval4, Glue, Jet, Parametric, Side, SideRule, Topology, positive};
+use crate::limits::FieldError;
 use glam::DVec4;
 use num_complex::Complex64 as C64;
 use serde::{Deserialize, Serialize};
@@ -199,13 +200,16 @@ impl Parametric for Fermat {
             euler_characteristic: None,
         }
     }
-    fn check(&self) -> Result<(), (&'static str, String)> {
+    fn check(&self) -> Result<(), FieldError> {
         if !(2..=6).contains(&self.n) {
-            return Err(("n", format!("must be between 2 and 6, got {}", self.n)));
+            return Err(FieldError::new(
+                "n",
+                format!("must be between 2 and 6, got {}", self.n),
+            ));
         }
         positive("y_range", self.y_range)?;
         if self.y_range > 4.0 {
-            return Err((
+            return Err(FieldError::new(
                 "y_range",
                 format!(
                     "must be at most 4 (coordinates grow like e^(2a/n)), got {}",
@@ -251,10 +255,10 @@ impl Parametric for ProductPolynomial {
             euler_characteristic: None,
         }
     }
-    fn check(&self) -> Result<(), (&'static str, String)> {
+    fn check(&self) -> Result<(), FieldError> {
         positive("u_range", self.u_range)?;
         if self.u_range > PI {
-            return Err((
+            return Err(FieldError::new(
                 "u_range",
                 format!(
                     "must be at most π (coordinates grow like e^a), got {}",

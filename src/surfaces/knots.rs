@@ -21,6 +21,7 @@
 //! embedded and the surface stays twice differentiable.
 
 use super::{Domain, Eval4, Jet, Parametric, Side, SideRule, Topology, positive};
+use crate::limits::FieldError;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, TAU};
 
@@ -183,7 +184,7 @@ impl Parametric for SpunTrefoil {
     fn topology(&self) -> Topology {
         SPHERE
     }
-    fn check(&self) -> Result<(), (&'static str, String)> {
+    fn check(&self) -> Result<(), FieldError> {
         positive("scale", self.scale)
     }
 }
@@ -221,10 +222,10 @@ impl Parametric for TwistSpunTrefoil {
     fn topology(&self) -> Topology {
         SPHERE
     }
-    fn check(&self) -> Result<(), (&'static str, String)> {
+    fn check(&self) -> Result<(), FieldError> {
         positive("scale", self.scale)?;
         if !(2..=12).contains(&self.twists) {
-            return Err((
+            return Err(FieldError::new(
                 "twists",
                 format!(
                     "must be between 2 and 12 (the 0-twist spin is `spun_trefoil`, the 1-twist spin is unknotted), got {}",

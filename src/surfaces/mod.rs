@@ -21,6 +21,7 @@ pub use jet::Jet;
 pub use knots::{SpunTrefoil, TwistSpunTrefoil};
 pub use simple::{FlatTorus, KleinBottle, Patches, ProjectivePlane};
 
+use crate::limits::FieldError;
 use glam::DVec4;
 use serde::{Deserialize, Serialize};
 
@@ -298,8 +299,8 @@ pub(crate) trait Parametric {
         self.eval(patch, u, v).p
     }
     fn topology(&self) -> Topology;
-    /// Checks parameter values; returns (field, message) for the first bad one.
-    fn check(&self) -> Result<(), (&'static str, String)>;
+    /// Checks parameter values, naming the first bad one.
+    fn check(&self) -> Result<(), FieldError>;
     /// The fewest grid cells along (u, v) that give a simplicial mesh: 4 across a seam or
     /// a pole, more where a side is glued to itself.
     fn min_cells(&self) -> [usize; 2] {
@@ -335,6 +336,26 @@ impl Surface {
             Surface::ProductPolynomial(ProductPolynomial::default()),
             Surface::Patches(Patches::default()),
         ]
+    }
+
+    /// The catalogue as `halo4d list` prints it: each surface's type and description, its
+    /// patches and its parameters' defaults.
+    pub fn catalogue_listing() -> String {
+        let mut out = String::new();
+        for s in Surface::catalogue() {
+            let mut params = serde_json::to_value(&s).unwrap_or_default();
+            if let Some(map) = params.as_object_mut() {
+                map.remove("type");
+            }
+            out += &format!("{:<20} {}\n", s.type_name(), s.description());
+            out += &format!(
+                "{:<20} patches: {}, defaults: {}\n",
+                "",
+                s.patch_count(),
+                params
+            );
+        }
+        out
     }
 
     /// The `type` name used in scene files.
@@ -404,18 +425,18 @@ impl Surface {
         dispatch!(self, s => s.min_cells())
     }
 
-    /// Checks the parameters: `Err((field, message))` names the first bad one.
-    pub fn check(&self) -> Result<(), (&'static str, String)> {
+    /// Checks the parameters: names the first bad field.
+    pub fn check(&self) -> Result<(), FieldError> {
         dispatch!(self, s => s.check())
     }
 }
 
 /// Checks that a parameter is finite and positive.
-pub(crate) fn positive(field: &'static str, x: f64) -> Result<(), (&'static str, String)> {
+pub(crate) fn positive(field: &'static str, x: f64) -> Result<(), FieldError> {
     if x.is_finite() && x > 0.0 {
         Ok(())
     } else {
-        Err((
+        Err(FieldError::new(
             field,
             format!("must be a finite number greater than 0, got {x}"),
         ))

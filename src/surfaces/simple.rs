@@ -2,6 +2,7 @@
 //! paper 000 fig. 1.
 
 use super::{Domain, Eval4, Glue, Jet, Parametric, Side, SideRule, Topology, positive};
+use crate::limits::FieldError;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, TAU};
 
@@ -47,7 +48,7 @@ impl Parametric for FlatTorus {
             euler_characteristic: Some(0),
         }
     }
-    fn check(&self) -> Result<(), (&'static str, String)> {
+    fn check(&self) -> Result<(), FieldError> {
         positive("r1", self.r1)?;
         positive("r2", self.r2)
     }
@@ -102,11 +103,11 @@ impl Parametric for KleinBottle {
             euler_characteristic: Some(0),
         }
     }
-    fn check(&self) -> Result<(), (&'static str, String)> {
+    fn check(&self) -> Result<(), FieldError> {
         positive("major_radius", self.major_radius)?;
         positive("minor_radius", self.minor_radius)?;
         if self.minor_radius >= self.major_radius {
-            return Err((
+            return Err(FieldError::new(
                 "minor_radius",
                 format!(
                     "must be smaller than major_radius ({}) or the surface is not embedded, got {}",
@@ -182,7 +183,7 @@ impl Parametric for ProjectivePlane {
     fn min_cells(&self) -> [usize; 2] {
         [4, 6]
     }
-    fn check(&self) -> Result<(), (&'static str, String)> {
+    fn check(&self) -> Result<(), FieldError> {
         positive("radius", self.radius)
     }
 }
@@ -257,9 +258,9 @@ impl Parametric for Patches {
             euler_characteristic: None,
         }
     }
-    fn check(&self) -> Result<(), (&'static str, String)> {
+    fn check(&self) -> Result<(), FieldError> {
         if !(1..=16).contains(&self.count) {
-            return Err((
+            return Err(FieldError::new(
                 "count",
                 format!("must be between 1 and 16, got {}", self.count),
             ));

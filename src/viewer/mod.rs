@@ -43,6 +43,7 @@ pub use gpu::Gpu;
 pub use renderer::{FrameTimes, Renderer};
 
 use crate::import::{ImportError, ImportedScene};
+use crate::limits::FieldError;
 use crate::render::camera::Camera;
 use crate::render::overlay::{AGREE, interior_edges};
 use crate::render::{CameraSettings, Colormap, RenderError};
@@ -130,10 +131,7 @@ impl ViewSettings {
     /// Checks the settings, naming the one that is wrong.
     pub fn check(&self) -> Result<(), ViewerError> {
         let bad = |field: &str, message: String| {
-            Err(ViewerError::Setting {
-                field: field.into(),
-                message,
-            })
+            Err(ViewerError::Setting(FieldError::new(field, message)))
         };
         if !(1..=crate::render::MAX_SIDE).contains(&self.width)
             || !(1..=crate::render::MAX_SIDE).contains(&self.height)
@@ -163,10 +161,9 @@ impl ViewSettings {
                 format!("{} is not 1, 4, 9 or 16 (a square grid)", self.samples),
             );
         }
-        self.camera.check().map_err(|(f, m)| ViewerError::Setting {
-            field: format!("camera.{f}"),
-            message: m,
-        })
+        self.camera
+            .check()
+            .map_err(|e| ViewerError::Setting(e.within("camera")))
     }
 }
 
@@ -196,13 +193,8 @@ pub enum ViewerError {
         why: String,
     },
     /// A setting is out of range.
-    #[error("{field}: {message}")]
-    Setting {
-        /// The setting.
-        field: String,
-        /// What is wrong.
-        message: String,
-    },
+    #[error("{0}")]
+    Setting(#[from] FieldError),
     /// No GPU adapter, or no device from it.
     #[error(
         "no GPU: {0}. On Linux without a GPU, install a software Vulkan driver (Debian: apt-get install mesa-vulkan-drivers)"
@@ -377,10 +369,7 @@ impl Asset {
             for &w in &s.w {
                 w_range = (w_range.0.min(w), w_range.1.max(w));
             }
-            let normals = s
-                .normals
-                .clone()
-                .unwrap_or_else(|| vertex_normals(&s.positions, &s.triangles));
+            let normals = &s.normals;
             let (slopes, reach) = w_slopes(&s.positions, &s.w, &s.triangles);
             for (i, &p) in s.positions.iter().enumerate() {
                 vertices.push(SurfaceVertex {
@@ -471,18 +460,6 @@ impl Asset {
 }
 
 /// Area-weighted vertex normals, for files without `NORMAL`.
-fn vertex_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
-    let mut n = vec![DVec3::ZERO; positions.len()];
-    for t in triangles {
-        let p = t.map(|v| positions[v as usize]);
-        let a = (p[1] - p[0]).cross(p[2] - p[0]);
-        for &v in t {
-            n[v as usize] += a;
-        }
-    }
-    n.into_iter().map(|v| v.normalize_or_zero()).collect()
-}
-
 /// Per vertex, the largest |grad w| over the triangles around it (w linear on each), and
 /// the longest edge there.
 fn w_slopes(positions: &[DVec3], w: &[f64], triangles: &[[u32; 3]]) -> (Vec<f64>, Vec<f64>) {
@@ -722,32 +699,6 @@ pub fn compare(
     progress: &mut dyn FnMut(&CompareRow),
 ) -> Result<(f64, Vec<CompareRow>), ViewerError> {
     settings.check()?;
-    let normals: Vec<Vec<DVec3>> = scene
-        .surfaces
-        .iter()
-        .map(|s| {
-            s.normals
-                .clone()
-                .unwrap_or_else(|| vertex_normals(&s.positions, &s.triangles))
-        })
-        .collect();
-    let uv: Vec<Vec<[f64; 2]>> = scene
-        .surfaces
-        .iter()
-        .map(|s| vec![[0.0; 2]; s.positions.len()])
-        .collect();
-    let surfaces: Vec<crate::render::RenderSurface> = scene
-        .surfaces
-        .iter()
-        .zip(normals.iter().zip(&uv))
-        .map(|(s, (normals, uv))| crate::render::RenderSurface {
-            positions: &s.positions,
-            w: &s.w,
-            normals,
-            uv,
-            triangles: &s.triangles,
-        })
-        .collect();
     let cpu_settings = crate::render::RenderSettings {
         width: settings.width,
         height: settings.height,
@@ -761,14 +712,11 @@ pub fn compare(
     };
     let no_curves = crate::intersect::Curves::default();
     let start = std::time::Instant::now();
-    let exact = scene.with_halos(|halos| {
-        let input = crate::render::RenderInput {
-            surfaces: &surfaces,
-            halos,
-            curves: &no_curves,
-        };
-        crate::render::render_with_depth(&input, &cpu_settings, &settings.camera)
-    })?;
+    let exact = crate::render::render_with_depth(
+        &scene.parts(&no_curves),
+        &cpu_settings,
+        &settings.camera,
+    )?;
     let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
     let mut renderer = Renderer::new(gpu, asset, renderer::OFFSCREEN_FORMAT)?;
     let mut rows = Vec::new();

@@ -1,6 +1,7 @@
 //! Pipelines, targets and the passes of a frame.
 
 use super::{Asset, Frame, Gpu, GpuCamera, HaloMode, ViewSettings, ViewerError, bounding_radius};
+use crate::limits::FieldError;
 use crate::render::{Picture, shade};
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
@@ -432,13 +433,13 @@ impl Renderer {
         let k = settings.samples.isqrt();
         let max = gpu.limits().max_texture_dimension_2d;
         if settings.width * k > max || settings.height * k > max {
-            return Err(ViewerError::Setting {
-                field: "samples".into(),
-                message: format!(
+            return Err(ViewerError::Setting(FieldError::new(
+                "samples",
+                format!(
                     "{}x{} at {} samples per pixel is larger than this GPU's {max}-pixel textures; use fewer samples or a smaller size",
                     settings.width, settings.height, settings.samples
                 ),
-            });
+            )));
         }
         let final_target = target;
         let settings = &ViewSettings {
@@ -878,13 +879,13 @@ impl Renderer {
             || dims[1] > limits.max_texture_dimension_3d
             || dims[2] > limits.max_texture_dimension_3d
         {
-            return Err(ViewerError::Setting {
-                field: "slices".into(),
-                message: format!(
+            return Err(ViewerError::Setting(FieldError::new(
+                "slices",
+                format!(
                     "{slices} is more than this GPU's 3D textures hold ({}); use fewer",
                     limits.max_texture_dimension_3d
                 ),
-            });
+            )));
         }
         // Work items (tetrahedron, z layer) for every layer of voxel centres a
         // tetrahedron's box spans, sorted by layer.

@@ -121,7 +121,7 @@ impl App {
             Ok(times) => times,
             // A setting this GPU cannot do (a grid too large, say): back to the last one
             // that rendered, with the reason in the title; anything else ends the viewer.
-            Err(e @ (ViewerError::TooLarge { .. } | ViewerError::Setting { .. })) => {
+            Err(e @ (ViewerError::TooLarge { .. } | ViewerError::Setting(_))) => {
                 self.settings = ViewSettings {
                     width: self.settings.width,
                     height: self.settings.height,

@@ -9,7 +9,15 @@
 //! fewest triangles wins. Rows give triangles, sampling milliseconds (the final mesh only,
 //! not the search) and the audited errors relative to the diagonal.
 
+mod picture;
+mod plot;
+
+pub use picture::picture_sweep;
+pub use plot::PlotError;
+
 use crate::error::Error;
+use crate::limits::{self, FieldError, GRID_CELLS, RELATIVE_TOLERANCE};
+use crate::render::RenderError;
 use crate::sample::{self, audit, bounding_diagonal, sample_adaptive, sample_uniform};
 use crate::surfaces::Surface;
 use serde::Serialize;
@@ -55,9 +63,81 @@ impl Default for Settings {
     fn default() -> Self {
         Settings {
             tolerances: TOLERANCES.to_vec(),
-            max_triangles: 8_000_000,
+            max_triangles: limits::SWEEP_TRIANGLES,
         }
     }
+}
+
+impl Settings {
+    /// Checks the settings for sweeping `surfaces` (name, surface), naming the first bad
+    /// field (`tolerances`, `max_triangles`): every tolerance within
+    /// [`limits::RELATIVE_TOLERANCE`], the budget within [`limits::TRIANGLES`] and at least
+    /// the coarsest grid of every surface ([`coarsest_grid_triangles`]).
+    pub fn check(&self, surfaces: &[(String, Surface)]) -> Result<(), FieldError> {
+        if let Some(bad) = self
+            .tolerances
+            .iter()
+            .find(|t| !RELATIVE_TOLERANCE.contains(*t))
+        {
+            return Err(FieldError::new(
+                "tolerances",
+                format!(
+                    "every tolerance must be from {:?} to {:?} (a share of the bounding diagonal), got {bad}",
+                    RELATIVE_TOLERANCE.start(),
+                    RELATIVE_TOLERANCE.end()
+                ),
+            ));
+        }
+        let max = self.max_triangles;
+        if !limits::TRIANGLES.contains(&max) {
+            return Err(FieldError::new(
+                "max_triangles",
+                format!(
+                    "must be from {} to {}, got {max}",
+                    limits::TRIANGLES.start(),
+                    limits::TRIANGLES.end()
+                ),
+            ));
+        }
+        for (name, surface) in surfaces {
+            let least = coarsest_grid_triangles(surface);
+            if max < least {
+                return Err(FieldError::new(
+                    "max_triangles",
+                    format!(
+                        "{max} is less than the {least} triangles of the coarsest grid of `{name}` ({} patches); give at least {least}",
+                        surface.patch_count()
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Why a sweep stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    /// A setting is out of range.
+    #[error(transparent)]
+    Setting(#[from] FieldError),
+    /// The build the picture sweep draws failed.
+    #[error(transparent)]
+    Build(#[from] Error),
+    /// A picture could not be made.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// The plot could not be made.
+    #[error(transparent)]
+    Plot(#[from] PlotError),
+    /// A file could not be written.
+    #[error("cannot write {}: {source}; check that the output folder is writable (choose another with --out)", path.display())]
+    Write {
+        /// The file or folder.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
 }
 
 fn ms(since: Instant) -> f64 {
@@ -148,8 +228,12 @@ impl<'a> GridSearch<'a> {
     fn cells(&self, k: f64, aspect: f64) -> [usize; 2] {
         let [min_u, min_v] = self.surface.min_cells();
         let even = |x: f64, min: usize| {
-            let n = (x.round().clamp(2.0, 4096.0) as usize).max(min);
-            (n + n % 2).min(4096)
+            let n = (x
+                .round()
+                .clamp(*GRID_CELLS.start() as f64, *GRID_CELLS.end() as f64)
+                as usize)
+                .max(min);
+            (n + n % 2).min(*GRID_CELLS.end())
         };
         [
             even(k * aspect.sqrt(), min_u),
@@ -187,7 +271,7 @@ impl<'a> GridSearch<'a> {
         let mut k = 8.0;
         for _ in 0..24 {
             let cells = self.cells(k, aspect);
-            if self.triangles(cells) > self.max_triangles || cells.contains(&4096) {
+            if self.triangles(cells) > self.max_triangles || cells.contains(GRID_CELLS.end()) {
                 // Beyond the budget: step back towards the last failing size, or down
                 // towards the coarsest grid while nothing was measured, or stop.
                 match (fail, pass) {
@@ -372,34 +456,44 @@ pub fn run(
     settings: &Settings,
     out_dir: &Path,
     progress: &mut dyn FnMut(&str),
-) -> Result<(Vec<Row>, Vec<PathBuf>), Error> {
+) -> Result<(Vec<Row>, Vec<PathBuf>), SweepError> {
+    settings.check(surfaces)?;
     let mut rows = Vec::new();
     for (name, surface) in surfaces {
         rows.extend(sweep_surface(name, surface, settings, progress));
     }
-    std::fs::create_dir_all(out_dir).map_err(|source| Error::Write {
+    let png = plot::speed_vs_error_png(
+        &rows,
+        "halo4d: audited error against triangles, adaptive and uniform",
+    )?;
+    let written = write_files(
+        out_dir,
+        [
+            ("speed_vs_error.csv", to_csv(&rows).into_bytes()),
+            ("speed_vs_error.png", png),
+        ],
+    )?;
+    Ok((rows, written))
+}
+
+/// Writes each (file, bytes) into `out_dir` (made when missing), each file whole or not at
+/// all; gives the paths.
+fn write_files<const N: usize>(
+    out_dir: &Path,
+    files: [(&str, Vec<u8>); N],
+) -> Result<Vec<PathBuf>, SweepError> {
+    std::fs::create_dir_all(out_dir).map_err(|source| SweepError::Write {
         path: out_dir.to_path_buf(),
         source,
     })?;
-    let png = crate::export::speed_vs_error_png(
-        &rows,
-        "halo4d: audited error against triangles, adaptive and uniform",
-    )
-    .map_err(|message| Error::Internal {
-        stage: "sweep",
-        message,
-    })?;
     let mut written = Vec::new();
-    for (file, bytes) in [
-        ("speed_vs_error.csv", to_csv(&rows).into_bytes()),
-        ("speed_vs_error.png", png),
-    ] {
+    for (file, bytes) in files {
         let path = out_dir.join(file);
-        crate::export::write_atomic(&path, &bytes).map_err(|source| Error::Write {
+        crate::export::write_atomic(&path, &bytes).map_err(|source| SweepError::Write {
             path: path.clone(),
             source,
         })?;
         written.push(path);
     }
-    Ok((rows, written))
+    Ok(written)
 }

@@ -1,21 +1,34 @@
 //! PNG plots of the sweeps: audited error against triangles, log-log.
 
-use crate::sweep::Row;
+use super::Row;
+use crate::render::compare::Comparison;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
+
+/// Why a plot could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    /// The rows hold nothing that can be drawn on the plot's axes.
+    #[error("nothing to plot: {0}")]
+    Empty(&'static str),
+    /// Drawing or encoding failed (a bug, not bad input).
+    #[error("internal error in the plot: {0}")]
+    Draw(String),
+}
 
 /// The font of every label, embedded so that plots look the same on every machine
 /// (DejaVu Sans Mono; licence in `assets/fonts/DejaVu-LICENSE.txt`).
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSansMono.ttf");
 const FAMILY: &str = "halo4d-mono";
 
-fn register_font() -> Result<(), String> {
+fn register_font() -> Result<(), PlotError> {
     static DONE: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
     DONE.get_or_init(|| {
         plotters::style::register_font(FAMILY, FontStyle::Normal, FONT)
             .map_err(|_| "the embedded plot font is not a valid font".to_string())
     })
     .clone()
+    .map_err(PlotError::Draw)
 }
 
 const COLOURS: [RGBColor; 8] = [
@@ -30,19 +43,19 @@ const COLOURS: [RGBColor; 8] = [
 ];
 
 /// Encodes an RGB buffer as PNG.
-pub fn encode_png(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>, String> {
+fn encode_png(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>, PlotError> {
     use image::ImageEncoder;
     let mut out = Vec::new();
     image::codecs::png::PngEncoder::new(&mut out)
         .write_image(rgb, width, height, image::ExtendedColorType::Rgb8)
-        .map_err(|e| format!("PNG encoding failed: {e}"))?;
+        .map_err(|e| PlotError::Draw(format!("PNG encoding failed: {e}")))?;
     Ok(out)
 }
 
 /// Audited max error (relative to the diagonal) against triangles, one line per surface and
 /// method: solid with dots for the adaptive sampler, dashed with crosses for uniform grids.
 /// Rows that did not meet their tolerance are drawn hollow.
-pub fn speed_vs_error_png(rows: &[Row], title: &str) -> Result<Vec<u8>, String> {
+pub(super) fn speed_vs_error_png(rows: &[Row], title: &str) -> Result<Vec<u8>, PlotError> {
     register_font()?;
     let (w, h) = (1200u32, 800u32);
     let mut rgb = vec![255u8; (w * h * 3) as usize];
@@ -51,7 +64,9 @@ pub fn speed_vs_error_png(rows: &[Row], title: &str) -> Result<Vec<u8>, String> 
         .filter(|r| r.triangles > 0 && r.max_error.is_finite() && r.max_error > 0.0)
         .collect();
     if finite.is_empty() {
-        return Err("no rows with a finite error to plot".into());
+        return Err(PlotError::Empty(
+            "no row has a finite, positive error and at least one triangle",
+        ));
     }
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
     for r in &finite {
@@ -135,24 +150,26 @@ pub fn speed_vs_error_png(rows: &[Row], title: &str) -> Result<Vec<u8>, String> 
         root.present()?;
         Ok(())
     };
-    draw(&mut rgb).map_err(|e| format!("plot failed: {e}"))?;
+    draw(&mut rgb).map_err(|e| PlotError::Draw(e.to_string()))?;
     encode_png(&rgb, w, h)
 }
 
 /// The multi-slice mode against the exact one: render time (left) and the share of covered
 /// pixels whose hidden/visible verdict differs with the 99th-percentile pixel difference
 /// (right), against slices on a log scale; the exact mode's time as a dashed line.
-pub fn render_speed_vs_error_png(
-    rows: &[crate::render::compare::Comparison],
+pub(super) fn render_speed_vs_error_png(
+    rows: &[Comparison],
     title: &str,
-) -> Result<Vec<u8>, String> {
+) -> Result<Vec<u8>, PlotError> {
     register_font()?;
     let (w, h) = (1400u32, 650u32);
     let mut rgb = vec![255u8; (w * h * 3) as usize];
     let exact_ms = rows.iter().find(|r| r.slices == 0).map(|r| r.ms);
     let sliced: Vec<_> = rows.iter().filter(|r| r.slices > 0).collect();
     if sliced.is_empty() {
-        return Err("no slice-mode rows to plot".into());
+        return Err(PlotError::Empty(
+            "no slice count to compare with the exact mode",
+        ));
     }
     let x0 = sliced
         .iter()
@@ -262,7 +279,7 @@ pub fn render_speed_vs_error_png(
         root.present()?;
         Ok(())
     };
-    draw(&mut rgb).map_err(|e| format!("plot failed: {e}"))?;
+    draw(&mut rgb).map_err(|e| PlotError::Draw(e.to_string()))?;
     encode_png(&rgb, w, h)
 }
 

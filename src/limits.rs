@@ -1,0 +1,183 @@
+//! Every limit a user can meet, in one home, and the one shape of a validation failure.
+//!
+//! The scene's checks, the command line's flags, the viewer and the README's table of limits
+//! ([`table`], which a test compares with the README) all take their numbers from here, so
+//! that a limit written twice cannot drift. A setting outside its limit is a [`FieldError`]
+//! naming the field, what is allowed and what was given.
+//!
+//! This module sits below every stage: it uses nothing of the crate.
+
+use std::fmt;
+use std::ops::RangeInclusive;
+
+/// A sampling tolerance relative to the surface's 4D bounding diagonal (`sampling.tolerance`,
+/// `halo4d sweep --tolerances`). Below 1e-9 the mesh's error is rounding; above a half the
+/// mesh is no longer a picture of the surface.
+pub const RELATIVE_TOLERANCE: RangeInclusive<f64> = 1e-9..=0.5;
+
+/// Cells of a uniform grid along u or along v (`sampling.u`, `sampling.v`), an even number: a
+/// seam glued at half a side needs a node there.
+pub const GRID_CELLS: RangeInclusive<usize> = 2..=4096;
+
+/// Triangles of one adaptive budget (`sampling.max_triangles`, `halo4d sweep
+/// --max-triangles`); the upper end also bounds all of a scene's uniform grids together.
+pub const TRIANGLES: RangeInclusive<usize> = 64..=20_000_000;
+
+/// The default of `halo4d sweep --max-triangles`: the most triangles of any one of its
+/// meshes.
+pub const SWEEP_TRIANGLES: usize = 8_000_000;
+
+/// Surfaces in one scene.
+pub const SURFACES: RangeInclusive<usize> = 1..=64;
+
+/// The length of a name (the scene's, a surface's), which becomes a file name.
+pub const NAME_LENGTH: RangeInclusive<usize> = 1..=64;
+
+/// A picture's width or height in pixels (`render.width`, `render.height`, `halo4d render
+/// --width`, the viewer's window and offscreen frames), so that a typo cannot ask for
+/// gigabytes.
+pub const PICTURE_SIDE: RangeInclusive<u32> = 1..=8192;
+
+/// Samples per pixel: a square grid.
+pub const SAMPLES: [u32; 4] = [1, 4, 9, 16];
+
+/// Slices of the halo depth in the CPU renderer (`render.slices`, `halo4d sweep --render
+/// --slices`).
+pub const SLICES: RangeInclusive<u32> = 1..=4096;
+
+/// Slices of the halo depth in the viewer, whose slice textures live on the GPU.
+pub const VIEWER_SLICES: RangeInclusive<u32> = 2..=1024;
+
+/// The most surface triangles the viewer loads (its vertex buffers are sized for them).
+pub const VIEWER_TRIANGLES: usize = 4 << 20;
+
+/// The most halo tetrahedra the viewer loads.
+pub const VIEWER_TETRAHEDRA: usize = 16 << 20;
+
+/// The largest relative difference between a halo's total tetrahedron volume and the volume
+/// its boundary encloses that the checker passes: rounding, never an overlap (the
+/// catalogue's halos stay below 1e-13).
+pub const VOLUME_DEFECT: f64 = 1e-9;
+
+/// A setting outside its limits, or inconsistent with another: the field's path (like
+/// `surfaces[0].sampling.u`) and what is wrong, with what is allowed.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FieldError {
+    /// Path of the field, from the settings value that was checked.
+    pub field: String,
+    /// What is wrong and what is allowed.
+    pub message: String,
+}
+
+impl FieldError {
+    /// A failure of `field`.
+    pub fn new(field: impl Into<String>, message: impl Into<String>) -> Self {
+        FieldError {
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+
+    /// The same failure seen from the value that holds the checked one at `parent`: the
+    /// field `u` of `sampling` becomes `sampling.u`.
+    pub fn within(self, parent: &str) -> Self {
+        FieldError {
+            field: format!("{parent}.{}", self.field),
+            ..self
+        }
+    }
+}
+
+impl fmt::Display for FieldError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.field, self.message)
+    }
+}
+
+impl std::error::Error for FieldError {}
+
+/// The limits as the README's table (Markdown), one row per limit.
+pub fn table() -> String {
+    let rows = [
+        (
+            "`sampling.tolerance`, `halo4d sweep --tolerances`",
+            range(&RELATIVE_TOLERANCE),
+            "of the 4D bounding diagonal",
+        ),
+        (
+            "`sampling.u`, `sampling.v`",
+            range(&GRID_CELLS),
+            "cells, even",
+        ),
+        (
+            "`sampling.max_triangles`, `halo4d sweep --max-triangles`; all uniform grids of a scene",
+            range(&TRIANGLES),
+            "triangles",
+        ),
+        (
+            "`halo4d sweep --max-triangles` default",
+            SWEEP_TRIANGLES.to_string(),
+            "triangles",
+        ),
+        ("`surfaces`", range(&SURFACES), "surfaces"),
+        (
+            "`name`, `surfaces[i].name`",
+            range(&NAME_LENGTH),
+            "characters",
+        ),
+        (
+            "`render.width`, `render.height`, the viewer's size",
+            range(&PICTURE_SIDE),
+            "pixels",
+        ),
+        (
+            "`render.samples`, the viewer's samples",
+            SAMPLES.map(|s| s.to_string()).join(", "),
+            "per pixel",
+        ),
+        (
+            "`render.slices`, `halo4d sweep --render --slices`",
+            range(&SLICES),
+            "slices",
+        ),
+        ("the viewer's slices", range(&VIEWER_SLICES), "slices"),
+        (
+            "surface triangles the viewer loads",
+            format!("up to {VIEWER_TRIANGLES}"),
+            "triangles",
+        ),
+        (
+            "halo tetrahedra the viewer loads",
+            format!("up to {VIEWER_TETRAHEDRA}"),
+            "tetrahedra",
+        ),
+        (
+            "a halo's volume defect (`halo4d check`, a build's verdict)",
+            format!("at most {VOLUME_DEFECT:e}"),
+            "relative",
+        ),
+    ];
+    let mut out = String::from("| setting | allowed | unit |\n| --- | --- | --- |\n");
+    for (setting, allowed, unit) in rows {
+        out += &format!("| {setting} | {allowed} | {unit} |\n");
+    }
+    out
+}
+
+fn range<T: fmt::Debug>(r: &RangeInclusive<T>) -> String {
+    // Debug writes 1e-9 as `1e-9`, where Display writes 0.000000001.
+    format!("{:?} to {:?}", r.start(), r.end())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_field_error_names_its_path_from_the_outermost_value() {
+        let e = FieldError::new("u", "must be even")
+            .within("sampling")
+            .within("surfaces[0]");
+        assert_eq!(e.to_string(), "surfaces[0].sampling.u: must be even");
+    }
+}

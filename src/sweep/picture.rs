@@ -1,0 +1,55 @@
+//! The picture's speed against error: the multi-slice mode against the exact one.
+
+use super::{SweepError, plot, write_files};
+use crate::limits::{FieldError, SLICES};
+use crate::render::compare::{self, Comparison};
+use crate::scene::Scene;
+use std::path::{Path, PathBuf};
+
+/// Builds `scene` (the stages its picture needs), renders it in the exact mode and with
+/// each of `slices` ([`compare::compare`]), and writes `render_speed_vs_error.csv` and
+/// `render_speed_vs_error.png` into `out_dir`. `progress` hears of each render. Gives the
+/// rows and the paths written.
+pub fn picture_sweep(
+    scene: &Scene,
+    slices: &[u32],
+    out_dir: &Path,
+    quiet: bool,
+    progress: &mut dyn FnMut(&Comparison),
+) -> Result<(Vec<Comparison>, Vec<PathBuf>), SweepError> {
+    if let Some(bad) = slices.iter().find(|n| !SLICES.contains(*n)) {
+        return Err(FieldError::new(
+            "slices",
+            format!(
+                "every count must be {} to {}, got {bad}",
+                SLICES.start(),
+                SLICES.end()
+            ),
+        )
+        .into());
+    }
+    let built = crate::pipeline::run_for_picture(scene, quiet)?;
+    let rows = compare::compare(
+        &built.parts(&scene.halo),
+        &scene.render,
+        &scene.camera,
+        slices,
+        progress,
+    )?;
+    let title = format!(
+        "{}: multi-slice halos against the exact mode, {} x {}",
+        scene.name, scene.render.width, scene.render.height
+    );
+    let png = plot::render_speed_vs_error_png(&rows, &title)?;
+    let written = write_files(
+        out_dir,
+        [
+            (
+                "render_speed_vs_error.csv",
+                compare::to_csv(&rows).into_bytes(),
+            ),
+            ("render_speed_vs_error.png", png),
+        ],
+    )?;
+    Ok((rows, written))
+}
