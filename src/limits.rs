@@ -59,6 +59,51 @@ pub const VIEWER_TETRAHEDRA: usize = 16 << 20;
 /// catalogue's halos stay below 1e-13).
 pub const VOLUME_DEFECT: f64 = 1e-9;
 
+/// The most bytes of one run of text without whitespace an error message echoes.
+pub const ECHO_RUN: usize = 60;
+
+/// The most bytes of user text one error message echoes.
+pub const ECHO_TOTAL: usize = 300;
+
+/// User text (a name, a key, a line of a file) as an error message echoes it: a run of
+/// more than 60 bytes without whitespace, and text of more than 300 bytes, keep their ends
+/// (whole characters) and say how much was left out, so that a long name or binary data
+/// read as text cannot bury the message.
+pub fn shorten(text: &str) -> String {
+    fn cut(s: &str, keep: usize) -> String {
+        if s.len() <= keep {
+            return s.to_string();
+        }
+        let mut head = keep / 2;
+        while !s.is_char_boundary(head) {
+            head -= 1;
+        }
+        let mut tail = s.len() - keep / 2;
+        while !s.is_char_boundary(tail) {
+            tail += 1;
+        }
+        format!(
+            "{}...({} bytes left out)...{}",
+            &s[..head],
+            tail - head,
+            &s[tail..]
+        )
+    }
+    let mut out = String::with_capacity(text.len().min(2 * ECHO_TOTAL));
+    let mut run = String::new();
+    for c in text.chars().chain(std::iter::once(' ')) {
+        if c.is_whitespace() {
+            out.push_str(&cut(&run, ECHO_RUN));
+            run.clear();
+            out.push(c);
+        } else {
+            run.push(c);
+        }
+    }
+    out.pop();
+    cut(&out, ECHO_TOTAL)
+}
+
 /// A setting outside its limits, or inconsistent with another: the field's path (like
 /// `surfaces[0].sampling.u`) and what is wrong, with what is allowed.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -179,5 +224,27 @@ mod tests {
             .within("sampling")
             .within("surfaces[0]");
         assert_eq!(e.to_string(), "surfaces[0].sampling.u: must be even");
+    }
+
+    #[test]
+    fn long_runs_and_long_texts_keep_their_ends() {
+        assert_eq!(shorten("a short message"), "a short message");
+        let long = format!("name `{}` is bad", "x".repeat(1000));
+        let s = shorten(&long);
+        assert!(s.starts_with("name `xxx") && s.ends_with("` is bad"), "{s}");
+        assert!(s.contains("(942 bytes left out)"), "{s}");
+        let emoji = "\u{1F600} ".repeat(400);
+        let s = shorten(&emoji);
+        assert!(s.len() < 400 && s.is_char_boundary(s.len()), "{s}");
+        let words = "word ".repeat(500);
+        let s = shorten(words.trim_end());
+        assert!(
+            s.len() < 500 && s.starts_with("word word") && s.ends_with("word"),
+            "{s}"
+        );
+        assert_eq!(
+            shorten("tabs\tand\nnewlines  stay"),
+            "tabs\tand\nnewlines  stay"
+        );
     }
 }

@@ -5,8 +5,8 @@
 //! range; every error names the file and the field (`surfaces[0].surface.n`) and says what
 //! is allowed. No input makes the parser panic.
 
-use crate::error::shorten;
 use crate::halo::HaloParams;
+use crate::limits::shorten;
 use crate::limits::{FieldError, NAME_LENGTH, SURFACES, TRIANGLES};
 use crate::render::{CameraSettings, RenderSettings};
 use crate::sample::Sampling;

@@ -1,6 +1,7 @@
 //! Integration tests, one module per stage.
 
 mod adaptive;
+mod architecture;
 mod cli;
 mod common;
 mod curves_export;

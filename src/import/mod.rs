@@ -22,8 +22,8 @@ pub use glb::{read_glb, read_scene_glb};
 pub use vtk::read_vtk;
 
 use crate::check::{LAYERS, TetMesh};
-use crate::error::shorten;
 use crate::intersect::Curves;
+use crate::limits::shorten;
 use crate::parts::{HaloPart, Parts, SurfacePart};
 use crate::render::CameraSettings;
 use glam::DVec3;

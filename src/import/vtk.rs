@@ -8,7 +8,7 @@
 use super::{FileParams, ImportError, ImportedHalo};
 use crate::check::TetMesh;
 use crate::convention::file_order;
-use crate::error::shorten;
+use crate::limits::shorten;
 use std::collections::HashMap;
 
 type Result<T> = std::result::Result<T, ImportError>;
