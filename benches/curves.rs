@@ -1,7 +1,8 @@
 //! Intersection curves: all curves of the flat-torus fixture's view, chained, on uniform
-//! grids of 316 x 316 (199,712 triangles) and 708 x 708 (1,002,528 triangles), on one
-//! thread. Before the timed runs, prints how one run splits between building the BVH,
-//! traversing it and the exact tests, and the halo verification's cost on the smaller mesh.
+//! grids of 316 x 316 (199,712 triangles) and 708 x 708 (1,002,528 triangles), on every
+//! core (`RAYON_NUM_THREADS=1` for one). Before the timed runs, prints how one run splits
+//! between building the BVH, traversing it with the exact tests (and the exact tests' time
+//! summed over the cores) and chaining.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use halo4d::intersect::{Sheet, curves};
@@ -25,9 +26,11 @@ fn curve_costs(c: &mut Criterion) {
         }];
         let r = curves(&sheets).report;
         eprintln!(
-            "{} triangles: {:.1} ms = BVH {:.1} + traversal {:.1} + exact {:.1} + chaining {:.1}; \
+            "{} triangles on {} threads: {:.1} ms = BVH {:.1} + traversal with the exact tests {:.1} \
+             (exact tests {:.1} summed over the threads) + chaining {:.1}; \
              {} candidate pairs, {} segments, {} curves, {:.2} M triangles/s",
             r.triangles,
+            rayon::current_num_threads(),
             r.ms,
             r.bvh_ms,
             r.traverse_ms,

@@ -661,3 +661,36 @@ fn planted_faults_are_caught_at_a_million_triangles() {
     );
     assert!(moved.spurious_hidden_samples > 0, "{moved:?}");
 }
+
+#[test]
+fn the_curves_do_not_depend_on_the_number_of_threads() {
+    // The twist-spun trefoil at 20k triangles: thousands of candidate pairs in every task of
+    // the parallel descent, and curves that end at branch points.
+    let mut scene = Scene::load(&fixture("scenes/twist-spun-trefoil.json")).unwrap();
+    scene.sampling = Sampling::Uniform { u: 100, v: 100 };
+    let mesh = sample(&scene.surfaces[0].surface, &scene.sampling).mesh;
+    let projected = scene.view.project(&mesh).unwrap();
+    let sheets = [Sheet {
+        positions: &projected.positions,
+        w: &projected.w,
+        triangles: &mesh.triangles,
+    }];
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut c = pool.install(|| curves(&sheets));
+        let r = &mut c.report;
+        (r.ms, r.bvh_ms, r.traverse_ms, r.exact_ms, r.chain_ms) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        c
+    };
+    let one = on(1);
+    assert!(
+        one.report.segments > 1000 && one.report.count > 1,
+        "{:?}",
+        one.report
+    );
+    assert_eq!(on(4), one);
+    assert_eq!(on(3), one);
+}

@@ -28,6 +28,7 @@ pub use exact::Node;
 use exact::{Pair, Segment, Soup};
 use glam::DVec3;
 use obvhs::aabb::Aabb;
+use rayon::prelude::*;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -156,9 +157,9 @@ pub struct CurvesReport {
     pub ms: f64,
     /// Of which merging the sheets, computing boxes and planes and building the BVH.
     pub bvh_ms: f64,
-    /// Traversing it.
+    /// Traversing it with the exact tests of the pairs it finds, on the cores (wall clock).
     pub traverse_ms: f64,
-    /// The exact tests.
+    /// The exact tests, summed over the cores (more than `traverse_ms` on several cores).
     pub exact_ms: f64,
     /// Placing, chaining and counting.
     pub chain_ms: f64,
@@ -210,11 +211,12 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
     let proper = |t: &[u32; 3]| t[0] != t[1] && t[1] != t[2] && t[2] != t[0];
     report.degenerate_triangles = soup.tris.iter().filter(|t| !proper(t)).count();
 
-    // Candidate pairs go to the exact tests in batches as the broad phase finds them: the
-    // memory they take is bounded however many there are (slivers and many-twist knots
-    // give thousands per triangle).
-    let mut exact = Exact::new(&soup);
-    match broad_phase {
+    // Candidate pairs go to the exact tests as the broad phase finds them, on the cores,
+    // each task keeping only the segments: the memory they take is bounded however many
+    // candidates there are (slivers and many-twist knots give thousands per triangle). The
+    // tasks' results are joined in the order a descent on one core finds them, so the curves
+    // do not depend on the number of threads.
+    let found = match broad_phase {
         BroadPhase::Bvh => {
             let boxes: Vec<_> = soup
                 .tris
@@ -240,47 +242,65 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
             let bvh = broad::build(&group_boxes, 2);
             report.bvh_ms = ms(start);
             let t = Instant::now();
-            let mut test = |a: u32, b: u32| {
+            let test = |found: &mut Found, a: u32, b: u32| {
                 if boxes[a as usize].intersect_aabb(&boxes[b as usize]) {
-                    exact.push(a.min(b), a.max(b));
+                    found.push(&soup, a.min(b), a.max(b));
                 }
             };
-            for g in groups.windows(2) {
-                for a in g[0]..g[1] {
-                    for b in a + 1..g[1] {
-                        test(a, b);
+            // Neighbours within a run of triangles, then the runs whose boxes touch.
+            let within: Vec<Found> = groups
+                .par_windows(2)
+                .chunks(GROUPS_PER_TASK)
+                .map(|chunk| {
+                    let mut found = Found::default();
+                    for g in chunk {
+                        for a in g[0]..g[1] {
+                            for b in a + 1..g[1] {
+                                test(&mut found, a, b);
+                            }
+                        }
                     }
-                }
-            }
-            broad::self_pairs(&bvh, &group_boxes, |ga, gb| {
-                for a in groups[ga as usize]..groups[ga as usize + 1] {
-                    for b in groups[gb as usize]..groups[gb as usize + 1] {
-                        test(a, b);
+                    found
+                })
+                .collect();
+            let across =
+                broad::self_pairs_par(&bvh, &group_boxes, Found::default, |found, ga, gb| {
+                    for a in groups[ga as usize]..groups[ga as usize + 1] {
+                        for b in groups[gb as usize]..groups[gb as usize + 1] {
+                            test(found, a, b);
+                        }
                     }
-                }
-            });
-            exact.flush();
-            report.traverse_ms = ms(t) - exact.ms;
+                });
+            let mut parts: Vec<Found> = within.into_iter().chain(across).collect();
+            parts.par_iter_mut().for_each(|f| f.flush(&soup));
+            let found = Found::join(&soup, parts);
+            report.traverse_ms = ms(t);
+            found
         }
         BroadPhase::AllPairs => {
             let ok: Vec<u32> = (0..soup.tris.len() as u32)
                 .filter(|&t| proper(&soup.tris[t as usize]))
                 .collect();
-            for (i, &a) in ok.iter().enumerate() {
-                for &b in &ok[i + 1..] {
-                    exact.push(a, b);
-                }
-            }
-            exact.flush();
+            let rows: Vec<Found> = (0..ok.len())
+                .into_par_iter()
+                .map(|i| {
+                    let mut found = Found::default();
+                    for &b in &ok[i + 1..] {
+                        found.push(&soup, ok[i], b);
+                    }
+                    found
+                })
+                .collect();
+            Found::join(&soup, rows)
         }
-    }
-    let Exact {
+    };
+    let Found {
         candidates,
         segments,
         inconsistent,
-        ms: exact_ms,
+        exact_ms,
         ..
-    } = exact;
+    } = found;
     report.candidate_pairs = candidates;
     report.unresolved += inconsistent;
     report.exact_ms = exact_ms;
@@ -340,52 +360,59 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
     Curves { curves, report }
 }
 
-/// The exact tests of candidate pairs, run a batch at a time.
-struct Exact<'a> {
-    soup: &'a Soup,
+/// Runs of triangles one task of the exact tests within runs takes.
+const GROUPS_PER_TASK: usize = 4096;
+
+/// What the exact tests of some candidate pairs found, in the order of the pairs. Pairs wait
+/// in a small batch so that the tests are timed a batch at a time, not a pair at a time.
+#[derive(Default)]
+struct Found {
     batch: Vec<(u32, u32)>,
     candidates: usize,
     segments: Vec<Segment>,
     /// Pairs whose predicates disagreed.
     inconsistent: usize,
     /// Milliseconds in the tests.
-    ms: f64,
+    exact_ms: f64,
 }
 
-impl<'a> Exact<'a> {
-    /// Candidate pairs held before they are tested: 8 MB.
-    const BATCH: usize = 1 << 20;
+impl Found {
+    /// Candidate pairs held before they are tested.
+    const BATCH: usize = 1024;
 
-    fn new(soup: &'a Soup) -> Self {
-        Exact {
-            soup,
-            batch: Vec::with_capacity(Self::BATCH.min(8 * soup.tris.len())),
-            candidates: 0,
-            segments: Vec::new(),
-            inconsistent: 0,
-            ms: 0.0,
-        }
-    }
-
-    fn push(&mut self, a: u32, b: u32) {
+    /// Triangles `a` and `b` of `soup` to be tested.
+    fn push(&mut self, soup: &Soup, a: u32, b: u32) {
         self.batch.push((a, b));
         if self.batch.len() == Self::BATCH {
-            self.flush();
+            self.flush(soup);
         }
     }
 
-    fn flush(&mut self) {
+    /// The exact tests of the pairs waiting.
+    fn flush(&mut self, soup: &Soup) {
         let t = Instant::now();
         self.candidates += self.batch.len();
         for &(a, b) in &self.batch {
-            match self.soup.pair(a, b) {
+            match soup.pair(a, b) {
                 Pair::Apart => {}
                 Pair::Cross(s) => self.segments.push(s),
                 Pair::Inconsistent(..) => self.inconsistent += 1,
             }
         }
         self.batch.clear();
-        self.ms += ms(t);
+        self.exact_ms += ms(t);
+    }
+
+    /// The findings of consecutive runs of pairs, in order, every pair tested.
+    fn join(soup: &Soup, parts: impl IntoIterator<Item = Found>) -> Found {
+        parts.into_iter().fold(Found::default(), |mut all, mut f| {
+            f.flush(soup);
+            all.candidates += f.candidates;
+            all.segments.extend(f.segments);
+            all.inconsistent += f.inconsistent;
+            all.exact_ms += f.exact_ms;
+            all
+        })
     }
 }
 
