@@ -216,3 +216,14 @@ fn truncated_and_mutated_scenes_never_panic() {
         }
     }
 }
+
+#[test]
+fn the_readme_lists_the_limits_of_the_code() {
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    let table = halo4d::limits::table();
+    assert!(
+        readme.contains(&table),
+        "the README's table of limits is not the code's; it should read:\n{table}"
+    );
+}

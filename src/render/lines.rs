@@ -69,9 +69,10 @@ use rustfft::num_complex::Complex;
 use rustfft::{Fft, FftPlanner};
 use std::sync::Arc;
 
-/// The largest image side accepted, in pixels. Broadening holds about six f32 images of the
-/// mask's size.
-pub const MAX_SIDE: usize = 16384;
+/// The largest image side accepted, in pixels: a picture's
+/// ([`crate::limits::PICTURE_SIDE`]). Broadening holds about six f32 images of the mask's
+/// size.
+pub const MAX_SIDE: usize = *crate::limits::PICTURE_SIDE.end() as usize;
 
 /// The farthest a segment's endpoint may lie from the origin, in pixels. Further out, f64
 /// cannot place the clipped segment to a small fraction of a pixel.

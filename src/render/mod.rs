@@ -19,7 +19,7 @@ pub mod shade;
 pub mod slices;
 pub mod trace;
 
-use crate::limits::FieldError;
+use crate::limits::{FieldError, PICTURE_SIDE, SAMPLES, SLICES};
 use crate::parts::{HaloIndex, Parts};
 use camera::Camera;
 use glam::DVec3;
@@ -195,32 +195,44 @@ impl Default for RenderSettings {
     }
 }
 
-/// The largest image side, so a typo cannot ask for gigabytes.
-pub const MAX_SIDE: u32 = 8192;
-
 impl RenderSettings {
     /// Checks the numbers: names the first bad field.
     pub fn check(&self) -> Result<(), FieldError> {
-        let side = |v: u32| (1..=MAX_SIDE).contains(&v);
+        let side = |v: u32| PICTURE_SIDE.contains(&v);
         if !side(self.width) {
             return Err(FieldError::new(
                 "width",
-                format!("must be 1 to {MAX_SIDE} pixels, got {}", self.width),
+                format!(
+                    "must be {} to {} pixels, got {}",
+                    PICTURE_SIDE.start(),
+                    PICTURE_SIDE.end(),
+                    self.width
+                ),
             ));
         }
         if !side(self.height) {
             return Err(FieldError::new(
                 "height",
-                format!("must be 1 to {MAX_SIDE} pixels, got {}", self.height),
+                format!(
+                    "must be {} to {} pixels, got {}",
+                    PICTURE_SIDE.start(),
+                    PICTURE_SIDE.end(),
+                    self.height
+                ),
             ));
         }
-        if !(1..=4096).contains(&self.slices) {
+        if !SLICES.contains(&self.slices) {
             return Err(FieldError::new(
                 "slices",
-                format!("must be 1 to 4096, got {}", self.slices),
+                format!(
+                    "must be {} to {}, got {}",
+                    SLICES.start(),
+                    SLICES.end(),
+                    self.slices
+                ),
             ));
         }
-        if ![1, 4, 9, 16].contains(&self.samples) {
+        if !SAMPLES.contains(&self.samples) {
             return Err(FieldError::new(
                 "samples",
                 format!(

@@ -47,9 +47,9 @@ pub enum Sampling {
     },
     /// A uniform grid of `u` by `v` cells on every patch.
     Uniform {
-        /// Cells along u per patch (even, 4 to 4096).
+        /// Cells along u per patch (even, within [`crate::limits::GRID_CELLS`]).
         u: usize,
-        /// Cells along v per patch (even, 4 to 4096).
+        /// Cells along v per patch (even, within [`crate::limits::GRID_CELLS`]).
         v: usize,
     },
 }

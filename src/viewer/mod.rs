@@ -43,17 +43,15 @@ pub use gpu::Gpu;
 pub use renderer::{FrameTimes, Renderer};
 
 use crate::import::{ImportError, ImportedScene};
-use crate::limits::FieldError;
+use crate::limits::{
+    FieldError, PICTURE_SIDE, SAMPLES, VIEWER_SLICES, VIEWER_TETRAHEDRA, VIEWER_TRIANGLES,
+};
 use crate::render::camera::Camera;
 use crate::render::overlay::{AGREE, interior_edges};
 use crate::render::{CameraSettings, Colormap, RenderError};
 use glam::{DMat4, DVec3, DVec4};
 use std::path::Path;
 
-/// The most surface triangles the viewer loads.
-pub const MAX_TRIANGLES: usize = 4 << 20;
-/// The most halo tetrahedra the viewer loads.
-pub const MAX_TETRAHEDRA: usize = 16 << 20;
 /// The slice counts the viewer offers.
 pub const SLICE_COUNTS: [u32; 4] = [64, 128, 256, 512];
 
@@ -133,29 +131,30 @@ impl ViewSettings {
         let bad = |field: &str, message: String| {
             Err(ViewerError::Setting(FieldError::new(field, message)))
         };
-        if !(1..=crate::render::MAX_SIDE).contains(&self.width)
-            || !(1..=crate::render::MAX_SIDE).contains(&self.height)
-        {
+        if !PICTURE_SIDE.contains(&self.width) || !PICTURE_SIDE.contains(&self.height) {
             return bad(
                 "size",
                 format!(
-                    "{}x{} is not between 1x1 and {m}x{m}",
+                    "{}x{} is not between {lo}x{lo} and {hi}x{hi}",
                     self.width,
                     self.height,
-                    m = crate::render::MAX_SIDE
+                    lo = PICTURE_SIDE.start(),
+                    hi = PICTURE_SIDE.end()
                 ),
             );
         }
-        if !(2..=1024).contains(&self.slices) {
+        if !VIEWER_SLICES.contains(&self.slices) {
             return bad(
                 "slices",
                 format!(
-                    "{} is not between 2 and 1024 (the viewer offers 64, 128, 256 and 512)",
-                    self.slices
+                    "{} is not between {} and {} (the viewer offers {SLICE_COUNTS:?})",
+                    self.slices,
+                    VIEWER_SLICES.start(),
+                    VIEWER_SLICES.end()
                 ),
             );
         }
-        if ![1, 4, 9, 16].contains(&self.samples) {
+        if !SAMPLES.contains(&self.samples) {
             return bad(
                 "samples",
                 format!("{} is not 1, 4, 9 or 16 (a square grid)", self.samples),
@@ -304,8 +303,8 @@ impl Asset {
         Ok((scene, asset))
     }
 
-    /// Gathers an imported scene, checking its size against [`MAX_TRIANGLES`] and
-    /// [`MAX_TETRAHEDRA`].
+    /// Gathers an imported scene, checking its size against [`VIEWER_TRIANGLES`] and
+    /// [`VIEWER_TETRAHEDRA`].
     pub fn new(scene: &ImportedScene, name: String) -> Result<Asset, ViewerError> {
         let triangles: usize = scene.surfaces.iter().map(|s| s.triangles.len()).sum();
         let tets: usize = scene
@@ -315,8 +314,8 @@ impl Asset {
             .map(|h| h.mesh.tets.len())
             .sum();
         for (what, count, limit) in [
-            ("surface triangles", triangles, MAX_TRIANGLES),
-            ("halo tetrahedra", tets, MAX_TETRAHEDRA),
+            ("surface triangles", triangles, VIEWER_TRIANGLES),
+            ("halo tetrahedra", tets, VIEWER_TETRAHEDRA),
         ] {
             if count > limit {
                 return Err(ViewerError::TooLarge {
