@@ -5,8 +5,8 @@
 //! summed over the cores) and chaining.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use halo4d::intersect::{Sheet, curves};
 use halo4d::{Scene, sample_uniform};
+use halo4d::{Sheet, curves};
 use std::hint::black_box;
 use std::path::Path;
 

@@ -5,7 +5,7 @@
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use glam::DVec2;
-use halo4d::render::lines::{Broadener, Mask};
+use halo4d::internals::lines::{Broadener, Mask};
 use std::hint::black_box;
 
 /// SplitMix64: reproducible pseudo-random numbers in [0, 1).
@@ -45,10 +45,10 @@ fn pictures(c: &mut Criterion) {
     let mut group = c.benchmark_group("render/default_scene_1024");
     group.sample_size(10);
     for (name, mode) in [
-        ("exact", halo4d::render::RenderMode::Exact),
-        ("slices_256", halo4d::render::RenderMode::Slices),
+        ("exact", halo4d::RenderMode::Exact),
+        ("slices_256", halo4d::RenderMode::Slices),
     ] {
-        let settings = halo4d::render::RenderSettings {
+        let settings = halo4d::RenderSettings {
             mode,
             slices: 256,
             ..scene.render

@@ -13,9 +13,10 @@
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use halo4d::Surface;
-use halo4d::sample::{audit, bounding_diagonal, sample_adaptive};
-use halo4d::surfaces::{Fermat, FlatTorus, KleinBottle, SpunTrefoil, TwistSpunTrefoil};
+use halo4d::internals::bounding_diagonal;
 use halo4d::sweep;
+use halo4d::{Fermat, FlatTorus, KleinBottle, SpunTrefoil, TwistSpunTrefoil};
+use halo4d::{audit, sample_adaptive};
 use std::hint::black_box;
 use std::path::PathBuf;
 

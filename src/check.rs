@@ -61,7 +61,7 @@ pub struct CheckStats {
     /// Tetrahedra with zero volume (exactly).
     pub flat: usize,
     /// Tetrahedra whose orientation the exact predicates cannot decide: a coordinate so much
-    /// smaller than the mesh's largest (by more than [`SAFE_RANGE`]) that their products
+    /// smaller than the mesh's largest (by more than a factor of 1e80) that their products
     /// would underflow.
     pub undecidable: usize,
     /// Tetrahedra repeating a vertex or naming one that does not exist.

@@ -1,40 +1,96 @@
 //! halo4d turns surfaces that live in four dimensions into verified 3D geometry.
 //!
-//! The pipeline, one module per stage (see the README's architecture section):
-//! [`scene`] (what to build) -> [`surfaces`] (4D parametric surfaces with exact derivatives)
-//! -> [`sample`](mod@sample) (meshes to a tolerance, welded by domain rules, audited) ->
-//! [`view`] (4D rotation and projection) -> [`halo`] (offsets, tetrahedra from [`tets`],
-//! checked by [`check`]) -> [`export`] (glTF, PLY, OBJ, VTK, report). [`pipeline`] runs them
-//! in order; [`sweep`] measures what each tolerance costs; [`import`] reads halos and scenes
-//! back for checking.
+//! A [`Scene`] says what to build; [`build`] runs the stages its outputs need and writes the
+//! files ([`run`] and [`write()`] do the two halves, [`render_to`] makes its picture). The
+//! stages, in the order of the pipeline: a [`Surface`] of the catalogue (4D, exact
+//! derivatives) is sampled to a tolerance ([`sample`], a welded, audited [`Mesh4`]), turned
+//! and projected by a [`View`] ([`Projected`]), thickened into a [`Halo`] of tetrahedra
+//! ([`build_halo`], checked by the independent [`check`]); the intersection [`curves`] of
+//! all surfaces are the ground truth the halos are verified against ([`verify`]), and
+//! [`Parts`] hands what a scene produced to the verification and the renderer ([`render`]).
+//! The files are read back with [`read_halos`] and [`read_scene_glb`], and checked again
+//! with [`check_file`] and [`check_dir`]. [`limits`] holds every limit a user can meet;
+//! [`sweep`] measures speed against error. The README's ARCHITECTURE section draws the
+//! module graph.
 #![warn(missing_docs)]
 
-pub mod check;
-pub mod convention;
-pub mod error;
-pub mod export;
-pub mod halo;
-pub mod import;
-pub mod inspect;
-pub mod intersect;
+mod check;
+mod convention;
+mod error;
+mod export;
+mod halo;
+mod import;
+mod inspect;
+mod intersect;
 pub mod limits;
-pub mod memory;
-pub mod parts;
-pub mod pipeline;
-pub mod render;
-pub mod sample;
-pub mod scene;
-pub mod surfaces;
+mod memory;
+mod parts;
+mod pipeline;
+mod render;
+mod sample;
+mod scene;
+mod surfaces;
 pub mod sweep;
-pub mod tets;
-pub mod verify;
-pub mod view;
+mod tets;
+mod verify;
+mod view;
 #[cfg(feature = "viewer")]
 pub mod viewer;
 
+// The scene, the build and what it gives.
 pub use error::Error;
-pub use pipeline::{Built, Report, build, render_to, run, run_for_picture, write};
-pub use sample::{Mesh4, MeshStats, Sampling, sample, sample_adaptive, sample_uniform};
-pub use scene::{Scene, SceneError};
-pub use surfaces::{Domain, Eval4, Surface, Topology};
-pub use view::{Projected, Projection, Rotation4, View};
+pub use pipeline::{
+    Bounds, Built, MemoryReport, Report, SamplingReport, Stages, SurfaceProduct, SurfaceReport,
+    Timings, build, render_to, run, run_for_picture, write,
+};
+pub use scene::{Outputs, Scene, SceneError, SceneSurface};
+
+// The stages, in the order of the pipeline.
+pub use check::{CheckStats, TetMesh, check};
+pub use halo::{Fold, Halo, HaloParams, HaloReport, build_halo};
+pub use intersect::{Curve, CurvePoint, Curves, CurvesReport, End, Face, Sheet, curves};
+pub use parts::{HaloIndex, HaloPart, Parts, SurfacePart};
+pub use render::compare::Comparison;
+pub use render::{
+    CameraProjection, CameraSettings, Colormap, Picture, RenderError, RenderMode, RenderSettings,
+    RibbonAxis, Ribbons, render,
+};
+pub use sample::{
+    Audit, Mesh4, MeshStats, Sampling, audit, sample, sample_adaptive, sample_uniform,
+};
+pub use surfaces::{
+    Domain, Eval4, Fermat, FlatTorus, Glue, KleinBottle, Patches, ProductPolynomial,
+    ProjectivePlane, Side, SideRule, SpunTrefoil, Surface, Topology, TwistSpunTrefoil,
+};
+pub use verify::{Ambiguous, Verification, verify};
+pub use view::{BehindEye, Projected, Projection, Rotation4, View};
+
+// The files: written, read back and checked.
+pub use export::{StagedError, SurfaceData, to_curves_ply, to_obj, to_ply, write_vtk};
+pub use import::{
+    FileParams, ImportError, ImportedCurves, ImportedHalo, ImportedScene, ImportedSurface,
+    read as read_halos, read_glb, read_scene_glb, read_vtk,
+};
+pub use inspect::{Checked, InspectError, check_dir, check_file, verify_scene};
+
+/// What the tests and benches reach into beneath the API: stage internals with their own
+/// contracts, kept public so that they can be tested on their own, not for use.
+pub mod internals {
+    pub use crate::convention::file_order;
+    pub use crate::export::{LOCK, glb_container, to_glb, write_atomic};
+    pub use crate::intersect::{BroadPhase, Node, curves_with};
+    pub use crate::render::camera::Camera;
+    pub use crate::render::compare::verdict_differs;
+    pub use crate::render::{Prober, Seen, line_coverage, render_with_depth};
+    pub use crate::sample::{bounding_diagonal, uniform_error};
+
+    /// One-pixel lines broadened to an exact width.
+    pub mod lines {
+        pub use crate::render::lines::*;
+    }
+
+    /// Prisms split into tetrahedra.
+    pub mod tets {
+        pub use crate::tets::*;
+    }
+}

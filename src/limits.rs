@@ -54,6 +54,33 @@ pub const VIEWER_TRIANGLES: usize = 4 << 20;
 /// The most halo tetrahedra the viewer loads.
 pub const VIEWER_TETRAHEDRA: usize = 16 << 20;
 
+/// The shortest edge adaptive sampling splits, as a share of the surface's extent (the
+/// diagonal of the 4D box of its starting grids). f32, which the files store, resolves about
+/// 6e-8 of it, and the later stages need distinct points: at a singular point of a surface,
+/// where the chordal error does not shrink with the triangles (a many-twist knot's tangle),
+/// the refinement would otherwise pile hundreds of thousands of triangles onto one f32
+/// point. Such triangles stay failing, and the sampling is reported incomplete.
+pub const MIN_EDGE: f64 = 1e-6;
+
+/// The largest coordinate (x, y, z or w) a projected surface may reach. The files and the GPU
+/// hold f32 (up to 3.4e38), and the exact predicates multiply three coordinate differences
+/// (`robust::orient3d` overflows from about 1e100); 1e30 leaves room for both, and for the
+/// halos' offsets around the surface.
+pub const MAX_COORDINATE: f64 = 1e30;
+
+/// The smallest extent (bounding-box diagonal) of a projected scene: below it f32 files lose
+/// their digits to subnormals and the predicates' products of three differences underflow.
+pub const MIN_EXTENT: f64 = 1e-30;
+
+/// How far from a branch point or a boundary end, in widths of the nearer sheet's halo
+/// (its largest half-width rho), a sample the halos do not explain is ambiguous rather
+/// than wrong. At a branch point the two sheets are one surface folded over; `fold:
+/// shrink` narrows the halo to zero there, and a sheet's own halo never hides it, so up
+/// to rho from the fold on either sheet (2 rho in all) the gap is the fold's, not the
+/// crossing's. On every fixture the farthest such sample is 1.27 rho away, and on fine
+/// meshes they all come within a few triangles.
+pub const BRANCH_REACH: f64 = 2.0;
+
 /// The largest relative difference between a halo's total tetrahedron volume and the volume
 /// its boundary encloses that the checker passes: rounding, never an overlap (the
 /// catalogue's halos stay below 1e-13).
@@ -164,6 +191,11 @@ pub fn table() -> String {
             SWEEP_TRIANGLES.to_string(),
             "triangles",
         ),
+        (
+            "the shortest edge adaptive sampling splits",
+            format!("{MIN_EDGE:?}"),
+            "of the surface's 4D extent",
+        ),
         ("`surfaces`", range(&SURFACES), "surfaces"),
         (
             "`name`, `surfaces[i].name`",
@@ -195,6 +227,21 @@ pub fn table() -> String {
             "halo tetrahedra the viewer loads",
             format!("up to {VIEWER_TETRAHEDRA}"),
             "tetrahedra",
+        ),
+        (
+            "a projected coordinate (x, y, z or w)",
+            format!("up to {MAX_COORDINATE:e}"),
+            "scene units",
+        ),
+        (
+            "a projected scene's bounding diagonal",
+            format!("at least {MIN_EXTENT:e}"),
+            "scene units",
+        ),
+        (
+            "a curve sample the halos do not explain is ambiguous, not wrong, this near a branch point or a boundary end",
+            format!("{BRANCH_REACH:?}"),
+            "halo widths rho",
         ),
         (
             "a halo's volume defect (`halo4d check`, a build's verdict)",

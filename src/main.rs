@@ -1,10 +1,10 @@
 //! The `halo4d` command line.
 
 use clap::{Parser, Subcommand};
+use halo4d::Comparison;
+use halo4d::RenderMode;
 use halo4d::limits::{self, FieldError};
-use halo4d::render::RenderMode;
-use halo4d::render::compare::Comparison;
-use halo4d::{Scene, Surface, inspect, sweep};
+use halo4d::{Scene, Surface, sweep};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -257,9 +257,9 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
         }
         Command::Check { file } => {
             let checked = if file.is_dir() {
-                inspect::check_dir(&file)
+                halo4d::check_dir(&file)
             } else {
-                inspect::check_file(&file)
+                halo4d::check_file(&file)
             };
             match checked {
                 Ok(c) => {

@@ -7,13 +7,14 @@ use crate::error::Error;
 use crate::export::{self, SurfaceData};
 use crate::halo::{Halo, HaloParams, HaloReport, build_halo};
 use crate::intersect::{self, Curves, CurvesReport};
+use crate::limits::{MAX_COORDINATE, MIN_EXTENT};
 use crate::parts::{HaloPart, Parts, SurfacePart};
 use crate::render::{self, CameraSettings, Picture, RenderError, RenderSettings};
 use crate::sample::{self, Audit, Mesh4, MeshStats, Sampling, audit};
 use crate::scene::Scene;
 use crate::surfaces::{Surface, Topology};
 use crate::verify::{self, Verification};
-use crate::view::{MAX_COORDINATE, MIN_EXTENT, Projected};
+use crate::view::Projected;
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -96,8 +97,8 @@ impl Stages {
 }
 
 /// `report.json`'s `memory`: what the stages from the halos on were estimated to need
-/// ([`crate::memory::BUILD_BYTES_PER_TRIANGLE`] per triangle) against the limit
-/// ([`crate::memory::limit`]), in GB. The picture is estimated on its own when it is made.
+/// ((`BUILD_BYTES_PER_TRIANGLE`, 1100 bytes, per triangle)) against the limit
+/// (`HALO4D_MAX_MEMORY` gigabytes, or three quarters of the machine's memory), in GB. The picture is estimated on its own when it is made.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct MemoryReport {
     /// Estimated peak of the stages from the halos on.

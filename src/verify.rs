@@ -15,7 +15,7 @@
 //!   by the farther's (`correct`; `third_sheet` where a third sheet's halo also hides the
 //!   nearer one, near triple points). A sample the halos do not explain is `wrong` unless a
 //!   reason excuses it as `ambiguous`, the first that applies in the order of
-//!   [`Ambiguous`]: within [`BRANCH_REACH`] halo widths of a curve's end at a branch point
+//!   [`Ambiguous`]: within [`BRANCH_REACH`](crate::limits::BRANCH_REACH) halo widths of a curve's end at a branch point
 //!   or at a boundary, where the nearer sheet's halo vanished at a corner of its triangle,
 //!   or where the mesh does not separate the sheets. The reaches are geometry (the halo's
 //!   width), not the mesh's size, so the verdict does not depend on the resolution.
@@ -46,14 +46,14 @@ pub struct Verification {
     /// Far sheet not hidden by the near sheet's halo, or near sheet hidden by the far's,
     /// where nothing below excuses it.
     pub wrong: usize,
-    /// Samples the halos do not explain, within [`BRANCH_REACH`] halo widths of a curve's
+    /// Samples the halos do not explain, within [`BRANCH_REACH`](crate::limits::BRANCH_REACH) halo widths of a curve's
     /// end at a branch point or a boundary, where the nearer sheet's halo vanished, or
     /// where the mesh does not separate the two sheets.
     pub ambiguous: usize,
     /// The ambiguous samples by reason.
     pub ambiguous_reasons: Ambiguous,
     /// The farthest that a sample excused as `branch_point` or `boundary` lies from the
-    /// curve end that excuses it, in halo widths rho (at most [`BRANCH_REACH`]; 0 when
+    /// curve end that excuses it, in halo widths rho (at most [`BRANCH_REACH`](crate::limits::BRANCH_REACH); 0 when
     /// there is none): how far from the ends the halos fail to explain the curves.
     pub ambiguous_reach: f64,
     /// The near sheet hidden by a third sheet's halo (near triple points).
@@ -79,10 +79,10 @@ pub struct Verification {
 /// first that applies, in the order of the fields).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Ambiguous {
-    /// Within [`BRANCH_REACH`] halo widths of a curve's end at a branch point (a cross-cap),
+    /// Within [`BRANCH_REACH`](crate::limits::BRANCH_REACH) halo widths of a curve's end at a branch point (a cross-cap),
     /// where the two sheets are one surface folded over and the halo must vanish.
     pub branch_point: usize,
-    /// Within [`BRANCH_REACH`] halo widths of a curve's end at a mesh boundary, where the
+    /// Within [`BRANCH_REACH`](crate::limits::BRANCH_REACH) halo widths of a curve's end at a mesh boundary, where the
     /// nearer sheet's halo ends in a side wall.
     pub boundary: usize,
     /// The nearer sheet's halo has zero width at a corner of its triangle (collapsed where
@@ -93,15 +93,6 @@ pub struct Ambiguous {
     /// triangles. Only coarse meshes leave such samples; refining removes them.
     pub resolution: usize,
 }
-
-/// How far from a branch point or a boundary end, in widths of the nearer sheet's halo
-/// (its largest half-width rho), a sample the halos do not explain is ambiguous rather
-/// than wrong. At a branch point the two sheets are one surface folded over; `fold:
-/// shrink` narrows the halo to zero there, and a sheet's own halo never hides it, so up
-/// to rho from the fold on either sheet (2 rho in all) the gap is the fold's, not the
-/// crossing's. On every fixture the farthest such sample is 1.27 rho away, and on fine
-/// meshes they all come within a few triangles.
-pub const BRANCH_REACH: f64 = 2.0;
 
 impl Verification {
     /// The verdict of a build and of `halo4d check DIR`: what the halos do not explain (a
@@ -490,7 +481,7 @@ impl<'a> Index<'a> {
                 .iter()
                 .map(|e| e.distance(s.x))
                 .fold(f64::INFINITY, f64::min);
-            let inside = nearest <= BRANCH_REACH * rho;
+            let inside = nearest <= crate::limits::BRANCH_REACH * rho;
             if inside && rho > 0.0 {
                 v.ambiguous_reach = v.ambiguous_reach.max(nearest / rho);
             }

@@ -144,16 +144,6 @@ pub struct BehindEye {
     pub eye: f64,
 }
 
-/// The largest coordinate (x, y, z or w) a projected surface may reach. The files and the GPU
-/// hold f32 (up to 3.4e38), and the exact predicates multiply three coordinate differences
-/// (`robust::orient3d` overflows from about 1e100); 1e30 leaves room for both, and for the
-/// halos' offsets around the surface.
-pub const MAX_COORDINATE: f64 = 1e30;
-
-/// The smallest extent (bounding-box diagonal) of a projected scene: below it f32 files lose
-/// their digits to subnormals and the predicates' products of three differences underflow.
-pub const MIN_EXTENT: f64 = 1e-30;
-
 /// A mesh projected to 3D.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Projected {
@@ -180,7 +170,7 @@ impl Projected {
         )
     }
 
-    /// The largest |x|, |y|, |z| or |w| when it exceeds [`MAX_COORDINATE`] (or is not finite).
+    /// The largest |x|, |y|, |z| or |w| when it exceeds [`MAX_COORDINATE`](crate::limits::MAX_COORDINATE) (or is not finite).
     pub fn out_of_range(&self) -> Option<f64> {
         let largest = self
             .positions
@@ -194,7 +184,7 @@ impl Projected {
                     f64::INFINITY
                 }
             });
-        (largest > MAX_COORDINATE).then_some(largest)
+        (largest > crate::limits::MAX_COORDINATE).then_some(largest)
     }
 
     /// Axis-aligned bounding box of the 3D positions, or `None` for an empty mesh.

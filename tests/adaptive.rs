@@ -2,9 +2,10 @@
 //! meshes keep the uniform sampler's guarantees, the audit is exact on a known case, and the
 //! budget stops refinement cleanly.
 
-use halo4d::sample::{Sampling, audit, bounding_diagonal, sample, sample_adaptive};
-use halo4d::surfaces::{Fermat, FlatTorus, SpunTrefoil, TwistSpunTrefoil};
+use halo4d::internals::bounding_diagonal;
+use halo4d::{Fermat, FlatTorus, SpunTrefoil, TwistSpunTrefoil};
 use halo4d::{Mesh4, Surface};
+use halo4d::{Sampling, audit, sample, sample_adaptive};
 
 /// Relative tolerances every catalogue surface is checked at.
 const TOLERANCES: [f64; 3] = [2e-2, 5e-3, 1e-3];
@@ -214,7 +215,7 @@ fn a_budget_refines_the_worst_triangles_first() {
     let out = sample_adaptive(&s, tol, 20_000);
     assert!(!out.complete);
     let error = audit(&s, &out.mesh).max_error;
-    let uniform = halo4d::sample::uniform_error(&s, out.mesh.triangles.len());
+    let uniform = halo4d::internals::uniform_error(&s, out.mesh.triangles.len());
     assert!(
         error <= 8.0 * uniform,
         "adaptive {error:e}, uniform {uniform:e} at {} triangles",

@@ -8,9 +8,9 @@ use crate::common::{
     Rng, assert_unreadable, fixture, fixture_scenes, halo4d, hard_scenes, with_json,
 };
 use glam::DVec3;
-use halo4d::import::{ImportError, ImportedScene, read_scene_glb};
-use halo4d::intersect::Curves;
+use halo4d::Curves;
 use halo4d::{Built, Scene};
+use halo4d::{ImportError, ImportedScene, read_scene_glb};
 use ply_rs::ply::Property;
 use serde_json::Value;
 use std::path::Path;
@@ -350,9 +350,9 @@ fn check_on_the_written_glb_finds_exactly_what_the_build_found() {
         let what = path.display();
         assert_eq!(built.failures(), Vec::<String>::new(), "{what}");
         let data: Vec<_> = built.surfaces.iter().map(|p| p.data(&scene.halo)).collect();
-        let glb = halo4d::export::to_glb(&data, &built.curves, 0.01, &Value::Null).unwrap();
-        let (curves, v) = halo4d::inspect::verify_scene(&read_scene_glb(&glb).unwrap());
-        let counts = |r: &halo4d::intersect::CurvesReport| {
+        let glb = halo4d::internals::to_glb(&data, &built.curves, 0.01, &Value::Null).unwrap();
+        let (curves, v) = halo4d::verify_scene(&read_scene_glb(&glb).unwrap());
+        let counts = |r: &halo4d::CurvesReport| {
             [
                 r.count,
                 r.closed,
@@ -368,7 +368,7 @@ fn check_on_the_written_glb_finds_exactly_what_the_build_found() {
             counts(&built.curves.report),
             "{what}"
         );
-        let untimed = |v: &halo4d::verify::Verification| halo4d::verify::Verification {
+        let untimed = |v: &halo4d::Verification| halo4d::Verification {
             ms: 0.0,
             ..v.clone()
         };
@@ -382,13 +382,13 @@ fn without_curves_the_glb_has_no_curves_mesh_and_the_ply_is_empty_but_valid() {
     let built = halo4d::run(&scene, true).unwrap();
     let data: Vec<_> = built.surfaces.iter().map(|p| p.data(&scene.halo)).collect();
     let none = Curves::default();
-    let glb = halo4d::export::to_glb(&data, &none, 0.01, &Value::Null).unwrap();
+    let glb = halo4d::internals::to_glb(&data, &none, 0.01, &Value::Null).unwrap();
     let gltf = gltf::Gltf::from_slice(&glb).unwrap();
     assert_eq!(gltf.meshes().count(), 2);
     assert!(gltf.meshes().all(|m| m.name() != Some("curves")));
     assert!(gltf.nodes().all(|n| n.name() != Some("curves")));
 
-    let bytes = halo4d::export::to_curves_ply(&none, "empty");
+    let bytes = halo4d::to_curves_ply(&none, "empty");
     let parser = ply_rs::parser::Parser::<ply_rs::ply::DefaultElement>::new();
     let ply = parser.read_ply(&mut bytes.as_slice()).unwrap();
     for element in ["vertex", "edge"] {
@@ -468,7 +468,7 @@ fn a_scene_reads_back_from_its_glb_with_every_surface_and_its_halo() {
     assert!(again.curves.is_none());
     assert_eq!(again.surfaces, read.surfaces);
     // The curves between the two surfaces are found again, and the halos explain them.
-    let (curves, v) = halo4d::inspect::verify_scene(&read);
+    let (curves, v) = halo4d::verify_scene(&read);
     assert!(curves.report.count > 0 && v.curve_samples > 0, "{v:?}");
     assert!(
         curves
@@ -817,7 +817,7 @@ fn no_cut_or_corrupted_scene_glb_panics_the_reader_or_the_verification() {
         }
         // Whatever a corrupted file still reads as is verified without a panic.
         if let Ok(s) = read_scene_glb(&bytes) {
-            let _ = halo4d::inspect::verify_scene(&s);
+            let _ = halo4d::verify_scene(&s);
             verified += 1;
         }
     }

@@ -35,7 +35,7 @@
 
 use crate::common::{fixture, fixture_scenes, pack_glb};
 use halo4d::Scene;
-use halo4d::import::{ImportedHalo, ImportedScene, read_glb, read_scene_glb, read_vtk};
+use halo4d::{ImportedHalo, ImportedScene, read_glb, read_scene_glb, read_vtk};
 use proptest::collection::vec;
 use proptest::prelude::*;
 use proptest::sample::select;
@@ -1363,7 +1363,7 @@ fn check_glb(bytes: &[u8], tally: &Tally) -> Result<(), String> {
             // seed: it must not panic.
             if scene.surfaces != glb_seed().scene.surfaces {
                 tally.add("verified a changed scene");
-                let _ = halo4d::inspect::verify_scene(scene);
+                let _ = halo4d::verify_scene(scene);
             }
             // The scene's halos are the file's halos.
             let mut in_scene: Vec<&ImportedHalo> = scene
@@ -1411,7 +1411,7 @@ fn check_glb(bytes: &[u8], tally: &Tally) -> Result<(), String> {
 fn check_changed(h: &ImportedHalo, seed: &ImportedHalo, tally: &Tally) {
     if h.mesh != seed.mesh {
         tally.add("checked a changed halo");
-        let _ = halo4d::check::check(&h.mesh);
+        let _ = halo4d::check(&h.mesh);
     }
 }
 
@@ -1481,7 +1481,7 @@ fn ascii_vtk(h: &ImportedHalo, version5: bool) -> String {
     let tets: Vec<[u32; 4]> = m
         .tets
         .iter()
-        .map(|&t| halo4d::convention::file_order(t))
+        .map(|&t| halo4d::internals::file_order(t))
         .collect();
     if version5 {
         s += "METADATA\nINFORMATION 0\n\n";

@@ -3,12 +3,12 @@
 
 use crate::common::{Rng, fixture, fixture_scenes};
 use glam::DVec3;
+use halo4d::Projected;
+use halo4d::Sampling;
 use halo4d::Scene;
-use halo4d::check::{CheckStats, TetMesh, check};
-use halo4d::halo::{Fold, Halo, HaloParams, HaloReport, build_halo};
-use halo4d::sample::Sampling;
-use halo4d::tets::{self, Corners, Split, prism};
-use halo4d::view::Projected;
+use halo4d::internals::tets::{self, Corners, Split, prism};
+use halo4d::{CheckStats, TetMesh, check};
+use halo4d::{Fold, Halo, HaloParams, HaloReport, build_halo};
 
 /// A bumpy height field over a jittered grid, its cells cut along random diagonals, its
 /// triangles' corners rotated at random (so each triangle's own order, the paper's starting
@@ -378,7 +378,7 @@ fn every_split_conforms_with_holes_and_bowtie_boundary_vertices() {
 }
 
 /// The products of a fixture scene with `edit` applied.
-fn run_fixture(name: &str, edit: impl FnOnce(&mut Scene)) -> Vec<halo4d::pipeline::SurfaceProduct> {
+fn run_fixture(name: &str, edit: impl FnOnce(&mut Scene)) -> Vec<halo4d::SurfaceProduct> {
     let mut scene = Scene::load(&fixture(&format!("scenes/{name}.json"))).unwrap();
     edit(&mut scene);
     halo4d::run(&scene, true).unwrap().surfaces

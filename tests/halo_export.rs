@@ -5,10 +5,11 @@
 use crate::common::{Rng, assert_unreadable, fixture, fixture_scenes, halo4d, with_json};
 use glam::{DVec3, Vec3};
 use halo4d::Scene;
-use halo4d::check::check;
-use halo4d::convention::file_order;
-use halo4d::import::{ImportError, ImportedHalo, read, read_glb, read_vtk};
-use halo4d::pipeline::SurfaceProduct;
+use halo4d::SurfaceProduct;
+use halo4d::check;
+use halo4d::internals::file_order;
+use halo4d::read_halos;
+use halo4d::{ImportError, ImportedHalo, read_glb, read_vtk};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -127,7 +128,7 @@ fn every_fixture_halo_reads_back_unchanged_from_glb_and_vtk() {
         let out = dir.path().join(&scene.name);
         let products = build(&scene, &out);
         let name = &scene.name;
-        let from_glb = read(&out.join(format!("{name}.glb"))).unwrap();
+        let from_glb = read_halos(&out.join(format!("{name}.glb"))).unwrap();
         assert_eq!(from_glb.len(), products.len(), "{name}");
         for (p, g) in products.iter().zip(&from_glb) {
             let halo = &p.halo;
@@ -340,11 +341,11 @@ fn a_scene_of_several_surfaces_writes_a_vtk_per_halo_and_checks_each() {
             "pair.png"
         ]
     );
-    let from_glb = read(&dir.path().join("pair.glb")).unwrap();
+    let from_glb = read_halos(&dir.path().join("pair.glb")).unwrap();
     let names: Vec<&str> = from_glb.iter().map(|h| h.name.as_str()).collect();
     assert_eq!(names, ["flat-halo", "torus-halo"]);
     for (p, g) in products.iter().zip(&from_glb) {
-        let v = read(&dir.path().join(format!("pair-{}-halo.vtk", p.name))).unwrap();
+        let v = read_halos(&dir.path().join(format!("pair-{}-halo.vtk", p.name))).unwrap();
         assert_eq!(v[0].mesh, p.halo.tet_mesh());
         assert_eq!(g.mesh.tets, p.halo.tets);
     }

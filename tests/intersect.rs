@@ -3,7 +3,8 @@
 
 use crate::common::{Rng, fixture, fixture_scenes};
 use glam::DVec3;
-use halo4d::intersect::{BroadPhase, Curves, End, Node, Sheet, curves, curves_with};
+use halo4d::internals::{BroadPhase, Node, curves_with};
+use halo4d::{Curves, End, Sheet, curves};
 use halo4d::{Sampling, Scene, sample, sample_uniform};
 
 /// A mesh in the intersection stage's terms.
@@ -425,7 +426,7 @@ fn where_a_view_folds_fermat_patches_together_the_curves_end_at_the_vertex() {
     let built = halo4d::run(&scene, true).unwrap();
     let report = &built.curves.report;
     assert_eq!(report.unresolved, 0, "{report:?}");
-    let at_fold = |p: &halo4d::intersect::CurvePoint| {
+    let at_fold = |p: &halo4d::CurvePoint| {
         matches!(p.node, Node::Vertex(_))
             && (p.position - DVec3::new(-1.0, 0.0, 0.0)).length() < 1e-9
     };
@@ -456,8 +457,8 @@ fn flat_torus_build() -> halo4d::Built {
     halo4d::run(&scene, true).unwrap()
 }
 
-fn verify(built: &halo4d::Built, scene: &Scene) -> halo4d::verify::Verification {
-    halo4d::verify::verify(&built.parts(&scene.halo))
+fn verify(built: &halo4d::Built, scene: &Scene) -> halo4d::Verification {
+    halo4d::verify(&built.parts(&scene.halo))
 }
 
 #[test]
@@ -522,10 +523,10 @@ fn empty_and_single_triangle_inputs_give_no_curves() {
     ] {
         let c = curves(&sheets);
         assert_eq!((c.report.count, c.report.unresolved), (0, 0));
-        let parts = halo4d::parts::Parts {
+        let parts = halo4d::Parts {
             surfaces: sheets
                 .iter()
-                .map(|s| halo4d::parts::SurfacePart {
+                .map(|s| halo4d::SurfacePart {
                     positions: s.positions,
                     w: s.w,
                     normals: &[],
@@ -536,7 +537,7 @@ fn empty_and_single_triangle_inputs_give_no_curves() {
             halos: vec![None; sheets.len()],
             curves: &c,
         };
-        let v = halo4d::verify::verify(&parts);
+        let v = halo4d::verify(&parts);
         assert_eq!(
             (v.wrong, v.spurious_hidden_samples, v.far_tetrahedra),
             (0, 0, 0)

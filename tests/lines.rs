@@ -4,7 +4,7 @@
 
 use crate::common::Rng;
 use glam::DVec2;
-use halo4d::render::lines::{
+use halo4d::internals::lines::{
     Broadener, Coverage, LinesError, MAX_COORDINATE, MAX_SIDE, Mask, broaden, sigma_for_width,
 };
 

@@ -3,9 +3,10 @@
 
 use crate::common::{fixture, fixture_scenes, halo4d, halo4d_with};
 use glam::DVec3;
+use halo4d::RenderSettings;
 use halo4d::Scene;
-use halo4d::render::camera::Camera;
-use halo4d::render::{Prober, RenderSettings, Seen};
+use halo4d::internals::Camera;
+use halo4d::internals::{Prober, Seen};
 
 /// Small, fast settings for tests.
 fn small(scene: &mut Scene) {
@@ -58,7 +59,7 @@ fn renders_are_deterministic_and_stereo_is_two_views() {
     };
     let pair = built.render(&scene.halo, &stereo, &scene.camera).unwrap();
     assert_eq!((pair.width, pair.height), (400, 200));
-    let half = |p: &halo4d::render::Picture, right: bool| -> Vec<u8> {
+    let half = |p: &halo4d::Picture, right: bool| -> Vec<u8> {
         (0..200)
             .flat_map(|y| {
                 let start = 3 * (y * 400 + if right { 200 } else { 0 });
@@ -403,7 +404,7 @@ fn the_drawn_curves_lie_on_the_computed_curves_at_the_width_asked_for() {
     let built = halo4d::run(&scene, true).unwrap();
     let parts = built.parts(&scene.halo);
     let input = parts;
-    let coverage = halo4d::render::line_coverage(&input, &scene.render, &scene.camera).unwrap();
+    let coverage = halo4d::internals::line_coverage(&input, &scene.render, &scene.camera).unwrap();
     let cam = *Prober::new(&input, &scene.render, &scene.camera)
         .unwrap()
         .camera();

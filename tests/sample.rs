@@ -1,7 +1,7 @@
 //! The uniform sampler: closed surfaces give closed manifold meshes of the right Euler
 //! characteristic, welded by rule; open ones have exactly the expected boundary.
 
-use halo4d::surfaces::{Fermat, Patches, ProductPolynomial, TwistSpunTrefoil};
+use halo4d::{Fermat, Patches, ProductPolynomial, TwistSpunTrefoil};
 use halo4d::{Surface, sample_uniform};
 
 const GRIDS: [(usize, usize); 4] = [(4, 4), (4, 6), (16, 8), (30, 64)];

@@ -4,7 +4,7 @@
 use crate::common::Rng;
 use glam::DVec4;
 use halo4d::Surface;
-use halo4d::surfaces::{Fermat, Side, SideRule, SpunTrefoil, TwistSpunTrefoil};
+use halo4d::{Fermat, Side, SideRule, SpunTrefoil, TwistSpunTrefoil};
 use std::f64::consts::FRAC_PI_2;
 
 fn surfaces_under_test() -> Vec<Surface> {

@@ -3,9 +3,10 @@
 
 use crate::common::fixture_scenes;
 use halo4d::Scene;
-use halo4d::render::compare::verdict_differs;
-use halo4d::render::{RenderMode, RenderSettings, render_with_depth};
+use halo4d::internals::render_with_depth;
+use halo4d::internals::verdict_differs;
 use halo4d::viewer::{self, Asset, Gpu, HaloMode, ViewSettings};
+use halo4d::{RenderMode, RenderSettings};
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -248,7 +249,7 @@ fn curves_colour_and_transparency_toggle_what_they_should() {
     // Every pixel the curves change is on a projected curve segment: within half the
     // curves' 2.5-pixel width and a pixel.
     let camera =
-        halo4d::render::camera::Camera::new(&scene.camera, asset.bounds, SIDE, SIDE, 0.0).unwrap();
+        halo4d::internals::Camera::new(&scene.camera, asset.bounds, SIDE, SIDE, 0.0).unwrap();
     let mut segments = Vec::new();
     for curve in &built.curves.curves {
         let p: Vec<[f64; 2]> = curve
@@ -336,7 +337,7 @@ fn edited(bytes: &[u8], edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
 
 /// A `.glb` of `json` and `bin`.
 fn glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
-    halo4d::export::glb_container(serde_json::to_vec(json).unwrap(), bin.to_vec())
+    halo4d::internals::glb_container(serde_json::to_vec(json).unwrap(), bin.to_vec())
 }
 
 /// Loading `bytes` fails with a message containing every one of `words`.
@@ -532,7 +533,7 @@ fn supersampling_draws_what_the_cpu_renderer_draws_with_as_many_samples() {
         )
         .unwrap()
     };
-    let mean_diff = |p: &halo4d::render::Picture| {
+    let mean_diff = |p: &halo4d::Picture| {
         p.rgb
             .iter()
             .zip(&reference.rgb)

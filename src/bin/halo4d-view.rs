@@ -2,8 +2,8 @@
 
 use clap::{Parser, ValueEnum};
 use halo4d::limits::FieldError;
-use halo4d::render::{CameraProjection, CameraSettings, Colormap};
 use halo4d::viewer::{self, Asset, Gpu, HaloMode, SLICE_COUNTS, ViewSettings, ViewerError};
+use halo4d::{CameraProjection, CameraSettings, Colormap};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -176,7 +176,7 @@ fn run(args: &Args) -> Result<(), ViewerError> {
     if let Some(out) = &args.screenshot {
         let gpu = Gpu::headless()?;
         let frame = viewer::screenshot(&gpu, &asset, &settings)?;
-        halo4d::export::write_atomic(out, &frame.picture.png()).map_err(|e| {
+        halo4d::internals::write_atomic(out, &frame.picture.png()).map_err(|e| {
             ViewerError::Write {
                 path: out.display().to_string(),
                 message: e.to_string(),
@@ -239,7 +239,7 @@ fn bench(asset: &Asset, settings: &ViewSettings, frames: u32) -> Result<(), View
 }
 
 fn compare(
-    scene: &halo4d::import::ImportedScene,
+    scene: &halo4d::ImportedScene,
     asset: &Asset,
     settings: &ViewSettings,
 ) -> Result<(), ViewerError> {

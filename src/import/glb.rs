@@ -42,7 +42,7 @@ pub fn read_glb(bytes: &[u8]) -> Result<Vec<ImportedHalo>> {
 /// carry `surface`: positions, `_W` and triangles) with its halo, if any (the mesh whose
 /// extras' `halo.surface_mesh` names the surface's mesh). Each halo has t, d_orig, delta_d
 /// and delta_t, and as many surface vertices as its surface, so that the scene can be
-/// verified ([`ImportedScene::verify`]).
+/// verified ([`crate::inspect::verify_scene`]).
 pub fn read_scene_glb(bytes: &[u8]) -> Result<ImportedScene> {
     let (json, bin) = chunks(bytes)?;
     let json = parse(json)?;

@@ -143,7 +143,7 @@ pub struct FileParams {
     pub split: Option<String>,
     /// Index of the surface's own mesh (`.glb` only).
     pub surface_mesh: Option<usize>,
-    /// Layers of prisms the halo's layout has ([`crate::check::LAYERS`]).
+    /// Layers of prisms the halo's layout has (`LAYERS`, 2: the offsets, then the surface itself).
     pub layers: Option<f64>,
 }
 

@@ -20,7 +20,7 @@ fn err(message: String) -> ImportError {
 /// The tetrahedron's VTK cell type.
 const VTK_TETRA: f64 = 10.0;
 
-/// Reads the halo of a legacy VTK file (see [`crate::export::to_vtk`]).
+/// Reads the halo of a legacy VTK file (see [`crate::export::write_vtk`]).
 pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
     let mut c = Cursor { bytes, pos: 0 };
     let magic = c.line().unwrap_or_default();

@@ -38,23 +38,17 @@ pub fn build(boxes: &[Aabb], leaf: u32) -> Bvh2 {
     bvh
 }
 
-/// Calls `pair(i, j)` with i < j for every two primitives whose boxes touch, by a
-/// simultaneous descent of the tree against itself (each node pair visited once).
-pub fn self_pairs(bvh: &Bvh2, boxes: &[Aabb], mut pair: impl FnMut(u32, u32)) {
-    if !bvh.nodes.is_empty() {
-        descend(bvh, boxes, (0, 0), &mut pair);
-    }
-}
-
 /// Node pairs the parallel descent hands out as tasks, at least: enough for the
 /// work-stealing pool to balance uneven subtrees on many cores, few enough that each is worth
 /// a task. A constant, so that the tasks, and the order of the pairs, do not depend on the
 /// number of threads.
 const TASKS: usize = 1024;
 
-/// The pairs of [`self_pairs`] in the same order, found on the cores: `pair` adds a pair to
-/// the value `init` makes for each task, and the values come back in the order of the
-/// pairs they hold (concatenated, they are what [`self_pairs`] calls `pair` with).
+/// Every two primitives whose boxes touch, (i, j) with i < j, found by a simultaneous
+/// descent of the tree against itself (each node pair visited once) on the cores: `pair`
+/// adds a pair to the value `init` makes for each task, and the values come back in the
+/// order of the pairs they hold. Concatenated, they are the pairs in the order of a
+/// depth-first descent on one core, whatever the number of threads.
 pub fn self_pairs_par<T: Send>(
     bvh: &Bvh2,
     boxes: &[Aabb],
@@ -227,7 +221,7 @@ mod tests {
         for leaf in [1, 4, 8] {
             let bvh = build(&boxes, leaf);
             let mut fast = Vec::new();
-            self_pairs(&bvh, &boxes, |a, b| fast.push((a, b)));
+            descend(&bvh, &boxes, (0, 0), &mut |a, b| fast.push((a, b)));
             fast.sort_unstable();
             let mut slow = Vec::new();
             for a in 0..boxes.len() as u32 {
@@ -239,7 +233,7 @@ mod tests {
             }
             // On the cores, however the descent is split: the same pairs in the same order.
             let mut ordered = Vec::new();
-            self_pairs(&bvh, &boxes, |a, b| ordered.push((a, b)));
+            descend(&bvh, &boxes, (0, 0), &mut |a, b| ordered.push((a, b)));
             for tasks in [1, 2, 7, 64, TASKS] {
                 let split = split_descent(&bvh, &boxes, tasks, Vec::new, |v, a, b| v.push((a, b)));
                 assert!(split.len() >= tasks.min(64), "{tasks}: {}", split.len());

@@ -44,6 +44,7 @@
 //! still a valid mesh, only coarser than asked.
 
 use super::{AUDIT_POINTS, Classes, Mesh4};
+use crate::limits::MIN_EDGE;
 use crate::surfaces::{Domain, Side, SideRule, Surface};
 use glam::DVec4;
 use rayon::prelude::*;
@@ -60,7 +61,7 @@ pub struct AdaptiveMesh {
     pub mesh: Mesh4,
     /// Whether every triangle met the tolerance (false when the triangle budget stopped the
     /// refinement, or an edge became too short to split: in floating point, or below
-    /// [`MIN_EDGE`] of the surface's extent).
+    /// [`MIN_EDGE`](crate::limits::MIN_EDGE) of the surface's extent).
     pub complete: bool,
     /// Triangles that still failed the tolerance when refinement stopped.
     pub failing: usize,
@@ -413,19 +414,11 @@ pub fn sample_adaptive(surface: &Surface, tolerance: f64, max_triangles: usize) 
     }
 }
 
-/// The shortest edge the sampler splits, as a share of the surface's extent (the diagonal
-/// of the 4D box of its starting grids). f32, which the files store, resolves about 6e-8 of
-/// it, and the later stages need distinct points: at a singular point of a surface, where
-/// the chordal error does not shrink with the triangles (a many-twist knot's tangle), the
-/// refinement would otherwise pile hundreds of thousands of triangles onto one f32 point.
-/// Such triangles stay failing, and the sampling is reported incomplete.
-pub const MIN_EDGE: f64 = 1e-6;
-
 /// What a patch needs to refine itself.
 struct Context<'a> {
     surface: &'a Surface,
     tolerance: f64,
-    /// Edges shorter than this (4D) are not split: [`MIN_EDGE`] of the extent.
+    /// Edges shorter than this (4D) are not split: [`MIN_EDGE`](crate::limits::MIN_EDGE) of the extent.
     min_edge: f64,
 }
 

@@ -18,7 +18,7 @@ mod adaptive;
 mod audit;
 mod uniform;
 
-pub use adaptive::{AdaptiveMesh, MIN_EDGE, metric_aspect, sample_adaptive};
+pub use adaptive::{metric_aspect, sample_adaptive};
 pub use audit::{AUDIT_POINTS, Audit, audit};
 pub use uniform::sample_uniform;
 

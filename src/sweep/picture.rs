@@ -7,7 +7,7 @@ use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 
 /// Builds `scene` (the stages its picture needs), renders it in the exact mode and with
-/// each of `slices` ([`compare::compare`]), and writes `render_speed_vs_error.csv` and
+/// each of `slices` (the exact render and each slice count, as `halo4d sweep --render` prints them), and writes `render_speed_vs_error.csv` and
 /// `render_speed_vs_error.png` into `out_dir`. `progress` hears of each render. Gives the
 /// rows and the paths written.
 pub fn picture_sweep(
