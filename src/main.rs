@@ -95,17 +95,18 @@ enum Command {
     /// output folder: its halos and their verification against the intersection curves.
     ///
     /// With a FILE, prints the checker's statistics, one column per halo. Exit status 0 when
-    /// every halo conforms and has no inverted or flat tetrahedron, 1 when one does not, 2
-    /// when the file cannot be read as halos.
+    /// every halo passes the checker (conforms, no inverted, flat or undecidable
+    /// tetrahedron, a volume defect of at most 1e-9), 1 when one does not, 2 when the file
+    /// cannot be read as halos.
     ///
     /// With a folder (what `halo4d build --out DIR` wrote), reads its one .glb, runs the
     /// checker on each halo, recomputes the intersection curves of the file's surfaces and
     /// verifies the halos against them (along every curve the far sheet hidden by the near
     /// sheet's halo and the near sheet visible; nowhere a halo cutting a gap away from its
-    /// sheet), and prints both. Exit status 0 when every halo conforms with no inverted or
-    /// flat tetrahedron and the verification finds no wrong curve sample and no spurious
-    /// hidden sample, 1 when something failed (a `FAILED` line says what), 2 when the folder
-    /// or its .glb cannot be read.
+    /// sheet), and prints both. Exit status 0 when every halo passes the checker, every
+    /// curve is resolved and the verification finds no wrong curve sample and no spurious
+    /// hidden sample (a build's own verdict), 1 when something failed (a `FAILED` line says
+    /// what), 2 when the folder or its .glb cannot be read.
     Check {
         /// A .glb (every mesh with `halo` extras) or legacy .vtk (with `surface_vertices`
         /// field data) file, or a folder with one scene .glb, as `halo4d build` writes them.

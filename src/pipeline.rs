@@ -596,7 +596,9 @@ fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error
     if stages.curves {
         bar.set_message("intersection curves");
         let start = Instant::now();
-        curves = intersect::curves(&parts(&products, &scene.halo, &curves).sheets());
+        // The curves are made from the sheets alone.
+        let none = Curves::default();
+        curves = intersect::curves(&parts(&products, &scene.halo, &none).sheets());
         timings.curves = ms(start);
     }
     bar.inc(1);
