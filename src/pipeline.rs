@@ -96,9 +96,9 @@ impl Stages {
     }
 }
 
-/// `report.json`'s `memory`: what the stages from the halos on were estimated to need
-/// ((`BUILD_BYTES_PER_TRIANGLE`, 1100 bytes, per triangle)) against the limit
-/// (`HALO4D_MAX_MEMORY` gigabytes, or three quarters of the machine's memory), in GB. The picture is estimated on its own when it is made.
+/// `report.json`'s `memory`: what the stages from the halos on were estimated to need (1100
+/// bytes per triangle) against the limit (`HALO4D_MAX_MEMORY` gigabytes, or three quarters
+/// of the machine's memory), in GB. The picture is estimated on its own when it is made.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct MemoryReport {
     /// Estimated peak of the stages from the halos on.

@@ -533,6 +533,17 @@ fn malformed_glb_files_are_clear_errors() {
     let mut garbled = good.clone();
     garbled[20..30].copy_from_slice(b"{not json!");
     glb_fails(&garbled, &["not valid JSON"]);
+    // What panics the gltf crate's own reading: a declared length under the header's 12
+    // bytes, and a POSITION accessor out of range (its validation indexes it unchecked).
+    let mut short = good.clone();
+    short[8..12].copy_from_slice(&5u32.to_le_bytes());
+    glb_fails(&short, &["the header says 5 bytes"]);
+    glb_fails(
+        &with_json(&good, |j| {
+            halo_mesh(j)["primitives"][0]["attributes"]["POSITION"] = 999.into()
+        }),
+        &["accessors[999] does not exist"],
+    );
     // A chunk that claims more than the file holds.
     let mut chunk = good.clone();
     chunk[12..16].copy_from_slice(&u32::MAX.to_le_bytes());

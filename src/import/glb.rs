@@ -1,5 +1,14 @@
-//! Halos and surfaces from `.glb`: the container, the JSON chunk (serde_json) and the
-//! accessors the meshes name, each bounds-checked against the BIN chunk before it is read.
+//! Halos and surfaces from `.glb`: the container split by the `gltf` crate, the JSON chunk
+//! read into `gltf-json`'s typed document, and the accessors the meshes name, each
+//! bounds-checked against the BIN chunk before it is read.
+//!
+//! By hand, because the crate does not do it: the 12-byte header is checked before the
+//! crate sees it (`gltf::binary::Glb::from_slice` subtracts 12 from the declared length
+//! unchecked, and reads past a declared length shorter than the file); every index the
+//! document holds is checked before it is followed (the crate's `Document` and its
+//! validation index the arrays without a check: an out-of-range POSITION accessor panics
+//! in `Gltf::from_slice`); and an accessor's elements are checked against its buffer view
+//! and the BIN chunk before anything is allocated for them (the crate trusts `count`).
 
 use super::{
     FileParams, ImportError, ImportedCurves, ImportedHalo, ImportedScene, ImportedSurface,
@@ -8,6 +17,10 @@ use crate::check::TetMesh;
 use crate::convention::{file_order, from_gltf};
 use crate::view::area_normal_sums;
 use glam::DVec3;
+use gltf_json as json;
+use json::accessor::{ComponentType, GenericComponentType, Type};
+use json::mesh::{Mode, Primitive, Semantic};
+use json::validation::Checked;
 use serde_json::Value;
 
 type Result<T> = std::result::Result<T, ImportError>;
@@ -18,13 +31,17 @@ fn glb_err(message: String) -> ImportError {
 
 /// Reads every mesh whose extras carry `halo` (see [`crate::export::to_glb`]).
 pub fn read_glb(bytes: &[u8]) -> Result<Vec<ImportedHalo>> {
-    let (json, bin) = chunks(bytes)?;
-    let json = parse(json)?;
-    let doc = Doc { json: &json, bin };
-    let meshes = meshes(&json)?;
+    let glb = container(bytes)?;
+    let root = parse(&glb.json)?;
+    let doc = Doc {
+        root: &root,
+        bin: glb.bin.as_deref(),
+    };
+    let meshes = &root.meshes;
     let mut halos = Vec::new();
     for (i, mesh) in meshes.iter().enumerate() {
-        let Some(halo) = extra(mesh, "halo") else {
+        let extras = extras(&mesh.extras);
+        let Some(halo) = extras.get("halo") else {
             continue;
         };
         halos.push(doc.halo(i, mesh, halo, mesh_name(mesh, i))?.validate()?);
@@ -44,15 +61,19 @@ pub fn read_glb(bytes: &[u8]) -> Result<Vec<ImportedHalo>> {
 /// and delta_t, and as many surface vertices as its surface, so that the scene can be
 /// verified ([`crate::inspect::verify_scene`]).
 pub fn read_scene_glb(bytes: &[u8]) -> Result<ImportedScene> {
-    let (json, bin) = chunks(bytes)?;
-    let json = parse(json)?;
-    let doc = Doc { json: &json, bin };
-    let meshes = meshes(&json)?;
+    let glb = container(bytes)?;
+    let root = parse(&glb.json)?;
+    let doc = Doc {
+        root: &root,
+        bin: glb.bin.as_deref(),
+    };
+    let meshes = &root.meshes;
+    let mesh_extras: Vec<Value> = meshes.iter().map(|m| extras(&m.extras)).collect();
     let mut surfaces: Vec<ImportedSurface> = Vec::new();
     // For each mesh, the surface it is.
     let mut surface_of = vec![None; meshes.len()];
     for (i, mesh) in meshes.iter().enumerate() {
-        if extra(mesh, "surface").is_some() {
+        if mesh_extras[i].get("surface").is_some() {
             surface_of[i] = Some(surfaces.len());
             surfaces.push(doc.surface(i, mesh, mesh_name(mesh, i))?);
         }
@@ -64,7 +85,7 @@ pub fn read_scene_glb(bytes: &[u8]) -> Result<ImportedScene> {
         )));
     }
     for (i, mesh) in meshes.iter().enumerate() {
-        let Some(extras) = extra(mesh, "halo") else {
+        let Some(extras) = mesh_extras[i].get("halo") else {
             continue;
         };
         let halo = doc.halo(i, mesh, extras, mesh_name(mesh, i))?.validate()?;
@@ -115,12 +136,13 @@ pub fn read_scene_glb(bytes: &[u8]) -> Result<ImportedScene> {
         }
         surfaces[s].halo = Some(halo);
     }
-    let name = json
-        .pointer("/asset/extras/halo4d/scene/name")
+    let asset = extras(&root.asset.extras);
+    let name = asset
+        .pointer("/halo4d/scene/name")
         .and_then(Value::as_str)
         .map(String::from);
-    let camera = json
-        .pointer("/asset/extras/halo4d/scene/camera")
+    let camera = asset
+        .pointer("/halo4d/scene/camera")
         .map(|c| {
             serde_path_to_error::deserialize(c.clone()).map_err(|e| {
                 glb_err(format!(
@@ -132,7 +154,7 @@ pub fn read_scene_glb(bytes: &[u8]) -> Result<ImportedScene> {
     let curves = match meshes
         .iter()
         .enumerate()
-        .find_map(|(i, m)| Some((i, m, extra(m, "curves")?)))
+        .find_map(|(i, m)| Some((i, m, mesh_extras[i].get("curves")?)))
     {
         Some((i, mesh, curves)) => doc.curves(i, curves, &mesh_name(mesh, i))?,
         None => None,
@@ -145,40 +167,43 @@ pub fn read_scene_glb(bytes: &[u8]) -> Result<ImportedScene> {
     })
 }
 
-/// The JSON chunk parsed.
-fn parse(json: &[u8]) -> Result<Value> {
-    serde_json::from_slice(json)
-        .map_err(|e| glb_err(format!("the JSON chunk is not valid JSON: {e}")))
+/// The JSON chunk as `gltf-json`'s document; an error names the field.
+fn parse(json: &[u8]) -> Result<json::Root> {
+    let mut de = serde_json::Deserializer::from_slice(json);
+    serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        let path = e.path().to_string();
+        glb_err(format!(
+            "the JSON chunk is not valid JSON for glTF 2: {}{}",
+            if path == "." {
+                String::new()
+            } else {
+                format!("{path}: ")
+            },
+            e.into_inner()
+        ))
+    })
 }
 
-/// The document's meshes (none when it has no `meshes`).
-fn meshes(json: &Value) -> Result<&[Value]> {
-    match json.get("meshes") {
-        None => Ok(&[]),
-        Some(Value::Array(m)) => Ok(m),
-        Some(_) => Err(glb_err("`meshes` is not an array".into())),
-    }
-}
-
-/// The entry `key` of a mesh's extras.
-fn extra<'v>(mesh: &'v Value, key: &str) -> Option<&'v Value> {
-    mesh.get("extras").and_then(|e| e.get(key))
+/// An object's extras as JSON (null when it has none).
+fn extras(extras: &json::Extras) -> Value {
+    extras
+        .as_ref()
+        .and_then(|raw| serde_json::from_str(raw.get()).ok())
+        .unwrap_or(Value::Null)
 }
 
 /// A mesh's name, or `mesh i` when it has none.
-fn mesh_name(mesh: &Value, i: usize) -> String {
-    match mesh.get("name") {
-        Some(Value::String(s)) => s.clone(),
-        _ => format!("mesh {i}"),
-    }
+fn mesh_name(mesh: &json::Mesh, i: usize) -> String {
+    mesh.name.clone().unwrap_or_else(|| format!("mesh {i}"))
 }
 
 fn u32_at(bytes: &[u8], at: usize) -> u32 {
     u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]])
 }
 
-/// The JSON chunk and the BIN chunk, if any, of a GLB container.
-fn chunks(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>)> {
+/// The JSON chunk and the BIN chunk, if any, of a GLB container: the header checked here,
+/// the chunks split by the `gltf` crate.
+fn container(bytes: &[u8]) -> Result<gltf::binary::Glb<'_>> {
     if bytes.len() < 12 {
         return Err(glb_err(format!(
             "truncated: the 12-byte header is incomplete, the file has {} bytes",
@@ -210,45 +235,40 @@ fn chunks(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>)> {
             bytes.len()
         )));
     }
-    let mut at = 12;
-    let mut json = None;
-    let mut bin = None;
-    while at < length {
-        if length - at < 8 {
-            return Err(glb_err(format!(
-                "truncated: a chunk header at byte {at} is incomplete"
-            )));
-        }
-        let len = u32_at(bytes, at) as usize;
-        let kind = &bytes[at + 4..at + 8];
-        let start = at + 8;
-        if len > length - start {
-            return Err(glb_err(format!(
-                "truncated: the chunk at byte {at} claims {len} bytes, {} remain",
-                length - start
-            )));
-        }
-        let data = &bytes[start..start + len];
-        match (kind, json.is_some()) {
-            (b"JSON", false) => json = Some(data),
-            (b"JSON", true) => return Err(glb_err("a second JSON chunk".into())),
-            (_, false) => return Err(glb_err("the first chunk is not the JSON chunk".into())),
-            (b"BIN\0", true) if bin.is_none() => bin = Some(data),
-            (b"BIN\0", true) => return Err(glb_err("a second BIN chunk".into())),
-            // Chunks of unknown types are to be ignored (glTF 2.0, 4.4.3).
-            _ => {}
-        }
-        at = start + len.next_multiple_of(4).min(length - start);
-    }
-    let json = json.ok_or_else(|| glb_err("no JSON chunk".into()))?;
-    Ok((json, bin))
+    gltf::binary::Glb::from_slice(bytes).map_err(|e| {
+        use gltf::binary::{ChunkType, Error};
+        let chunk = |ty: ChunkType| match ty {
+            ChunkType::Json => "JSON",
+            ChunkType::Bin => "BIN",
+        };
+        glb_err(match e {
+            gltf::Error::Binary(Error::ChunkLength {
+                ty,
+                length,
+                length_read,
+            }) => format!(
+                "truncated: the {} chunk claims {length} bytes, {length_read} remain",
+                chunk(ty)
+            ),
+            gltf::Error::Binary(Error::ChunkType(ChunkType::Json)) => {
+                "a second JSON chunk where the BIN chunk belongs".into()
+            }
+            gltf::Error::Binary(Error::ChunkType(ChunkType::Bin)) => {
+                "the first chunk is not the JSON chunk".into()
+            }
+            gltf::Error::Binary(Error::UnknownChunkType(ty)) => format!(
+                "a chunk of unknown type {:?} (halo4d reads a JSON and a BIN chunk)",
+                String::from_utf8_lossy(&ty)
+            ),
+            gltf::Error::Binary(Error::Io(_)) => "truncated: a chunk header is incomplete".into(),
+            other => format!("the container cannot be split into its chunks: {other}"),
+        })
+    })
 }
 
 /// A primitive's points as [`Doc::points`] reads them.
 struct Points<'a> {
-    /// `meshes[i] (`name`)`, for messages.
-    what: String,
-    attributes: &'a Value,
+    primitive: &'a Primitive,
     positions: Vec<DVec3>,
     w: Vec<f64>,
     indices: Vec<u32>,
@@ -256,7 +276,7 @@ struct Points<'a> {
 
 /// A parsed glTF document and its binary chunk.
 struct Doc<'a> {
-    json: &'a Value,
+    root: &'a json::Root,
     bin: Option<&'a [u8]>,
 }
 
@@ -274,17 +294,57 @@ fn to_usize(x: u64, what: &str) -> Result<usize> {
     usize::try_from(x).map_err(|_| glb_err(format!("{what} is too large: {x}")))
 }
 
+/// An accessor's type as the file spells it.
+fn type_name(t: &Checked<Type>) -> &'static str {
+    match t {
+        Checked::Valid(Type::Scalar) => "SCALAR",
+        Checked::Valid(Type::Vec2) => "VEC2",
+        Checked::Valid(Type::Vec3) => "VEC3",
+        Checked::Valid(Type::Vec4) => "VEC4",
+        Checked::Valid(Type::Mat2) => "MAT2",
+        Checked::Valid(Type::Mat3) => "MAT3",
+        Checked::Valid(Type::Mat4) => "MAT4",
+        Checked::Invalid => "?",
+    }
+}
+
+/// An accessor's component type, when it is a valid one.
+fn component(c: &Checked<GenericComponentType>) -> Option<ComponentType> {
+    match c {
+        Checked::Valid(GenericComponentType(c)) => Some(*c),
+        Checked::Invalid => None,
+    }
+}
+
+/// An accessor's component type as the file numbers it.
+fn component_name(c: &Checked<GenericComponentType>) -> String {
+    component(c).map_or("?".into(), |c| c.as_gl_enum().to_string())
+}
+
+/// The accessor a primitive's attribute `semantic` names, when it has one.
+fn attribute(primitive: &Primitive, semantic: Semantic) -> Option<u64> {
+    primitive
+        .attributes
+        .get(&Checked::Valid(semantic))
+        .map(|a| a.value() as u64)
+}
+
+/// A custom attribute (`_W`, `_T`, `_D`).
+fn custom(name: &str) -> Semantic {
+    Semantic::Extras(name.trim_start_matches('_').to_string())
+}
+
 impl<'a> Doc<'a> {
-    /// Element `i` of the top-level array `key`.
-    fn item(&self, key: &str, i: u64) -> Result<&'a Value> {
-        let all = self.json.get(key).and_then(Value::as_array);
-        let len = all.map_or(0, Vec::len);
+    /// Accessor `i`, checked to exist.
+    fn accessor(&self, i: u64) -> Result<&'a json::Accessor> {
+        let all = &self.root.accessors;
         usize::try_from(i)
             .ok()
-            .and_then(|i| all.and_then(|a| a.get(i)))
+            .and_then(|i| all.get(i))
             .ok_or_else(|| {
                 glb_err(format!(
-                    "{key}[{i}] does not exist (the file has {len} {key})"
+                    "accessors[{i}] does not exist (the file has {} accessors)",
+                    all.len()
                 ))
             })
     }
@@ -294,20 +354,33 @@ impl<'a> Doc<'a> {
     fn accessor_bytes(
         &self,
         i: u64,
-        accessor: &Value,
+        accessor: &json::Accessor,
         element: usize,
     ) -> Result<(&'a [u8], usize, usize)> {
         let what = format!("accessors[{i}]");
-        if accessor.get("sparse").is_some() {
+        if accessor.sparse.is_some() {
             return Err(glb_err(format!("{what} is sparse, which halos never are")));
         }
-        let count = to_usize(index(accessor, "count", &what, None)?, "count")?;
-        let view_index = index(accessor, "bufferView", &what, None)?;
-        let view = self.item("bufferViews", view_index)?;
+        let count = to_usize(accessor.count.0, "count")?;
+        let view_index = accessor
+            .buffer_view
+            .ok_or_else(|| glb_err(format!("{what} has no `bufferView`")))?
+            .value();
+        let view = self.root.buffer_views.get(view_index).ok_or_else(|| {
+            glb_err(format!(
+                "bufferViews[{view_index}] does not exist (the file has {} bufferViews)",
+                self.root.buffer_views.len()
+            ))
+        })?;
         let view_what = format!("bufferViews[{view_index}]");
-        let buffer = index(view, "buffer", &view_what, None)?;
-        let buffer_json = self.item("buffers", buffer)?;
-        if buffer != 0 || buffer_json.get("uri").is_some() {
+        let buffer = view.buffer.value();
+        let buffer_json = self.root.buffers.get(buffer).ok_or_else(|| {
+            glb_err(format!(
+                "buffers[{buffer}] does not exist (the file has {} buffers)",
+                self.root.buffers.len()
+            ))
+        })?;
+        if buffer != 0 || buffer_json.uri.is_some() {
             return Err(glb_err(format!(
                 "{view_what} is in buffer {buffer}, not in the .glb's own binary chunk"
             )));
@@ -315,8 +388,8 @@ impl<'a> Doc<'a> {
         let bin = self
             .bin
             .ok_or_else(|| glb_err(format!("{what} needs a BIN chunk, and there is none")))?;
-        let view_offset = to_usize(index(view, "byteOffset", &view_what, Some(0))?, "offset")?;
-        let view_len = to_usize(index(view, "byteLength", &view_what, None)?, "length")?;
+        let view_offset = to_usize(view.byte_offset.map_or(0, |o| o.0), "offset")?;
+        let view_len = to_usize(view.byte_length.0, "length")?;
         if view_offset
             .checked_add(view_len)
             .is_none_or(|end| end > bin.len())
@@ -326,16 +399,13 @@ impl<'a> Doc<'a> {
                 bin.len()
             )));
         }
-        let stride = to_usize(
-            index(view, "byteStride", &view_what, Some(element as u64))?,
-            "stride",
-        )?;
+        let stride = view.byte_stride.map_or(element, |s| s.0);
         if stride < element {
             return Err(glb_err(format!(
                 "{view_what}.byteStride {stride} is less than the {element}-byte elements of {what}"
             )));
         }
-        let offset = to_usize(index(accessor, "byteOffset", &what, Some(0))?, "offset")?;
+        let offset = to_usize(accessor.byte_offset.map_or(0, |o| o.0), "offset")?;
         let needed = match count {
             0 => Some(offset),
             _ => (count - 1)
@@ -355,15 +425,17 @@ impl<'a> Doc<'a> {
         ))
     }
 
-    /// Accessor `i` as floats: FLOAT components of `type_` (`SCALAR` or `VEC3`).
-    fn floats(&self, i: u64, type_: &str, components: usize) -> Result<Vec<f32>> {
-        let accessor = self.item("accessors", i)?;
-        let what = format!("accessors[{i}]");
-        let component_type = index(accessor, "componentType", &what, None)?;
-        let found = accessor.get("type").and_then(Value::as_str).unwrap_or("?");
-        if component_type != 5126 || found != type_ {
+    /// Accessor `i` as floats: FLOAT components of `expected` (`SCALAR` or `VEC3`).
+    fn floats(&self, i: u64, expected: Type, components: usize) -> Result<Vec<f32>> {
+        let accessor = self.accessor(i)?;
+        if component(&accessor.component_type) != Some(ComponentType::F32)
+            || accessor.type_ != Checked::Valid(expected)
+        {
             return Err(glb_err(format!(
-                "{what} is {found} of component type {component_type}, expected {type_} of FLOAT (5126)"
+                "accessors[{i}] is {} of component type {}, expected {} of FLOAT (5126)",
+                type_name(&accessor.type_),
+                component_name(&accessor.component_type),
+                type_name(&Checked::Valid(expected))
             )));
         }
         let (bytes, count, stride) = self.accessor_bytes(i, accessor, 4 * components)?;
@@ -380,10 +452,19 @@ impl<'a> Doc<'a> {
         Ok(out)
     }
 
+    /// Accessor `i` as FLOAT SCALARs, widened.
+    fn scalars(&self, i: u64) -> Result<Vec<f64>> {
+        Ok(self
+            .floats(i, Type::Scalar, 1)?
+            .into_iter()
+            .map(f64::from)
+            .collect())
+    }
+
     /// Accessor `i` as FLOAT VEC3s (points or directions) in halo4d's frame.
     fn vec3s(&self, i: u64) -> Result<Vec<DVec3>> {
         Ok(self
-            .floats(i, "VEC3", 3)?
+            .floats(i, Type::Vec3, 3)?
             .chunks_exact(3)
             .map(|c| from_gltf(DVec3::new(c[0].into(), c[1].into(), c[2].into())))
             .collect())
@@ -391,19 +472,18 @@ impl<'a> Doc<'a> {
 
     /// Accessor `i` as unsigned integer SCALARs (UNSIGNED_BYTE, _SHORT or _INT).
     fn unsigned(&self, i: u64) -> Result<Vec<u32>> {
-        let accessor = self.item("accessors", i)?;
-        let what = format!("accessors[{i}]");
-        let component_type = index(accessor, "componentType", &what, None)?;
-        let found = accessor.get("type").and_then(Value::as_str).unwrap_or("?");
-        let size = match component_type {
-            5121 => 1,
-            5123 => 2,
-            5125 => 4,
+        let accessor = self.accessor(i)?;
+        let size = match component(&accessor.component_type) {
+            Some(ComponentType::U8) => 1,
+            Some(ComponentType::U16) => 2,
+            Some(ComponentType::U32) => 4,
             _ => 0,
         };
-        if size == 0 || found != "SCALAR" {
+        if size == 0 || accessor.type_ != Checked::Valid(Type::Scalar) {
             return Err(glb_err(format!(
-                "{what} is {found} of component type {component_type}, expected SCALAR of an unsigned integer type"
+                "accessors[{i}] is {} of component type {}, expected SCALAR of an unsigned integer type",
+                type_name(&accessor.type_),
+                component_name(&accessor.component_type)
             )));
         }
         let (bytes, count, stride) = self.accessor_bytes(i, accessor, size)?;
@@ -420,40 +500,34 @@ impl<'a> Doc<'a> {
     }
 
     /// The first primitive of mesh `i`, which must be of TRIANGLES: its POSITION, `_W` and
-    /// indices, and its attributes.
-    fn points(&self, i: usize, mesh: &'a Value, name: &str) -> Result<Points<'a>> {
+    /// indices, and the primitive.
+    fn points(&self, i: usize, mesh: &'a json::Mesh, name: &str) -> Result<Points<'a>> {
         let what = format!("meshes[{i}] (`{name}`)");
         let primitive = mesh
-            .get("primitives")
-            .and_then(|p| p.get(0))
+            .primitives
+            .first()
             .ok_or_else(|| glb_err(format!("{what} has no primitive")))?;
-        let found = index(primitive, "mode", &format!("{what}.primitives[0]"), Some(4))?;
-        if found != 4 {
+        if primitive.mode != Checked::Valid(Mode::Triangles) {
             return Err(glb_err(format!(
-                "{what} has primitives of mode {found}, expected TRIANGLES (4)"
+                "{what} has primitives of mode {}, expected TRIANGLES (4)",
+                match primitive.mode {
+                    Checked::Valid(m) => m.as_gl_enum().to_string(),
+                    Checked::Invalid => "?".into(),
+                }
             )));
         }
-        let attributes = primitive
-            .get("attributes")
-            .ok_or_else(|| glb_err(format!("{what} has no attributes")))?;
-        let attribute = |key: &str| -> Result<u64> {
-            index(attributes, key, &format!("{what} attributes"), None)
+        let needed = |key: &str, semantic: Semantic| {
+            attribute(primitive, semantic)
+                .ok_or_else(|| glb_err(format!("{what} attributes has no `{key}`")))
         };
-        let positions: Vec<DVec3> = self.vec3s(attribute("POSITION")?)?;
-        let w: Vec<f64> = self
-            .floats(attribute("_W")?, "SCALAR", 1)?
-            .into_iter()
-            .map(f64::from)
-            .collect();
-        let indices = self.unsigned(index(
-            primitive,
-            "indices",
-            &format!("{what}.primitives[0]"),
-            None,
-        )?)?;
+        let positions = self.vec3s(needed("POSITION", Semantic::Positions)?)?;
+        let w = self.scalars(needed("_W", custom("_W"))?)?;
+        let indices = primitive
+            .indices
+            .ok_or_else(|| glb_err(format!("{what}.primitives[0] has no `indices`")))?;
+        let indices = self.unsigned(indices.value() as u64)?;
         Ok(Points {
-            what,
-            attributes,
+            primitive,
             positions,
             w,
             indices,
@@ -462,21 +536,16 @@ impl<'a> Doc<'a> {
 
     /// The surface of mesh `i`: its first primitive's POSITION, `_W`, NORMAL if any, and
     /// triangles.
-    fn surface(&self, i: usize, mesh: &'a Value, name: String) -> Result<ImportedSurface> {
+    fn surface(&self, i: usize, mesh: &'a json::Mesh, name: String) -> Result<ImportedSurface> {
         let Points {
-            attributes,
+            primitive,
             positions,
             w,
             indices,
-            what,
         } = self.points(i, mesh, &name)?;
-        let attribute = |key: &str| -> Result<u64> {
-            index(attributes, key, &format!("{what} attributes"), None)
-        };
-        let file_normals: Option<Vec<DVec3>> = match attributes.get("NORMAL") {
-            None => None,
-            Some(_) => Some(self.vec3s(attribute("NORMAL")?)?),
-        };
+        let file_normals: Option<Vec<DVec3>> = attribute(primitive, Semantic::Normals)
+            .map(|a| self.vec3s(a))
+            .transpose()?;
         let bad = |message: String| ImportError::BadSurface {
             name: name.clone(),
             message,
@@ -566,11 +635,7 @@ impl<'a> Doc<'a> {
         }
         let [position, w, indices] = ids;
         let positions: Vec<DVec3> = self.vec3s(position)?;
-        let w: Vec<f64> = self
-            .floats(w, "SCALAR", 1)?
-            .into_iter()
-            .map(f64::from)
-            .collect();
+        let w = self.scalars(w)?;
         let indices = self.unsigned(indices)?;
         let nv = positions.len();
         let bad = |message: String| glb_err(format!("{what}: {message}"));
@@ -598,29 +663,29 @@ impl<'a> Doc<'a> {
     /// that follows "accessors[i], which". A program that re-saves a `.glb` keeps the
     /// meshes' extras but may drop such accessors and give their numbers to others (Blender
     /// 4.5 makes the tetrahedra's a triangle index buffer).
-    fn own_accessor(&self, i: u64, expected: &str) -> std::result::Result<&'a Value, String> {
-        let all = self.json.get("accessors").and_then(Value::as_array);
-        let accessor = all
-            .and_then(|a| a.get(usize::try_from(i).ok()?))
-            .ok_or_else(|| format!("does not exist (the file has {})", all.map_or(0, Vec::len)))?;
-        match accessor.get("name").and_then(Value::as_str) {
+    fn own_accessor(
+        &self,
+        i: u64,
+        expected: &str,
+    ) -> std::result::Result<&'a json::Accessor, String> {
+        let all = &self.root.accessors;
+        let accessor = usize::try_from(i)
+            .ok()
+            .and_then(|i| all.get(i))
+            .ok_or_else(|| format!("does not exist (the file has {})", all.len()))?;
+        match &accessor.name {
             Some(n) if n == expected => {}
             Some(n) => return Err(format!("is named `{n}`, not `{expected}`")),
             None => return Err(format!("has no name (halo4d names it `{expected}`)")),
         }
         let used = self
-            .json
-            .get("meshes")
-            .and_then(Value::as_array)
-            .into_iter()
-            .flatten()
-            .filter_map(|m| m.get("primitives").and_then(Value::as_array))
-            .flatten()
+            .root
+            .meshes
+            .iter()
+            .flat_map(|m| &m.primitives)
             .any(|p| {
-                p.get("indices").and_then(Value::as_u64) == Some(i)
-                    || p.get("attributes")
-                        .and_then(Value::as_object)
-                        .is_some_and(|a| a.values().any(|v| v.as_u64() == Some(i)))
+                p.indices.is_some_and(|a| a.value() as u64 == i)
+                    || p.attributes.values().any(|a| a.value() as u64 == i)
             });
         if used {
             return Err("a primitive reads as its indices or an attribute".into());
@@ -641,12 +706,13 @@ impl<'a> Doc<'a> {
         let accessor = self
             .own_accessor(i, &format!("{name} tetrahedra"))
             .map_err(missing)?;
-        let type_ = accessor.get("type").and_then(Value::as_str).unwrap_or("?");
-        let component = accessor.get("componentType").and_then(Value::as_u64);
-        if type_ != "SCALAR" || component != Some(5125) {
+        if accessor.type_ != Checked::Valid(Type::Scalar)
+            || component(&accessor.component_type) != Some(ComponentType::U32)
+        {
             return Err(missing(format!(
-                "is {type_} of component type {}, not SCALAR of UNSIGNED_INT (5125)",
-                component.map_or("?".into(), |c| c.to_string())
+                "is {} of component type {}, not SCALAR of UNSIGNED_INT (5125)",
+                type_name(&accessor.type_),
+                component_name(&accessor.component_type)
             )));
         }
         let indices = self.unsigned(i)?;
@@ -666,24 +732,23 @@ impl<'a> Doc<'a> {
     }
 
     /// The halo of mesh `i`, whose extras' `halo` is `halo`.
-    fn halo(&self, i: usize, mesh: &Value, halo: &Value, name: String) -> Result<ImportedHalo> {
+    fn halo(
+        &self,
+        i: usize,
+        mesh: &json::Mesh,
+        halo: &Value,
+        name: String,
+    ) -> Result<ImportedHalo> {
         let what = format!("meshes[{i}] (`{name}`)");
         let extras = format!("{what}.extras.halo");
         if !halo.is_object() {
             return Err(glb_err(format!("{extras} is not an object")));
         }
-        let attributes = mesh
-            .get("primitives")
-            .and_then(|p| p.get(0))
-            .and_then(|p| p.get("attributes"))
+        let primitive = mesh
+            .primitives
+            .first()
             .ok_or_else(|| glb_err(format!("{what} has no primitive with attributes")))?;
-        let attribute = |key: &str| -> Result<Option<u64>> {
-            match attributes.get(key) {
-                None => Ok(None),
-                Some(_) => index(attributes, key, &format!("{what} attributes"), None).map(Some),
-            }
-        };
-        let position = attribute("POSITION")?
+        let position = attribute(primitive, Semantic::Positions)
             .ok_or_else(|| glb_err(format!("{what} has no POSITION attribute")))?;
         let positions: Vec<[f64; 3]> = self
             .vec3s(position)?
@@ -691,10 +756,10 @@ impl<'a> Doc<'a> {
             .map(|p| p.to_array())
             .collect();
         let scalar = |key: &str| -> Result<Option<Vec<f64>>> {
-            let Some(a) = attribute(key)? else {
+            let Some(a) = attribute(primitive, custom(key)) else {
                 return Ok(None);
             };
-            let values = self.floats(a, "SCALAR", 1)?;
+            let values = self.scalars(a)?;
             if values.len() != positions.len() {
                 return Err(glb_err(format!(
                     "{what}: {key} has {} values for {} positions",
@@ -702,7 +767,7 @@ impl<'a> Doc<'a> {
                     positions.len()
                 )));
             }
-            Ok(Some(values.into_iter().map(f64::from).collect()))
+            Ok(Some(values))
         };
         let t = scalar("_T")?;
         let d_orig = scalar("_D")?;

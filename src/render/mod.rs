@@ -198,28 +198,17 @@ impl Default for RenderSettings {
 impl RenderSettings {
     /// Checks the numbers: names the first bad field.
     pub fn check(&self) -> Result<(), FieldError> {
-        let side = |v: u32| PICTURE_SIDE.contains(&v);
-        if !side(self.width) {
-            return Err(FieldError::new(
-                "width",
-                format!(
-                    "must be {} to {} pixels, got {}",
-                    PICTURE_SIDE.start(),
-                    PICTURE_SIDE.end(),
-                    self.width
-                ),
-            ));
-        }
-        if !side(self.height) {
-            return Err(FieldError::new(
-                "height",
-                format!(
-                    "must be {} to {} pixels, got {}",
-                    PICTURE_SIDE.start(),
-                    PICTURE_SIDE.end(),
-                    self.height
-                ),
-            ));
+        for (field, side) in [("width", self.width), ("height", self.height)] {
+            if !PICTURE_SIDE.contains(&side) {
+                return Err(FieldError::new(
+                    field,
+                    format!(
+                        "must be {} to {} pixels, got {side}",
+                        PICTURE_SIDE.start(),
+                        PICTURE_SIDE.end()
+                    ),
+                ));
+            }
         }
         if !SLICES.contains(&self.slices) {
             return Err(FieldError::new(
