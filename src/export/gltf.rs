@@ -237,7 +237,6 @@ fn halo_faces(halo: &Halo) -> Vec<[u32; 3]> {
     faces
 }
 
-/// Area-weighted normals of the vertices of `faces` (zero at a vertex that no face uses).
 /// The patch of each halo vertex: that of its surface vertex for the offsets and the surface,
 /// that of the triangle whose prism it is in for an inserted vertex.
 fn halo_patches(s: &SurfaceData) -> Vec<f32> {

@@ -33,10 +33,7 @@ fn glb_err(message: String) -> ImportError {
 pub fn read_glb(bytes: &[u8]) -> Result<Vec<ImportedHalo>> {
     let glb = container(bytes)?;
     let root = parse(&glb.json)?;
-    let doc = Doc {
-        root: &root,
-        bin: glb.bin.as_deref(),
-    };
+    let doc = Doc::new(&root, &glb);
     let meshes = &root.meshes;
     let mut halos = Vec::new();
     for (i, mesh) in meshes.iter().enumerate() {
@@ -63,10 +60,7 @@ pub fn read_glb(bytes: &[u8]) -> Result<Vec<ImportedHalo>> {
 pub fn read_scene_glb(bytes: &[u8]) -> Result<ImportedScene> {
     let glb = container(bytes)?;
     let root = parse(&glb.json)?;
-    let doc = Doc {
-        root: &root,
-        bin: glb.bin.as_deref(),
-    };
+    let doc = Doc::new(&root, &glb);
     let meshes = &root.meshes;
     let mesh_extras: Vec<Value> = meshes.iter().map(|m| extras(&m.extras)).collect();
     let mut surfaces: Vec<ImportedSurface> = Vec::new();
@@ -335,6 +329,13 @@ fn custom(name: &str) -> Semantic {
 }
 
 impl<'a> Doc<'a> {
+    fn new(root: &'a json::Root, glb: &'a gltf::binary::Glb) -> Self {
+        Doc {
+            root,
+            bin: glb.bin.as_deref(),
+        }
+    }
+
     /// Accessor `i`, checked to exist.
     fn accessor(&self, i: u64) -> Result<&'a json::Accessor> {
         let all = &self.root.accessors;

@@ -271,9 +271,7 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
                         }
                     }
                 });
-            let mut parts: Vec<Found> = within.into_iter().chain(across).collect();
-            parts.par_iter_mut().for_each(|f| f.flush(&soup));
-            let found = Found::join(&soup, parts);
+            let found = Found::join(&soup, within.into_iter().chain(across).collect());
             report.traverse_ms = ms(t);
             found
         }
@@ -403,10 +401,11 @@ impl Found {
         self.exact_ms += ms(t);
     }
 
-    /// The findings of consecutive runs of pairs, in order, every pair tested.
-    fn join(soup: &Soup, parts: impl IntoIterator<Item = Found>) -> Found {
-        parts.into_iter().fold(Found::default(), |mut all, mut f| {
-            f.flush(soup);
+    /// The findings of consecutive runs of pairs, in order, every pair tested (the pairs
+    /// still waiting in each, on the cores).
+    fn join(soup: &Soup, mut parts: Vec<Found>) -> Found {
+        parts.par_iter_mut().for_each(|f| f.flush(soup));
+        parts.into_iter().fold(Found::default(), |mut all, f| {
             all.candidates += f.candidates;
             all.segments.extend(f.segments);
             all.inconsistent += f.inconsistent;

@@ -61,7 +61,7 @@ pub struct AdaptiveMesh {
     pub mesh: Mesh4,
     /// Whether every triangle met the tolerance (false when the triangle budget stopped the
     /// refinement, or an edge became too short to split: in floating point, or below
-    /// [`MIN_EDGE`](crate::limits::MIN_EDGE) of the surface's extent).
+    /// [`MIN_EDGE`] of the surface's extent).
     pub complete: bool,
     /// Triangles that still failed the tolerance when refinement stopped.
     pub failing: usize,
@@ -418,7 +418,7 @@ pub fn sample_adaptive(surface: &Surface, tolerance: f64, max_triangles: usize) 
 struct Context<'a> {
     surface: &'a Surface,
     tolerance: f64,
-    /// Edges shorter than this (4D) are not split: [`MIN_EDGE`](crate::limits::MIN_EDGE) of the extent.
+    /// Edges shorter than this (4D) are not split: [`MIN_EDGE`] of the extent.
     min_edge: f64,
 }
 
