@@ -58,6 +58,72 @@ impl Rotation4 {
     }
 }
 
+impl Rotation4 {
+    /// The angles of a rotation matrix (in the order [`Rotation4::matrix`] composes them),
+    /// each in (-180, 180]: `Rotation4::from_matrix(r.matrix())` is `r`'s rotation, whatever
+    /// the angles `r` wrote it with. Exact where the decomposition is not unique (an angle of
+    /// ±90 degrees in xw, say): the angles left free are 0.
+    ///
+    /// How: xy, xz and yz fix w, and yz commutes with xw, so R = W Q with W = R_zw R_yw R_xw
+    /// and Q = R_yz R_xz R_xy a rotation of x, y, z. W alone moves e_w, to
+    /// (-sin xw, -cos xw sin yw, -cos xw cos yw sin zw, cos xw cos yw cos zw): the w column of
+    /// R gives xw, yw and zw; Q = W^T R gives xz and yz from its z column the same way, and
+    /// what is left is R_xy.
+    pub fn from_matrix(m: DMat4) -> Rotation4 {
+        let w = m.w_axis;
+        let xw = (-w.x).clamp(-1.0, 1.0).asin();
+        let yw = (-w.y).atan2(w.z.hypot(w.w));
+        let zw = (-w.z).atan2(w.w);
+        let outer = plane_rotation("zw", zw) * plane_rotation("yw", yw) * plane_rotation("xw", xw);
+        let q = outer.transpose() * m;
+        let z = q.z_axis;
+        let xz = (-z.x).clamp(-1.0, 1.0).asin();
+        let yz = (-z.y).atan2(z.z);
+        let p = (plane_rotation("yz", yz) * plane_rotation("xz", xz)).transpose() * q;
+        let xy = p.x_axis.y.atan2(p.x_axis.x);
+        let deg = |a: f64| {
+            let d = a.to_degrees();
+            // atan2 and asin give (-180, 180] already; -180 itself becomes 180.
+            if d <= -180.0 { d + 360.0 } else { d }
+        };
+        Rotation4 {
+            xy: deg(xy),
+            xz: deg(xz),
+            xw: deg(xw),
+            yz: deg(yz),
+            yw: deg(yw),
+            zw: deg(zw),
+        }
+    }
+
+    /// This rotation followed by a turn of `degrees` in the plane of the unit 3D direction
+    /// `towards` (in the projected space) and w, turning that direction towards w: Hanson's
+    /// 4D rolling ball, a drag along `towards` on the screen.
+    pub fn rolled(&self, towards: DVec3, degrees: f64) -> Rotation4 {
+        let d = towards.normalize_or_zero().extend(0.0);
+        let (s, c) = degrees.to_radians().sin_cos();
+        let outer = |a: DVec4, b: DVec4| DMat4::from_cols(a * b.x, a * b.y, a * b.z, a * b.w);
+        // x -> x + (cos - 1)((x.d) d + (x.w) w) + sin ((x.d) w - (x.w) d).
+        let turn = DMat4::IDENTITY
+            + (outer(d, d) + outer(DVec4::W, DVec4::W)) * (c - 1.0)
+            + (outer(DVec4::W, d) - outer(d, DVec4::W)) * s;
+        Rotation4::from_matrix(turn * self.matrix())
+    }
+
+    /// The angle of the plane named `name` (`xy`, `xz`, `xw`, `yz`, `yw` or `zw`).
+    pub fn angle_mut(&mut self, name: &str) -> Option<&mut f64> {
+        Some(match name {
+            "xy" => &mut self.xy,
+            "xz" => &mut self.xz,
+            "xw" => &mut self.xw,
+            "yz" => &mut self.yz,
+            "yw" => &mut self.yw,
+            "zw" => &mut self.zw,
+            _ => return None,
+        })
+    }
+}
+
 /// Rotation by `angle` in the plane of axes `name` (e.g. "xw"), turning the first axis towards
 /// the second.
 fn plane_rotation(name: &str, angle: f64) -> DMat4 {
@@ -311,6 +377,79 @@ mod tests {
         assert!((r * DVec4::X - DVec4::W).length() < 1e-15);
         let r = plane_rotation("yz", std::f64::consts::FRAC_PI_2);
         assert!((r * DVec4::Y - DVec4::Z).length() < 1e-15);
+    }
+
+    #[test]
+    fn angles_are_recovered_from_the_matrix_everywhere_even_at_gimbal_lock() {
+        let mut cases = vec![
+            Rotation4::default(),
+            Rotation4 {
+                xw: 90.0,
+                yw: 30.0,
+                zw: -40.0,
+                ..Default::default()
+            },
+            Rotation4 {
+                xz: -90.0,
+                xy: 20.0,
+                yz: 70.0,
+                ..Default::default()
+            },
+        ];
+        // Seeded angles over the whole circle (a linear congruential generator).
+        let mut seed = 12345u64;
+        let mut angle = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 720.0 - 360.0
+        };
+        for _ in 0..200 {
+            cases.push(Rotation4 {
+                xy: angle(),
+                xz: angle(),
+                xw: angle(),
+                yz: angle(),
+                yw: angle(),
+                zw: angle(),
+            });
+        }
+        for r in cases {
+            let m = r.matrix();
+            let back = Rotation4::from_matrix(m);
+            assert!(
+                (back.matrix() - m)
+                    .to_cols_array()
+                    .iter()
+                    .all(|e| e.abs() < 1e-12),
+                "{r:?} came back as {back:?}"
+            );
+            assert!(
+                back.planes()
+                    .iter()
+                    .all(|(_, a)| (-180.0..=180.0).contains(a))
+            );
+        }
+    }
+
+    #[test]
+    fn the_rolling_ball_turns_the_drag_direction_towards_w() {
+        let start = Rotation4 {
+            xy: 10.0,
+            yw: 25.0,
+            ..Default::default()
+        };
+        let towards = DVec3::new(0.6, -0.8, 0.0);
+        let rolled = start.rolled(towards, 90.0);
+        // A point that was at `towards` in the projected space is now on +w.
+        let p = start.matrix().inverse() * towards.extend(0.0);
+        assert!((rolled.matrix() * p - DVec4::W).length() < 1e-12);
+        // Turning by 0 changes nothing; w itself goes to -towards.
+        assert!(
+            (start.rolled(towards, 0.0).matrix() - start.matrix()).abs_diff_eq(DMat4::ZERO, 1e-12)
+        );
+        let q = start.matrix().inverse() * DVec4::W;
+        assert!((rolled.matrix() * q + towards.extend(0.0)).length() < 1e-12);
     }
 
     #[test]

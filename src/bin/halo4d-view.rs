@@ -1,22 +1,34 @@
-//! `halo4d-view`: the wgpu viewer of a scene's `.glb` (see `halo4d::viewer`).
+//! `halo4d-view`: the wgpu viewer and 4D explorer of scenes and `.glb` files (see
+//! `halo4d::viewer`).
 
 use clap::{Parser, ValueEnum};
 use halo4d::limits::FieldError;
-use halo4d::viewer::{self, Asset, Gpu, HaloMode, SLICE_COUNTS, ViewSettings, ViewerError};
-use halo4d::{CameraProjection, CameraSettings, Colormap};
-use std::path::PathBuf;
+use halo4d::viewer::{
+    self, Asset, Gpu, HaloMode, Model, SLICE_COUNTS, Source, ViewSettings, ViewerError,
+};
+use halo4d::{CameraProjection, CameraSettings, Colormap, Scene, View};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser, Debug)]
 #[command(
     name = "halo4d-view",
     version,
-    about = "View a scene's .glb (written by `halo4d build`): surfaces, halos and curves on the GPU",
+    about = "Explore a scene in 4D (SCENE.json, or the default scene), or view a scene's .glb (written by `halo4d build`): surfaces, halos and curves on the GPU",
     after_help = viewer::window::HELP
 )]
 struct Args {
-    /// The scene's .glb, e.g. exports/default/default.glb.
-    file: PathBuf,
+    /// A scene file (turned in 4D, its halos rebuilt on the GPU for every view), or a
+    /// scene's .glb as `halo4d build` writes it (turned in 3D); the default scene if none.
+    file: Option<PathBuf>,
+    /// Turn the scene's 4D view: PLANE=DEGREES added to the scene's angle of that plane
+    /// (xy, xz, xw, yz, yw or zw; applied in that order, as in the scene file). Repeatable.
+    #[arg(long, value_name = "PLANE=DEGREES", value_parser = parse_rotate, allow_hyphen_values = true)]
+    rotate: Vec<(String, f64)>,
+    /// Write the scene with the current 4D view and camera to OUT.json, which `halo4d build`
+    /// turns into the verified asset of that view.
+    #[arg(long, value_name = "OUT.json")]
+    save_scene: Option<PathBuf>,
     /// Render offscreen (no window, no display) and write --screenshot.
     #[arg(long)]
     headless: bool,
@@ -107,6 +119,26 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((n(w)?, n(h)?))
 }
 
+fn parse_rotate(s: &str) -> Result<(String, f64), String> {
+    let (plane, degrees) = s
+        .split_once('=')
+        .ok_or_else(|| format!("`{s}` is not PLANE=DEGREES, e.g. xw=20"))?;
+    let plane = plane.trim().to_ascii_lowercase();
+    if halo4d::Rotation4::default().angle_mut(&plane).is_none() {
+        return Err(format!(
+            "`{plane}` is not a plane of R^4: use xy, xz, xw, yz, yw or zw"
+        ));
+    }
+    let degrees: f64 = degrees
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{degrees}` in `{s}` is not a number of degrees"))?;
+    if !degrees.is_finite() {
+        return Err(format!("`{s}`: the angle must be finite"));
+    }
+    Ok((plane, degrees))
+}
+
 fn main() -> ExitCode {
     let args = Args::parse();
     match run(&args) {
@@ -119,20 +151,49 @@ fn main() -> ExitCode {
 }
 
 fn run(args: &Args) -> Result<(), ViewerError> {
-    if args.headless && args.screenshot.is_none() && !args.bench && !args.compare {
+    if args.headless
+        && args.screenshot.is_none()
+        && args.save_scene.is_none()
+        && !args.bench
+        && !args.compare
+    {
         return Err(ViewerError::Setting(FieldError::new(
             "--headless",
-            "needs --screenshot OUT.png (or --bench, or --compare)",
+            "needs --screenshot OUT.png (or --save-scene OUT.json, --bench or --compare)",
         )));
     }
-    let (scene, asset) = Asset::read(&args.file)?;
-    if !asset.surfaces_without_halo.is_empty() {
-        eprintln!(
-            "note: no halo for {}: those surfaces are never hidden (build with halo.enabled)",
-            asset.surfaces_without_halo.join(", ")
-        );
-    }
-    let recorded = asset.camera.unwrap_or_default();
+    let source = open(args.file.as_deref())?;
+    let view = match &source {
+        Source::Model(model) => {
+            let mut view = model.scene.view;
+            for (plane, degrees) in &args.rotate {
+                *view
+                    .rotation
+                    .angle_mut(plane)
+                    .expect("checked by the parser") += degrees;
+            }
+            Some(view)
+        }
+        Source::Asset(asset) => {
+            if !args.rotate.is_empty() || args.save_scene.is_some() {
+                return Err(ViewerError::Setting(FieldError::new(
+                    "--rotate",
+                    format!(
+                        "{} has no 4D mesh and turns only in 3D; open its scene file to turn it in 4D or save a view",
+                        asset.1.name
+                    ),
+                )));
+            }
+            if !asset.1.surfaces_without_halo.is_empty() {
+                eprintln!(
+                    "note: no halo for {}: those surfaces are never hidden (build with halo.enabled)",
+                    asset.1.surfaces_without_halo.join(", ")
+                );
+            }
+            None
+        }
+    };
+    let recorded = source.camera();
     let settings = ViewSettings {
         width: args.size.0,
         height: args.size.1,
@@ -167,15 +228,24 @@ fn run(args: &Args) -> Result<(), ViewerError> {
         },
     };
     settings.check()?;
+    if let (Some(out), Source::Model(model), Some(view)) = (&args.save_scene, &source, &view) {
+        let written = viewer::save_scene(&model.scene, view, &settings.camera, out)?;
+        println!(
+            "{}: scene `{}` in this view; build it with `halo4d build {}`",
+            out.display(),
+            written.name,
+            out.display()
+        );
+    }
     if args.bench {
-        return bench(&asset, &settings, args.frames);
+        return bench(&source, view.as_ref(), &settings, args.frames);
     }
     if args.compare {
-        return compare(&scene, &asset, &settings);
+        return compare(&source, view.as_ref(), &settings);
     }
     if let Some(out) = &args.screenshot {
         let gpu = Gpu::headless()?;
-        let frame = viewer::screenshot(&gpu, &asset, &settings)?;
+        let frame = viewer::screenshot_of(&gpu, &source, view.as_ref(), &settings)?;
         halo4d::internals::write_atomic(out, &frame.picture.png()).map_err(|e| {
             ViewerError::Write {
                 path: out.display().to_string(),
@@ -198,11 +268,35 @@ fn run(args: &Args) -> Result<(), ViewerError> {
         );
         return Ok(());
     }
+    if args.headless {
+        return Ok(());
+    }
     println!("{}", viewer::window::HELP);
-    viewer::window::run(asset, settings)
+    viewer::window::run(source, view, settings)
 }
 
-fn bench(asset: &Asset, settings: &ViewSettings, frames: u32) -> Result<(), ViewerError> {
+/// The scene or `.glb` at `path`, or the default scene.
+fn open(path: Option<&Path>) -> Result<Source, ViewerError> {
+    let Some(path) = path else {
+        return Ok(Source::Model(Model::new(Scene::default_scene())?.into()));
+    };
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+    {
+        let (scene, asset) = Asset::read(path)?;
+        return Ok(Source::Asset(Box::new((scene, asset))));
+    }
+    let scene = Scene::load(path).map_err(halo4d::Error::from)?;
+    Ok(Source::Model(Model::new(scene)?.into()))
+}
+
+fn bench(
+    source: &Source,
+    view: Option<&View>,
+    settings: &ViewSettings,
+    frames: u32,
+) -> Result<(), ViewerError> {
     if frames == 0 {
         return Err(ViewerError::Setting(FieldError::new(
             "--frames",
@@ -210,50 +304,62 @@ fn bench(asset: &Asset, settings: &ViewSettings, frames: u32) -> Result<(), View
         )));
     }
     let gpu = Gpu::headless()?;
+    let (triangles, tets) = match source {
+        Source::Model(m) => (m.triangle_count(), 6 * m.triangle_count()),
+        Source::Asset(a) => (a.1.triangle_count(), a.1.tet_count()),
+    };
     println!(
-        "{}: {} triangles, {} tetrahedra, {}x{}, {} frames per orbit, on {}",
-        asset.name,
-        asset.triangle_count(),
-        asset.tet_count(),
+        "{}: {triangles} triangles, {tets} tetrahedra, {}x{}, {frames} frames per motion, on {}",
+        source.name(),
         settings.width,
         settings.height,
-        frames,
         gpu.describe()
     );
     println!(
-        "| mode | slices | grid build (ms) | ms per frame (mean) | median | frames per second |"
+        "| motion | mode | slices | halo rebuild (ms) | grid build (ms) | ms per frame (mean) | median | frames per second |"
     );
-    println!("| --- | --- | --- | --- | --- | --- |");
-    viewer::bench(&gpu, asset, settings, &SLICE_COUNTS, frames, &mut |r| {
-        println!(
-            "| {} | {} | {} | {:.2} | {:.2} | {:.1} |",
-            r.mode.name(),
-            r.slices,
-            r.grid_ms.map_or_else(|| "-".into(), |g| format!("{g:.1}")),
-            r.mean_ms,
-            r.median_ms,
-            1e3 / r.mean_ms
-        );
-    })?;
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
+    let ms = |v: Option<f64>| v.map_or_else(|| "-".into(), |g| format!("{g:.1}"));
+    viewer::bench(
+        &gpu,
+        source,
+        view,
+        settings,
+        &SLICE_COUNTS,
+        frames,
+        &mut |r| {
+            println!(
+                "| {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.1} |",
+                r.motion.name(),
+                r.mode.name(),
+                r.slices,
+                ms(r.turn_ms),
+                ms(r.grid_ms),
+                r.mean_ms,
+                r.median_ms,
+                1e3 / r.mean_ms
+            );
+        },
+    )?;
     Ok(())
 }
 
 fn compare(
-    scene: &halo4d::ImportedScene,
-    asset: &Asset,
+    source: &Source,
+    view: Option<&View>,
     settings: &ViewSettings,
 ) -> Result<(), ViewerError> {
     let gpu = Gpu::headless()?;
     println!(
         "{}: {}x{}, against the CPU renderer's exact mode (one sample per pixel), on {}",
-        asset.name,
+        source.name(),
         settings.width,
         settings.height,
         gpu.describe()
     );
     println!("| mode | slices | verdict differs | ms (GPU frame) |");
     println!("| --- | --- | --- | --- |");
-    let (cpu_ms, _) = viewer::compare(&gpu, scene, asset, settings, &SLICE_COUNTS, &mut |r| {
+    let mut row = |r: &viewer::CompareRow| {
         println!(
             "| {} | {} | {:.3}% | {:.1} |",
             r.mode.name(),
@@ -261,7 +367,21 @@ fn compare(
             r.verdict_differs * 100.0,
             r.ms
         );
-    })?;
-    println!("exact CPU render: {cpu_ms:.0} ms");
+    };
+    match (source, view) {
+        (Source::Model(model), Some(view)) => {
+            let found =
+                viewer::compare_turned(&gpu, model, view, settings, &SLICE_COUNTS, &mut row)?;
+            println!(
+                "build and exact CPU render of the scene in this view: {:.0} ms; the build shrank rho at {} of {} vertices (the GPU's halos keep it)",
+                found.cpu_ms, found.shrunk, found.vertices
+            );
+        }
+        (Source::Asset(a), _) => {
+            let (cpu_ms, _) = viewer::compare(&gpu, &a.0, &a.1, settings, &SLICE_COUNTS, &mut row)?;
+            println!("exact CPU render: {cpu_ms:.0} ms");
+        }
+        (Source::Model(_), None) => unreachable!("a model always has a view"),
+    }
     Ok(())
 }

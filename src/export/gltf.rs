@@ -32,8 +32,8 @@
 //! record the scene as parsed and the build's verdict: `{"halo4d": {"scene", "verified",
 //! "failures"}}`.
 
+use super::SurfaceData;
 use super::tubes::tubes;
-use super::{SurfaceData, curve_segments};
 use crate::check::LAYERS;
 use crate::convention::{file_order, to_gltf};
 use crate::halo::Halo;
@@ -478,7 +478,7 @@ fn curves_mesh(
 ) -> Result<Option<json::Index<json::Mesh>>, String> {
     use json::accessor::Type::Scalar;
     use json::mesh::Semantic;
-    let segments: Vec<u32> = curve_segments(curves).into_iter().flatten().collect();
+    let segments: Vec<u32> = curves.segments().into_iter().flatten().collect();
     let tubes = tubes(curves, radius);
     if segments.is_empty() || tubes.triangles.is_empty() {
         return Ok(None);

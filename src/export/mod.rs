@@ -27,7 +27,6 @@ mod staged;
 pub use staged::{LOCK, Staged, StagedError};
 
 use crate::halo::{Halo, HaloParams};
-use crate::intersect::Curves;
 use crate::sample::Mesh4;
 use crate::view::Projected;
 use std::io::Write;
@@ -52,22 +51,6 @@ pub struct SurfaceData<'a> {
     pub halo_params: &'a HaloParams,
     /// The halo's half-width, absolute (before any local shrinking).
     pub rho: f64,
-}
-
-/// The line segments of `curves` as pairs of indices into their points, numbered curve
-/// after curve: consecutive points, and for a closed curve the last back to the first.
-fn curve_segments(curves: &Curves) -> Vec<[u32; 2]> {
-    let mut out = Vec::new();
-    let mut base = 0u32;
-    for c in &curves.curves {
-        let n = c.points.len() as u32;
-        out.extend((1..n).map(|k| [base + k - 1, base + k]));
-        if c.closed && n > 1 {
-            out.push([base + n - 1, base]);
-        }
-        base += n;
-    }
-    out
 }
 
 /// Writes `bytes` to `path` through a temporary file in the same folder and a rename.

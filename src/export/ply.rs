@@ -1,6 +1,6 @@
 //! Binary PLY of the projected surfaces and of the intersection curves, for MeshLab.
 
-use super::{SurfaceData, curve_segments};
+use super::SurfaceData;
 use crate::intersect::Curves;
 
 /// Builds a binary little-endian PLY with all surfaces in one mesh: per vertex x, y, z,
@@ -70,7 +70,7 @@ pub fn to_ply(surfaces: &[SurfaceData], scene_name: &str) -> Vec<u8> {
 /// and no edge.
 pub fn to_curves_ply(curves: &Curves, scene_name: &str) -> Vec<u8> {
     let vertices: usize = curves.curves.iter().map(|c| c.points.len()).sum();
-    let segments = curve_segments(curves);
+    let segments = curves.segments();
     let header = format!(
         "ply\nformat binary_little_endian 1.0\n\
          comment halo4d {}: scene {scene_name}; intersection curves, quality is w_far - w_near\n\

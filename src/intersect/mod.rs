@@ -196,6 +196,24 @@ pub struct Curves {
     pub report: CurvesReport,
 }
 
+impl Curves {
+    /// The line segments of the curves as pairs of indices into their points, numbered curve
+    /// after curve: consecutive points, and for a closed curve the last back to the first.
+    pub fn segments(&self) -> Vec<[u32; 2]> {
+        let mut out = Vec::new();
+        let mut base = 0u32;
+        for c in &self.curves {
+            let n = c.points.len() as u32;
+            out.extend((1..n).map(|k| [base + k - 1, base + k]));
+            if c.closed && n > 1 {
+                out.push([base + n - 1, base]);
+            }
+            base += n;
+        }
+        out
+    }
+}
+
 /// The intersection curves of `sheets`, with the BVH broad phase.
 pub fn curves(sheets: &[Sheet]) -> Curves {
     curves_with(sheets, BroadPhase::Bvh)

@@ -183,6 +183,50 @@ impl Gpu {
             },
         );
         self.queue.submit([encoder.finish()]);
+        let data = self.map_read(&buffer)?;
+        let mut out = Vec::with_capacity((w * h) as usize);
+        for y in 0..h as usize {
+            let line = &data[y * row as usize..][..4 * w as usize];
+            out.extend(line.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]));
+        }
+        Ok(out)
+    }
+
+    /// Reads the first `size` bytes of each of `buffers` (made with `COPY_SRC`) back, in
+    /// one copy and one wait.
+    pub(crate) fn read_buffers(
+        &self,
+        buffers: &[(&wgpu::Buffer, u64)],
+    ) -> Result<Vec<Vec<u8>>, ViewerError> {
+        let total: u64 = buffers.iter().map(|b| b.1.next_multiple_of(4)).sum();
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: total.max(4),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        let mut at = 0;
+        for &(buffer, size) in buffers {
+            let size = size.next_multiple_of(4);
+            encoder.copy_buffer_to_buffer(buffer, 0, &staging, at, size);
+            at += size;
+        }
+        self.queue.submit([encoder.finish()]);
+        let data = self.map_read(&staging)?;
+        let mut at = 0usize;
+        Ok(buffers
+            .iter()
+            .map(|&(_, size)| {
+                let part = data[at..at + size as usize].to_vec();
+                at += size.next_multiple_of(4) as usize;
+                part
+            })
+            .collect())
+    }
+
+    /// Waits for the GPU and maps `buffer` (made with `MAP_READ`): its bytes.
+    fn map_read(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>, ViewerError> {
         let slice = buffer.slice(..);
         let (tx, rx) = std::sync::mpsc::channel();
         slice.map_async(wgpu::MapMode::Read, move |r| {
@@ -194,14 +238,9 @@ impl Gpu {
             .map_err(|e| ViewerError::Gpu(e.to_string()))?;
         let data = slice
             .get_mapped_range()
-            .map_err(|e| ViewerError::Gpu(e.to_string()))?;
-        let mut out = Vec::with_capacity((w * h) as usize);
-        for y in 0..h as usize {
-            let line = &data[y * row as usize..][..4 * w as usize];
-            out.extend(line.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]));
-        }
-        drop(data);
+            .map_err(|e| ViewerError::Gpu(e.to_string()))?
+            .to_vec();
         buffer.unmap();
-        Ok(out)
+        Ok(data)
     }
 }

@@ -37,10 +37,12 @@
 
 mod gpu;
 mod renderer;
+mod turn;
 pub mod window;
 
 pub use gpu::Gpu;
 pub use renderer::{FrameTimes, Renderer};
+pub use turn::{Framing, Model};
 
 use crate::import::{ImportError, ImportedScene};
 use crate::limits::{
@@ -205,6 +207,12 @@ pub enum ViewerError {
     /// A camera cannot be placed.
     #[error(transparent)]
     Camera(#[from] RenderError),
+    /// The 4D view cannot be drawn (the surfaces behind the 4D eye, say).
+    #[error("the 4D view: {0}")]
+    View(String),
+    /// The scene cannot be sampled or built.
+    #[error(transparent)]
+    Scene(#[from] crate::error::Error),
     /// An output could not be written.
     #[error("cannot write {path}: {message}")]
     Write {
@@ -347,19 +355,7 @@ impl Asset {
         for s in &scene.surfaces {
             let base = vertices.len() as u32;
             let first_triangle = face_normals.len() as u32;
-            edges.extend(
-                interior_edges(&s.triangles)
-                    .into_iter()
-                    .map(|[a, b, i, j]| {
-                        let agree = j & AGREE;
-                        [
-                            a + base,
-                            b + base,
-                            i + first_triangle,
-                            ((j & !AGREE) + first_triangle) | agree,
-                        ]
-                    }),
-            );
+            push_edges(&mut edges, &s.triangles, base, first_triangle);
             face_normals.extend(s.triangles.iter().map(|t| {
                 let p = t.map(|v| s.positions[v as usize]);
                 let [x, y, z] = (p[1] - p[0]).cross(p[2] - p[0]).as_vec3().to_array();
@@ -458,7 +454,21 @@ impl Asset {
     }
 }
 
-/// Area-weighted vertex normals, for files without `NORMAL`.
+/// Appends the interior edges of a surface's `triangles` (see
+/// [`interior_edges`]) whose first vertex and triangle are `base` and `first_triangle` in the
+/// asset.
+fn push_edges(edges: &mut Vec<[u32; 4]>, triangles: &[[u32; 3]], base: u32, first_triangle: u32) {
+    edges.extend(interior_edges(triangles).into_iter().map(|[a, b, i, j]| {
+        let agree = j & AGREE;
+        [
+            a + base,
+            b + base,
+            i + first_triangle,
+            ((j & !AGREE) + first_triangle) | agree,
+        ]
+    }));
+}
+
 /// Per vertex, the largest |grad w| over the triangles around it (w linear on each), and
 /// the longest edge there.
 fn w_slopes(positions: &[DVec3], w: &[f64], triangles: &[[u32; 3]]) -> (Vec<f64>, Vec<f64>) {
@@ -590,37 +600,164 @@ pub fn screenshot(gpu: &Gpu, asset: &Asset, settings: &ViewSettings) -> Result<F
     renderer.read_frame(gpu, settings)
 }
 
-/// One line of [`bench()`]: a mode and slice count over a fixed orbit.
+/// What the viewer shows: a scene sampled in 4D (turned in 4D and 3D), or a scene's `.glb`
+/// (turned in 3D only).
+#[derive(Clone, Debug)]
+pub enum Source {
+    /// A scene, sampled in 4D.
+    Model(std::sync::Arc<Model>),
+    /// A scene's `.glb`: as imported, and as drawn.
+    Asset(Box<(ImportedScene, Asset)>),
+}
+
+impl Source {
+    /// The scene's name.
+    pub fn name(&self) -> &str {
+        match self {
+            Source::Model(m) => &m.scene.name,
+            Source::Asset(a) => &a.1.name,
+        }
+    }
+
+    /// The camera the scene records (the default where a `.glb` records none).
+    pub fn camera(&self) -> CameraSettings {
+        match self {
+            Source::Model(m) => m.scene.camera,
+            Source::Asset(a) => a.1.camera.unwrap_or_default(),
+        }
+    }
+
+    /// A renderer of the source into `format`: a model turned to `view` (its scene's when
+    /// `None`), with its curves in that view when `curves` (computed here, on the CPU).
+    pub fn renderer(
+        &self,
+        gpu: &Gpu,
+        view: Option<&crate::view::View>,
+        curves: bool,
+        format: wgpu::TextureFormat,
+    ) -> Result<Renderer, ViewerError> {
+        match self {
+            Source::Asset(a) => Renderer::new(gpu, &a.1, format),
+            Source::Model(m) => {
+                let view = view.unwrap_or(&m.scene.view);
+                let mut renderer = Renderer::for_model(gpu, m, view, format)?;
+                if curves {
+                    renderer.set_curves(gpu, &m.curves(view)?)?;
+                }
+                Ok(renderer)
+            }
+        }
+    }
+}
+
+/// Renders one frame of `source` offscreen (a model in `view`, with its curves).
+pub fn screenshot_of(
+    gpu: &Gpu,
+    source: &Source,
+    view: Option<&crate::view::View>,
+    settings: &ViewSettings,
+) -> Result<Frame, ViewerError> {
+    settings.check()?;
+    let mut renderer = source.renderer(gpu, view, settings.curves, renderer::OFFSCREEN_FORMAT)?;
+    renderer.read_frame(gpu, settings)
+}
+
+/// Writes `scene` with `view` and `camera` to `path` (atomically), named after the file
+/// where that is a valid scene name (else `<name>-view`), so that `halo4d build` builds the
+/// verified asset of that view. The scene written.
+pub fn save_scene(
+    scene: &crate::scene::Scene,
+    view: &crate::view::View,
+    camera: &CameraSettings,
+    path: &Path,
+) -> Result<crate::scene::Scene, ViewerError> {
+    let mut saved = crate::scene::Scene {
+        view: *view,
+        camera: *camera,
+        ..scene.clone()
+    };
+    saved.name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .filter(|stem| {
+            let named = crate::scene::Scene {
+                name: stem.clone(),
+                ..saved.clone()
+            };
+            named.validate().is_ok()
+        })
+        .unwrap_or_else(|| format!("{}-view", scene.name));
+    saved.validate()?;
+    let text = serde_json::to_string_pretty(&saved).map_err(|e| ViewerError::Write {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    crate::export::write_atomic(path, format!("{text}\n").as_bytes()).map_err(|e| {
+        ViewerError::Write {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        }
+    })?;
+    Ok(saved)
+}
+
+/// What a bench row times.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BenchMotion {
+    /// The 3D camera orbits; the halos stay.
+    Orbit,
+    /// The 4D view turns (zw swinging 30 degrees either way): every frame rebuilds the
+    /// surfaces and halos on the GPU (and the grid, in grid mode).
+    Turn4d,
+}
+
+impl BenchMotion {
+    /// Its name in the bench's table.
+    pub fn name(self) -> &'static str {
+        match self {
+            BenchMotion::Orbit => "3D orbit",
+            BenchMotion::Turn4d => "4D turn",
+        }
+    }
+}
+
+/// One line of [`bench()`]: a motion, a mode and a slice count.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BenchRow {
+    /// What moves.
+    pub motion: BenchMotion,
     /// How the halo depth was sliced.
     pub mode: HaloMode,
     /// Slices.
     pub slices: u32,
-    /// Building the grid (grid mode), once before the orbit.
+    /// Building the grid (grid mode): once before an orbit; the mean per frame of a 4D turn.
     pub grid_ms: Option<f64>,
+    /// The mean per frame of rebuilding the surfaces and halos (a 4D turn).
+    pub turn_ms: Option<f64>,
     /// Frames rendered.
     pub frames: u32,
-    /// Mean milliseconds per frame, from the first command to the GPU finishing it.
+    /// Mean milliseconds per frame, from the first command to the GPU finishing it (the
+    /// rebuild and the grid included for a 4D turn).
     pub mean_ms: f64,
     /// Median milliseconds per frame.
     pub median_ms: f64,
 }
 
-/// Renders `frames` frames on a full orbit (azimuth in equal steps from the settings') for
-/// each mode and each of `slices`, offscreen, after one frame that is not counted (and
-/// before each mode's first slice count, a whole orbit that is not).
-/// `progress` hears of each row.
+/// Renders `frames` frames of each motion the source allows (a 3D orbit, azimuth in equal
+/// steps from the settings'; for a model also a 4D turn from `view`) for each mode and each
+/// of `slices`, offscreen, after one frame that is not counted (and before each mode's
+/// first slice count, a whole orbit that is not). `progress` hears of each row.
 pub fn bench(
     gpu: &Gpu,
-    asset: &Asset,
+    source: &Source,
+    view: Option<&crate::view::View>,
     settings: &ViewSettings,
     slices: &[u32],
     frames: u32,
     progress: &mut dyn FnMut(&BenchRow),
 ) -> Result<Vec<BenchRow>, ViewerError> {
     settings.check()?;
-    let mut renderer = Renderer::new(gpu, asset, renderer::OFFSCREEN_FORMAT)?;
+    let mut renderer = source.renderer(gpu, view, settings.curves, renderer::OFFSCREEN_FORMAT)?;
     let target = renderer::frame_texture(
         gpu,
         "bench frame",
@@ -628,8 +765,9 @@ pub fn bench(
         renderer::OFFSCREEN_FORMAT,
         wgpu::TextureUsages::RENDER_ATTACHMENT,
     );
-    let view = target.create_view(&Default::default());
+    let target = target.create_view(&Default::default());
     let mut rows = Vec::new();
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
     for mode in [HaloMode::Grid, HaloMode::View] {
         for &n in slices {
             let mut s = ViewSettings {
@@ -637,35 +775,71 @@ pub fn bench(
                 slices: n,
                 ..*settings
             };
-            let grid_ms = renderer.render(gpu, &view, &s)?.grid_ms;
+            let grid_ms = renderer.render(gpu, &target, &s)?.grid_ms;
             let orbit = |f: u32| settings.camera.azimuth + 360.0 * f64::from(f) / f64::from(frames);
             if n == slices[0] {
                 // A whole orbit first, untimed: drivers finish compiling shaders on the
                 // first frames that need them (lavapipe does, over several frames).
                 for f in 0..frames {
                     s.camera.azimuth = orbit(f);
-                    renderer.render(gpu, &view, &s)?;
+                    renderer.render(gpu, &target, &s)?;
                 }
             }
             let mut times = Vec::with_capacity(frames as usize);
             for f in 0..frames {
                 s.camera.azimuth = orbit(f);
-                times.push(renderer.render(gpu, &view, &s)?.frame_ms);
+                times.push(renderer.render(gpu, &target, &s)?.frame_ms);
             }
-            times.sort_by(f64::total_cmp);
             let row = BenchRow {
+                motion: BenchMotion::Orbit,
                 mode,
                 slices: n,
                 grid_ms,
+                turn_ms: None,
                 frames,
-                mean_ms: times.iter().sum::<f64>() / times.len().max(1) as f64,
-                median_ms: times.get(times.len() / 2).copied().unwrap_or(0.0),
+                mean_ms: mean(&times),
+                median_ms: median(&mut times),
+            };
+            progress(&row);
+            rows.push(row);
+            let Source::Model(model) = source else {
+                continue;
+            };
+            let start = *view.unwrap_or(&model.scene.view);
+            s.camera = settings.camera;
+            let (mut times, mut turns, mut grids) = (Vec::new(), Vec::new(), Vec::new());
+            for f in 0..frames {
+                let mut v = start;
+                v.rotation.zw +=
+                    30.0 * (std::f64::consts::TAU * f64::from(f + 1) / f64::from(frames)).sin();
+                let clock = std::time::Instant::now();
+                turns.push(renderer.turn(gpu, model, &v)?);
+                let frame = renderer.render(gpu, &target, &s)?;
+                grids.push(frame.grid_ms.unwrap_or(0.0));
+                times.push(clock.elapsed().as_secs_f64() * 1e3);
+            }
+            renderer.turn(gpu, model, &start)?;
+            let row = BenchRow {
+                motion: BenchMotion::Turn4d,
+                mode,
+                slices: n,
+                grid_ms: (mode == HaloMode::Grid).then(|| mean(&grids)),
+                turn_ms: Some(mean(&turns)),
+                frames,
+                mean_ms: mean(&times),
+                median_ms: median(&mut times),
             };
             progress(&row);
             rows.push(row);
         }
     }
     Ok(rows)
+}
+
+/// The median of `v` (sorted in place); 0 when empty.
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(0.0)
 }
 
 /// One line of [`compare`]: a mode and slice count against the exact CPU render.
@@ -698,6 +872,66 @@ pub fn compare(
     progress: &mut dyn FnMut(&CompareRow),
 ) -> Result<(f64, Vec<CompareRow>), ViewerError> {
     settings.check()?;
+    let no_curves = crate::intersect::Curves::default();
+    let (exact, cpu_ms) = exact_distances(&scene.parts(&no_curves), settings)?;
+    let mut renderer = Renderer::new(gpu, asset, renderer::OFFSCREEN_FORMAT)?;
+    let rows = compare_rows(gpu, &mut renderer, &exact, settings, slices, progress)?;
+    Ok((cpu_ms, rows))
+}
+
+/// What [`compare_turned`] found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TurnedComparison {
+    /// The CPU's milliseconds: building the scene in the view and its exact render.
+    pub cpu_ms: f64,
+    /// One row per GPU mode and slice count.
+    pub rows: Vec<CompareRow>,
+    /// Surface vertices, all surfaces.
+    pub vertices: usize,
+    /// Of those, where the build shrank rho (or collapsed it, or found no offset direction):
+    /// the only places the GPU's halos (rho everywhere) may differ from the build's.
+    pub shrunk: usize,
+}
+
+/// [`compare`] for a model turned to `view` on the GPU, against `halo4d render --mode
+/// exact` of the model's scene with `view` written into it (built from scratch).
+pub fn compare_turned(
+    gpu: &Gpu,
+    model: &Model,
+    view: &crate::view::View,
+    settings: &ViewSettings,
+    slices: &[u32],
+    progress: &mut dyn FnMut(&CompareRow),
+) -> Result<TurnedComparison, ViewerError> {
+    settings.check()?;
+    let start = std::time::Instant::now();
+    let scene = crate::scene::Scene {
+        view: *view,
+        ..model.scene.clone()
+    };
+    let built = crate::pipeline::run_for_picture(&scene, true)?;
+    let parts = built.parts(&scene.halo);
+    let (exact, _) = exact_distances(&parts, settings)?;
+    let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+    let mut renderer = Renderer::for_model(gpu, model, view, renderer::OFFSCREEN_FORMAT)?;
+    let rows = compare_rows(gpu, &mut renderer, &exact, settings, slices, progress)?;
+    let reports = built.surfaces.iter().map(|s| &s.halo_report);
+    Ok(TurnedComparison {
+        cpu_ms,
+        rows,
+        vertices: model.vertex_count(),
+        shrunk: reports
+            .map(|r| r.shrunk_vertices + r.singular_vertices)
+            .sum(),
+    })
+}
+
+/// The CPU renderer's exact mode at the settings' size and camera, one sample per pixel,
+/// no lines: per pixel the distance to the first visible surface; and its milliseconds.
+fn exact_distances(
+    parts: &crate::parts::Parts,
+    settings: &ViewSettings,
+) -> Result<(Vec<f64>, f64), ViewerError> {
     let cpu_settings = crate::render::RenderSettings {
         width: settings.width,
         height: settings.height,
@@ -709,15 +943,21 @@ pub fn compare(
         colormap: settings.colormap,
         ..Default::default()
     };
-    let no_curves = crate::intersect::Curves::default();
     let start = std::time::Instant::now();
-    let exact = crate::render::render_with_depth(
-        &scene.parts(&no_curves),
-        &cpu_settings,
-        &settings.camera,
-    )?;
-    let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
-    let mut renderer = Renderer::new(gpu, asset, renderer::OFFSCREEN_FORMAT)?;
+    let exact = crate::render::render_with_depth(parts, &cpu_settings, &settings.camera)?;
+    Ok((exact.1, start.elapsed().as_secs_f64() * 1e3))
+}
+
+/// Renders with `renderer` in each mode and each of `slices` (no lines, one sample per
+/// pixel) and compares each frame's distances with `exact`.
+fn compare_rows(
+    gpu: &Gpu,
+    renderer: &mut Renderer,
+    exact: &[f64],
+    settings: &ViewSettings,
+    slices: &[u32],
+    progress: &mut dyn FnMut(&CompareRow),
+) -> Result<Vec<CompareRow>, ViewerError> {
     let mut rows = Vec::new();
     for mode in [HaloMode::Grid, HaloMode::View] {
         for &n in slices {
@@ -736,12 +976,12 @@ pub fn compare(
             let row = CompareRow {
                 mode,
                 slices: n,
-                verdict_differs: crate::render::compare::verdict_differs(&exact.1, &distance, 1e-4),
+                verdict_differs: crate::render::compare::verdict_differs(exact, &distance, 1e-4),
                 ms,
             };
             progress(&row);
             rows.push(row);
         }
     }
-    Ok((cpu_ms, rows))
+    Ok(rows)
 }

@@ -1,8 +1,14 @@
 //! Pipelines, targets and the passes of a frame.
 
-use super::{Asset, Frame, Gpu, GpuCamera, HaloMode, ViewSettings, ViewerError, bounding_radius};
+use super::turn::Turner;
+use super::{
+    Asset, Frame, Gpu, GpuCamera, HaloMode, HaloVertex, Model, SurfaceVertex, ViewSettings,
+    ViewerError, bounding_radius,
+};
+use crate::intersect::Curves;
 use crate::limits::FieldError;
 use crate::render::{Picture, shade};
+use crate::view::View;
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
 use std::time::Instant;
@@ -112,6 +118,8 @@ pub struct Renderer {
     empty_grid: wgpu::TextureView,
     grid: Option<Grid>,
     targets: Option<Targets>,
+    /// The model's passes, when the renderer turns a model in 4D.
+    turner: Option<Turner>,
 }
 
 impl Renderer {
@@ -128,7 +136,7 @@ impl Renderer {
         let vertices = gpu.buffer(
             "surface vertices",
             bytemuck::cast_slice(&asset.vertices),
-            storage,
+            storage | U::COPY_SRC,
         )?;
         let triangles = gpu.buffer(
             "surface triangles",
@@ -148,7 +156,7 @@ impl Renderer {
         let halo_vertices = gpu.buffer(
             "halo vertices",
             bytemuck::cast_slice(&asset.halo_vertices),
-            storage,
+            storage | U::COPY_SRC,
         )?;
         let tets = gpu.buffer(
             "halo tetrahedra",
@@ -400,7 +408,93 @@ impl Renderer {
             empty_grid,
             grid: None,
             targets: None,
+            turner: None,
         })
+    }
+
+    /// Uploads `model` and draws it in the 4D `view`.
+    pub fn for_model(
+        gpu: &Gpu,
+        model: &Model,
+        view: &View,
+        colour_format: wgpu::TextureFormat,
+    ) -> Result<Renderer, ViewerError> {
+        let mut renderer = Renderer::new(gpu, &model.asset(), colour_format)?;
+        renderer.turner = Some(Turner::new(gpu, model)?);
+        renderer.turn(gpu, model, view)?;
+        Ok(renderer)
+    }
+
+    /// Rebuilds the surfaces and halos of `model` (the one this renderer was made for) in
+    /// the 4D `view` on the GPU and reads them back (the view mode's slab lists and the
+    /// grid's voxelization read the positions); the curves are dropped until
+    /// [`Renderer::set_curves`] gives the view's. Milliseconds it took.
+    pub fn turn(&mut self, gpu: &Gpu, model: &Model, view: &View) -> Result<f64, ViewerError> {
+        let start = Instant::now();
+        let turner = self
+            .turner
+            .as_ref()
+            .ok_or_else(|| ViewerError::View("this asset has no 4D mesh to turn".into()))?;
+        let framing = model.framing(view)?;
+        turner.run(
+            gpu,
+            &model.scene,
+            view,
+            &framing,
+            (&self.vertices, &self.halo_vertices, &self.face_normals),
+        )?;
+        let bytes = |n: usize, size: usize| (n * size) as u64;
+        let back = gpu.read_buffers(&[
+            (
+                &self.vertices,
+                bytes(self.asset.vertices.len(), size_of::<SurfaceVertex>()),
+            ),
+            (
+                &self.halo_vertices,
+                bytes(self.asset.halo_vertices.len(), size_of::<HaloVertex>()),
+            ),
+        ])?;
+        self.asset.vertices = bytemuck::pod_collect_to_vec(&back[0]);
+        self.asset.halo_vertices = bytemuck::pod_collect_to_vec(&back[1]);
+        self.asset.bounds = framing.bounds;
+        self.asset.w_range = framing.w_range;
+        self.asset.depth_range = framing.depth_range;
+        self.asset.curve_points.clear();
+        self.asset.curve_segments.clear();
+        self.grid = None;
+        Ok(start.elapsed().as_secs_f64() * 1e3)
+    }
+
+    /// Draws `curves` (of the view the renderer was last turned to).
+    pub fn set_curves(&mut self, gpu: &Gpu, curves: &Curves) -> Result<(), ViewerError> {
+        let centre = self.asset.centre();
+        self.asset.curve_points = curves
+            .curves
+            .iter()
+            .flat_map(|c| &c.points)
+            .map(|p| {
+                let [x, y, z] = (p.position - centre).as_vec3().to_array();
+                [x, y, z, p.w[0].min(p.w[1]) as f32]
+            })
+            .collect();
+        self.asset.curve_segments = curves.segments();
+        // Curves come once per settled view: new buffers of their size.
+        self.curve_points = gpu.buffer(
+            "curve points",
+            bytemuck::cast_slice(&self.asset.curve_points),
+            wgpu::BufferUsages::STORAGE,
+        )?;
+        self.curve_segments = gpu.buffer(
+            "curve segments",
+            bytemuck::cast_slice(&self.asset.curve_segments),
+            wgpu::BufferUsages::STORAGE,
+        )?;
+        Ok(())
+    }
+
+    /// The asset as drawn now (after the last turn).
+    pub fn asset(&self) -> &Asset {
+        &self.asset
     }
 
     /// Renders one frame into `target` (a view of a texture of `colour_format`, of the

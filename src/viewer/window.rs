@@ -1,39 +1,70 @@
-//! The interactive window: an orbit camera around the scene, keys for the settings, the
-//! settings and frame time in the title.
+//! The interactive window: an orbit camera around the scene and, for a scene file, its 4D
+//! view turned live (the halos rebuilt on the GPU when the 4D view changes, the exact curves
+//! computed on the CPU in the background once it stops); keys for the settings; the
+//! settings, the 4D view and the frame time in the title.
 //!
-//! Drag with the left button to turn (azimuth, elevation), wheel to zoom, `R` to reset the
-//! camera (the title shows it, in `halo4d render`'s terms), `S` to cycle the slice count
-//! (64, 128, 256, 512), `M` to switch between the grid and view-slice modes, `H` halos, `C`
-//! curves, `O` silhouettes (outlines), `T` transparency, `W` colour by w, `Escape` or `Q`
-//! to quit.
+//! Drag with the left button to turn the camera (azimuth, elevation), wheel to zoom, `R` to
+//! reset the camera (the title shows it, in `halo4d render`'s terms), `S` to cycle the slice
+//! count (64, 128, 256, 512), `M` to switch between the grid and view-slice modes, `H` halos,
+//! `C` curves, `O` silhouettes (outlines), `T` transparency, `W` colour by w, `Escape` or `Q`
+//! to quit. In 4D (a scene file): Shift + drag turns the direction of the drag on the screen
+//! towards w (Hanson's rolling ball); the keys `1` to `6` turn the planes xy, xz, xw, yz, yw
+//! and zw by 15 degrees (with Shift, back); `[` and `]` move the surfaces along w; `P`
+//! switches the 4D projection between orthographic and perspective; `V` resets the 4D view;
+//! `F` writes the current view as a scene file (`exports/views/<name>-<k>.json`) and `B`
+//! builds it in the background (`exports/<name>-<k>/`), its verification in the title. The
+//! title shows the 4D view in the scene file's terms.
 
-use super::{Asset, Gpu, HaloMode, Renderer, SLICE_COUNTS, ViewSettings, ViewerError};
+use super::{Gpu, HaloMode, Renderer, SLICE_COUNTS, Source, ViewSettings, ViewerError};
+use crate::intersect::Curves;
+use crate::view::{Projection, View};
+use std::path::PathBuf;
 use std::sync::Arc;
+use std::sync::mpsc::{Receiver, channel};
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
-use winit::keyboard::{Key, NamedKey};
+use winit::keyboard::{Key, KeyCode, ModifiersState, NamedKey, PhysicalKey};
 use winit::window::{Window, WindowId};
 
 /// The window's help, printed when it opens.
-pub const HELP: &str = "drag: turn | wheel: zoom | R: reset camera | S: slices | M: grid/view mode | H: halos | C: curves | O: silhouettes | T: transparency | W: colour by w | Q/Esc: quit";
+pub const HELP: &str = "drag: turn | wheel: zoom | R: reset camera | S: slices | M: grid/view mode | H: halos | C: curves | O: silhouettes | T: transparency | W: colour by w | Q/Esc: quit\n4D (a scene file): Shift+drag: turn towards w | 1-6: turn xy xz xw yz yw zw by 15 degrees (Shift: back) | [ ]: move along w | P: 4D perspective/orthographic | V: reset the 4D view | F: save the view as a scene | B: build the saved view";
 
-/// Opens a window on `asset` with `settings` (its size the window's first size) and runs
-/// until it is closed.
-pub fn run(asset: Asset, settings: ViewSettings) -> Result<(), ViewerError> {
+/// Degrees a plane key turns.
+const STEP: f64 = 15.0;
+/// Degrees of a 4D or 3D turn per pixel dragged.
+const DRAG: f64 = 0.4;
+
+/// Opens a window on `source` with `settings` (its size the window's first size), a model
+/// in the 4D `view` (its scene's when `None`), and runs until it is closed.
+pub fn run(source: Source, view: Option<View>, settings: ViewSettings) -> Result<(), ViewerError> {
     settings.check()?;
     let event_loop = EventLoop::new()
         .map_err(|e| ViewerError::NoAdapter(format!("no display to open a window on: {e}")))?;
+    let view = match &source {
+        Source::Model(m) => Some(view.unwrap_or(m.scene.view)),
+        Source::Asset(_) => None,
+    };
     let mut app = App {
-        asset,
+        source,
         initial: settings,
         settings,
+        initial_view: view,
+        view,
+        drawn_view: view,
         state: None,
         error: None,
         drag: None,
         cursor: (0.0, 0.0),
+        modifiers: ModifiersState::default(),
         last_ms: 0.0,
+        turn_ms: None,
         last_good: settings,
+        curves: CurveJob::default(),
+        saved: None,
+        saves: 0,
+        build: None,
+        note: String::new(),
     };
     event_loop
         .run_app(&mut app)
@@ -49,23 +80,47 @@ struct State {
     renderer: Renderer,
 }
 
+/// The exact curves of a view, computed on the CPU in the background: at most one job at a
+/// time; one finished for a view no longer shown is dropped and the current view's started.
+#[derive(Default)]
+struct CurveJob {
+    running: Option<Receiver<(View, Result<Curves, ViewerError>)>>,
+    /// The view whose curves the renderer draws.
+    shown: Option<View>,
+}
+
 struct App {
-    asset: Asset,
+    source: Source,
     initial: ViewSettings,
     settings: ViewSettings,
+    /// The 4D view it opened in, the one asked for, and the one drawn (a model only).
+    initial_view: Option<View>,
+    view: Option<View>,
+    drawn_view: Option<View>,
     state: Option<State>,
     error: Option<ViewerError>,
     drag: Option<(f64, f64)>,
     cursor: (f64, f64),
+    modifiers: ModifiersState,
     last_ms: f64,
+    /// What the last 4D turn cost, while it is the frame's news.
+    turn_ms: Option<f64>,
     /// The last settings that rendered.
     last_good: ViewSettings,
+    curves: CurveJob,
+    /// The last scene saved with `F`.
+    saved: Option<(crate::scene::Scene, PathBuf)>,
+    saves: u32,
+    /// A build running in the background: its outcome in words.
+    build: Option<Receiver<String>>,
+    /// The last message for the title (a save, a build's outcome, a refused view).
+    note: String,
 }
 
 impl App {
     fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<State, ViewerError> {
         let attributes = Window::default_attributes()
-            .with_title(format!("halo4d-view: {}", self.asset.name))
+            .with_title(format!("halo4d-view: {}", self.source.name()))
             .with_inner_size(winit::dpi::PhysicalSize::new(
                 self.settings.width,
                 self.settings.height,
@@ -90,7 +145,9 @@ impl App {
             config.format = srgb;
         }
         surface.configure(&gpu.device, &config);
-        let renderer = Renderer::new(&gpu, &self.asset, config.format)?;
+        let renderer = self
+            .source
+            .renderer(&gpu, self.view.as_ref(), false, config.format)?;
         Ok(State {
             window,
             surface,
@@ -104,6 +161,52 @@ impl App {
         let Some(state) = &mut self.state else {
             return Ok(());
         };
+        // A new 4D view: the surfaces and halos rebuilt on the GPU (a view that cannot be
+        // drawn is refused, the last one kept, the reason in the title).
+        if let (Source::Model(model), Some(view)) = (&self.source, self.view)
+            && self.drawn_view != Some(view)
+        {
+            match state.renderer.turn(&state.gpu, model, &view) {
+                Ok(ms) => {
+                    self.drawn_view = Some(view);
+                    self.turn_ms = Some(ms);
+                }
+                Err(e @ ViewerError::View(_)) => {
+                    self.note = e.to_string();
+                    self.view = self.drawn_view;
+                }
+                Err(e) => return Err(e),
+            }
+        }
+        // The curves: the finished job's, when they are of the view drawn; a new job when
+        // the drawn view has none and none is running.
+        if let Some(rx) = &self.curves.running
+            && let Ok((view, curves)) = rx.try_recv()
+        {
+            self.curves.running = None;
+            if Some(view) == self.drawn_view {
+                state.renderer.set_curves(&state.gpu, &curves?)?;
+                self.curves.shown = Some(view);
+            }
+        }
+        if let (Source::Model(model), Some(view)) = (&self.source, self.drawn_view)
+            && self.curves.running.is_none()
+            && self.curves.shown != Some(view)
+        {
+            let (tx, rx) = channel();
+            let (model, window) = (Arc::clone(model), Arc::clone(&state.window));
+            std::thread::spawn(move || {
+                let _ = tx.send((view, model.curves(&view)));
+                window.request_redraw();
+            });
+            self.curves.running = Some(rx);
+        }
+        if let Some(rx) = &self.build
+            && let Ok(outcome) = rx.try_recv()
+        {
+            self.note = outcome;
+            self.build = None;
+        }
         let frame = match state.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(f)
             | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
@@ -137,9 +240,28 @@ impl App {
         self.last_ms = times.frame_ms;
         let s = &self.settings;
         let on = |b: bool| if b { "on" } else { "off" };
+        let four = match self.drawn_view {
+            None => String::new(),
+            Some(v) => format!(
+                " | 4D {}{}{} | {}",
+                describe(&v),
+                self.turn_ms
+                    .map_or_else(String::new, |ms| format!(" (halos rebuilt in {ms:.0} ms)")),
+                if self.note.is_empty() {
+                    String::new()
+                } else {
+                    format!(" | {}", self.note)
+                },
+                if !s.curves || self.curves.shown == Some(v) {
+                    "settled"
+                } else {
+                    "computing the curves"
+                }
+            ),
+        };
         state.window.set_title(&format!(
-            "halo4d-view: {} | {} {} slices | {} spp | halos {} | curves {} | silhouettes {} | {} | colour {} | azimuth {:.0} elevation {:.0} distance {:.2} | {:.1} ms{}",
-            self.asset.name,
+            "halo4d-view: {} | {} {} slices | {} spp | halos {} | curves {} | silhouettes {} | {} | colour {} | azimuth {:.0} elevation {:.0} distance {:.2} | {:.1} ms{}{four}",
+            self.source.name(),
             s.mode.name(),
             s.slices,
             s.samples,
@@ -160,7 +282,10 @@ impl App {
     }
 
     /// Applies a key; whether it changed anything.
-    fn key(&mut self, key: &Key, event_loop: &ActiveEventLoop) -> bool {
+    fn key(&mut self, key: &Key, physical: PhysicalKey, event_loop: &ActiveEventLoop) -> bool {
+        if self.key_4d(key, physical) {
+            return true;
+        }
         let s = &mut self.settings;
         match key {
             Key::Named(NamedKey::Escape) => event_loop.exit(),
@@ -188,6 +313,161 @@ impl App {
         }
         true
     }
+
+    /// Applies a key of the 4D view; whether it was one (a model only).
+    fn key_4d(&mut self, key: &Key, physical: PhysicalKey) -> bool {
+        let (Source::Model(model), Some(view)) = (&self.source, &mut self.view) else {
+            return false;
+        };
+        let sign = if self.modifiers.shift_key() {
+            -1.0
+        } else {
+            1.0
+        };
+        let plane = match physical {
+            PhysicalKey::Code(KeyCode::Digit1) => Some("xy"),
+            PhysicalKey::Code(KeyCode::Digit2) => Some("xz"),
+            PhysicalKey::Code(KeyCode::Digit3) => Some("xw"),
+            PhysicalKey::Code(KeyCode::Digit4) => Some("yz"),
+            PhysicalKey::Code(KeyCode::Digit5) => Some("yw"),
+            PhysicalKey::Code(KeyCode::Digit6) => Some("zw"),
+            _ => None,
+        };
+        if let Some(plane) = plane {
+            let angle = view.rotation.angle_mut(plane).expect("a plane of R^4");
+            *angle = wrap(*angle + sign * STEP);
+            self.note.clear();
+            return true;
+        }
+        let Key::Character(c) = key else {
+            return false;
+        };
+        let reach = model.radius_4d();
+        match c.to_lowercase().as_str() {
+            "[" => view.translation[3] -= 0.05 * reach,
+            "]" => view.translation[3] += 0.05 * reach,
+            "v" => *view = self.initial_view.expect("a model has a view"),
+            "p" => {
+                view.projection = match view.projection {
+                    Projection::Perspective { .. } => Projection::Orthographic,
+                    Projection::Orthographic => match model.scene.view.projection {
+                        p @ Projection::Perspective { .. } => p,
+                        // The eye three 4D radii away from the hyperplane w = 0.
+                        Projection::Orthographic => Projection::Perspective {
+                            eye_distance: 3.0 * reach,
+                        },
+                    },
+                }
+            }
+            "f" => {
+                let (view, camera) = (*view, self.settings.camera);
+                self.saves += 1;
+                let path = PathBuf::from("exports/views")
+                    .join(format!("{}-{}.json", model.scene.name, self.saves));
+                self.note = match std::fs::create_dir_all("exports/views")
+                    .map_err(|e| ViewerError::Write {
+                        path: "exports/views".into(),
+                        message: e.to_string(),
+                    })
+                    .and_then(|()| super::save_scene(&model.scene, &view, &camera, &path))
+                {
+                    Ok(scene) => {
+                        let note = format!("saved {}", path.display());
+                        self.saved = Some((scene, path));
+                        note
+                    }
+                    Err(e) => e.to_string(),
+                };
+                return true;
+            }
+            "b" => {
+                let Some((scene, path)) = self.saved.clone() else {
+                    self.note = "nothing saved to build: press F first".into();
+                    return true;
+                };
+                if self.build.is_some() {
+                    self.note = "a build is running".into();
+                    return true;
+                }
+                let out = PathBuf::from("exports").join(&scene.name);
+                let window = self.state.as_ref().map(|s| Arc::clone(&s.window));
+                let (tx, rx) = channel();
+                self.note = format!("building {}", path.display());
+                std::thread::spawn(move || {
+                    let outcome = match crate::pipeline::build(&scene, &out, true) {
+                        Ok(report) if report.verified => {
+                            format!("built {} from {}: verified", out.display(), path.display())
+                        }
+                        Ok(report) => format!(
+                            "built {}: NOT verified: {}",
+                            out.display(),
+                            report.failures.join("; ")
+                        ),
+                        Err(e) => format!("the build of {} failed: {e}", path.display()),
+                    };
+                    let _ = tx.send(outcome);
+                    if let Some(w) = window {
+                        w.request_redraw();
+                    }
+                });
+                self.build = Some(rx);
+                return true;
+            }
+            _ => return false,
+        }
+        self.note.clear();
+        true
+    }
+
+    /// A drag of (dx, dy) pixels with Shift: the 4D rolling ball.
+    fn roll(&mut self, dx: f64, dy: f64) -> bool {
+        let (Some(view), Some(state)) = (&mut self.view, &self.state) else {
+            return false;
+        };
+        let Ok(camera) = crate::render::camera::Camera::new(
+            &self.settings.camera,
+            state.renderer.asset().bounds,
+            self.settings.width,
+            self.settings.height,
+            0.0,
+        ) else {
+            return false;
+        };
+        let towards = camera.right * dx - camera.up * dy;
+        if towards.length() == 0.0 {
+            return false;
+        }
+        view.rotation = view.rotation.rolled(towards, DRAG * dx.hypot(dy));
+        self.note.clear();
+        true
+    }
+}
+
+/// An angle in (-180, 180].
+fn wrap(degrees: f64) -> f64 {
+    let d = degrees.rem_euclid(360.0);
+    if d > 180.0 { d - 360.0 } else { d }
+}
+
+/// A 4D view in the scene file's terms.
+fn describe(v: &View) -> String {
+    let angles: Vec<String> = v
+        .rotation
+        .planes()
+        .iter()
+        .map(|(name, a)| format!("{name} {a:.0}"))
+        .collect();
+    let [x, y, z, w] = v.translation;
+    let shift = if v.translation == [0.0; 4] {
+        String::new()
+    } else {
+        format!(" translation [{x:.2}, {y:.2}, {z:.2}, {w:.2}]")
+    };
+    let projection = match v.projection {
+        Projection::Orthographic => "orthographic".to_string(),
+        Projection::Perspective { eye_distance } => format!("perspective eye {eye_distance:.2}"),
+    };
+    format!("{}{shift} {projection}", angles.join(" "))
 }
 
 impl ApplicationHandler for App {
@@ -235,9 +515,16 @@ impl ApplicationHandler for App {
             } => {
                 self.drag = (pressed == ElementState::Pressed).then_some(self.cursor);
             }
+            WindowEvent::ModifiersChanged(m) => self.modifiers = m.state(),
             WindowEvent::CursorMoved { position, .. } => {
                 self.cursor = (position.x, position.y);
-                if let Some((x, y)) = self.drag {
+                if let Some((x, y)) = self.drag
+                    && self.modifiers.shift_key()
+                    && self.view.is_some()
+                {
+                    redraw = self.roll(position.x - x, position.y - y);
+                    self.drag = Some(self.cursor);
+                } else if let Some((x, y)) = self.drag {
                     let c = &mut self.settings.camera;
                     c.azimuth = (c.azimuth - (position.x - x) * 0.4).rem_euclid(360.0);
                     c.elevation = (c.elevation + (position.y - y) * 0.4).clamp(-89.0, 89.0);
@@ -255,7 +542,7 @@ impl ApplicationHandler for App {
                 redraw = true;
             }
             WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
-                redraw = self.key(&event.logical_key, event_loop);
+                redraw = self.key(&event.logical_key, event.physical_key, event_loop);
             }
             _ => {}
         }
