@@ -237,6 +237,52 @@ fn every_fixture_turned_in_4d_on_the_gpu_matches_the_exact_render_of_its_rotated
     );
 }
 
+#[test]
+fn the_halos_rebuilt_on_the_gpu_conform_in_every_view() {
+    let gpu = gpu();
+    let mut inverted = (0, 0);
+    for (k, path) in fixture_scenes().into_iter().enumerate() {
+        let scene = Scene::load(&path).unwrap();
+        let model = Model::new(scene.clone()).unwrap();
+        for rotation in seeded_rotations(100 + k as u64, 2) {
+            let mut view = scene.view;
+            for (name, a) in rotation.planes() {
+                *view.rotation.angle_mut(name).unwrap() += a;
+            }
+            let renderer =
+                viewer::Renderer::for_model(gpu, &model, &view, viewer::OFFSCREEN_FORMAT).unwrap();
+            let meshes = model.halo_meshes(renderer.asset());
+            assert_eq!(
+                meshes.iter().map(|m| m.tets.len()).sum::<usize>(),
+                6 * model.triangle_count(),
+                "{}: six tetrahedra per prism, none inserted",
+                scene.name
+            );
+            for (i, mesh) in meshes.iter().enumerate() {
+                let stats = halo4d::check(mesh);
+                let name = format!("{} surface {i} turned by {rotation:?}", scene.name);
+                assert_eq!(
+                    stats.degenerate + stats.duplicate_tets,
+                    0,
+                    "{name}: {stats:?}"
+                );
+                assert_eq!(stats.overshared_faces, 0, "{name}: {stats:?}");
+                assert_eq!(stats.quad_mismatches, 0, "{name}: {stats:?}");
+                assert_eq!(stats.missing_offset_faces, 0, "{name}: {stats:?}");
+                assert_eq!(stats.unexpected_boundary_faces, 0, "{name}: {stats:?}");
+                assert_eq!(stats.missing_surface_faces, 0, "{name}: {stats:?}");
+                inverted.0 += stats.inverted + stats.flat;
+                inverted.1 += stats.tets;
+            }
+        }
+    }
+    // Where rho is not shrunk, offsets can fold: counted, not refused.
+    eprintln!(
+        "inverted or flat: {} of {} tetrahedra",
+        inverted.0, inverted.1
+    );
+}
+
 /// The default fixture, exported, with its built products.
 fn default_export() -> (Scene, tempfile::TempDir, halo4d::Built, Asset) {
     let scene = Scene::load(&crate::common::fixture("scenes/default.json")).unwrap();
@@ -611,6 +657,127 @@ fn the_binary_writes_a_screenshot_and_refuses_bad_flags() {
             assert!(
                 text.contains(&format!("| {mode} | {n} |")),
                 "no {mode} {n} row in {text}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_view_saved_in_the_explorer_builds_to_that_view_and_checks() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene_path = crate::common::fixture("scenes/flat-torus.json");
+    let view = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_halo4d-view"))
+            .args(args)
+            .current_dir(dir.path())
+            .output()
+            .unwrap()
+    };
+    let scene = Scene::load(&scene_path).unwrap();
+    let out = view(&[
+        scene_path.to_str().unwrap(),
+        "--headless",
+        "--save-scene",
+        "turned.json",
+        "--screenshot",
+        "turned.png",
+        "--size",
+        "96x96",
+        "--rotate",
+        "xw=20",
+        "--rotate",
+        "YW=-35.5",
+        "--rotate",
+        "xw=5",
+        "--azimuth",
+        "60",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(image::open(dir.path().join("turned.png")).is_ok());
+    // The view asked for: the scene's angles plus every --rotate of the plane.
+    let mut expected = scene.view;
+    expected.rotation.xw += 25.0;
+    expected.rotation.yw -= 35.5;
+    let saved = Scene::load(&dir.path().join("turned.json")).unwrap();
+    assert_eq!(saved.name, "turned");
+    assert_eq!(saved.view, expected);
+    assert_eq!(saved.camera.azimuth, 60.0);
+    let built = crate::common::halo4d(&["build", "turned.json"], dir.path());
+    assert!(
+        built.status.success(),
+        "{}",
+        String::from_utf8_lossy(&built.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(dir.path().join("exports/turned/report.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(
+        report["scene"]["view"],
+        serde_json::to_value(expected).unwrap(),
+        "the build's view is the one on screen"
+    );
+    assert_eq!(report["verified"], true);
+    let checked = crate::common::halo4d(&["check", "exports/turned"], dir.path());
+    assert!(
+        checked.status.success(),
+        "{}",
+        String::from_utf8_lossy(&checked.stdout)
+    );
+
+    // Bad --rotate values, and a .glb (no 4D mesh), get a clear error.
+    let glb = dir.path().join("exports/turned/turned.glb");
+    for (args, words) in [
+        (
+            vec!["--rotate", "qw=3"],
+            &["qw", "xy, xz, xw, yz, yw or zw"][..],
+        ),
+        (vec!["--rotate", "xw"], &["PLANE=DEGREES"][..]),
+        (vec!["--rotate", "xw=ten"], &["ten", "degrees"][..]),
+        (
+            vec![glb.to_str().unwrap(), "--rotate", "xw=3"],
+            &["turns only in 3D", "scene file"][..],
+        ),
+    ] {
+        let mut all = vec!["--headless", "--screenshot", "x.png"];
+        all.extend(args.iter().copied());
+        if !args[0].ends_with(".glb") {
+            all.insert(0, scene_path.to_str().unwrap());
+        }
+        let out = view(&all);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_ne!(out.status.code(), Some(0), "{args:?}");
+        for w in words {
+            assert!(err.contains(w), "{args:?}: `{w}` not in {err}");
+        }
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    assert!(!dir.path().join("x.png").exists());
+
+    // --bench times the 4D turn (halos rebuilt every frame) apart from the 3D orbit.
+    let out = view(&[
+        scene_path.to_str().unwrap(),
+        "--bench",
+        "--frames",
+        "2",
+        "--size",
+        "64x48",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    for motion in ["3D orbit", "4D turn"] {
+        for n in [64, 512] {
+            assert!(
+                text.contains(&format!("| {motion} | view | {n} |")),
+                "no {motion} {n} row in {text}"
             );
         }
     }

@@ -41,7 +41,7 @@ mod turn;
 pub mod window;
 
 pub use gpu::Gpu;
-pub use renderer::{FrameTimes, Renderer};
+pub use renderer::{FrameTimes, OFFSCREEN_FORMAT, Renderer};
 pub use turn::{Framing, Model};
 
 use crate::import::{ImportError, ImportedScene};

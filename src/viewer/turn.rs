@@ -154,6 +154,34 @@ impl Model {
         asset
     }
 
+    /// Each surface's halo as the checker reads it ([`crate::check`]), from `asset` as a
+    /// renderer of this model last turned it ([`Renderer::asset`](super::Renderer::asset)).
+    pub fn halo_meshes(&self, asset: &super::Asset) -> Vec<crate::check::TetMesh> {
+        let mut base = 0usize;
+        self.surfaces
+            .iter()
+            .map(|(_, mesh)| {
+                let n = mesh.positions.len();
+                let range = base as u32..(base + 3 * n) as u32;
+                let out = crate::check::TetMesh {
+                    positions: asset.halo_vertices[base..base + 3 * n]
+                        .iter()
+                        .map(|v| v.pos.map(f64::from))
+                        .collect(),
+                    surface_vertices: n,
+                    tets: asset
+                        .tets
+                        .iter()
+                        .filter(|k| range.contains(&k[0]))
+                        .map(|k| k.map(|v| v - range.start))
+                        .collect(),
+                };
+                base += 3 * n;
+                out
+            })
+            .collect()
+    }
+
     /// Projects the positions for `view` (as the build does: rotation, translation,
     /// projection, rounded to f32) and gives what frames the picture, or why the view
     /// cannot be drawn.
