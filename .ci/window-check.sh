@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # The viewer's window on a virtual X display: it opens, shows its settings in the title,
-# answers the keys, a drag and the wheel, and quits on Q. Usage: .ci/window-check.sh SCENE.glb
+# answers the keys, a drag and the wheel, and quits on Q; on a scene file it turns in 4D (a
+# plane key, a Shift drag), settles its curves, resets and saves the view.
+# Usage: .ci/window-check.sh SCENE.glb SCENE.json (a scene whose view turns only yw by 30)
 set -euo pipefail
 glb=$1
+scene=$2
 if ! command -v Xvfb >/dev/null || ! command -v xdotool >/dev/null; then
   apt-get update -qq && apt-get install -y -qq xvfb xdotool
 fi
@@ -11,21 +14,23 @@ xvfb=$!
 trap 'kill "$xvfb" 2>/dev/null || true' EXIT
 export DISPLAY=:97
 sleep 1
-./target/release/halo4d-view "$glb" --size 480x360 --slices 64 --azimuth 35 &
-viewer=$!
+# Waits for a window of the viewer ($1: its pid) and gives it the keyboard.
 w=
-for _ in $(seq 1 150); do
-  w=$(xdotool search --name '^halo4d-view' 2>/dev/null | head -n 1 || true)
-  [ -n "$w" ] && break
-  sleep 0.2
-done
-[ -n "$w" ] || { echo "no viewer window appeared"; exit 1; }
-# No window manager: give the window the keyboard, then type (XTEST) and drag.
-xdotool windowfocus "$w" 2>/dev/null || true
+find_window() {
+  w=
+  for _ in $(seq 1 150); do
+    w=$(xdotool search --pid "$1" --name '^halo4d-view' 2>/dev/null | head -n 1 || true)
+    [ -n "$w" ] && break
+    sleep 0.2
+  done
+  [ -n "$w" ] || { echo "no viewer window appeared"; exit 1; }
+  # No window manager: give the window the keyboard, then type (XTEST) and drag.
+  xdotool windowfocus "$w" 2>/dev/null || true
+}
 # Waits until the window's title contains $1.
 expect() {
   local t=
-  for _ in $(seq 1 150); do
+  for _ in $(seq 1 300); do
     t=$(xdotool getwindowname "$w" 2>/dev/null || true)
     case "$t" in *"$1"*) echo "  $t"; return 0 ;; esac
     sleep 0.2
@@ -33,6 +38,9 @@ expect() {
   echo "the window's title never showed '$1' (last: '$t')"
   exit 1
 }
+./target/release/halo4d-view "$glb" --size 480x360 --slices 64 --azimuth 35 &
+viewer=$!
+find_window "$viewer"
 expect "grid 64 slices | 1 spp | halos on | curves on | silhouettes on | opaque | colour by w | azimuth 35"
 xdotool key s; expect "grid 128 slices"
 xdotool key m; expect "view 128 slices"
@@ -48,3 +56,27 @@ xdotool key r; expect "azimuth 35 elevation 25 distance 3.20"
 xdotool key q
 wait "$viewer"
 echo "the viewer's window answered every key and quit"
+
+./target/release/halo4d-view "$scene" --size 480x360 --slices 64 &
+viewer=$!
+find_window "$viewer"
+expect "4D xy 0 xz 0 xw 0 yz 0 yw 30 zw 0 orthographic"
+expect "settled"
+xdotool key 3; expect "4D xy 0 xz 0 xw 15 yz 0 yw 30 zw 0 orthographic"
+xdotool key shift+3; expect "4D xy 0 xz 0 xw 0 yz 0 yw 30 zw 0 orthographic"
+# The 4D rolling ball: Shift and a drag across the window turn the drag's direction towards w.
+xdotool mousemove --window "$w" 150 180 keydown shift mousedown 1 mousemove --window "$w" 250 180 mouseup 1 keyup shift
+t=$(xdotool getwindowname "$w")
+for _ in $(seq 1 100); do
+  case "$t" in *"4D xy 0 xz 0 xw 0 yz 0 yw 30 zw 0 orthographic"*) sleep 0.2; t=$(xdotool getwindowname "$w") ;; *) break ;; esac
+done
+case "$t" in
+  *"4D xy 0 xz 0 xw 0 yz 0 yw 30 zw 0 orthographic"*) echo "a Shift drag did not turn the 4D view: $t"; exit 1 ;;
+esac
+echo "  $t"
+expect "settled"
+xdotool key v; expect "4D xy 0 xz 0 xw 0 yz 0 yw 30 zw 0 orthographic"
+xdotool key f; expect "saved exports/views/"
+xdotool key q
+wait "$viewer"
+echo "the explorer turned the scene in 4D, settled its curves and saved the view"

@@ -729,8 +729,10 @@ fn a_view_saved_in_the_explorer_builds_to_that_view_and_checks() {
         String::from_utf8_lossy(&checked.stdout)
     );
 
-    // Bad --rotate values, and a .glb (no 4D mesh), get a clear error.
-    let glb = dir.path().join("exports/turned/turned.glb");
+    // Bad --rotate values, and a .glb without the 4D mesh, get a clear error.
+    let glb = std::fs::read(dir.path().join("exports/turned/turned.glb")).unwrap();
+    let flat = dir.path().join("flat.glb");
+    std::fs::write(&flat, without_4d(&glb)).unwrap();
     for (args, words) in [
         (
             vec!["--rotate", "qw=3"],
@@ -739,8 +741,8 @@ fn a_view_saved_in_the_explorer_builds_to_that_view_and_checks() {
         (vec!["--rotate", "xw"], &["PLANE=DEGREES"][..]),
         (vec!["--rotate", "xw=ten"], &["ten", "degrees"][..]),
         (
-            vec![glb.to_str().unwrap(), "--rotate", "xw=3"],
-            &["turns only in 3D", "scene file"][..],
+            vec![flat.to_str().unwrap(), "--rotate", "xw=3"],
+            &["turns in 3D only", "no _POSITION_4D", "open its scene file"][..],
         ),
     ] {
         let mut all = vec!["--headless", "--screenshot", "x.png"];
@@ -781,6 +783,75 @@ fn a_view_saved_in_the_explorer_builds_to_that_view_and_checks() {
             );
         }
     }
+}
+
+/// `bytes` (a scene's `.glb`) without the surfaces' 4D attributes.
+fn without_4d(bytes: &[u8]) -> Vec<u8> {
+    edited(bytes, |json| {
+        for mesh in json["meshes"].as_array_mut().unwrap() {
+            for p in mesh["primitives"].as_array_mut().unwrap() {
+                let attributes = p["attributes"].as_object_mut().unwrap();
+                attributes.retain(|name, _| !name.ends_with("_4D"));
+            }
+        }
+    })
+}
+
+#[test]
+fn a_glb_turns_in_4d_as_its_scene_does_and_one_without_the_4d_mesh_in_3d() {
+    let gpu = gpu();
+    let (scene, dir, built, _) = default_export();
+    let path = dir.path().join(format!("{}.glb", scene.name));
+    // The file's 4D mesh is the sampled one, in f32.
+    let imported = halo4d::read_scene_glb(&std::fs::read(&path).unwrap()).unwrap();
+    for (s, product) in imported.surfaces.iter().zip(&built.surfaces) {
+        let mesh = s.mesh_4d.as_ref().unwrap_or_else(|e| panic!("{e}"));
+        for (file, sampled) in [
+            (&mesh.positions, &product.mesh.positions),
+            (&mesh.tangent_u, &product.mesh.tangent_u),
+            (&mesh.tangent_v, &product.mesh.tangent_v),
+        ] {
+            assert_eq!(file.len(), sampled.len());
+            assert!(
+                file.iter()
+                    .zip(sampled)
+                    .all(|(a, b)| *a == b.as_vec4().as_dvec4())
+            );
+        }
+        assert_eq!(mesh.triangles, product.mesh.triangles);
+    }
+    let (from_file, notes) = viewer::Source::open(Some(&path)).unwrap();
+    assert!(notes.is_empty(), "{notes:?}");
+    assert!(matches!(from_file, viewer::Source::Model(_)));
+    let from_scene = viewer::Source::Model(Model::new(scene.clone()).unwrap().into());
+    let mut view = scene.view;
+    view.rotation.xw += 25.0;
+    view.rotation.zw -= 40.0;
+    let s = ViewSettings {
+        curves: false,
+        ..settings(&scene, HaloMode::Grid, 128)
+    };
+    let frames = [&from_file, &from_scene]
+        .map(|source| distances(&viewer::screenshot_of(gpu, source, Some(&view), &s).unwrap()));
+    let differs = verdict_differs(&frames[0], &frames[1], SAME);
+    assert!(
+        differs < 0.001,
+        "the file and the scene differ on {:.3}%",
+        differs * 100.0
+    );
+
+    // Without the 4D attributes (a program that re-saved the file may drop them): in 3D,
+    // with the reason.
+    let flat = dir.path().join("flat.glb");
+    std::fs::write(&flat, without_4d(&std::fs::read(&path).unwrap())).unwrap();
+    let (source, notes) = viewer::Source::open(Some(&flat)).unwrap();
+    assert!(matches!(source, viewer::Source::Asset(_)));
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.contains("turns in 3D only") && n.contains("_POSITION_4D")),
+        "{notes:?}"
+    );
 }
 
 #[test]

@@ -3,11 +3,9 @@
 
 use clap::{Parser, ValueEnum};
 use halo4d::limits::FieldError;
-use halo4d::viewer::{
-    self, Asset, Gpu, HaloMode, Model, SLICE_COUNTS, Source, ViewSettings, ViewerError,
-};
-use halo4d::{CameraProjection, CameraSettings, Colormap, Scene, View};
-use std::path::{Path, PathBuf};
+use halo4d::viewer::{self, Gpu, HaloMode, SLICE_COUNTS, Source, ViewSettings, ViewerError};
+use halo4d::{CameraProjection, CameraSettings, Colormap, View};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Parser, Debug)]
@@ -162,7 +160,10 @@ fn run(args: &Args) -> Result<(), ViewerError> {
             "needs --screenshot OUT.png (or --save-scene OUT.json, --bench or --compare)",
         )));
     }
-    let source = open(args.file.as_deref())?;
+    let (source, notes) = Source::open(args.file.as_deref())?;
+    for note in notes {
+        eprintln!("note: {note}");
+    }
     let view = match &source {
         Source::Model(model) => {
             let mut view = model.scene.view;
@@ -179,16 +180,10 @@ fn run(args: &Args) -> Result<(), ViewerError> {
                 return Err(ViewerError::Setting(FieldError::new(
                     "--rotate",
                     format!(
-                        "{} has no 4D mesh and turns only in 3D; open its scene file to turn it in 4D or save a view",
+                        "{} turns only in 3D (see the note above); open its scene file to turn it in 4D or save a view",
                         asset.1.name
                     ),
                 )));
-            }
-            if !asset.1.surfaces_without_halo.is_empty() {
-                eprintln!(
-                    "note: no halo for {}: those surfaces are never hidden (build with halo.enabled)",
-                    asset.1.surfaces_without_halo.join(", ")
-                );
             }
             None
         }
@@ -273,22 +268,6 @@ fn run(args: &Args) -> Result<(), ViewerError> {
     }
     println!("{}", viewer::window::HELP);
     viewer::window::run(source, view, settings)
-}
-
-/// The scene or `.glb` at `path`, or the default scene.
-fn open(path: Option<&Path>) -> Result<Source, ViewerError> {
-    let Some(path) = path else {
-        return Ok(Source::Model(Model::new(Scene::default_scene())?.into()));
-    };
-    if path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
-    {
-        let (scene, asset) = Asset::read(path)?;
-        return Ok(Source::Asset(Box::new((scene, asset))));
-    }
-    let scene = Scene::load(path).map_err(halo4d::Error::from)?;
-    Ok(Source::Model(Model::new(scene)?.into()))
 }
 
 fn bench(

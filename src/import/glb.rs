@@ -16,7 +16,7 @@ use super::{
 use crate::check::TetMesh;
 use crate::convention::{file_order, from_gltf};
 use crate::view::area_normal_sums;
-use glam::DVec3;
+use glam::{DVec3, DVec4};
 use gltf_json as json;
 use json::accessor::{ComponentType, GenericComponentType, Type};
 use json::mesh::{Mode, Primitive, Semantic};
@@ -158,6 +158,7 @@ pub fn read_scene_glb(bytes: &[u8]) -> Result<ImportedScene> {
         surfaces,
         curves,
         camera,
+        scene: asset.pointer("/halo4d/scene").cloned(),
     })
 }
 
@@ -426,7 +427,7 @@ impl<'a> Doc<'a> {
         ))
     }
 
-    /// Accessor `i` as floats: FLOAT components of `expected` (`SCALAR` or `VEC3`).
+    /// Accessor `i` as floats: FLOAT components of `expected` (`SCALAR`, `VEC3` or `VEC4`).
     fn floats(&self, i: u64, expected: Type, components: usize) -> Result<Vec<f32>> {
         let accessor = self.accessor(i)?;
         if component(&accessor.component_type) != Some(ComponentType::F32)
@@ -604,6 +605,7 @@ impl<'a> Doc<'a> {
                 .map(|n| n.normalize_or_zero())
                 .collect()
         });
+        let mesh_4d = self.mesh_4d(primitive, &triangles, nv);
         Ok(ImportedSurface {
             name,
             mesh: i,
@@ -612,6 +614,51 @@ impl<'a> Doc<'a> {
             triangles,
             normals,
             halo: None,
+            mesh_4d,
+        })
+    }
+
+    /// The 4D mesh before the view, from `_POSITION_4D`, `_TANGENT_U_4D` and
+    /// `_TANGENT_V_4D` (FLOAT VEC4, in the scene's own coordinates), or why there is none:
+    /// the file is read without it (a program that re-saved the file may have dropped or
+    /// converted them), and only the viewer's 4D turning needs it.
+    fn mesh_4d(
+        &self,
+        primitive: &json::mesh::Primitive,
+        triangles: &[[u32; 3]],
+        nv: usize,
+    ) -> std::result::Result<crate::sample::Mesh4, String> {
+        let mut columns = Vec::with_capacity(3);
+        for name in ["POSITION_4D", "TANGENT_U_4D", "TANGENT_V_4D"] {
+            let accessor = attribute(primitive, Semantic::Extras(name.into()))
+                .ok_or_else(|| format!("no _{name}"))?;
+            let values = self
+                .floats(accessor, Type::Vec4, 4)
+                .map_err(|e| format!("_{name}: {e}"))?;
+            let column: Vec<DVec4> = values
+                .chunks_exact(4)
+                .map(|c| DVec4::new(c[0].into(), c[1].into(), c[2].into(), c[3].into()))
+                .collect();
+            if column.len() != nv {
+                return Err(format!(
+                    "_{name} has {} values for {nv} positions",
+                    column.len()
+                ));
+            }
+            if let Some(k) = column.iter().position(|p| !p.is_finite()) {
+                return Err(format!("_{name} of vertex {k} is not finite"));
+            }
+            columns.push(column);
+        }
+        let tangent_v = columns.pop().expect("three columns");
+        let tangent_u = columns.pop().expect("three columns");
+        let positions = columns.pop().expect("three columns");
+        Ok(crate::sample::Mesh4 {
+            positions,
+            tangent_u,
+            tangent_v,
+            triangles: triangles.to_vec(),
+            ..Default::default()
         })
     }
 

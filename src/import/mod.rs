@@ -45,7 +45,7 @@ pub struct ImportedHalo {
 }
 
 /// A surface read from a scene's `.glb`, with its halo.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ImportedSurface {
     /// The glTF mesh name (the surface's name in the scene).
     pub name: String,
@@ -63,6 +63,10 @@ pub struct ImportedSurface {
     /// Its halo, when the file has one: with t, d_orig, delta_d and delta_t, and as many
     /// surface vertices as the surface has vertices.
     pub halo: Option<ImportedHalo>,
+    /// The 4D mesh before the view (positions and tangents from the file's `_POSITION_4D`,
+    /// `_TANGENT_U_4D`, `_TANGENT_V_4D`; the surface's triangles; no (u, v)), or why the
+    /// file has none.
+    pub mesh_4d: Result<crate::sample::Mesh4, String>,
 }
 
 /// A scene read from its `.glb` ([`read_scene_glb`]).
@@ -78,6 +82,8 @@ pub struct ImportedScene {
     /// The camera the scene was built with (`camera` of the scene recorded in the asset's
     /// extras), when recorded.
     pub camera: Option<CameraSettings>,
+    /// The scene recorded in the asset's extras (`halo4d.scene`), as JSON, when recorded.
+    pub scene: Option<serde_json::Value>,
 }
 
 /// The intersection curves of a scene's `.glb`, as line segments.

@@ -1,9 +1,13 @@
-//! The wgpu viewer of exported scenes (`halo4d-view`, cargo feature `viewer`).
+//! The wgpu viewer and 4D explorer (`halo4d-view`, cargo feature `viewer`).
 //!
-//! Takes: a scene's `.glb` as `halo4d build` writes it ([`crate::import::read_scene_glb`]:
-//! surfaces with w, halo tetrahedra with t, d_orig and the eq. 3 parameters, curves). Gives:
-//! pictures on the GPU, in a window ([`window`]) or offscreen ([`screenshot`]), with the
-//! camera of [`crate::render`], so that the two renderers can be compared pixel for pixel.
+//! Takes ([`Source::open`]): a scene, sampled in 4D and turned in 4D with its surfaces and
+//! halos rebuilt on the GPU for every view ([`Model`], `turn.rs`); or a scene's `.glb` as
+//! `halo4d build` writes it ([`crate::import::read_scene_glb`]: surfaces with w, halo
+//! tetrahedra with t, d_orig and the eq. 3 parameters, curves), turned in 4D when it carries
+//! the 4D mesh and its scene. Gives: pictures on the GPU, in a window ([`window`]) or
+//! offscreen ([`screenshot_of`]), with the camera of [`crate::render`], so that the two
+//! renderers can be compared pixel for pixel; the view found, as a scene file
+//! ([`save_scene`]).
 //!
 //! A surface fragment at x with depth w is hidden when the halo depth there (paper 000 eq. 3)
 //! is below w, by more than the sheet's own halo can be (see below). The halo depth comes
@@ -611,6 +615,71 @@ pub enum Source {
 }
 
 impl Source {
+    /// Opens `path`: a scene file (sampled in 4D), a scene's `.glb` (turned in 4D when it
+    /// carries the 4D mesh and the scene, else in 3D, with a note saying why), or with no
+    /// path the default scene. Gives the source and the notes for the user.
+    pub fn open(path: Option<&Path>) -> Result<(Source, Vec<String>), ViewerError> {
+        use crate::scene::Scene;
+        let Some(path) = path else {
+            return Ok((
+                Source::Model(Model::new(Scene::default_scene())?.into()),
+                vec![],
+            ));
+        };
+        if !path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+        {
+            let scene = Scene::load(path).map_err(crate::error::Error::from)?;
+            return Ok((Source::Model(Model::new(scene)?.into()), vec![]));
+        }
+        let (imported, asset) = Asset::read(path)?;
+        let mut notes = Vec::new();
+        if !asset.surfaces_without_halo.is_empty() {
+            notes.push(format!(
+                "no halo for {}: those surfaces are never hidden (build with halo.enabled)",
+                asset.surfaces_without_halo.join(", ")
+            ));
+        }
+        let scene = imported
+            .scene
+            .as_ref()
+            .ok_or_else(|| "no scene recorded in asset.extras.halo4d.scene".to_string())
+            .and_then(|json| {
+                Scene::parse(
+                    &json.to_string(),
+                    &format!("{} (asset.extras.halo4d.scene)", path.display()),
+                )
+                .map_err(|e| e.to_string())
+            });
+        let meshes: Result<Vec<(String, crate::sample::Mesh4)>, String> = imported
+            .surfaces
+            .iter()
+            .map(|s| {
+                s.mesh_4d
+                    .clone()
+                    .map(|m| (s.name.clone(), m))
+                    .map_err(|e| format!("surface {}: {e}", s.name))
+            })
+            .collect();
+        let why = match (scene, meshes) {
+            (Ok(scene), Ok(meshes)) if meshes.len() == scene.surfaces.len() => {
+                return Ok((
+                    Source::Model(Model::with_meshes(scene, meshes)?.into()),
+                    notes,
+                ));
+            }
+            (Err(e), _) | (_, Err(e)) => e,
+            (Ok(scene), Ok(meshes)) => format!(
+                "{} surfaces in the file, {} in its scene",
+                meshes.len(),
+                scene.surfaces.len()
+            ),
+        };
+        notes.push(format!("{} turns in 3D only: {why}", path.display()));
+        Ok((Source::Asset(Box::new((imported, asset))), notes))
+    }
+
     /// The scene's name.
     pub fn name(&self) -> &str {
         match self {

@@ -71,6 +71,12 @@ impl Model {
                 (scene.surface_name(i), sampled.mesh)
             })
             .collect();
+        Model::with_meshes(scene, surfaces)
+    }
+
+    /// A model of `scene` with its surfaces' 4D meshes given (read from a file), refusing
+    /// more triangles or tetrahedra than the viewer loads.
+    pub fn with_meshes(scene: Scene, surfaces: Vec<(String, Mesh4)>) -> Result<Model, ViewerError> {
         let triangles: usize = surfaces.iter().map(|s| s.1.triangles.len()).sum();
         for (what, count, limit) in [
             ("surface triangles", triangles, VIEWER_TRIANGLES),

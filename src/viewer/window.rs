@@ -455,7 +455,8 @@ fn describe(v: &View) -> String {
         .rotation
         .planes()
         .iter()
-        .map(|(name, a)| format!("{name} {a:.0}"))
+        // Whole degrees, with no "-0".
+        .map(|(name, a)| format!("{name} {}", a.round() + 0.0))
         .collect();
     let [x, y, z, w] = v.translation;
     let shift = if v.translation == [0.0; 4] {
