@@ -325,19 +325,7 @@ impl Asset {
             .filter_map(|s| s.halo.as_ref())
             .map(|h| h.mesh.tets.len())
             .sum();
-        for (what, count, limit) in [
-            ("surface triangles", triangles, VIEWER_TRIANGLES),
-            ("halo tetrahedra", tets, VIEWER_TETRAHEDRA),
-        ] {
-            if count > limit {
-                return Err(ViewerError::TooLarge {
-                    what: format!("the scene's {what}"),
-                    count: count as u64,
-                    limit: limit as u64,
-                    why: "the most the viewer loads".into(),
-                });
-            }
-        }
+        check_size(triangles, tets)?;
         let bounds = crate::render::triangle_bounds(
             scene
                 .surfaces
@@ -456,6 +444,25 @@ impl Asset {
     pub fn tet_count(&self) -> usize {
         self.tets.len()
     }
+}
+
+/// Refuses a scene of more than [`VIEWER_TRIANGLES`] triangles or [`VIEWER_TETRAHEDRA`]
+/// tetrahedra.
+fn check_size(triangles: usize, tets: usize) -> Result<(), ViewerError> {
+    for (what, count, limit) in [
+        ("surface triangles", triangles, VIEWER_TRIANGLES),
+        ("halo tetrahedra", tets, VIEWER_TETRAHEDRA),
+    ] {
+        if count > limit {
+            return Err(ViewerError::TooLarge {
+                what: format!("the scene's {what}"),
+                count: count as u64,
+                limit: limit as u64,
+                why: "the most the viewer loads".into(),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Appends the interior edges of a surface's `triangles` (see

@@ -176,7 +176,9 @@ impl Renderer {
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("viewer.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("viewer.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(
+                concat!(include_str!("vertices.wgsl"), include_str!("viewer.wgsl")).into(),
+            ),
         });
         let opaque_targets = |distance: bool| {
             [

@@ -27,7 +27,7 @@
 
 use super::{HaloVertex, SurfaceVertex, ViewerError};
 use crate::intersect::{Curves, Sheet};
-use crate::limits::{MAX_COORDINATE, MIN_EXTENT, VIEWER_TETRAHEDRA, VIEWER_TRIANGLES};
+use crate::limits::{MAX_COORDINATE, MIN_EXTENT};
 use crate::sample::Mesh4;
 use crate::scene::Scene;
 use crate::tets::{self, Corners, Split};
@@ -78,19 +78,7 @@ impl Model {
     /// more triangles or tetrahedra than the viewer loads.
     pub fn with_meshes(scene: Scene, surfaces: Vec<(String, Mesh4)>) -> Result<Model, ViewerError> {
         let triangles: usize = surfaces.iter().map(|s| s.1.triangles.len()).sum();
-        for (what, count, limit) in [
-            ("surface triangles", triangles, VIEWER_TRIANGLES),
-            ("halo tetrahedra", 6 * triangles, VIEWER_TETRAHEDRA),
-        ] {
-            if count > limit {
-                return Err(ViewerError::TooLarge {
-                    what: format!("the scene's {what}"),
-                    count: count as u64,
-                    limit: limit as u64,
-                    why: "the most the viewer loads".into(),
-                });
-            }
-        }
+        super::check_size(triangles, 6 * triangles)?;
         Ok(Model { scene, surfaces })
     }
 
@@ -432,7 +420,9 @@ impl Turner {
         )?;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("turn.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("turn.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(
+                concat!(include_str!("vertices.wgsl"), include_str!("turn.wgsl")).into(),
+            ),
         });
         let pipeline = |entry: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {

@@ -28,26 +28,6 @@ struct Point4 {
     tv: vec4<f32>,
 }
 
-struct SurfaceVertex {
-    pos: vec3<f32>,
-    w: f32,
-    normal: vec3<f32>,
-    slope: f32,
-    spread: f32,
-    pad0: f32,
-    pad1: f32,
-    pad2: f32,
-}
-
-struct HaloVertex {
-    pos: vec3<f32>,
-    t: f32,
-    d: f32,
-    delta_t: f32,
-    delta_d: f32,
-    pad: f32,
-}
-
 // Per surface: x: its halo's first vertex; y: its vertices n; z: 1 when it has a halo.
 // Then rho (absolute), delta_t, delta_d.
 struct SurfaceInfo {

@@ -34,26 +34,6 @@ struct View {
     stops: array<vec4<f32>, 8>,
 }
 
-struct SurfaceVertex {
-    pos: vec3<f32>,
-    w: f32,
-    normal: vec3<f32>,
-    slope: f32,
-    spread: f32,
-    pad0: f32,
-    pad1: f32,
-    pad2: f32,
-}
-
-struct HaloVertex {
-    pos: vec3<f32>,
-    t: f32,
-    d: f32,
-    delta_t: f32,
-    delta_d: f32,
-    pad: f32,
-}
-
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<storage, read> vertices: array<SurfaceVertex>;
 @group(0) @binding(2) var grid: texture_3d<u32>;

@@ -185,7 +185,11 @@ impl App {
         {
             self.curves.running = None;
             if Some(view) == self.drawn_view {
-                state.renderer.set_curves(&state.gpu, &curves?)?;
+                match curves {
+                    Ok(curves) => state.renderer.set_curves(&state.gpu, &curves)?,
+                    // Drawn without curves, the reason in the title.
+                    Err(e) => self.note = format!("no curves: {e}"),
+                }
                 self.curves.shown = Some(view);
             }
         }
