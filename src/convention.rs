@@ -12,8 +12,21 @@
 //!   `robust::orient3d(a, b, c, d) > 0`, i.e. det[b − a, c − a, d − a] < 0. The files (`.vtk`
 //!   and the `.glb`'s tetrahedra) take VTK's convention, which meshio and Gmsh share: a, b, c
 //!   seen from d run counter-clockwise, det[b − a, c − a, d − a] > 0 ([`file_order`]).
+//! - **4D.** The `.glb` holds each surface's 4D mesh before the view as twelve float SCALAR
+//!   custom attributes ([`MESH_4D`]): R^4 has no up axis and no program but halo4d reads
+//!   them, so they are (x, y, z, w) in the scene's own coordinates. SCALARs, because
+//!   Blender's importer (4.5) fails on a primitive whose custom attributes mix SCALAR and
+//!   VEC4.
 
 use glam::DVec3;
+
+/// The names (without the leading `_`) of the `.glb`'s custom attributes of a surface's 4D
+/// mesh: the position, ∂p/∂u and ∂p/∂v, each as its x, y, z and w.
+pub const MESH_4D: [[&str; 4]; 3] = [
+    ["X4", "Y4", "Z4", "W4"],
+    ["XU4", "YU4", "ZU4", "WU4"],
+    ["XV4", "YV4", "ZV4", "WV4"],
+];
 
 /// A point or direction of halo4d's frame in glTF's (y up).
 pub fn to_gltf(p: DVec3) -> DVec3 {

@@ -178,7 +178,11 @@ fn run(args: &Args) -> Result<(), ViewerError> {
         Source::Asset(asset) => {
             if !args.rotate.is_empty() || args.save_scene.is_some() {
                 return Err(ViewerError::Setting(FieldError::new(
-                    "--rotate",
+                    if args.rotate.is_empty() {
+                        "--save-scene"
+                    } else {
+                        "--rotate"
+                    },
                     format!(
                         "{} turns only in 3D (see the note above); open its scene file to turn it in 4D or save a view",
                         asset.1.name

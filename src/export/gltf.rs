@@ -4,10 +4,9 @@
 //! Per surface, two meshes, each with its own node:
 //! - the surface, named after it, as TRIANGLES with POSITION (min/max computed from the f32
 //!   values actually stored), unit NORMAL, float SCALAR custom attributes `_W` (w-depth),
-//!   `_U`, `_V` (surface parameters) and `_PATCH` (patch index), and float VEC4 custom
-//!   attributes `_POSITION_4D`, `_TANGENT_U_4D`, `_TANGENT_V_4D`: the 4D mesh before the
-//!   view (x, y, z, w in the scene's own coordinates, no glTF axis convention: R^4 has none),
-//!   from which `halo4d-view` turns the file in 4D;
+//!   `_U`, `_V` (surface parameters) and `_PATCH` (patch index), and twelve more: the 4D mesh
+//!   before the view (`_X4` … `_W4`, `_XU4` … `_WU4`, `_XV4` … `_WV4`:
+//!   [`crate::convention::MESH_4D`]), from which `halo4d-view` turns the file in 4D;
 //! - its halo, `<surface>-halo`: every halo vertex in the layout of [`crate::check`] with
 //!   POSITION, unit NORMAL and float SCALAR attributes `_T`, `_D` (d_orig) and `_PATCH`, and
 //!   as TRIANGLES only the halo's boundary faces (those of exactly one tetrahedron, turned
@@ -38,7 +37,7 @@
 use super::SurfaceData;
 use super::tubes::tubes;
 use crate::check::LAYERS;
-use crate::convention::{file_order, to_gltf};
+use crate::convention::{MESH_4D, file_order, to_gltf};
 use crate::halo::Halo;
 use crate::intersect::{CurvePoint, Curves};
 use crate::view::area_normal_sums;
@@ -102,10 +101,10 @@ impl Builder {
         type_: json::accessor::Type,
         minmax: Option<(Vec<f32>, Vec<f32>)>,
     ) -> json::Index<json::Accessor> {
-        let components = match type_ {
-            json::accessor::Type::Vec3 => 3,
-            json::accessor::Type::Vec4 => 4,
-            _ => 1,
+        let components = if type_ == json::accessor::Type::Vec3 {
+            3
+        } else {
+            1
         };
         let view = self.view(
             values.iter().map(|x| x.to_le_bytes()),
@@ -298,12 +297,9 @@ pub fn glb_chunks(
                 .map(|i| f(i) as f32)
                 .collect::<Vec<f32>>()
         };
-        use json::accessor::Type::{Scalar, Vec4};
+        use json::accessor::Type::Scalar;
         use json::mesh::Semantic;
-        let vec4s = |v: &[glam::DVec4]| -> Vec<f32> {
-            v.iter().flat_map(|p| p.as_vec4().to_array()).collect()
-        };
-        let attributes = [
+        let mut attributes = vec![
             (Semantic::Positions, b.positions(&p.positions)),
             (Semantic::Normals, b.normals(&p.normals)),
             (
@@ -322,19 +318,18 @@ pub fn glb_chunks(
                 Semantic::Extras("PATCH".into()),
                 b.floats(&scalar(&|i| f64::from(s.mesh.patch[i])), Scalar, None),
             ),
-            (
-                Semantic::Extras("POSITION_4D".into()),
-                b.floats(&vec4s(&s.mesh.positions), Vec4, None),
-            ),
-            (
-                Semantic::Extras("TANGENT_U_4D".into()),
-                b.floats(&vec4s(&s.mesh.tangent_u), Vec4, None),
-            ),
-            (
-                Semantic::Extras("TANGENT_V_4D".into()),
-                b.floats(&vec4s(&s.mesh.tangent_v), Vec4, None),
-            ),
         ];
+        // The 4D mesh before the view, a SCALAR per coordinate (see `crate::convention`).
+        let columns = [&s.mesh.positions, &s.mesh.tangent_u, &s.mesh.tangent_v];
+        for (column, names) in columns.iter().zip(MESH_4D) {
+            for (c, name) in names.iter().enumerate() {
+                let values: Vec<f32> = column.iter().map(|p| p[c] as f32).collect();
+                attributes.push((
+                    Semantic::Extras((*name).into()),
+                    b.floats(&values, Scalar, None),
+                ));
+            }
+        }
         let triangles: Vec<u32> = s.mesh.triangles.iter().flatten().copied().collect();
         let index_accessor = b.indices(
             &triangles,

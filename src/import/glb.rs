@@ -14,7 +14,7 @@ use super::{
     FileParams, ImportError, ImportedCurves, ImportedHalo, ImportedScene, ImportedSurface,
 };
 use crate::check::TetMesh;
-use crate::convention::{file_order, from_gltf};
+use crate::convention::{MESH_4D, file_order, from_gltf};
 use crate::view::area_normal_sums;
 use glam::{DVec3, DVec4};
 use gltf_json as json;
@@ -427,7 +427,7 @@ impl<'a> Doc<'a> {
         ))
     }
 
-    /// Accessor `i` as floats: FLOAT components of `expected` (`SCALAR`, `VEC3` or `VEC4`).
+    /// Accessor `i` as floats: FLOAT components of `expected` (`SCALAR` or `VEC3`).
     fn floats(&self, i: u64, expected: Type, components: usize) -> Result<Vec<f32>> {
         let accessor = self.accessor(i)?;
         if component(&accessor.component_type) != Some(ComponentType::F32)
@@ -618,10 +618,10 @@ impl<'a> Doc<'a> {
         })
     }
 
-    /// The 4D mesh before the view, from `_POSITION_4D`, `_TANGENT_U_4D` and
-    /// `_TANGENT_V_4D` (FLOAT VEC4, in the scene's own coordinates), or why there is none:
-    /// the file is read without it (a program that re-saved the file may have dropped or
-    /// converted them), and only the viewer's 4D turning needs it.
+    /// The 4D mesh before the view, from its twelve float SCALAR custom attributes
+    /// ([`crate::convention::MESH_4D`], in the scene's own coordinates), or why there is
+    /// none: the file is read without it (a program that re-saved the file may have dropped
+    /// or converted them), and only the viewer's 4D turning needs it.
     fn mesh_4d(
         &self,
         primitive: &json::mesh::Primitive,
@@ -629,24 +629,26 @@ impl<'a> Doc<'a> {
         nv: usize,
     ) -> std::result::Result<crate::sample::Mesh4, String> {
         let mut columns = Vec::with_capacity(3);
-        for name in ["POSITION_4D", "TANGENT_U_4D", "TANGENT_V_4D"] {
-            let accessor = attribute(primitive, Semantic::Extras(name.into()))
-                .ok_or_else(|| format!("no _{name}"))?;
-            let values = self
-                .floats(accessor, Type::Vec4, 4)
-                .map_err(|e| format!("_{name}: {e}"))?;
-            let column: Vec<DVec4> = values
-                .chunks_exact(4)
-                .map(|c| DVec4::new(c[0].into(), c[1].into(), c[2].into(), c[3].into()))
-                .collect();
-            if column.len() != nv {
-                return Err(format!(
-                    "_{name} has {} values for {nv} positions",
-                    column.len()
-                ));
-            }
-            if let Some(k) = column.iter().position(|p| !p.is_finite()) {
-                return Err(format!("_{name} of vertex {k} is not finite"));
+        for names in MESH_4D {
+            let mut column = vec![DVec4::ZERO; nv];
+            for (c, name) in names.iter().enumerate() {
+                let accessor = attribute(primitive, Semantic::Extras((*name).into()))
+                    .ok_or_else(|| format!("no _{name}"))?;
+                let values = self
+                    .scalars(accessor)
+                    .map_err(|e| format!("_{name}: {e}"))?;
+                if values.len() != nv {
+                    return Err(format!(
+                        "_{name} has {} values for {nv} positions",
+                        values.len()
+                    ));
+                }
+                if let Some(k) = values.iter().position(|x| !x.is_finite()) {
+                    return Err(format!("_{name} of vertex {k} is not finite"));
+                }
+                for (p, x) in column.iter_mut().zip(values) {
+                    p[c] = x;
+                }
             }
             columns.push(column);
         }

@@ -63,9 +63,9 @@ pub struct ImportedSurface {
     /// Its halo, when the file has one: with t, d_orig, delta_d and delta_t, and as many
     /// surface vertices as the surface has vertices.
     pub halo: Option<ImportedHalo>,
-    /// The 4D mesh before the view (positions and tangents from the file's `_POSITION_4D`,
-    /// `_TANGENT_U_4D`, `_TANGENT_V_4D`; the surface's triangles; no (u, v)), or why the
-    /// file has none.
+    /// The 4D mesh before the view (positions and tangents from the file's twelve 4D
+    /// attributes, `_X4` to `_WV4`; the surface's triangles; no (u, v)), or why the file has
+    /// none.
     pub mesh_4d: Result<crate::sample::Mesh4, String>,
 }
 

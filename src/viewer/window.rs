@@ -179,7 +179,7 @@ impl App {
             }
         }
         // The curves: the finished job's, when they are of the view drawn; a new job when
-        // the drawn view has none and none is running.
+        // the drawn view has none, none is running and the curves are shown.
         if let Some(rx) = &self.curves.running
             && let Ok((view, curves)) = rx.try_recv()
         {
@@ -194,6 +194,7 @@ impl App {
             }
         }
         if let (Source::Model(model), Some(view)) = (&self.source, self.drawn_view)
+            && self.settings.curves
             && self.curves.running.is_none()
             && self.curves.shown != Some(view)
         {
