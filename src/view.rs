@@ -81,11 +81,7 @@ impl Rotation4 {
         let yz = (-z.y).atan2(z.z);
         let p = (plane_rotation("yz", yz) * plane_rotation("xz", xz)).transpose() * q;
         let xy = p.x_axis.y.atan2(p.x_axis.x);
-        let deg = |a: f64| {
-            let d = a.to_degrees();
-            // atan2 and asin give (-180, 180] already; -180 itself becomes 180.
-            if d <= -180.0 { d + 360.0 } else { d }
-        };
+        let deg = |a: f64| wrap_degrees(a.to_degrees());
         Rotation4 {
             xy: deg(xy),
             xz: deg(xz),
@@ -122,6 +118,12 @@ impl Rotation4 {
             _ => return None,
         })
     }
+}
+
+/// An angle in degrees as the same angle in (-180, 180].
+pub fn wrap_degrees(degrees: f64) -> f64 {
+    let d = degrees.rem_euclid(360.0);
+    if d > 180.0 { d - 360.0 } else { d }
 }
 
 /// Rotation by `angle` in the plane of axes `name` (e.g. "xw"), turning the first axis towards

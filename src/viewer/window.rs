@@ -340,7 +340,7 @@ impl App {
         };
         if let Some(plane) = plane {
             let angle = view.rotation.angle_mut(plane).expect("a plane of R^4");
-            *angle = wrap(*angle + sign * STEP);
+            *angle = crate::view::wrap_degrees(*angle + sign * STEP);
             self.note.clear();
             return true;
         }
@@ -446,12 +446,6 @@ impl App {
         self.note.clear();
         true
     }
-}
-
-/// An angle in (-180, 180].
-fn wrap(degrees: f64) -> f64 {
-    let d = degrees.rem_euclid(360.0);
-    if d > 180.0 { d - 360.0 } else { d }
 }
 
 /// A 4D view in the scene file's terms.
