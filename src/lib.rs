@@ -29,6 +29,7 @@ mod pipeline;
 mod render;
 mod sample;
 mod scene;
+mod stipple;
 mod surfaces;
 pub mod sweep;
 mod tets;
@@ -53,11 +54,12 @@ pub use parts::{HaloIndex, HaloPart, Parts, SurfacePart};
 pub use render::compare::Comparison;
 pub use render::{
     CameraProjection, CameraSettings, Colormap, Picture, RenderError, RenderMode, RenderSettings,
-    RibbonAxis, Ribbons, render,
+    RibbonAxis, Ribbons, StippleSettings, Style, render,
 };
 pub use sample::{
     Audit, Mesh4, MeshStats, Sampling, audit, sample, sample_adaptive, sample_uniform,
 };
+pub use stipple::{Stipples, poisson_radius};
 pub use surfaces::{
     Domain, Eval4, Fermat, FlatTorus, Glue, KleinBottle, Patches, ProductPolynomial,
     ProjectivePlane, Side, SideRule, SpunTrefoil, Surface, Topology, TwistSpunTrefoil,

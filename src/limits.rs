@@ -45,6 +45,13 @@ pub const SAMPLES: [u32; 4] = [1, 4, 9, 16];
 /// --slices`).
 pub const SLICES: RangeInclusive<u32> = 1..=4096;
 
+/// Stipples per surface (`render.stipple.count`): the set ranks four candidates per
+/// stipple, about 70 bytes each.
+pub const STIPPLES: RangeInclusive<usize> = 1..=4_194_304;
+
+/// A stipple's diameter in pixels (`render.stipple.size`).
+pub const STIPPLE_SIZE: RangeInclusive<f64> = 0.5..=16.0;
+
 /// Slices of the halo depth in the viewer, whose slice textures live on the GPU.
 pub const VIEWER_SLICES: RangeInclusive<u32> = 2..=1024;
 
@@ -218,6 +225,16 @@ pub fn table() -> String {
             "slices",
         ),
         ("the viewer's slices", range(&VIEWER_SLICES), "slices"),
+        (
+            "`render.stipple.count`",
+            range(&STIPPLES),
+            "stipples per surface",
+        ),
+        (
+            "`render.stipple.size`",
+            range(&STIPPLE_SIZE),
+            "pixels (diameter)",
+        ),
         (
             "surface triangles the viewer loads",
             format!("up to {VIEWER_TRIANGLES}"),

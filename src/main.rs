@@ -2,8 +2,8 @@
 
 use clap::{Parser, Subcommand};
 use halo4d::Comparison;
-use halo4d::RenderMode;
 use halo4d::limits::{self, FieldError};
+use halo4d::{RenderMode, Style};
 use halo4d::{Scene, Surface, sweep};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -82,6 +82,9 @@ enum Command {
         /// Slices for --mode slices.
         #[arg(long)]
         slices: Option<u32>,
+        /// How surfaces are drawn: shaded (Phong over the w colours) or stipple (paper 003).
+        #[arg(long, value_enum)]
+        style: Option<Style>,
         /// A cross-eyed stereo pair side by side.
         #[arg(long)]
         stereo: bool,
@@ -177,6 +180,7 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
             height,
             mode,
             slices,
+            style,
             stereo,
             quiet,
         } => {
@@ -187,6 +191,7 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
             r.slices = slices.unwrap_or(r.slices);
             r.stereo |= stereo;
             r.mode = mode.unwrap_or(r.mode);
+            r.style = style.unwrap_or(r.style);
             let out = out.unwrap_or_else(|| {
                 Path::new("exports")
                     .join(&scene.name)

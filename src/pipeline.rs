@@ -9,9 +9,10 @@ use crate::halo::{Halo, HaloParams, HaloReport, build_halo};
 use crate::intersect::{self, Curves, CurvesReport};
 use crate::limits::{MAX_COORDINATE, MIN_EXTENT};
 use crate::parts::{HaloPart, Parts, SurfacePart};
-use crate::render::{self, CameraSettings, Picture, RenderError, RenderSettings};
+use crate::render::{self, CameraSettings, Picture, RenderError, RenderSettings, Style};
 use crate::sample::{self, Audit, Mesh4, MeshStats, Sampling, audit};
 use crate::scene::Scene;
+use crate::stipple::Stipples;
 use crate::surfaces::{Surface, Topology};
 use crate::verify::{self, Verification};
 use crate::view::Projected;
@@ -41,6 +42,8 @@ pub struct SurfaceProduct {
     pub halo: Halo,
     /// The halo's report.
     pub halo_report: HaloReport,
+    /// Its stipples, made from the 4D mesh when the stipple style or a stipple file asks.
+    pub stipples: Option<Stipples>,
 }
 
 /// Everything a build computes before writing.
@@ -75,6 +78,9 @@ pub struct Stages {
     /// The halos checked against the curves: whenever a halo file is written, and where
     /// `outputs.verify` asks for it.
     pub verify: bool,
+    /// Stipples on the 4D meshes: for a picture in `render.style` `stipple` and for
+    /// `outputs.stipples`.
+    pub stipples: bool,
 }
 
 impl Stages {
@@ -92,6 +98,7 @@ impl Stages {
             halos: verify || o.glb || o.vtk || (picture && scene.render.halos),
             curves: verify || o.glb || o.ply || (picture && scene.render.curves),
             verify,
+            stipples: o.stipples || (picture && scene.render.style == Style::Stipple),
         }
     }
 }
@@ -157,6 +164,7 @@ fn parts<'a>(surfaces: &'a [SurfaceProduct], halo: &HaloParams, curves: &'a Curv
                 normals: &p.projected.normals,
                 uv: Some(&p.mesh.uv),
                 triangles: &p.mesh.triangles,
+                stipples: p.stipples.as_ref(),
             })
             .collect(),
         halos: surfaces
@@ -298,6 +306,8 @@ pub struct Timings {
     pub curves: f64,
     /// Verifying the halos against the curves.
     pub verify: f64,
+    /// Ranking the stipples, all surfaces.
+    pub stipples: f64,
     /// Rendering the picture.
     pub render: f64,
     /// Writing the outputs.
@@ -343,6 +353,8 @@ pub struct SurfaceReport {
     pub w_range: Option<[f64; 2]>,
     /// The halo (null when no output needs one).
     pub halo: Option<HaloReport>,
+    /// Stipples ranked on the 4D mesh (null when none were made).
+    pub stipples: Option<usize>,
 }
 
 /// `report.json`.
@@ -581,6 +593,14 @@ fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error
             Default::default()
         };
         bar.inc(1);
+        let stipples = stages.stipples.then(|| {
+            bar.set_message(format!("stipples of {name}"));
+            let start = Instant::now();
+            let st = &scene.render.stipple;
+            let set = Stipples::generate(&mesh.positions, &mesh.triangles, st.count, st.seed);
+            timings.stipples += ms(start);
+            set
+        });
         products.push(SurfaceProduct {
             name,
             surface: entry.surface.clone(),
@@ -590,6 +610,7 @@ fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error
             projected,
             halo,
             halo_report,
+            stipples,
         });
     }
     let mut curves = Curves::default();
@@ -738,6 +759,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
         + timings.halo
         + timings.curves
         + timings.verify
+        + timings.stipples
         + timings.render
         + timings.export;
     let report = Report {
@@ -803,5 +825,6 @@ fn surface_report(p: &SurfaceProduct, halo: bool) -> SurfaceReport {
         }),
         w_range: p.projected.w_range(),
         halo: halo.then(|| p.halo_report.clone()),
+        stipples: p.stipples.as_ref().map(Stipples::len),
     }
 }

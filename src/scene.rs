@@ -86,6 +86,12 @@ pub struct Outputs {
     /// verdict in `report.json` and the exit status).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub verify: Option<bool>,
+    /// The stipples of the stipple style (`render.stipple`): a `stipples` point cloud in
+    /// `<name>.glb` (when `glb`) and `<name>-stipples.ply`, every stipple the set ranks, at
+    /// its place in the view, with its w and the radius of `render.stipple.size` at the
+    /// camera's distance.
+    #[serde(default)]
+    pub stipples: bool,
     /// Radius of the intersection curves' tubes in `<name>.glb`, a share of the projected
     /// scene's diagonal (as `halo.rho`).
     pub curve_radius: f64,
@@ -132,6 +138,7 @@ impl Default for Outputs {
             png: true,
             curve_radius: CURVE_RADIUS,
             verify: None,
+            stipples: false,
         }
     }
 }

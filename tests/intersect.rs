@@ -532,6 +532,7 @@ fn empty_and_single_triangle_inputs_give_no_curves() {
                     normals: &[],
                     uv: None,
                     triangles: s.triangles,
+                    stipples: None,
                 })
                 .collect(),
             halos: vec![None; sheets.len()],

@@ -113,6 +113,7 @@ impl ImportedScene {
                     normals: &s.normals,
                     uv: None,
                     triangles: &s.triangles,
+                    stipples: None,
                 })
                 .collect(),
             halos: self

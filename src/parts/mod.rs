@@ -16,6 +16,7 @@ pub use index::HaloIndex;
 pub(crate) use index::{inserted_sets, tet_box};
 
 use crate::intersect::{Curves, Sheet};
+use crate::stipple::Stipples;
 use glam::DVec3;
 
 /// One surface after the view, as its readers take it.
@@ -31,6 +32,8 @@ pub struct SurfacePart<'a> {
     pub uv: Option<&'a [[f64; 2]]>,
     /// Triangles.
     pub triangles: &'a [[u32; 3]],
+    /// The stipples fixed to the surface's 4D mesh (for the stipple style), when made.
+    pub stipples: Option<&'a Stipples>,
 }
 
 /// A surface's halo as its readers take it.

@@ -103,6 +103,16 @@ impl Camera {
         ))
     }
 
+    /// The eye ray (origin, unit direction) through point `p`, whose distance along it is
+    /// [`Camera::ray_distance`].
+    pub fn ray_to(&self, p: DVec3) -> (DVec3, DVec3) {
+        let t = self.ray_distance(p);
+        match self.projection {
+            CameraProjection::Perspective => (self.eye, (p - self.eye) / t),
+            CameraProjection::Orthographic => (p - self.forward * t, self.forward),
+        }
+    }
+
     /// The distance along a ray from this camera to `p` (what ray hits report as t).
     pub fn ray_distance(&self, p: DVec3) -> f64 {
         match self.projection {

@@ -17,6 +17,7 @@ pub mod lines;
 pub(crate) mod overlay;
 pub mod shade;
 pub mod slices;
+pub mod stipple;
 pub mod trace;
 
 use crate::limits::{FieldError, PICTURE_SIDE, SAMPLES, SLICES};
@@ -115,10 +116,53 @@ pub struct Ribbons {
     pub gap: f64,
 }
 
+/// How surfaces are drawn.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum Style {
+    /// Phong shading over a colour by w-depth, composited through every sheet.
+    #[default]
+    Shaded,
+    /// Paper 003's stipples: black (or coloured) dots whose density carries the tone, on
+    /// the first sheet the halos leave visible.
+    Stipple,
+}
+
+/// The stipple style's settings (`render.stipple` in a scene file).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StippleSettings {
+    /// A stipple's diameter in pixels.
+    pub size: f64,
+    /// Stipples ranked per surface: the most a picture can draw of each. A place where the
+    /// tone asks for more is drawn lighter (`halo4d render` says how much of the picture).
+    pub count: usize,
+    /// Seed of the stipples' random numbers.
+    pub seed: u64,
+    /// Stipples in the colour of their w-depth (paper 003's coloured stipples with tone
+    /// shading) instead of black.
+    pub colour: bool,
+}
+
+impl Default for StippleSettings {
+    fn default() -> Self {
+        StippleSettings {
+            size: 2.0,
+            count: 400_000,
+            seed: 1,
+            colour: false,
+        }
+    }
+}
+
 /// How a scene is drawn (`render` in a scene file).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RenderSettings {
+    /// `shaded` or `stipple`.
+    pub style: Style,
+    /// The stipple style's settings.
+    pub stipple: StippleSettings,
     /// Image width in pixels (each half of a stereo pair).
     pub width: u32,
     /// Image height in pixels.
@@ -171,6 +215,8 @@ pub struct RenderSettings {
 impl Default for RenderSettings {
     fn default() -> Self {
         RenderSettings {
+            style: Style::Shaded,
+            stipple: StippleSettings::default(),
             width: 1024,
             height: 1024,
             mode: RenderMode::Exact,
@@ -227,6 +273,29 @@ impl RenderSettings {
                 format!(
                     "must be 1, 4, 9 or 16 (a square grid), got {}",
                     self.samples
+                ),
+            ));
+        }
+        let st = &self.stipple;
+        if !crate::limits::STIPPLE_SIZE.contains(&st.size) {
+            return Err(FieldError::new(
+                "stipple.size",
+                format!(
+                    "must be {:?} to {:?} pixels (a stipple's diameter), got {}",
+                    crate::limits::STIPPLE_SIZE.start(),
+                    crate::limits::STIPPLE_SIZE.end(),
+                    st.size
+                ),
+            ));
+        }
+        if !crate::limits::STIPPLES.contains(&st.count) {
+            return Err(FieldError::new(
+                "stipple.count",
+                format!(
+                    "must be {} to {} stipples per surface, got {}",
+                    crate::limits::STIPPLES.start(),
+                    crate::limits::STIPPLES.end(),
+                    st.count
                 ),
             ));
         }
@@ -355,6 +424,14 @@ pub enum RenderError {
     /// Nothing to draw.
     #[error("the scene has no triangles to render")]
     Empty,
+    /// The stipple style asked of a surface without stipples.
+    #[error(
+        "render.style stipple: surface {surface} has no stipples (they are made from its 4D mesh by a build; a file read back without its 4D mesh has none): use render.style shaded"
+    )]
+    NoStipples {
+        /// The surface's index.
+        surface: usize,
+    },
     /// The picture would need more memory than the limit (`HALO4D_MAX_MEMORY` gigabytes, or three quarters of the machine's memory).
     #[error(
         "the picture would need about {:.2} GB ({what}), more than the limit of {:.2} GB ({source_of_limit}); lower render.width and render.height or render.samples, or use render.mode exact, which needs no per-sample store",
@@ -417,7 +494,7 @@ pub fn render(
     settings: &RenderSettings,
     camera: &CameraSettings,
 ) -> Result<Picture, RenderError> {
-    Ok(render_with_depth(input, settings, camera)?.0)
+    Ok(render_eyes(input, settings, camera, false)?.0)
 }
 
 /// [`render`], and per pixel of the first eye the ray distance of the first surface the
@@ -427,6 +504,17 @@ pub fn render_with_depth(
     input: &Parts,
     settings: &RenderSettings,
     camera: &CameraSettings,
+) -> Result<(Picture, Vec<f64>), RenderError> {
+    render_eyes(input, settings, camera, true)
+}
+
+/// The picture, and the first eye's distances when `depth` asks for them (the stipple style
+/// traces them apart; empty otherwise).
+fn render_eyes(
+    input: &Parts,
+    settings: &RenderSettings,
+    camera: &CameraSettings,
+    depth_wanted: bool,
 ) -> Result<(Picture, Vec<f64>), RenderError> {
     let (bounds, scene) = prepare(input, settings, camera)?;
     // Cross-eyed: the left image is the right eye's (turned right, +azimuth).
@@ -441,8 +529,11 @@ pub fn render_with_depth(
     let mut rgb = vec![0u8; 3 * (w as usize * eyes.len()) * h as usize];
     for (e, &offset) in eyes.iter().enumerate() {
         let cam = Camera::new(camera, bounds, w, h, offset)?;
-        let mut view = scene.view(&cam);
-        if e == 0 {
+        let mut view = match settings.style {
+            Style::Shaded => scene.view(&cam),
+            Style::Stipple => scene.view_stipples(&cam, depth_wanted && e == 0)?,
+        };
+        if e == 0 && depth_wanted {
             depth.clone_from(&view.front);
         }
         if let Some(coverage) = scene.lines(&cam)? {
@@ -471,6 +562,24 @@ pub fn render_with_depth(
         },
         depth,
     ))
+}
+
+/// The stipples the first eye's picture in the stipple style draws (whatever
+/// `settings.style` says), in the order of their surfaces and ranks.
+pub fn stipples_drawn(
+    input: &Parts,
+    settings: &RenderSettings,
+    camera: &CameraSettings,
+) -> Result<Vec<stipple::Drawn>, RenderError> {
+    let (bounds, scene) = prepare(input, settings, camera)?;
+    let cam = Camera::new(
+        camera,
+        bounds,
+        settings.width,
+        settings.height,
+        first_eye(settings),
+    )?;
+    scene.stipples(&cam)
 }
 
 /// The coverage in [0, 1] of the lines (curves and silhouettes, as the settings ask) in the

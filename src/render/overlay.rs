@@ -104,15 +104,14 @@ impl Scene<'_> {
 
     /// Whether a surface the halos leave visible lies between the eye and `p` (surfaces
     /// through `p` itself, as both sheets at a curve point, do not count).
-    fn occluded(&self, cam: &Camera, p: DVec3, hits: &mut Vec<super::trace::Hit>) -> bool {
-        let t_p = cam.ray_distance(p);
-        let (origin, dir) = match cam.projection {
-            super::CameraProjection::Perspective => (cam.eye, (p - cam.eye) / t_p),
-            super::CameraProjection::Orthographic => (p - cam.forward * t_p, cam.forward),
-        };
-        self.trace(origin, dir, hits);
-        let before = t_p - 1e-9 * self.radius.max(t_p);
-        hits.iter().take_while(|hit| hit.t < before).any(|hit| {
+    pub(super) fn occluded(
+        &self,
+        cam: &Camera,
+        p: DVec3,
+        hits: &mut Vec<super::trace::Hit>,
+    ) -> bool {
+        let (origin, dir) = self.hits_before(cam, p, hits);
+        hits.iter().any(|hit| {
             let surf = &self.input.surfaces[hit.surface as usize];
             let tri = surf.triangles[hit.triangle as usize];
             let x = origin + dir * hit.t;
@@ -122,6 +121,23 @@ impl Scene<'_> {
                 .as_ref()
                 .is_some_and(|index| index.hidden(x, w, hit.surface, tri))
         })
+    }
+
+    /// Traces the eye ray through `p` and keeps in `hits` the surfaces it meets before `p`
+    /// (those through `p` itself do not count); gives the ray (origin, unit direction).
+    pub(super) fn hits_before(
+        &self,
+        cam: &Camera,
+        p: DVec3,
+        hits: &mut Vec<super::trace::Hit>,
+    ) -> (DVec3, DVec3) {
+        let (origin, dir) = cam.ray_to(p);
+        self.trace(origin, dir, hits);
+        let t_p = cam.ray_distance(p);
+        let before = t_p - 1e-9 * self.radius.max(t_p);
+        let keep = hits.iter().take_while(|hit| hit.t < before).count();
+        hits.truncate(keep);
+        (origin, dir)
     }
 
     /// The mesh edges between a triangle facing the eye and one facing away: where the eye
