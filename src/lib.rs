@@ -83,7 +83,8 @@ pub mod internals {
     pub use crate::intersect::{BroadPhase, Node, curves_with};
     pub use crate::render::camera::Camera;
     pub use crate::render::compare::verdict_differs;
-    pub use crate::render::{Prober, Seen, line_coverage, render_with_depth};
+    pub use crate::render::stipple::{Drawn, density, luminance, tone};
+    pub use crate::render::{Prober, Seen, line_coverage, render_with_depth, stipples_drawn};
     pub use crate::sample::{bounding_diagonal, uniform_error};
 
     /// One-pixel lines broadened to an exact width.

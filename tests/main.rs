@@ -14,6 +14,7 @@ mod lines;
 mod render;
 mod sample;
 mod scene;
+mod stipple;
 mod surfaces;
 mod view;
 #[cfg(feature = "viewer")]
