@@ -7,9 +7,10 @@ its own, so that a crash is a failure reported with its signal, not a dead CI.
     - Blender imports <scene>.glb with no warning or error; every surface mesh keeps its
       vertices in order with POSITION (turned to Blender's z-up) and _W, _U, _V, _PATCH
       exactly the file's; every halo keeps its offset vertices at their indices with _T and
-      _D; the curves' tubes keep _DW, _CURVE and _W;
+      _D; the curves' tubes keep _DW, _CURVE and _W; the stipples (POINTS) keep _RADIUS
+      and _W;
     - MeshLab loads every file the README tells MeshLab users to open (.glb, .ply,
-      -curves.ply, .obj);
+      -curves.ply, -stipples.ply, .obj);
     - every tetrahedron of every *-halo.vtk has positive volume under vtkMeshQuality, the
       smallest and largest equal to report.json's, and the boundary vtkDataSetSurfaceFilter
       extracts encloses positive volume, report.json's boundary volume;
@@ -159,8 +160,11 @@ def child_blender_import(path):
             kind, names, kept = "surface", ["_W", "_U", "_V", "_PATCH"], np.arange(len(positions))
         elif "curves" in extras:
             kind, names, kept = "curves", ["_DW", "_CURVE", "_W"], np.arange(len(positions))
+        elif "stipples" in extras:
+            # A mesh of POINTS: vertices only.
+            kind, names, kept = "stipples", ["_RADIUS", "_W"], np.arange(len(positions))
         else:
-            problems.append(f"mesh {m.name}: neither surface, halo nor curves")
+            problems.append(f"mesh {m.name}: neither surface, halo, curves nor stipples")
             continue
         keep = len(kept)
         if len(mesh.vertices) != keep:
@@ -176,7 +180,8 @@ def child_blender_import(path):
                 problems.append(f"{kind} {m.name}: Blender has no float point attribute {name}")
             elif not np.array_equal(values, accessor(g, blob, attrs.__dict__[name])[kept]):
                 problems.append(f"{kind} {m.name}: {name} differs from the file's")
-        if len(mesh.polygons) != len(accessor(g, blob, prim.indices)) // 3:
+        faces = 0 if prim.indices is None else len(accessor(g, blob, prim.indices)) // 3
+        if len(mesh.polygons) != faces:
             problems.append(f"{kind} {m.name}: Blender has {len(mesh.polygons)} faces")
         print(f"  Blender {kind} {m.name}: {keep} vertices, {len(mesh.polygons)} faces, {', '.join(names)} exact")
     for p in problems:

@@ -667,6 +667,17 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     };
     let name = &scene.name;
     let failures = built.failures();
+    // The stipples of the picture, for the files that carry them.
+    let stipples = if scene.outputs.stipples {
+        render::stipples_drawn(&built.parts(&scene.halo), &scene.render, &scene.camera).map_err(
+            |source| Error::Render {
+                scene: scene.name.clone(),
+                source,
+            },
+        )?
+    } else {
+        Vec::new()
+    };
     // The files are made on the cores side by side, each written as it is made (a halo's
     // `.vtk` streamed, the `.glb`'s chunks written as they are, with no copy of the whole
     // file in memory); the report lists them in this order.
@@ -687,6 +698,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
                 &data,
                 &built.curves,
                 scene.outputs.curve_radius * built.diagonal,
+                &stipples,
                 &asset,
             )
             .map_err(|message| Error::Internal {
@@ -710,6 +722,14 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
                     &export::to_curves_ply(&built.curves, name),
                 )?,
             ])
+        }));
+    }
+    if scene.outputs.stipples {
+        jobs.push(Box::new(|| {
+            Ok(vec![write(
+                format!("{name}-stipples.ply"),
+                &export::to_stipples_ply(&stipples, name),
+            )?])
         }));
     }
     if scene.outputs.obj {

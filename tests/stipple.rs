@@ -328,3 +328,88 @@ fn a_surface_without_stipples_is_a_clear_error() {
         "{e}"
     );
 }
+
+#[test]
+fn the_stipples_files_hold_the_pictures_stipples() {
+    let path = fixture("scenes/klein-bottle-stipples.json");
+    let scene = Scene::load(&path).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let report = halo4d::build(&scene, dir.path(), true).unwrap();
+    assert_eq!(report.surfaces[0].stipples, Some(200_000));
+    let built = halo4d::run(&scene, true).unwrap();
+    let drawn = stipples_drawn(&built.parts(&scene.halo), &scene.render, &scene.camera).unwrap();
+    assert!(drawn.len() > 1000, "{} stipples drawn", drawn.len());
+    let name = &scene.name;
+
+    // PLY: a point cloud, a vertex per drawn stipple, in order.
+    let bytes = std::fs::read(dir.path().join(format!("{name}-stipples.ply"))).unwrap();
+    let parser = ply_rs::parser::Parser::<ply_rs::ply::DefaultElement>::new();
+    let ply = parser.read_ply(&mut bytes.as_slice()).unwrap();
+    let vertices = &ply.payload["vertex"];
+    assert_eq!(vertices.len(), drawn.len());
+    assert!(!ply.payload.contains_key("face"));
+    let float = |p: &ply_rs::ply::Property| match p {
+        ply_rs::ply::Property::Float(x) => f64::from(*x),
+        ply_rs::ply::Property::Int(x) => f64::from(*x),
+        other => panic!("unexpected property {other:?}"),
+    };
+    for (v, d) in vertices.iter().zip(&drawn) {
+        assert_eq!(float(&v["x"]), f64::from(d.position.x as f32));
+        assert_eq!(float(&v["z"]), f64::from(d.position.z as f32));
+        assert_eq!(float(&v["radius"]), f64::from(d.radius as f32));
+        assert_eq!(float(&v["quality"]), f64::from(d.w as f32));
+        assert_eq!(float(&v["rank"]), f64::from(d.rank));
+        assert!(d.radius > 0.0);
+    }
+
+    // glTF: a mesh `stipples` of POINTS with _RADIUS and _W, positions y-up.
+    let glb = std::fs::read(dir.path().join(format!("{name}.glb"))).unwrap();
+    let gltf = gltf::Gltf::from_slice(&glb).unwrap();
+    let blob = gltf.blob.as_deref().unwrap();
+    let mesh = gltf
+        .meshes()
+        .find(|m| m.name() == Some("stipples"))
+        .expect("a stipples mesh");
+    let prim = mesh.primitives().next().unwrap();
+    assert_eq!(prim.mode(), gltf::mesh::Mode::Points);
+    let reader = prim.reader(|_| Some(blob));
+    let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
+    assert_eq!(positions.len(), drawn.len());
+    for (p, d) in positions.iter().zip(&drawn) {
+        // glTF's y is halo4d's z, its z halo4d's -y.
+        assert_eq!(
+            *p,
+            [
+                d.position.x as f32,
+                d.position.z as f32,
+                -d.position.y as f32
+            ]
+        );
+    }
+    for (attr, expect) in [
+        (
+            "_RADIUS",
+            drawn.iter().map(|d| d.radius).collect::<Vec<_>>(),
+        ),
+        ("_W", drawn.iter().map(|d| d.w).collect()),
+    ] {
+        let acc = prim
+            .attributes()
+            .find(|(s, _)| s.to_string() == attr)
+            .unwrap_or_else(|| panic!("no {attr}"))
+            .1;
+        let view = acc.view().unwrap();
+        let bytes = &blob[view.offset() + acc.offset()..][..acc.count() * 4];
+        for (chunk, e) in bytes.chunks_exact(4).zip(&expect) {
+            assert_eq!(
+                f32::from_le_bytes(chunk.try_into().unwrap()),
+                *e as f32,
+                "{attr}"
+            );
+        }
+    }
+    // The build still checks clean: the point cloud is no surface.
+    let checked = halo4d::check_dir(dir.path()).unwrap();
+    assert!(checked.failures().is_empty(), "{:?}", checked.failures());
+    assert_eq!(checked.halos.len(), 1);
+}

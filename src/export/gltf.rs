@@ -40,6 +40,7 @@ use crate::check::LAYERS;
 use crate::convention::{MESH_4D, file_order, to_gltf};
 use crate::halo::Halo;
 use crate::intersect::{CurvePoint, Curves};
+use crate::render::stipple::Drawn;
 use crate::view::area_normal_sums;
 use glam::{DVec3, Vec3};
 use gltf_json as json;
@@ -265,16 +266,18 @@ pub fn to_glb(
     curve_radius: f64,
     asset: &serde_json::Value,
 ) -> Result<Vec<u8>, String> {
-    let (text, bin) = glb_chunks(surfaces, curves, curve_radius, asset)?;
+    let (text, bin) = glb_chunks(surfaces, curves, curve_radius, &[], asset)?;
     Ok(glb_container(text, bin))
 }
 
-/// The JSON and binary chunks of [`to_glb`]'s file, for [`write_glb_container`] to write
-/// without a copy of the whole file in memory.
+/// The JSON and binary chunks of [`to_glb`]'s file, with the `stipples` of the scene's
+/// picture as a point cloud when there are any, for [`write_glb_container`] to write without
+/// a copy of the whole file in memory.
 pub fn glb_chunks(
     surfaces: &[SurfaceData],
     curves: &Curves,
     curve_radius: f64,
+    stipples: &[Drawn],
     asset: &serde_json::Value,
 ) -> Result<(Vec<u8>, Vec<u8>), String> {
     let extras = |v: serde_json::Value| to_raw_value(&v).map(Some).map_err(|e| e.to_string());
@@ -387,6 +390,14 @@ pub fn glb_chunks(
             ..Default::default()
         }));
     }
+    if !stipples.is_empty() {
+        let mesh = stipples_mesh(&mut b, stipples)?;
+        nodes.push(b.root.push(json::Node {
+            mesh: Some(mesh),
+            name: Some("stipples".into()),
+            ..Default::default()
+        }));
+    }
     let scene = b.root.push(json::Scene {
         extensions: None,
         extras: None,
@@ -403,6 +414,54 @@ pub fn glb_chunks(
     });
     let text = b.root.to_vec().map_err(|e| e.to_string())?;
     Ok((text, b.bin))
+}
+
+/// Appends the stipples as a mesh of POINTS: positions, `_RADIUS` (each disc's radius in
+/// scene units, which Blender's importer gives a point cloud as its radius) and `_W` (the
+/// w-depth), in black.
+fn stipples_mesh(b: &mut Builder, stipples: &[Drawn]) -> Result<json::Index<json::Mesh>, String> {
+    use json::accessor::Type::Scalar;
+    use json::mesh::Semantic;
+    let positions: Vec<DVec3> = stipples.iter().map(|d| d.position).collect();
+    let column =
+        |f: &dyn Fn(&Drawn) -> f64| stipples.iter().map(|d| f(d) as f32).collect::<Vec<f32>>();
+    let attributes = [
+        (Semantic::Positions, b.positions(&positions)),
+        (
+            Semantic::Extras("RADIUS".into()),
+            b.floats(&column(&|d| d.radius), Scalar, None),
+        ),
+        (
+            Semantic::Extras("W".into()),
+            b.floats(&column(&|d| d.w), Scalar, None),
+        ),
+    ];
+    let material = b.root.push(json::Material {
+        name: Some("stipples".into()),
+        pbr_metallic_roughness: json::material::PbrMetallicRoughness {
+            base_color_factor: json::material::PbrBaseColorFactor([0.02, 0.02, 0.02, 1.0]),
+            metallic_factor: json::material::StrengthFactor(0.0),
+            roughness_factor: json::material::StrengthFactor(1.0),
+            ..Default::default()
+        },
+        ..Default::default()
+    });
+    let extras = serde_json::json!({ "stipples": { "count": stipples.len() } });
+    Ok(b.root.push(json::Mesh {
+        name: Some("stipples".into()),
+        extras: Some(to_raw_value(&extras).map_err(|e| e.to_string())?),
+        extensions: None,
+        primitives: vec![json::mesh::Primitive {
+            attributes: attributes.into_iter().map(|(k, v)| (Valid(k), v)).collect(),
+            extensions: None,
+            extras: None,
+            indices: None,
+            material: Some(material),
+            mode: Valid(json::mesh::Mode::Points),
+            targets: None,
+        }],
+        weights: None,
+    }))
 }
 
 /// Appends the halo mesh of `s` (see the module documentation); `surface_mesh` is the

@@ -20,7 +20,7 @@ mod vtk;
 
 pub use gltf::{glb_chunks, glb_container, to_glb, write_glb_container};
 pub use obj::to_obj;
-pub use ply::{to_curves_ply, to_ply};
+pub use ply::{to_curves_ply, to_ply, to_stipples_ply};
 pub use vtk::write_vtk;
 
 mod staged;

@@ -2,6 +2,7 @@
 
 use super::SurfaceData;
 use crate::intersect::Curves;
+use crate::render::stipple::Drawn;
 
 /// Builds a binary little-endian PLY with all surfaces in one mesh: per vertex x, y, z,
 /// nx, ny, nz, `quality` (the w-depth, which MeshLab keeps as its per-vertex scalar), u, v,
@@ -58,6 +59,35 @@ pub fn to_ply(surfaces: &[SurfaceData], scene_name: &str) -> Vec<u8> {
             }
         }
         base += s.projected.positions.len();
+    }
+    out
+}
+
+/// Builds a binary little-endian PLY of the stipples a picture draws (`<name>-stipples.ply`):
+/// a point cloud, per stipple x, y, z, `radius` (its disc's radius in scene units, which
+/// MeshLab keeps as its per-vertex radius), `quality` (its w-depth), `surface` and `rank`
+/// (its place in the surface's ranking). No faces.
+pub fn to_stipples_ply(stipples: &[Drawn], scene_name: &str) -> Vec<u8> {
+    let header = format!(
+        "ply\nformat binary_little_endian 1.0\n\
+         comment halo4d {}: scene {scene_name}; the stipples of its picture, quality is the w-depth\n\
+         element vertex {}\n\
+         property float x\nproperty float y\nproperty float z\n\
+         property float radius\nproperty float quality\n\
+         property int surface\nproperty int rank\n\
+         end_header\n",
+        env!("CARGO_PKG_VERSION"),
+        stipples.len(),
+    );
+    let mut out = header.into_bytes();
+    out.reserve(stipples.len() * 28);
+    for d in stipples {
+        let p = d.position;
+        for f in [p.x, p.y, p.z, d.radius, d.w] {
+            out.extend_from_slice(&(f as f32).to_le_bytes());
+        }
+        out.extend_from_slice(&(d.surface as i32).to_le_bytes());
+        out.extend_from_slice(&(d.rank as i32).to_le_bytes());
     }
     out
 }
