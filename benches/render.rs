@@ -1,5 +1,6 @@
 //! Rendering costs: the default scene's picture at 1024 x 1024 in the exact mode and with 256
-//! slices (both cores), and broadening one-pixel lines to bands (`render::lines`) with the
+//! slices (both cores), in the stipple style, and ranking its stipples (once per surface);
+//! and broadening one-pixel lines to bands (`render::lines`) with the
 //! FFT plans kept between calls: masks of a few hundred seeded random segments, on a sweep of
 //! image sizes and widths, and with widths that vary along the segments.
 
@@ -64,6 +65,30 @@ fn pictures(c: &mut Criterion) {
     group.finish();
 }
 
+fn stipples(c: &mut Criterion) {
+    let mut scene = halo4d::Scene::default_scene();
+    scene.render.style = halo4d::Style::Stipple;
+    let built = halo4d::run(&scene, true).expect("the default scene builds");
+    let mut group = c.benchmark_group("render/default_scene_1024");
+    group.sample_size(10);
+    group.bench_function("stipple", |b| {
+        b.iter(|| {
+            built
+                .render(&scene.halo, black_box(&scene.render), &scene.camera)
+                .expect("the default scene renders")
+        })
+    });
+    group.finish();
+    let mesh = &built.surfaces[0].mesh;
+    let count = scene.render.stipple.count;
+    let mut group = c.benchmark_group("stipples/default_scene");
+    group.sample_size(10);
+    group.bench_function(format!("rank_{count}"), |b| {
+        b.iter(|| halo4d::Stipples::generate(black_box(&mesh.positions), &mesh.triangles, count, 1))
+    });
+    group.finish();
+}
+
 fn broaden(c: &mut Criterion) {
     let mut group = c.benchmark_group("render/broaden");
     group.sample_size(20);
@@ -91,5 +116,5 @@ fn broaden(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, pictures, broaden);
+criterion_group!(benches, pictures, stipples, broaden);
 criterion_main!(benches);

@@ -353,7 +353,8 @@ pub struct SurfaceReport {
     pub w_range: Option<[f64; 2]>,
     /// The halo (null when no output needs one).
     pub halo: Option<HaloReport>,
-    /// Stipples ranked on the 4D mesh (null when none were made).
+    /// Stipples ranked on the 4D mesh (absent when none were made).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub stipples: Option<usize>,
 }
 

@@ -56,14 +56,17 @@ fn every_fixture_builds_and_reads_back() {
         }
 
         // glTF: one mesh per surface, named after it, with the custom attributes, one per
-        // halo (tests/halo_export.rs reads those) and one of the curves, if any
-        // (tests/curves_export.rs reads that).
+        // halo (tests/halo_export.rs reads those), one of the curves, if any
+        // (tests/curves_export.rs reads that), and one of the stipples where the scene asks
+        // (tests/stipple.rs reads that).
         let glb = std::fs::read(out.join(format!("{name}.glb"))).unwrap();
         let gltf = gltf::Gltf::from_slice(&glb).unwrap_or_else(|e| panic!("{name}.glb: {e}"));
         let blob = gltf.blob.as_deref().expect("binary chunk");
         assert_eq!(
             gltf.meshes().count(),
-            2 * products.len() + usize::from(!built.curves.curves.is_empty())
+            2 * products.len()
+                + usize::from(!built.curves.curves.is_empty())
+                + usize::from(scene.outputs.stipples)
         );
         let extras = gltf
             .document
@@ -172,8 +175,12 @@ fn every_fixture_builds_and_reads_back() {
             json["surfaces"][0]["triangles"],
             products[0].mesh.triangles.len()
         );
-        // .glb, .ply, -curves.ply, .obj, .png, report.json and a .vtk per halo.
-        assert_eq!(report.files.len(), 6 + products.len());
+        // .glb, .ply, -curves.ply, .obj, .png, report.json, a .vtk per halo and
+        // -stipples.ply where the scene asks.
+        assert_eq!(
+            report.files.len(),
+            6 + products.len() + usize::from(scene.outputs.stipples)
+        );
         assert!(
             !text.contains("NaN") && !text.contains("null,"),
             "report has a non-number"
