@@ -35,9 +35,11 @@ use std::hash::{BuildHasherDefault, Hasher};
 const OVERSAMPLE: usize = 4;
 /// Ratio of one level's radius to the previous one's.
 const LEVEL_RATIO: f64 = 0.917_004_043_204_671_2; // 2^(-1/8)
-/// Levels between rebuilds of the neighbour grid (its cells stay at least twice the
-/// radius, so a query visits 2^4 cells).
+/// Levels between rebuilds of the neighbour grid.
 const LEVELS_PER_GRID: usize = 4;
+/// The grid's cell over the radius when it is built: a query looks up p's own cell and those
+/// its ball reaches across a face into, on average about 4 of the 16 it can meet.
+const CELL: f64 = 4.0;
 
 /// A progressive blue-noise point set on one surface's mesh, in rank order.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -175,7 +177,7 @@ fn rank(
     let radius = |j: usize| first * LEVEL_RATIO.powi(j as i32);
     let mut waiting: Vec<Vec<u32>> = vec![Vec::new(); levels];
     let mut accepted: Vec<u32> = Vec::with_capacity(count);
-    let mut grid = Grid::new(2.0 * radius(0));
+    let mut grid = Grid::new(CELL * radius(0));
     let mut active = 0usize;
     for j in 0..levels {
         if accepted.len() >= count {
@@ -183,7 +185,7 @@ fn rank(
         }
         let r = radius(j);
         if j % LEVELS_PER_GRID == 0 {
-            grid = Grid::new(2.0 * r);
+            grid = Grid::new(CELL * r);
             for &i in &accepted {
                 grid.insert(points[i as usize]);
             }
@@ -259,16 +261,28 @@ impl Grid {
     /// at the first that holds one: the distance is the nearest of that cell's, an upper
     /// bound of the nearest distance (a rejected candidate only comes back sooner).
     fn near_within(&self, p: DVec4, r: f64) -> Option<f64> {
-        // The ball of radius r meets at most two cells per axis, from the one of `lo`.
-        let lo = p - DVec4::splat(r);
-        let own = (0..4).fold(0u32, |bits, axis| {
-            let step = (p[axis] / self.cell).floor() - (lo[axis] / self.cell).floor();
-            bits | (u32::from(step > 0.0) << axis)
-        });
-        for corner in 0..16 {
+        // The ball of radius r meets at most two cells per axis: p's own, and the next one
+        // down or up where it reaches across a face.
+        let cell = |x: f64| (x / self.cell).floor();
+        let (mut down, mut up) = (0u32, 0u32);
+        for axis in 0..4 {
+            let own = cell(p[axis]);
+            down |= u32::from(cell(p[axis] - r) < own) << axis;
+            up |= u32::from(cell(p[axis] + r) > own) << axis;
+        }
+        let reach = down | up;
+        let base = p - DVec4::select(
+            glam::BVec4::new(down & 1 != 0, down & 2 != 0, down & 4 != 0, down & 8 != 0),
+            DVec4::splat(r),
+            DVec4::ZERO,
+        );
+        // Every subset of the axes it reaches across, p's own cell first.
+        let mut subset = 0u32;
+        loop {
+            let corner = subset ^ down;
             let best = self
                 .cells
-                .get(&self.key(lo, corner ^ own))
+                .get(&self.key(base, corner))
                 .into_iter()
                 .flatten()
                 .map(|q| q.distance_squared(p))
@@ -276,8 +290,12 @@ impl Grid {
             if best < r * r {
                 return Some(best.sqrt());
             }
+            // The next subset of `reach`.
+            subset = subset.wrapping_sub(reach) & reach;
+            if subset == 0 {
+                return None;
+            }
         }
-        None
     }
 }
 
