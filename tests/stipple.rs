@@ -413,3 +413,45 @@ fn the_stipples_files_hold_the_pictures_stipples() {
     assert!(checked.failures().is_empty(), "{:?}", checked.failures());
     assert_eq!(checked.halos.len(), 1);
 }
+
+#[test]
+fn coloured_stipples_take_the_w_colours() {
+    let (mut scene, built) = default_scene();
+    scene.render.stipple.colour = true;
+    (scene.render.curves, scene.render.silhouettes) = (false, false);
+    let picture = built
+        .render(&scene.halo, &scene.render, &scene.camera)
+        .unwrap();
+    // Inked pixels of clearly different hues: blue (near) and orange (far) among them.
+    let (mut blue, mut orange) = (0, 0);
+    for p in picture.rgb.chunks(3) {
+        let [r, g, b] = [p[0], p[1], p[2]].map(i32::from);
+        blue += usize::from(b > r + 40 && b > g);
+        orange += usize::from(r > b + 40 && r > g);
+    }
+    assert!(
+        blue > 100 && orange > 100,
+        "{blue} blue, {orange} orange pixels"
+    );
+}
+
+#[test]
+fn bad_stipple_settings_name_their_field() {
+    for (json, field) in [
+        (r#"{"stipple": {"size": 0.1}}"#, "render.stipple.size"),
+        (r#"{"stipple": {"size": 40}}"#, "render.stipple.size"),
+        (r#"{"stipple": {"count": 0}}"#, "render.stipple.count"),
+        (
+            r#"{"stipple": {"count": 99999999}}"#,
+            "render.stipple.count",
+        ),
+        (r#"{"stipple": {"dots": 3}}"#, "dots"),
+        (r#"{"style": "pointillist"}"#, "pointillist"),
+    ] {
+        let text = format!(
+            r#"{{"name": "s", "surfaces": [{{"surface": {{"type": "flat_torus"}}}}], "render": {json}}}"#
+        );
+        let e = Scene::parse(&text, "s.json").unwrap_err().to_string();
+        assert!(e.contains(field), "{json}: {e}");
+    }
+}
