@@ -457,6 +457,20 @@ pub fn render_to(scene: &Scene, out: &Path, quiet: bool) -> Result<(Picture, f64
         .render(&scene.halo, &scene.render, &scene.camera)
         .map_err(render_error)?;
     let took = ms(start);
+    if scene.render.style == Style::Stipple {
+        let parts = built.parts(&scene.halo);
+        let drawn =
+            render::stipples_drawn(&parts, &scene.render, &scene.camera).map_err(render_error)?;
+        let saturated = drawn.iter().filter(|d| d.saturated).count();
+        if saturated * 100 > drawn.len() {
+            eprintln!(
+                "warning: {saturated} of {} stipples are where the tone asks for more than render.stipple.count = {} ranks; those places are drawn lighter: raise the count (about 0.4 per pixel of the picture: {})",
+                drawn.len(),
+                scene.render.stipple.count,
+                (0.4 * f64::from(scene.render.width) * f64::from(scene.render.height)).ceil()
+            );
+        }
+    }
     let write_error = |path: &Path| {
         let path = path.to_path_buf();
         move |source| Error::Write { path, source }

@@ -135,7 +135,8 @@ pub struct StippleSettings {
     /// A stipple's diameter in pixels.
     pub size: f64,
     /// Stipples ranked per surface: the most a picture can draw of each. A place where the
-    /// tone asks for more is drawn lighter (`halo4d render` says how much of the picture).
+    /// tone asks for more is drawn lighter (`halo4d render` warns); about 0.4 stipples per
+    /// pixel of the picture are enough for the darkest tones.
     pub count: usize,
     /// Seed of the stipples' random numbers.
     pub seed: u64,
