@@ -88,18 +88,12 @@ impl Torus {
         Torus { scene, built }
     }
 
+    /// The camera of the picture.
     fn camera(&self) -> Camera {
-        let (lo, hi) = self
-            .built
-            .surfaces
-            .iter()
-            .filter_map(|p| p.projected.bounds())
-            .fold(
-                (DVec3::INFINITY, DVec3::NEG_INFINITY),
-                |(a, b), (lo, hi)| (a.min(lo), b.max(hi)),
-            );
-        let r = &self.scene.render;
-        Camera::new(&self.scene.camera, (lo, hi), r.width, r.height, 0.0).unwrap()
+        let parts = self.built.parts(&self.scene.halo);
+        *Prober::new(&parts, &self.scene.render, &self.scene.camera)
+            .unwrap()
+            .camera()
     }
 
     /// What the picture shows at image points, with halos or without.
@@ -477,9 +471,11 @@ fn the_drawn_curves_lie_on_the_computed_curves_at_the_width_asked_for() {
             if !within(q) || crowded {
                 continue;
             }
-            // Only where this stretch of curve is drawn at all (it may be hidden).
+            // Only where this stretch of curve is drawn (it may be hidden), and away from
+            // where it ends or goes behind a surface: drawn a width on either side too.
             let at = |p: [f64; 2]| coverage[p[1] as usize * w + p[0] as usize] as f64;
-            if at(q) < 0.5 {
+            let along = |s: f64| [q[0] + tangent[0] / len * s, q[1] + tangent[1] / len * s];
+            if at(q) < 0.5 || at(along(-4.0)) < 0.5 || at(along(4.0)) < 0.5 {
                 continue;
             }
             let step = 0.125;
@@ -627,4 +623,117 @@ fn a_picture_beyond_the_memory_limit_is_refused_before_it_allocates() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(dir.path().join("p.png").exists());
+}
+
+#[test]
+fn the_default_camera_fits_the_surfaces_in_the_picture() {
+    let mut scene = Scene::default_scene();
+    (
+        scene.render.width,
+        scene.render.height,
+        scene.render.samples,
+    ) = (300, 240, 1);
+    assert_eq!(scene.camera.distance, None, "the default camera is fitted");
+    let built = halo4d::run(&scene, true).unwrap();
+    let parts = built.parts(&scene.halo);
+    let picture = halo4d::render(&parts, &scene.render, &scene.camera).unwrap();
+    let (w, h) = (picture.width as usize, picture.height as usize);
+    // The surfaces' extent, from the picture: the columns and rows that are not background.
+    let covered = |x: usize, y: usize| picture.rgb[3 * (y * w + x)..][..3] != [255, 255, 255];
+    let columns: Vec<usize> = (0..w).filter(|&x| (0..h).any(|y| covered(x, y))).collect();
+    let rows: Vec<usize> = (0..h).filter(|&y| (0..w).any(|x| covered(x, y))).collect();
+    let span = |v: &[usize]| v.last().unwrap() - v.first().unwrap() + 1;
+    // Every vertex in the picture, outside the margin of 5% on each side.
+    let prober = Prober::new(&parts, &scene.render, &scene.camera).unwrap();
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for s in &parts.surfaces {
+        for &v in s.triangles.iter().flatten() {
+            let (xy, _) = prober
+                .camera()
+                .project(s.positions[v as usize], w as u32, h as u32)
+                .expect("in front of the eye");
+            for k in 0..2 {
+                (lo[k], hi[k]) = (lo[k].min(xy[k]), hi[k].max(xy[k]));
+            }
+        }
+    }
+    let size = [w as f64, h as f64];
+    for k in 0..2 {
+        let margin = 0.05 * size[k];
+        assert!(
+            lo[k] >= margin - 1e-6 && hi[k] <= size[k] - margin + 1e-6,
+            "axis {k}: vertices from {} to {} of {}",
+            lo[k],
+            hi[k],
+            size[k]
+        );
+    }
+    // Tight on one axis: a vertex on the margin.
+    let touches = (0..2).any(|k| {
+        let margin = 0.05 * size[k];
+        (lo[k] - margin).abs() < 1e-6 || (hi[k] - (size[k] - margin)).abs() < 1e-6
+    });
+    assert!(touches, "{lo:?} {hi:?} in {size:?}");
+    let (across, down) = (
+        span(&columns) as f64 / w as f64,
+        span(&rows) as f64 / h as f64,
+    );
+    assert!(
+        across.max(down) >= 0.85,
+        "the surfaces span {across:.3} of the width and {down:.3} of the height"
+    );
+}
+
+#[test]
+fn a_camera_at_a_given_distance_stands_where_it_always_has() {
+    let torus = Torus::new();
+    let parts = torus.built.parts(&torus.scene.halo);
+    let (lo, hi) = torus
+        .built
+        .surfaces
+        .iter()
+        .filter_map(|p| p.projected.bounds())
+        .fold(
+            (DVec3::INFINITY, DVec3::NEG_INFINITY),
+            |(a, b), (lo, hi)| (a.min(lo), b.max(hi)),
+        );
+    let (centre, radius) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
+    for projection in [
+        halo4d::CameraProjection::Perspective,
+        halo4d::CameraProjection::Orthographic,
+    ] {
+        let camera = halo4d::CameraSettings {
+            distance: Some(3.2),
+            projection,
+            ..torus.scene.camera
+        };
+        let prober = Prober::new(&parts, &torus.scene.render, &camera).unwrap();
+        let cam = prober.camera();
+        // The eye at 3.2 half-diagonals from the box's centre, the picture spanning
+        // tan(fov / 2) (perspective) or the bounding sphere and 5% (orthographic), to the
+        // last bit.
+        let (az, el) = (camera.azimuth.to_radians(), camera.elevation.to_radians());
+        let towards_eye = DVec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+        assert_eq!(cam.eye, centre + towards_eye * 3.2 * radius);
+        assert_eq!(cam.forward, -towards_eye);
+        let half_height = match projection {
+            halo4d::CameraProjection::Perspective => (camera.fov.to_radians() * 0.5).tan(),
+            halo4d::CameraProjection::Orthographic => radius * 1.05,
+        };
+        assert_eq!(cam.half_height, half_height);
+        // A scene file that gives the distance reads as that camera, and one that gives none
+        // as the fitted one.
+        let given: halo4d::CameraSettings = serde_json::from_str(r#"{ "distance": 3.2 }"#).unwrap();
+        assert_eq!(given.distance, Some(3.2));
+        let fitted: halo4d::CameraSettings = serde_json::from_str("{}").unwrap();
+        assert_eq!(fitted, halo4d::CameraSettings::default());
+        assert_eq!(
+            serde_json::to_string(&fitted).unwrap().find("distance"),
+            None
+        );
+    }
+    // The fitted camera of the same scene stands nearer: the surfaces fill more of the
+    // picture.
+    let fitted = Prober::new(&parts, &torus.scene.render, &torus.scene.camera).unwrap();
+    assert!((fitted.camera().eye - centre).length() < 2.5 * radius);
 }

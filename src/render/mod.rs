@@ -47,8 +47,10 @@ pub struct CameraSettings {
     /// Degrees above the xy plane (z is up), in [-89, 89].
     pub elevation: f64,
     /// Distance of the eye from the centre of the projected scene's bounding box, in units
-    /// of half its diagonal.
-    pub distance: f64,
+    /// of half its diagonal; when absent the camera is fitted so that the surfaces fill the
+    /// picture ([`camera::Placement`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub distance: Option<f64>,
     /// Vertical field of view in degrees (perspective).
     pub fov: f64,
     /// Perspective or orthographic.
@@ -60,7 +62,7 @@ impl Default for CameraSettings {
         CameraSettings {
             azimuth: 35.0,
             elevation: 25.0,
-            distance: 3.2,
+            distance: None,
             fov: 38.0,
             projection: CameraProjection::Perspective,
         }
@@ -319,12 +321,13 @@ impl CameraSettings {
                 format!("must be -89 to 89 degrees, got {}", self.elevation),
             ));
         }
-        if !(self.distance.is_finite() && self.distance > 0.0 && self.distance <= 1e4) {
+        if let Some(d) = self.distance
+            && !(d.is_finite() && d > 0.0 && d <= 1e4)
+        {
             return Err(FieldError::new(
                 "distance",
                 format!(
-                    "must be in (0, 10000] (units of half the scene's diagonal), got {}",
-                    self.distance
+                    "must be in (0, 10000] (units of half the scene's diagonal), or absent for a camera fitted to the surfaces, got {d}"
                 ),
             ));
         }
@@ -428,19 +431,14 @@ pub fn render_with_depth(
     settings: &RenderSettings,
     camera: &CameraSettings,
 ) -> Result<(Picture, Vec<f64>), RenderError> {
-    let (bounds, scene) = prepare(input, settings, camera)?;
-    // Cross-eyed: the left image is the right eye's (turned right, +azimuth).
-    let eyes: Vec<f64> = if settings.stereo {
-        vec![first_eye(settings), -first_eye(settings)]
-    } else {
-        vec![0.0]
-    };
+    let (placement, scene) = prepare(input, settings, camera)?;
+    let eyes = eyes(settings);
     let mut depth = Vec::new();
     let (w, h) = (settings.width, settings.height);
-    scene.check_memory(&Camera::new(camera, bounds, w, h, eyes[0])?, eyes.len())?;
+    scene.check_memory(&Camera::new(camera, &placement, w, h, eyes[0])?, eyes.len())?;
     let mut rgb = vec![0u8; 3 * (w as usize * eyes.len()) * h as usize];
     for (e, &offset) in eyes.iter().enumerate() {
-        let cam = Camera::new(camera, bounds, w, h, offset)?;
+        let cam = Camera::new(camera, &placement, w, h, offset)?;
         let mut view = scene.view(&cam);
         if e == 0 {
             depth.clone_from(&view.front);
@@ -480,10 +478,10 @@ pub fn line_coverage(
     settings: &RenderSettings,
     camera: &CameraSettings,
 ) -> Result<Vec<f32>, RenderError> {
-    let (bounds, scene) = prepare(input, settings, camera)?;
+    let (placement, scene) = prepare(input, settings, camera)?;
     let cam = Camera::new(
         camera,
-        bounds,
+        &placement,
         settings.width,
         settings.height,
         first_eye(settings),
@@ -522,10 +520,10 @@ impl<'a> Prober<'a> {
         settings: &'a RenderSettings,
         camera: &CameraSettings,
     ) -> Result<Self, RenderError> {
-        let (bounds, scene) = prepare(input, settings, camera)?;
+        let (placement, scene) = prepare(input, settings, camera)?;
         let cam = Camera::new(
             camera,
-            bounds,
+            &placement,
             settings.width,
             settings.height,
             first_eye(settings),
@@ -575,12 +573,33 @@ fn first_eye(settings: &RenderSettings) -> f64 {
     }
 }
 
-/// Checks the settings and indexes the scene.
+/// The azimuth offset of each image, left to right. Cross-eyed: the left image is the right
+/// eye's (turned right, +azimuth).
+fn eyes(settings: &RenderSettings) -> Vec<f64> {
+    if settings.stereo {
+        vec![first_eye(settings), -first_eye(settings)]
+    } else {
+        vec![0.0]
+    }
+}
+
+/// Every vertex of a triangle of the surfaces, once per corner: what a fitted camera frames.
+fn triangle_corners<'a>(input: &'a Parts<'a>) -> impl Iterator<Item = DVec3> + Clone + 'a {
+    input.surfaces.iter().flat_map(|s| {
+        s.triangles
+            .iter()
+            .flatten()
+            .map(move |&v| s.positions[v as usize])
+    })
+}
+
+/// Checks the settings, places the camera (one placement for both eyes of a stereo pair)
+/// and indexes the scene.
 fn prepare<'a>(
     input: &'a Parts<'a>,
     settings: &'a RenderSettings,
     camera: &CameraSettings,
-) -> Result<((DVec3, DVec3), Scene<'a>), RenderError> {
+) -> Result<(camera::Placement, Scene<'a>), RenderError> {
     settings
         .check()
         .map_err(|e| RenderError::Setting(e.within("render")))?;
@@ -589,7 +608,15 @@ fn prepare<'a>(
         .map_err(|e| RenderError::Setting(e.within("camera")))?;
     let bounds = triangle_bounds(input.surfaces.iter().map(|s| (s.positions, s.triangles)))
         .ok_or(RenderError::Empty)?;
-    Ok((bounds, Scene::new(input, settings, bounds)))
+    let placement = camera::Placement::new(
+        camera,
+        bounds,
+        triangle_corners(input),
+        settings.width,
+        settings.height,
+        &eyes(settings),
+    );
+    Ok((placement, Scene::new(input, settings, bounds)))
 }
 
 /// The box around every vertex of a triangle of the surfaces (positions, triangles), which
