@@ -81,6 +81,7 @@ pub mod internals {
     pub use crate::intersect::{BroadPhase, Node, curves_with};
     pub use crate::render::camera::{Camera, Placement};
     pub use crate::render::compare::verdict_differs;
+    pub use crate::render::overlay::{INK, OVER_INKS};
     pub use crate::render::{Prober, Seen, line_coverage, render_with_depth};
     pub use crate::sample::{bounding_diagonal, uniform_error};
 

@@ -737,3 +737,185 @@ fn a_camera_at_a_given_distance_stands_where_it_always_has() {
     let fitted = Prober::new(&parts, &torus.scene.render, &torus.scene.camera).unwrap();
     assert!((fitted.camera().eye - centre).length() < 2.5 * radius);
 }
+
+/// The 8-bit sRGB of a linear colour, as the renderer writes it.
+fn srgb8(c: DVec3) -> [u8; 3] {
+    c.to_array().map(|c| {
+        let s = if c <= 0.003_130_8 {
+            12.92 * c
+        } else {
+            1.055 * c.powf(1.0 / 2.4) - 0.055
+        };
+        (s * 255.0).round() as u8
+    })
+}
+
+/// Per curve of the scene's build, at the pixels of its points whose sheet over (nearer in
+/// w) is that of both neighbours and which no other curve comes near in the picture, where
+/// the curves change the picture: how many such pixels there are, and how many carry the
+/// ink of the sheet over, and the other sheet's, per sheet.
+fn inks_along_the_curves(
+    scene: &Scene,
+    built: &halo4d::Built,
+    colours: bool,
+) -> Vec<[[usize; 3]; 2]> {
+    let parts = built.parts(&scene.halo);
+    let with = RenderSettings {
+        curves: true,
+        curve_colours: colours,
+        silhouettes: false,
+        legend: false,
+        ..scene.render
+    };
+    let without = RenderSettings {
+        curves: false,
+        ..with
+    };
+    let drawn = halo4d::render(&parts, &with, &scene.camera).unwrap();
+    let bare = halo4d::render(&parts, &without, &scene.camera).unwrap();
+    let prober = Prober::new(&parts, &with, &scene.camera).unwrap();
+    let cam = prober.camera();
+    let (w, h) = (with.width, with.height);
+    let inks = if colours {
+        halo4d::internals::OVER_INKS.map(srgb8)
+    } else {
+        [srgb8(halo4d::internals::INK); 2]
+    };
+    let near = |p: &halo4d::CurvePoint| (p.w[0] != p.w[1]).then(|| p.near());
+    let close = |a: &[u8], b: [u8; 3]| (0..3).all(|k| a[k].abs_diff(b[k]) <= 8);
+    // Every projected curve segment: (curve, its length along the curve in the picture up
+    // to the segment, ends).
+    let project = |p: DVec3| cam.project(p, w, h).map(|(xy, _)| glam::DVec2::from(xy));
+    let mut segments = Vec::new();
+    let mut arc: Vec<Vec<f64>> = Vec::new();
+    for (i, curve) in built.curves.curves.iter().enumerate() {
+        let n = curve.points.len();
+        let mut length = vec![0.0; n];
+        for k in 0..n {
+            let j = if k + 1 < n {
+                k + 1
+            } else if curve.closed {
+                0
+            } else {
+                break;
+            };
+            if let (Some(a), Some(b)) = (
+                project(curve.points[k].position),
+                project(curve.points[j].position),
+            ) {
+                segments.push((i, length[k], a, b));
+                if j > 0 {
+                    length[j] = length[k] + (b - a).length();
+                }
+            }
+        }
+        arc.push(length);
+    }
+    let segment_distance = |p: glam::DVec2, a: glam::DVec2, b: glam::DVec2| {
+        let d = b - a;
+        let t = if d.length_squared() > 0.0 {
+            ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (a + d * t - p).length()
+    };
+    // Another curve, or another stretch of the same one, within reach of the line's ink.
+    let reach = 2.0 * with.line_width;
+    let crowded = |curve: usize, k: usize, p: glam::DVec2| {
+        segments.iter().any(|&(i, along, a, b)| {
+            (i != curve || (along - arc[curve][k]).abs() > 3.0 * reach)
+                && segment_distance(p, a, b) < reach
+        })
+    };
+    built
+        .curves
+        .curves
+        .iter()
+        .enumerate()
+        .map(|(i, curve)| {
+            let mut counts = [[0; 3]; 2];
+            let mut seen = std::collections::HashSet::new();
+            for k in 1..curve.points.len().saturating_sub(1) {
+                let sheet = near(&curve.points[k]);
+                let Some(sheet) = sheet else { continue };
+                if near(&curve.points[k - 1]) != Some(sheet)
+                    || near(&curve.points[k + 1]) != Some(sheet)
+                {
+                    continue;
+                }
+                let Some((xy, _)) = cam.project(curve.points[k].position, w, h) else {
+                    continue;
+                };
+                if crowded(i, k, glam::DVec2::from(xy)) {
+                    continue;
+                }
+                let (x, y) = (xy[0].floor(), xy[1].floor());
+                if x < 0.0 || y < 0.0 || x >= f64::from(w) || y >= f64::from(h) {
+                    continue;
+                }
+                let at = 3 * (y as usize * w as usize + x as usize);
+                // Each pixel once, however many curve points it holds.
+                if !seen.insert(at) {
+                    continue;
+                }
+                let pixel = &drawn.rgb[at..at + 3];
+                if pixel == &bare.rgb[at..at + 3] {
+                    continue;
+                }
+                counts[sheet][0] += 1;
+                counts[sheet][1] += usize::from(close(pixel, inks[sheet]));
+                counts[sheet][2] += usize::from(colours && close(pixel, inks[1 - sheet]));
+            }
+            counts
+        })
+        .collect()
+}
+
+#[test]
+fn curves_are_drawn_in_the_ink_of_the_sheet_that_passes_over() {
+    let torus = Torus::new();
+    // Every arc of the flat torus has one sheet over along all of it (the sheets' w are
+    // equal only at the cross-caps where it ends).
+    for colours in [true, false] {
+        let counts = inks_along_the_curves(&torus.scene, &torus.built, colours);
+        let sum = |k: usize| -> usize { counts.iter().flatten().map(|c| c[k]).sum() };
+        let (drawn, right, wrong) = (sum(0), sum(1), sum(2));
+        assert!(drawn > 50, "{drawn} curve pixels drawn");
+        assert!(
+            right * 100 >= drawn * 90 && wrong == 0,
+            "colours {colours}: {right} of {drawn} curve pixels in the ink of the sheet over, {wrong} in the other's"
+        );
+    }
+    // The curves' sheets as the picture says: the ink is the nearer sheet's in w.
+    let counts = inks_along_the_curves(&torus.scene, &torus.built, true);
+    for (curve, c) in torus.built.curves.curves.iter().zip(&counts) {
+        let sheet = curve.points[curve.points.len() / 2].near();
+        assert!(c[sheet][1] > 0 && c[1 - sheet][0] == 0, "{c:?}");
+    }
+}
+
+#[test]
+fn where_the_sheet_over_changes_along_a_curve_both_inks_are_drawn() {
+    // A flat torus and the Fermat quartic: the two surfaces meet in 4D, so along the curves
+    // between them the sheet that passes over changes.
+    let mut scene = Scene::load(&fixture("hard/two-surfaces.json")).unwrap();
+    (
+        scene.render.width,
+        scene.render.height,
+        scene.render.samples,
+    ) = (400, 400, 1);
+    let built = halo4d::run(&scene, true).unwrap();
+    let counts = inks_along_the_curves(&scene, &built, true);
+    let both = counts
+        .iter()
+        .filter(|c| c[0][1] >= 3 && c[1][1] >= 3)
+        .count();
+    assert!(both > 0, "no curve is drawn in both inks: {counts:?}");
+    let sum = |k: usize| -> usize { counts.iter().flatten().map(|c| c[k]).sum() };
+    let (drawn, right, wrong) = (sum(0), sum(1), sum(2));
+    assert!(
+        drawn > 100 && right * 100 >= drawn * 90 && wrong == 0,
+        "{right} of {drawn} curve pixels in the ink of the sheet over, {wrong} in the other's"
+    );
+}

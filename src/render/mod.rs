@@ -154,6 +154,11 @@ pub struct RenderSettings {
     pub ribbons: Option<Ribbons>,
     /// Draw the self-intersection curves.
     pub curves: bool,
+    /// Draw each piece of a curve in the ink of the sheet that passes over it (nearer in
+    /// w): dark red (sRGB 170, 20, 28) where the curve's sheet 0 does, dark blue (sRGB 25,
+    /// 61, 170) where its sheet 1 does, the sheets labelled as in [`crate::CurvePoint`];
+    /// `false` draws the curves in the silhouettes' near-black ink.
+    pub curve_colours: bool,
     /// Draw silhouettes (where the eye ray lies in the tangent plane).
     pub silhouettes: bool,
     /// Line width in pixels.
@@ -187,6 +192,7 @@ impl Default for RenderSettings {
             hither: None,
             ribbons: None,
             curves: true,
+            curve_colours: true,
             silhouettes: true,
             line_width: 2.5,
             line_width_far: None,
@@ -443,9 +449,9 @@ pub fn render_with_depth(
         if e == 0 {
             depth.clone_from(&view.front);
         }
-        if let Some(coverage) = scene.lines(&cam)? {
-            for (c, &k) in view.rgb.iter_mut().zip(coverage.values()) {
-                *c = c.lerp(overlay::INK, f64::from(k));
+        for lines in scene.lines(&cam)? {
+            for (c, &k) in view.rgb.iter_mut().zip(lines.coverage.values()) {
+                *c = c.lerp(lines.ink, f64::from(k));
             }
         }
         if settings.legend {
@@ -472,7 +478,9 @@ pub fn render_with_depth(
 }
 
 /// The coverage in [0, 1] of the lines (curves and silhouettes, as the settings ask) in the
-/// first eye's image, row-major; all zero when there are none.
+/// first eye's image, row-major; all zero when there are none. Where the lines are drawn in
+/// several inks, their coverages `c` combine as the picture lays them over each other,
+/// 1 - prod(1 - c).
 pub fn line_coverage(
     input: &Parts,
     settings: &RenderSettings,
@@ -486,10 +494,20 @@ pub fn line_coverage(
         settings.height,
         first_eye(settings),
     )?;
-    Ok(match scene.lines(&cam)? {
-        Some(c) => c.values().to_vec(),
-        None => vec![0.0; settings.width as usize * settings.height as usize],
-    })
+    let mut inks = scene.lines(&cam)?.into_iter();
+    let Some(first) = inks.next() else {
+        return Ok(vec![
+            0.0;
+            settings.width as usize * settings.height as usize
+        ]);
+    };
+    let mut total = first.coverage.values().to_vec();
+    for lines in inks {
+        for (t, &c) in total.iter_mut().zip(lines.coverage.values()) {
+            *t += c - *t * c;
+        }
+    }
+    Ok(total)
 }
 
 /// What the centre ray of a pixel sees first, for probing a picture at known places.
