@@ -919,3 +919,59 @@ fn where_the_sheet_over_changes_along_a_curve_both_inks_are_drawn() {
         "{right} of {drawn} curve pixels in the ink of the sheet over, {wrong} in the other's"
     );
 }
+
+#[test]
+fn the_colour_bar_is_labelled_with_w_where_the_picture_has_room() {
+    let torus = Torus::new();
+    let parts = torus.built.parts(&torus.scene.halo);
+    // 512 px: labels a 32nd of the side high above the bar; 200 px: too small for them,
+    // so only the bar is drawn.
+    for side in [512u32, 200] {
+        let bare = RenderSettings {
+            width: side,
+            height: side,
+            ..torus.scene.render
+        };
+        let legend = RenderSettings {
+            legend: true,
+            ..bare
+        };
+        let without = halo4d::render(&parts, &bare, &torus.scene.camera).unwrap();
+        let with = halo4d::render(&parts, &legend, &torus.scene.camera).unwrap();
+        let side = side as usize;
+        let (margin, bar) = ((side / 40).max(2), (side / 40).max(4));
+        let bar_top = side - margin - bar;
+        let text = side / 32;
+        let (mut changed, mut dark, mut elsewhere) = (0, 0, 0);
+        for y in 0..side {
+            for x in 0..side {
+                let at = 3 * (y * side + x);
+                let (a, b) = (&with.rgb[at..at + 3], &without.rgb[at..at + 3]);
+                if a == b {
+                    continue;
+                }
+                let in_bar = y >= bar_top && y < side - margin && x >= margin && x < side - margin;
+                // The labels' rows: above the bar, within a few label heights.
+                let in_labels = y < bar_top && y + 3 * text >= bar_top;
+                if in_labels {
+                    changed += 1;
+                    dark += usize::from(a.iter().all(|&c| c < 80));
+                } else if !in_bar {
+                    elsewhere += 1;
+                }
+            }
+        }
+        assert_eq!(
+            elsewhere, 0,
+            "{side} px: the legend changed pixels elsewhere"
+        );
+        if side >= 256 {
+            assert!(
+                changed > 0 && dark > 5 * text,
+                "{side} px: {changed} pixels changed above the bar, {dark} of them dark text"
+            );
+        } else {
+            assert_eq!(changed, 0, "{side} px: no labels");
+        }
+    }
+}

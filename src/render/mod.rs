@@ -17,6 +17,7 @@ pub mod lines;
 pub(crate) mod overlay;
 pub mod shade;
 pub mod slices;
+pub(crate) mod text;
 pub mod trace;
 
 use crate::limits::{FieldError, PICTURE_SIDE, SAMPLES, SLICES};
@@ -383,6 +384,9 @@ pub enum RenderError {
     /// The memory limit is set wrong.
     #[error("{0}")]
     MemoryLimit(String),
+    /// Something that cannot fail did (a bug, not bad input).
+    #[error("internal error in the renderer: {0}")]
+    Internal(String),
 }
 
 /// An RGB picture, 8 bits per channel, row-major from the top.
@@ -455,7 +459,12 @@ pub fn render_with_depth(
             }
         }
         if settings.legend {
-            legend(&mut view.rgb, w as usize, h as usize, settings.colormap);
+            legend(
+                &mut view.rgb,
+                (w as usize, h as usize),
+                settings,
+                scene.w_range,
+            )?;
         }
         for y in 0..h as usize {
             for x in 0..w as usize {
@@ -655,12 +664,19 @@ pub fn triangle_bounds<'a>(
 }
 
 /// A colour bar of the w scale along the bottom of an image, near w at the left, far at the
-/// right, framed in black.
-fn legend(rgb: &mut [DVec3], w: usize, h: usize, map: Colormap) {
+/// right, framed in black, with the w of its ends and middle above it where they fit
+/// ([`text::label_bar`]): in the lines' ink on a light background, in white on a dark one,
+/// outlined in the background's colour.
+fn legend(
+    rgb: &mut [DVec3],
+    (w, h): (usize, usize),
+    settings: &RenderSettings,
+    (w0, w1): (f64, f64),
+) -> Result<(), RenderError> {
     let margin = (w.min(h) / 40).max(2);
     let bar = (h / 40).max(4);
     if w <= 2 * margin + 2 || h <= 2 * margin + bar + 2 {
-        return;
+        return Ok(());
     }
     let (x0, x1) = (margin, w - margin);
     let (y0, y1) = (h - margin - bar, h - margin);
@@ -670,10 +686,26 @@ fn legend(rgb: &mut [DVec3], w: usize, h: usize, map: Colormap) {
             rgb[y * w + x] = if frame {
                 DVec3::ZERO
             } else {
-                shade::colormap(map, (x - x0) as f64 / (x1 - x0 - 1) as f64)
+                shade::colormap(settings.colormap, (x - x0) as f64 / (x1 - x0 - 1) as f64)
             };
         }
     }
+    // The colours span w0 to w0 + span ([`Scene::shade`]).
+    let span = if w1 > w0 { w1 - w0 } else { 1.0 };
+    let background = DVec3::from(settings.background);
+    let light = background.dot(DVec3::new(0.2126, 0.7152, 0.0722)) > 0.18;
+    let ink = if light { overlay::INK } else { DVec3::ONE };
+    text::label_bar(
+        rgb,
+        (w, h),
+        y0,
+        (x0, x1),
+        [w0, w0 + 0.5 * span, w0 + span],
+        ink,
+        background,
+    )
+    .map_err(RenderError::Internal)?;
+    Ok(())
 }
 
 /// Linear [0, 1] to an 8-bit sRGB value.
