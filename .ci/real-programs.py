@@ -331,6 +331,37 @@ def check_resaves(folder, halo4d):
 # -- the render -------------------------------------------------------------------------
 
 
+def place_camera(settings, corners, aspect=1.0, margin=0.05):
+    """The eye and the point it looks at of halo4d's perspective camera
+    (src/render/camera.rs, Placement): `distance` half-diagonals from the centre of the
+    vertices' box, or, without one, fitted: moved across the view so that the vertices are
+    centred and as near as every vertex allows with `margin` of the picture free on each
+    side."""
+    if settings.get("projection", "perspective") != "perspective":
+        sys.exit("the render check takes a perspective camera")
+    lo, hi = corners.min(axis=0), corners.max(axis=0)
+    centre, radius = (lo + hi) / 2, max(np.linalg.norm(hi - lo) / 2, 1e-300)
+    az, el = np.radians(settings["azimuth"]), np.radians(settings["elevation"])
+    towards_eye = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+    if settings.get("distance") is not None:
+        return centre + towards_eye * settings["distance"] * radius, centre
+    forward = -towards_eye
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    right = right / np.linalg.norm(right) if np.linalg.norm(right) > 0 else np.array([0.0, 1.0, 0.0])
+    up = np.cross(right, forward)
+    t = np.tan(np.radians(settings["fov"]) / 2) * (1 - 2 * margin)
+    k = (t * aspect, t)
+    v = corners - centre
+    a, b, c = v @ right, v @ up, v @ forward
+    shift = [kk * (np.max(x / kk - c) - np.max(-x / kk - c)) / 2 for x, kk in ((a, k[0]), (b, k[1]))]
+    target = centre + right * shift[0] + up * shift[1]
+    v = corners - target
+    a, b, c = v @ right, v @ up, v @ forward
+    d = max(np.max(np.abs(a) / k[0] - c), np.max(np.abs(b) / k[1] - c))
+    d = max(d, 1.01 * radius + np.linalg.norm(target - centre))
+    return target + towards_eye * d, target
+
+
 def child_render(folder, out_png):
     """Renders the folder's .glb in Cycles through the scene's camera, with and without the
     curves; prints the shares of visible curve points that are dark as JSON."""
@@ -359,18 +390,15 @@ def child_render(folder, out_png):
         points += [o.matrix_world @ v.co for v in o.data.vertices]
         world_triangles += [[base + i for i in p.vertices] for p in o.data.polygons]
     corners = np.array([tuple(p) for p in points])
-    lo, hi = corners.min(axis=0), corners.max(axis=0)
-    centre, radius = (lo + hi) / 2, np.linalg.norm(hi - lo) / 2
-    az, el = np.radians(settings["azimuth"]), np.radians(settings["elevation"])
-    towards_eye = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
-    eye = Vector(centre + towards_eye * settings["distance"] * radius)
+    eye, target = place_camera(settings, corners)
+    eye = Vector(eye)
     cam_data = bpy.data.cameras.new("camera")
     cam_data.sensor_fit = "VERTICAL"
     cam_data.angle = np.radians(settings["fov"])
     cam = bpy.data.objects.new("camera", cam_data)
     scene.collection.objects.link(cam)
     cam.location = eye
-    cam.rotation_euler = (Vector(centre) - eye).to_track_quat("-Z", "Y").to_euler()
+    cam.rotation_euler = (Vector(target) - eye).to_track_quat("-Z", "Y").to_euler()
     scene.camera = cam
     sun = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
     sun.data.energy = 2.5

@@ -81,8 +81,9 @@ pub mod internals {
     pub use crate::convention::file_order;
     pub use crate::export::{LOCK, glb_container, to_glb, write_atomic};
     pub use crate::intersect::{BroadPhase, Node, curves_with};
-    pub use crate::render::camera::Camera;
+    pub use crate::render::camera::{Camera, Placement};
     pub use crate::render::compare::verdict_differs;
+    pub use crate::render::overlay::{INK, OVER_INKS};
     pub use crate::render::stipple::{Drawn, density, luminance, tone};
     pub use crate::render::{Prober, Seen, line_coverage, render_with_depth, stipples_drawn};
     pub use crate::sample::{bounding_diagonal, uniform_error};

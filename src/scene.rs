@@ -97,11 +97,12 @@ pub struct Outputs {
     pub curve_radius: f64,
 }
 
-/// The default [`Outputs::curve_radius`]: through the default camera, tubes about 7 pixels
-/// across in a 1024-pixel picture, so that a curve in the crease between two sheets, which
-/// bury most of its tube, still shows (measured in Blender by `.ci/real-programs.py
-/// --render`: a radius of 0.003 leaves half of the default scene's visible curve points
-/// light at 640 pixels, 0.004 one in twelve).
+/// The default [`Outputs::curve_radius`]: through the camera at distance 3.2 (the default
+/// before the camera was fitted, which shows the default scene about 1.4 times larger),
+/// tubes about 7 pixels across in a 1024-pixel picture, so that a curve in the crease
+/// between two sheets, which bury most of its tube, still shows (measured in Blender by
+/// `.ci/real-programs.py --render`: a radius of 0.003 leaves half of the default scene's
+/// visible curve points light at 640 pixels, 0.004 one in twelve).
 pub const CURVE_RADIUS: f64 = 0.004;
 
 impl Outputs {

@@ -88,18 +88,12 @@ impl Torus {
         Torus { scene, built }
     }
 
+    /// The camera of the picture.
     fn camera(&self) -> Camera {
-        let (lo, hi) = self
-            .built
-            .surfaces
-            .iter()
-            .filter_map(|p| p.projected.bounds())
-            .fold(
-                (DVec3::INFINITY, DVec3::NEG_INFINITY),
-                |(a, b), (lo, hi)| (a.min(lo), b.max(hi)),
-            );
-        let r = &self.scene.render;
-        Camera::new(&self.scene.camera, (lo, hi), r.width, r.height, 0.0).unwrap()
+        let parts = self.built.parts(&self.scene.halo);
+        *Prober::new(&parts, &self.scene.render, &self.scene.camera)
+            .unwrap()
+            .camera()
     }
 
     /// What the picture shows at image points, with halos or without.
@@ -477,9 +471,11 @@ fn the_drawn_curves_lie_on_the_computed_curves_at_the_width_asked_for() {
             if !within(q) || crowded {
                 continue;
             }
-            // Only where this stretch of curve is drawn at all (it may be hidden).
+            // Only where this stretch of curve is drawn (it may be hidden), and away from
+            // where it ends or goes behind a surface: drawn a width on either side too.
             let at = |p: [f64; 2]| coverage[p[1] as usize * w + p[0] as usize] as f64;
-            if at(q) < 0.5 {
+            let along = |s: f64| [q[0] + tangent[0] / len * s, q[1] + tangent[1] / len * s];
+            if at(q) < 0.5 || at(along(-4.0)) < 0.5 || at(along(4.0)) < 0.5 {
                 continue;
             }
             let step = 0.125;
@@ -627,4 +623,355 @@ fn a_picture_beyond_the_memory_limit_is_refused_before_it_allocates() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(dir.path().join("p.png").exists());
+}
+
+#[test]
+fn the_default_camera_fits_the_surfaces_in_the_picture() {
+    let mut scene = Scene::default_scene();
+    (
+        scene.render.width,
+        scene.render.height,
+        scene.render.samples,
+    ) = (300, 240, 1);
+    assert_eq!(scene.camera.distance, None, "the default camera is fitted");
+    let built = halo4d::run(&scene, true).unwrap();
+    let parts = built.parts(&scene.halo);
+    let picture = halo4d::render(&parts, &scene.render, &scene.camera).unwrap();
+    let (w, h) = (picture.width as usize, picture.height as usize);
+    // The surfaces' extent, from the picture: the columns and rows that are not background.
+    let covered = |x: usize, y: usize| picture.rgb[3 * (y * w + x)..][..3] != [255, 255, 255];
+    let columns: Vec<usize> = (0..w).filter(|&x| (0..h).any(|y| covered(x, y))).collect();
+    let rows: Vec<usize> = (0..h).filter(|&y| (0..w).any(|x| covered(x, y))).collect();
+    let span = |v: &[usize]| v.last().unwrap() - v.first().unwrap() + 1;
+    // Every vertex in the picture, outside the margin of 5% on each side.
+    let prober = Prober::new(&parts, &scene.render, &scene.camera).unwrap();
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for s in &parts.surfaces {
+        for &v in s.triangles.iter().flatten() {
+            let (xy, _) = prober
+                .camera()
+                .project(s.positions[v as usize], w as u32, h as u32)
+                .expect("in front of the eye");
+            for k in 0..2 {
+                (lo[k], hi[k]) = (lo[k].min(xy[k]), hi[k].max(xy[k]));
+            }
+        }
+    }
+    let size = [w as f64, h as f64];
+    for k in 0..2 {
+        let margin = 0.05 * size[k];
+        assert!(
+            lo[k] >= margin - 1e-6 && hi[k] <= size[k] - margin + 1e-6,
+            "axis {k}: vertices from {} to {} of {}",
+            lo[k],
+            hi[k],
+            size[k]
+        );
+    }
+    // Tight on one axis: a vertex on the margin.
+    let touches = (0..2).any(|k| {
+        let margin = 0.05 * size[k];
+        (lo[k] - margin).abs() < 1e-6 || (hi[k] - (size[k] - margin)).abs() < 1e-6
+    });
+    assert!(touches, "{lo:?} {hi:?} in {size:?}");
+    let (across, down) = (
+        span(&columns) as f64 / w as f64,
+        span(&rows) as f64 / h as f64,
+    );
+    assert!(
+        across.max(down) >= 0.85,
+        "the surfaces span {across:.3} of the width and {down:.3} of the height"
+    );
+}
+
+#[test]
+fn a_camera_at_a_given_distance_stands_where_it_always_has() {
+    let torus = Torus::new();
+    let parts = torus.built.parts(&torus.scene.halo);
+    let (lo, hi) = torus
+        .built
+        .surfaces
+        .iter()
+        .filter_map(|p| p.projected.bounds())
+        .fold(
+            (DVec3::INFINITY, DVec3::NEG_INFINITY),
+            |(a, b), (lo, hi)| (a.min(lo), b.max(hi)),
+        );
+    let (centre, radius) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
+    for projection in [
+        halo4d::CameraProjection::Perspective,
+        halo4d::CameraProjection::Orthographic,
+    ] {
+        let camera = halo4d::CameraSettings {
+            distance: Some(3.2),
+            projection,
+            ..torus.scene.camera
+        };
+        let prober = Prober::new(&parts, &torus.scene.render, &camera).unwrap();
+        let cam = prober.camera();
+        // The eye at 3.2 half-diagonals from the box's centre, the picture spanning
+        // tan(fov / 2) (perspective) or the bounding sphere and 5% (orthographic), to the
+        // last bit.
+        let (az, el) = (camera.azimuth.to_radians(), camera.elevation.to_radians());
+        let towards_eye = DVec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+        assert_eq!(cam.eye, centre + towards_eye * 3.2 * radius);
+        assert_eq!(cam.forward, -towards_eye);
+        let half_height = match projection {
+            halo4d::CameraProjection::Perspective => (camera.fov.to_radians() * 0.5).tan(),
+            halo4d::CameraProjection::Orthographic => radius * 1.05,
+        };
+        assert_eq!(cam.half_height, half_height);
+        // A scene file that gives the distance reads as that camera, and one that gives none
+        // as the fitted one.
+        let given: halo4d::CameraSettings = serde_json::from_str(r#"{ "distance": 3.2 }"#).unwrap();
+        assert_eq!(given.distance, Some(3.2));
+        let fitted: halo4d::CameraSettings = serde_json::from_str("{}").unwrap();
+        assert_eq!(fitted, halo4d::CameraSettings::default());
+        assert_eq!(
+            serde_json::to_string(&fitted).unwrap().find("distance"),
+            None
+        );
+    }
+    // The fitted camera of the same scene stands nearer: the surfaces fill more of the
+    // picture.
+    let fitted = Prober::new(&parts, &torus.scene.render, &torus.scene.camera).unwrap();
+    assert!((fitted.camera().eye - centre).length() < 2.5 * radius);
+}
+
+/// The 8-bit sRGB of a linear colour, as the renderer writes it.
+fn srgb8(c: DVec3) -> [u8; 3] {
+    c.to_array().map(|c| {
+        let s = if c <= 0.003_130_8 {
+            12.92 * c
+        } else {
+            1.055 * c.powf(1.0 / 2.4) - 0.055
+        };
+        (s * 255.0).round() as u8
+    })
+}
+
+/// Per curve of the scene's build, at the pixels of its points whose sheet over (nearer in
+/// w) is that of both neighbours and which no other curve comes near in the picture, where
+/// the curves change the picture: how many such pixels there are, and how many carry the
+/// ink of the sheet over, and the other sheet's, per sheet.
+fn inks_along_the_curves(
+    scene: &Scene,
+    built: &halo4d::Built,
+    colours: bool,
+) -> Vec<[[usize; 3]; 2]> {
+    let parts = built.parts(&scene.halo);
+    let with = RenderSettings {
+        curves: true,
+        curve_colours: colours,
+        silhouettes: false,
+        legend: false,
+        ..scene.render
+    };
+    let without = RenderSettings {
+        curves: false,
+        ..with
+    };
+    let drawn = halo4d::render(&parts, &with, &scene.camera).unwrap();
+    let bare = halo4d::render(&parts, &without, &scene.camera).unwrap();
+    let prober = Prober::new(&parts, &with, &scene.camera).unwrap();
+    let cam = prober.camera();
+    let (w, h) = (with.width, with.height);
+    let inks = if colours {
+        halo4d::internals::OVER_INKS.map(srgb8)
+    } else {
+        [srgb8(halo4d::internals::INK); 2]
+    };
+    let near = |p: &halo4d::CurvePoint| (p.w[0] != p.w[1]).then(|| p.near());
+    let close = |a: &[u8], b: [u8; 3]| (0..3).all(|k| a[k].abs_diff(b[k]) <= 8);
+    // Every projected curve segment: (curve, its length along the curve in the picture up
+    // to the segment, ends).
+    let project = |p: DVec3| cam.project(p, w, h).map(|(xy, _)| glam::DVec2::from(xy));
+    let mut segments = Vec::new();
+    let mut arc: Vec<Vec<f64>> = Vec::new();
+    for (i, curve) in built.curves.curves.iter().enumerate() {
+        let n = curve.points.len();
+        let mut length = vec![0.0; n];
+        for k in 0..n {
+            let j = if k + 1 < n {
+                k + 1
+            } else if curve.closed {
+                0
+            } else {
+                break;
+            };
+            if let (Some(a), Some(b)) = (
+                project(curve.points[k].position),
+                project(curve.points[j].position),
+            ) {
+                segments.push((i, length[k], a, b));
+                if j > 0 {
+                    length[j] = length[k] + (b - a).length();
+                }
+            }
+        }
+        arc.push(length);
+    }
+    let segment_distance = |p: glam::DVec2, a: glam::DVec2, b: glam::DVec2| {
+        let d = b - a;
+        let t = if d.length_squared() > 0.0 {
+            ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (a + d * t - p).length()
+    };
+    // Another curve, or another stretch of the same one, within reach of the line's ink.
+    let reach = 2.0 * with.line_width;
+    let crowded = |curve: usize, k: usize, p: glam::DVec2| {
+        segments.iter().any(|&(i, along, a, b)| {
+            (i != curve || (along - arc[curve][k]).abs() > 3.0 * reach)
+                && segment_distance(p, a, b) < reach
+        })
+    };
+    built
+        .curves
+        .curves
+        .iter()
+        .enumerate()
+        .map(|(i, curve)| {
+            let mut counts = [[0; 3]; 2];
+            let mut seen = std::collections::HashSet::new();
+            for k in 1..curve.points.len().saturating_sub(1) {
+                let sheet = near(&curve.points[k]);
+                let Some(sheet) = sheet else { continue };
+                if near(&curve.points[k - 1]) != Some(sheet)
+                    || near(&curve.points[k + 1]) != Some(sheet)
+                {
+                    continue;
+                }
+                let Some((xy, _)) = cam.project(curve.points[k].position, w, h) else {
+                    continue;
+                };
+                if crowded(i, k, glam::DVec2::from(xy)) {
+                    continue;
+                }
+                let (x, y) = (xy[0].floor(), xy[1].floor());
+                if x < 0.0 || y < 0.0 || x >= f64::from(w) || y >= f64::from(h) {
+                    continue;
+                }
+                let at = 3 * (y as usize * w as usize + x as usize);
+                // Each pixel once, however many curve points it holds.
+                if !seen.insert(at) {
+                    continue;
+                }
+                let pixel = &drawn.rgb[at..at + 3];
+                if pixel == &bare.rgb[at..at + 3] {
+                    continue;
+                }
+                counts[sheet][0] += 1;
+                counts[sheet][1] += usize::from(close(pixel, inks[sheet]));
+                counts[sheet][2] += usize::from(colours && close(pixel, inks[1 - sheet]));
+            }
+            counts
+        })
+        .collect()
+}
+
+#[test]
+fn curves_are_drawn_in_the_ink_of_the_sheet_that_passes_over() {
+    let torus = Torus::new();
+    // Every arc of the flat torus has one sheet over along all of it (the sheets' w are
+    // equal only at the cross-caps where it ends).
+    for colours in [true, false] {
+        let counts = inks_along_the_curves(&torus.scene, &torus.built, colours);
+        let sum = |k: usize| -> usize { counts.iter().flatten().map(|c| c[k]).sum() };
+        let (drawn, right, wrong) = (sum(0), sum(1), sum(2));
+        assert!(drawn > 50, "{drawn} curve pixels drawn");
+        assert!(
+            right * 100 >= drawn * 90 && wrong == 0,
+            "colours {colours}: {right} of {drawn} curve pixels in the ink of the sheet over, {wrong} in the other's"
+        );
+    }
+    // The curves' sheets as the picture says: the ink is the nearer sheet's in w.
+    let counts = inks_along_the_curves(&torus.scene, &torus.built, true);
+    for (curve, c) in torus.built.curves.curves.iter().zip(&counts) {
+        let sheet = curve.points[curve.points.len() / 2].near();
+        assert!(c[sheet][1] > 0 && c[1 - sheet][0] == 0, "{c:?}");
+    }
+}
+
+#[test]
+fn where_the_sheet_over_changes_along_a_curve_both_inks_are_drawn() {
+    // A flat torus and the Fermat quartic: the two surfaces meet in 4D, so along the curves
+    // between them the sheet that passes over changes.
+    let mut scene = Scene::load(&fixture("hard/two-surfaces.json")).unwrap();
+    (
+        scene.render.width,
+        scene.render.height,
+        scene.render.samples,
+    ) = (400, 400, 1);
+    let built = halo4d::run(&scene, true).unwrap();
+    let counts = inks_along_the_curves(&scene, &built, true);
+    let both = counts
+        .iter()
+        .filter(|c| c[0][1] >= 3 && c[1][1] >= 3)
+        .count();
+    assert!(both > 0, "no curve is drawn in both inks: {counts:?}");
+    let sum = |k: usize| -> usize { counts.iter().flatten().map(|c| c[k]).sum() };
+    let (drawn, right, wrong) = (sum(0), sum(1), sum(2));
+    assert!(
+        drawn > 100 && right * 100 >= drawn * 90 && wrong == 0,
+        "{right} of {drawn} curve pixels in the ink of the sheet over, {wrong} in the other's"
+    );
+}
+
+#[test]
+fn the_colour_bar_is_labelled_with_w_where_the_picture_has_room() {
+    let torus = Torus::new();
+    let parts = torus.built.parts(&torus.scene.halo);
+    // 512 px: labels a 32nd of the side high above the bar; 200 px: too small for them,
+    // so only the bar is drawn.
+    for side in [512u32, 200] {
+        let bare = RenderSettings {
+            width: side,
+            height: side,
+            ..torus.scene.render
+        };
+        let legend = RenderSettings {
+            legend: true,
+            ..bare
+        };
+        let without = halo4d::render(&parts, &bare, &torus.scene.camera).unwrap();
+        let with = halo4d::render(&parts, &legend, &torus.scene.camera).unwrap();
+        let side = side as usize;
+        let (margin, bar) = ((side / 40).max(2), (side / 40).max(4));
+        let bar_top = side - margin - bar;
+        let text = side / 32;
+        let (mut changed, mut dark, mut elsewhere) = (0, 0, 0);
+        for y in 0..side {
+            for x in 0..side {
+                let at = 3 * (y * side + x);
+                let (a, b) = (&with.rgb[at..at + 3], &without.rgb[at..at + 3]);
+                if a == b {
+                    continue;
+                }
+                let in_bar = y >= bar_top && y < side - margin && x >= margin && x < side - margin;
+                // The labels' rows: above the bar, within a few label heights.
+                let in_labels = y < bar_top && y + 3 * text >= bar_top;
+                if in_labels {
+                    changed += 1;
+                    dark += usize::from(a.iter().all(|&c| c < 80));
+                } else if !in_bar {
+                    elsewhere += 1;
+                }
+            }
+        }
+        assert_eq!(
+            elsewhere, 0,
+            "{side} px: the legend changed pixels elsewhere"
+        );
+        if side >= 256 {
+            assert!(
+                changed > 0 && dark > 5 * text,
+                "{side} px: {changed} pixels changed above the bar, {dark} of them dark text"
+            );
+        } else {
+            assert_eq!(changed, 0, "{side} px: no labels");
+        }
+    }
 }

@@ -4,7 +4,7 @@
 
 use crate::common::{fixture, fixture_scenes};
 use glam::{DVec3, DVec4};
-use halo4d::internals::{Camera, Drawn, stipples_drawn, tone};
+use halo4d::internals::{Camera, Drawn, Placement, stipples_drawn, tone};
 use halo4d::{CameraSettings, Curves, Parts, RenderSettings, Scene, Stipples, Style, SurfacePart};
 use std::collections::BTreeSet;
 
@@ -67,10 +67,14 @@ fn sphere_bands(
         halos: false,
         ..RenderSettings::default()
     };
-    let camera = CameraSettings::default();
+    let camera = CameraSettings {
+        distance: Some(3.2),
+        ..CameraSettings::default()
+    };
     let picture = halo4d::render(&parts, &settings, &camera).unwrap();
     let bounds = (DVec3::splat(-1.0), DVec3::splat(1.0));
-    let cam = Camera::new(&camera, bounds, side, side, 0.0).unwrap();
+    let placement = Placement::new(&camera, bounds, std::iter::empty(), side, side, &[0.0]);
+    let cam = Camera::new(&camera, &placement, side, side, 0.0).unwrap();
     let mut bands = vec![(0usize, 0.0, 0.0); 8];
     for y in 0..side {
         for x in 0..side {

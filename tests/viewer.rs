@@ -404,8 +404,9 @@ fn curves_colour_and_transparency_toggle_what_they_should() {
     );
     // Every pixel the curves change is on a projected curve segment: within half the
     // curves' 2.5-pixel width and a pixel.
+    let placement = asset.placement(&scene.camera, SIDE, SIDE);
     let camera =
-        halo4d::internals::Camera::new(&scene.camera, asset.bounds, SIDE, SIDE, 0.0).unwrap();
+        halo4d::internals::Camera::new(&scene.camera, &placement, SIDE, SIDE, 0.0).unwrap();
     let mut segments = Vec::new();
     for curve in &built.curves.curves {
         let p: Vec<[f64; 2]> = curve

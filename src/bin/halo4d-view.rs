@@ -52,7 +52,8 @@ struct Args {
     /// Camera elevation in degrees, -89 to 89 (default: the scene's, else 25).
     #[arg(long, allow_negative_numbers = true)]
     elevation: Option<f64>,
-    /// Eye distance in half-diagonals of the scene (default: the scene's, else 3.2).
+    /// Eye distance in half-diagonals of the scene (default: the scene's, else fitted so
+    /// that the surfaces fill the picture).
     #[arg(long)]
     distance: Option<f64>,
     /// Vertical field of view in degrees (default: the scene's, else 38).
@@ -199,7 +200,7 @@ fn run(args: &Args) -> Result<(), ViewerError> {
         camera: CameraSettings {
             azimuth: args.azimuth.unwrap_or(recorded.azimuth),
             elevation: args.elevation.unwrap_or(recorded.elevation),
-            distance: args.distance.unwrap_or(recorded.distance),
+            distance: args.distance.or(recorded.distance),
             fov: args.fov.unwrap_or(recorded.fov),
             projection: if args.orthographic {
                 CameraProjection::Orthographic

@@ -18,6 +18,7 @@ pub(crate) mod overlay;
 pub mod shade;
 pub mod slices;
 pub mod stipple;
+pub(crate) mod text;
 pub mod trace;
 
 use crate::limits::{FieldError, PICTURE_SIDE, SAMPLES, SLICES};
@@ -48,8 +49,10 @@ pub struct CameraSettings {
     /// Degrees above the xy plane (z is up), in [-89, 89].
     pub elevation: f64,
     /// Distance of the eye from the centre of the projected scene's bounding box, in units
-    /// of half its diagonal.
-    pub distance: f64,
+    /// of half its diagonal; when absent the camera is fitted so that the surfaces fill the
+    /// picture ([`camera::Placement`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub distance: Option<f64>,
     /// Vertical field of view in degrees (perspective).
     pub fov: f64,
     /// Perspective or orthographic.
@@ -61,7 +64,7 @@ impl Default for CameraSettings {
         CameraSettings {
             azimuth: 35.0,
             elevation: 25.0,
-            distance: 3.2,
+            distance: None,
             fov: 38.0,
             projection: CameraProjection::Perspective,
         }
@@ -197,6 +200,11 @@ pub struct RenderSettings {
     pub ribbons: Option<Ribbons>,
     /// Draw the self-intersection curves.
     pub curves: bool,
+    /// Draw each piece of a curve in the ink of the sheet that passes over it (nearer in
+    /// w): dark red (sRGB 170, 20, 28) where the curve's sheet 0 does, dark blue (sRGB 25,
+    /// 61, 170) where its sheet 1 does, the sheets labelled as in [`crate::CurvePoint`];
+    /// `false` draws the curves in the silhouettes' near-black ink.
+    pub curve_colours: bool,
     /// Draw silhouettes (where the eye ray lies in the tangent plane).
     pub silhouettes: bool,
     /// Line width in pixels.
@@ -232,6 +240,7 @@ impl Default for RenderSettings {
             hither: None,
             ribbons: None,
             curves: true,
+            curve_colours: true,
             silhouettes: true,
             line_width: 2.5,
             line_width_far: None,
@@ -389,12 +398,13 @@ impl CameraSettings {
                 format!("must be -89 to 89 degrees, got {}", self.elevation),
             ));
         }
-        if !(self.distance.is_finite() && self.distance > 0.0 && self.distance <= 1e4) {
+        if let Some(d) = self.distance
+            && !(d.is_finite() && d > 0.0 && d <= 1e4)
+        {
             return Err(FieldError::new(
                 "distance",
                 format!(
-                    "must be in (0, 10000] (units of half the scene's diagonal), got {}",
-                    self.distance
+                    "must be in (0, 10000] (units of half the scene's diagonal), or absent for a camera fitted to the surfaces, got {d}"
                 ),
             ));
         }
@@ -452,6 +462,9 @@ pub enum RenderError {
     /// The memory limit is set wrong.
     #[error("{0}")]
     MemoryLimit(String),
+    /// Something that cannot fail did (a bug, not bad input).
+    #[error("internal error in the renderer: {0}")]
+    Internal(String),
 }
 
 /// An RGB picture, 8 bits per channel, row-major from the top.
@@ -517,19 +530,14 @@ fn render_eyes(
     camera: &CameraSettings,
     depth_wanted: bool,
 ) -> Result<(Picture, Vec<f64>), RenderError> {
-    let (bounds, scene) = prepare(input, settings, camera)?;
-    // Cross-eyed: the left image is the right eye's (turned right, +azimuth).
-    let eyes: Vec<f64> = if settings.stereo {
-        vec![first_eye(settings), -first_eye(settings)]
-    } else {
-        vec![0.0]
-    };
+    let (placement, scene) = prepare(input, settings, camera)?;
+    let eyes = eyes(settings);
     let mut depth = Vec::new();
     let (w, h) = (settings.width, settings.height);
-    scene.check_memory(&Camera::new(camera, bounds, w, h, eyes[0])?, eyes.len())?;
+    scene.check_memory(&Camera::new(camera, &placement, w, h, eyes[0])?, eyes.len())?;
     let mut rgb = vec![0u8; 3 * (w as usize * eyes.len()) * h as usize];
     for (e, &offset) in eyes.iter().enumerate() {
-        let cam = Camera::new(camera, bounds, w, h, offset)?;
+        let cam = Camera::new(camera, &placement, w, h, offset)?;
         let mut view = match settings.style {
             Style::Shaded => scene.view(&cam),
             Style::Stipple => scene.view_stipples(&cam, depth_wanted && e == 0)?,
@@ -537,13 +545,18 @@ fn render_eyes(
         if e == 0 && depth_wanted {
             depth.clone_from(&view.front);
         }
-        if let Some(coverage) = scene.lines(&cam)? {
-            for (c, &k) in view.rgb.iter_mut().zip(coverage.values()) {
-                *c = c.lerp(overlay::INK, f64::from(k));
+        for lines in scene.lines(&cam)? {
+            for (c, &k) in view.rgb.iter_mut().zip(lines.coverage.values()) {
+                *c = c.lerp(lines.ink, f64::from(k));
             }
         }
         if settings.legend {
-            legend(&mut view.rgb, w as usize, h as usize, settings.colormap);
+            legend(
+                &mut view.rgb,
+                (w as usize, h as usize),
+                settings,
+                scene.w_range,
+            )?;
         }
         for y in 0..h as usize {
             for x in 0..w as usize {
@@ -572,10 +585,10 @@ pub fn stipples_drawn(
     settings: &RenderSettings,
     camera: &CameraSettings,
 ) -> Result<Vec<stipple::Drawn>, RenderError> {
-    let (bounds, scene) = prepare(input, settings, camera)?;
+    let (placement, scene) = prepare(input, settings, camera)?;
     let cam = Camera::new(
         camera,
-        bounds,
+        &placement,
         settings.width,
         settings.height,
         first_eye(settings),
@@ -584,24 +597,36 @@ pub fn stipples_drawn(
 }
 
 /// The coverage in [0, 1] of the lines (curves and silhouettes, as the settings ask) in the
-/// first eye's image, row-major; all zero when there are none.
+/// first eye's image, row-major; all zero when there are none. Where the lines are drawn in
+/// several inks, their coverages `c` combine as the picture lays them over each other,
+/// 1 - prod(1 - c).
 pub fn line_coverage(
     input: &Parts,
     settings: &RenderSettings,
     camera: &CameraSettings,
 ) -> Result<Vec<f32>, RenderError> {
-    let (bounds, scene) = prepare(input, settings, camera)?;
+    let (placement, scene) = prepare(input, settings, camera)?;
     let cam = Camera::new(
         camera,
-        bounds,
+        &placement,
         settings.width,
         settings.height,
         first_eye(settings),
     )?;
-    Ok(match scene.lines(&cam)? {
-        Some(c) => c.values().to_vec(),
-        None => vec![0.0; settings.width as usize * settings.height as usize],
-    })
+    let mut inks = scene.lines(&cam)?.into_iter();
+    let Some(first) = inks.next() else {
+        return Ok(vec![
+            0.0;
+            settings.width as usize * settings.height as usize
+        ]);
+    };
+    let mut total = first.coverage.values().to_vec();
+    for lines in inks {
+        for (t, &c) in total.iter_mut().zip(lines.coverage.values()) {
+            *t += c - *t * c;
+        }
+    }
+    Ok(total)
 }
 
 /// What the centre ray of a pixel sees first, for probing a picture at known places.
@@ -632,10 +657,10 @@ impl<'a> Prober<'a> {
         settings: &'a RenderSettings,
         camera: &CameraSettings,
     ) -> Result<Self, RenderError> {
-        let (bounds, scene) = prepare(input, settings, camera)?;
+        let (placement, scene) = prepare(input, settings, camera)?;
         let cam = Camera::new(
             camera,
-            bounds,
+            &placement,
             settings.width,
             settings.height,
             first_eye(settings),
@@ -685,12 +710,33 @@ fn first_eye(settings: &RenderSettings) -> f64 {
     }
 }
 
-/// Checks the settings and indexes the scene.
+/// The azimuth offset of each image, left to right. Cross-eyed: the left image is the right
+/// eye's (turned right, +azimuth).
+fn eyes(settings: &RenderSettings) -> Vec<f64> {
+    if settings.stereo {
+        vec![first_eye(settings), -first_eye(settings)]
+    } else {
+        vec![0.0]
+    }
+}
+
+/// Every vertex of a triangle of the surfaces, once per corner: what a fitted camera frames.
+fn triangle_corners<'a>(input: &'a Parts<'a>) -> impl Iterator<Item = DVec3> + Clone + 'a {
+    input.surfaces.iter().flat_map(|s| {
+        s.triangles
+            .iter()
+            .flatten()
+            .map(move |&v| s.positions[v as usize])
+    })
+}
+
+/// Checks the settings, places the camera (one placement for both eyes of a stereo pair)
+/// and indexes the scene.
 fn prepare<'a>(
     input: &'a Parts<'a>,
     settings: &'a RenderSettings,
     camera: &CameraSettings,
-) -> Result<((DVec3, DVec3), Scene<'a>), RenderError> {
+) -> Result<(camera::Placement, Scene<'a>), RenderError> {
     settings
         .check()
         .map_err(|e| RenderError::Setting(e.within("render")))?;
@@ -699,7 +745,15 @@ fn prepare<'a>(
         .map_err(|e| RenderError::Setting(e.within("camera")))?;
     let bounds = triangle_bounds(input.surfaces.iter().map(|s| (s.positions, s.triangles)))
         .ok_or(RenderError::Empty)?;
-    Ok((bounds, Scene::new(input, settings, bounds)))
+    let placement = camera::Placement::new(
+        camera,
+        bounds,
+        triangle_corners(input),
+        settings.width,
+        settings.height,
+        &eyes(settings),
+    );
+    Ok((placement, Scene::new(input, settings, bounds)))
 }
 
 /// The box around every vertex of a triangle of the surfaces (positions, triangles), which
@@ -720,12 +774,19 @@ pub fn triangle_bounds<'a>(
 }
 
 /// A colour bar of the w scale along the bottom of an image, near w at the left, far at the
-/// right, framed in black.
-fn legend(rgb: &mut [DVec3], w: usize, h: usize, map: Colormap) {
+/// right, framed in black, with the w of its ends and middle above it where they fit
+/// ([`text::label_bar`]): in the lines' ink on a light background, in white on a dark one,
+/// outlined in the background's colour.
+fn legend(
+    rgb: &mut [DVec3],
+    (w, h): (usize, usize),
+    settings: &RenderSettings,
+    (w0, w1): (f64, f64),
+) -> Result<(), RenderError> {
     let margin = (w.min(h) / 40).max(2);
     let bar = (h / 40).max(4);
     if w <= 2 * margin + 2 || h <= 2 * margin + bar + 2 {
-        return;
+        return Ok(());
     }
     let (x0, x1) = (margin, w - margin);
     let (y0, y1) = (h - margin - bar, h - margin);
@@ -735,10 +796,26 @@ fn legend(rgb: &mut [DVec3], w: usize, h: usize, map: Colormap) {
             rgb[y * w + x] = if frame {
                 DVec3::ZERO
             } else {
-                shade::colormap(map, (x - x0) as f64 / (x1 - x0 - 1) as f64)
+                shade::colormap(settings.colormap, (x - x0) as f64 / (x1 - x0 - 1) as f64)
             };
         }
     }
+    // The colours span w0 to w0 + span ([`Scene::shade`]).
+    let span = if w1 > w0 { w1 - w0 } else { 1.0 };
+    let background = DVec3::from(settings.background);
+    let light = background.dot(DVec3::new(0.2126, 0.7152, 0.0722)) > 0.18;
+    let ink = if light { overlay::INK } else { DVec3::ONE };
+    text::label_bar(
+        rgb,
+        (w, h),
+        y0,
+        (x0, x1),
+        [w0, w0 + 0.5 * span, w0 + span],
+        ink,
+        background,
+    )
+    .map_err(RenderError::Internal)?;
+    Ok(())
 }
 
 /// Linear [0, 1] to an 8-bit sRGB value.

@@ -1,39 +1,126 @@
 //! The lines over a picture: the self-intersection curves and the silhouettes, drawn one
 //! pixel wide where they are visible and broadened to an exact width ([`super::lines`]).
+//!
+//! The curves are drawn in the ink of the sheet that passes over ([`OVER_INKS`]), each ink
+//! in a mask of its own broadened on its own, so that every line keeps its width; the inks
+//! are laid over the picture in a fixed order (silhouettes, then sheet 0 over, then sheet 1
+//! over).
 
 use super::camera::Camera;
 use super::lines::{Broadener, Coverage, Mask};
 use super::{RenderError, Scene};
+use crate::intersect::Curve;
 use crate::limits::FieldError;
 use glam::{DVec2, DVec3};
 
-/// The colour of the lines (linear RGB).
+/// The colour of the silhouettes, and of the curves when they are drawn in one ink (linear
+/// RGB).
 pub const INK: DVec3 = DVec3::splat(0.02);
 
+/// The colours of the curves (linear RGB) where their sheet 0 passes over (is nearer in
+/// w), a dark red (sRGB 170, 20, 28), and where their sheet 1 does, a dark blue (sRGB 25,
+/// 61, 170): the sheets as the intersection stage labels them, consistently along each
+/// curve.
+pub const OVER_INKS: [DVec3; 2] = [
+    DVec3::new(0.402, 0.007, 0.0116),
+    DVec3::new(0.0097, 0.0467, 0.402),
+];
+
+/// The lines of one ink: its colour and how much of each pixel it covers.
+pub(super) struct Lines {
+    /// Linear RGB.
+    pub ink: DVec3,
+    /// Coverage in [0, 1] per pixel.
+    pub coverage: Coverage,
+}
+
+/// A curve cut where the sheet that passes over changes: pieces of (the sheet nearer in w,
+/// the piece's points). `points` are the curve's points, each with the sheet nearer in w
+/// there ([`crate::CurvePoint::near`]), `None` where the two sheets' w are equal (at a
+/// branch point where a curve ends, or where two surfaces meet in 4D): such a point takes
+/// the sheet of the point before it (the first with one, where none is before it). A
+/// segment whose two ends have different sheets over is cut at its middle, and a closed
+/// curve's last segment returns to its first point (its last piece and its first are one
+/// where they have the same sheet over, so a curve with one sheet over throughout is one
+/// piece, drawn as in a single ink). A curve whose sheets' w are equal everywhere is one
+/// piece with no sheet over.
+pub(crate) fn over_pieces(
+    points: &[(DVec3, Option<usize>)],
+    closed: bool,
+) -> Vec<(Option<usize>, Vec<DVec3>)> {
+    let Some(&(first, _)) = points.first() else {
+        return Vec::new();
+    };
+    let closing = closed.then_some(first);
+    let Some(first_over) = points.iter().find_map(|p| p.1) else {
+        let all = points.iter().map(|p| p.0).chain(closing).collect();
+        return vec![(None, all)];
+    };
+    // Before the first point with a sheet over: a closed curve comes round from its last.
+    let mut over = if closed {
+        points.iter().rev().find_map(|p| p.1).unwrap_or(first_over)
+    } else {
+        first_over
+    };
+    let mut resolved: Vec<(DVec3, usize)> = points
+        .iter()
+        .map(|&(p, near)| {
+            over = near.unwrap_or(over);
+            (p, over)
+        })
+        .collect();
+    if closed {
+        resolved.push(resolved[0]);
+    }
+    let mut pieces = Vec::new();
+    let mut piece = (resolved[0].1, vec![resolved[0].0]);
+    for pair in resolved.windows(2) {
+        let ((p, _), (q, near)) = (pair[0], pair[1]);
+        if near != piece.0 {
+            let middle = (p + q) * 0.5;
+            piece.1.push(middle);
+            pieces.push(std::mem::replace(&mut piece, (near, vec![middle])));
+        }
+        piece.1.push(q);
+    }
+    pieces.push(piece);
+    if closed && pieces.len() > 1 && pieces[0].0 == pieces[pieces.len() - 1].0 {
+        let head = pieces.remove(0);
+        if let Some(tail) = pieces.last_mut() {
+            // The tail ends at the curve's first point, where the head starts.
+            tail.1.extend_from_slice(&head.1[1..]);
+        }
+    }
+    pieces
+        .into_iter()
+        .map(|(near, piece)| (Some(near), piece))
+        .collect()
+}
+
+/// Where a polyline is drawn: the silhouettes' and single ink's mask (0), or that of the
+/// curves over which sheet 0 (1) or sheet 1 (2) passes over.
+type InkClass = usize;
+
 impl Scene<'_> {
-    /// The coverage of the scene's lines in the image of `cam`.
-    pub(super) fn lines(&self, cam: &Camera) -> Result<Option<Coverage>, RenderError> {
+    /// The scene's lines in the image of `cam`, one entry per ink that has any, in the
+    /// order they are laid over the picture.
+    pub(super) fn lines(&self, cam: &Camera) -> Result<Vec<Lines>, RenderError> {
         let s = self.settings;
         if !s.curves && !s.silhouettes {
-            return Ok(None);
+            return Ok(Vec::new());
         }
         let (w, h) = (s.width, s.height);
-        let mut mask = Mask::new(w as usize, h as usize).map_err(line_error)?;
-        let mut polylines: Vec<Vec<DVec3>> = Vec::new();
+        let mut polylines: Vec<(InkClass, Vec<DVec3>)> = Vec::new();
         if s.curves {
             for c in &self.input.curves.curves {
-                let mut p: Vec<DVec3> = c.points.iter().map(|p| p.position).collect();
-                if c.closed && !p.is_empty() {
-                    p.push(p[0]);
-                }
-                polylines.push(p);
+                polylines.extend(curve_polylines(c, s.curve_colours));
             }
         }
         if s.silhouettes {
             polylines.extend(
                 self.silhouette_edges(cam)
                     .into_iter()
-                    .map(|[a, b]| vec![a, b]),
+                    .map(|[a, b]| (0, vec![a, b])),
             );
         }
         let depth_of = |p: DVec3| (p - cam.eye).dot(cam.forward);
@@ -50,7 +137,12 @@ impl Scene<'_> {
         };
         let mut hits = Vec::new();
         let see_through = s.opacity < 1.0 || s.opacity_far.is_some_and(|o| o < 1.0);
-        for line in &polylines {
+        let mut masks: [Option<Mask>; 3] = [None, None, None];
+        for (class, line) in &polylines {
+            let mask = match &mut masks[*class] {
+                Some(mask) => mask,
+                empty => empty.insert(Mask::new(w as usize, h as usize).map_err(line_error)?),
+            };
             let mut run: Vec<(DVec2, f64)> = Vec::new();
             let mut flush = |run: &mut Vec<(DVec2, f64)>| -> Result<(), RenderError> {
                 if run.len() >= 2 {
@@ -90,16 +182,24 @@ impl Scene<'_> {
             }
             flush(&mut run)?;
         }
-        if mask.is_empty() {
-            return Ok(None);
-        }
         let mut broadener = Broadener::new();
-        let coverage = match s.line_width_far {
-            Some(_) => broadener.broaden_varying(&mask),
-            None => broadener.broaden(&mask, s.line_width),
+        let mut out = Vec::new();
+        for (class, mask) in masks.into_iter().enumerate() {
+            let Some(mask) = mask.filter(|m| !m.is_empty()) else {
+                continue;
+            };
+            let coverage = match s.line_width_far {
+                Some(_) => broadener.broaden_varying(&mask),
+                None => broadener.broaden(&mask, s.line_width),
+            }
+            .map_err(line_error)?;
+            let ink = match class {
+                0 => INK,
+                k => OVER_INKS[k - 1],
+            };
+            out.push(Lines { ink, coverage });
         }
-        .map_err(line_error)?;
-        Ok(Some(coverage))
+        Ok(out)
     }
 
     /// Whether a surface the halos leave visible lies between the eye and `p` (surfaces
@@ -171,6 +271,29 @@ impl Scene<'_> {
     }
 }
 
+/// A curve's polylines with the mask each is drawn into: the whole curve in the single ink,
+/// or its pieces in the ink of the sheet over them (a curve with no sheet over anywhere in
+/// the single ink).
+fn curve_polylines(c: &Curve, colours: bool) -> Vec<(InkClass, Vec<DVec3>)> {
+    if colours {
+        let points: Vec<(DVec3, Option<usize>)> = c
+            .points
+            .iter()
+            .map(|p| (p.position, (p.w[0] != p.w[1]).then(|| p.near())))
+            .collect();
+        over_pieces(&points, c.closed)
+            .into_iter()
+            .map(|(near, piece)| (near.map_or(0, |n| 1 + n), piece))
+            .collect()
+    } else {
+        let mut p: Vec<DVec3> = c.points.iter().map(|p| p.position).collect();
+        if c.closed && !p.is_empty() {
+            p.push(p[0]);
+        }
+        vec![(0, p)]
+    }
+}
+
 fn line_error(e: super::lines::LinesError) -> RenderError {
     RenderError::Setting(FieldError::new("render.line_width", e.to_string()))
 }
@@ -200,4 +323,76 @@ pub(crate) fn interior_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 4]> {
             [w[0].0[0], w[0].0[1], w[0].1, w[1].1 | agree]
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(x: f64) -> DVec3 {
+        DVec3::new(x, 0.0, 0.0)
+    }
+
+    #[test]
+    fn a_curve_is_cut_at_the_middle_of_the_segment_where_the_sheet_over_changes() {
+        let points = [
+            (at(0.0), Some(0)),
+            (at(1.0), Some(0)),
+            (at(2.0), Some(1)),
+            (at(4.0), Some(1)),
+        ];
+        assert_eq!(
+            over_pieces(&points, false),
+            vec![
+                (Some(0), vec![at(0.0), at(1.0), at(1.5)]),
+                (Some(1), vec![at(1.5), at(2.0), at(4.0)]),
+            ]
+        );
+        // Closed: the last segment returns to the first point, cut at its middle too, and
+        // the first and last pieces, both with sheet 0 over, are one through the start.
+        assert_eq!(
+            over_pieces(&points, true),
+            vec![
+                (Some(1), vec![at(1.5), at(2.0), at(4.0), at(2.0)]),
+                (Some(0), vec![at(2.0), at(0.0), at(1.0), at(1.5)]),
+            ]
+        );
+    }
+
+    #[test]
+    fn points_without_a_sheet_over_take_their_neighbours() {
+        // A curve between two branch points, where the sheets' w are equal: one piece.
+        let points = [
+            (at(0.0), None),
+            (at(1.0), Some(1)),
+            (at(2.0), Some(1)),
+            (at(3.0), None),
+        ];
+        assert_eq!(
+            over_pieces(&points, false),
+            vec![(Some(1), vec![at(0.0), at(1.0), at(2.0), at(3.0)])]
+        );
+        // Through a point where the sheets meet in 4D, the sheet over may change after it.
+        let points = [(at(0.0), Some(0)), (at(1.0), None), (at(2.0), Some(1))];
+        assert_eq!(
+            over_pieces(&points, false),
+            vec![
+                (Some(0), vec![at(0.0), at(1.0), at(1.5)]),
+                (Some(1), vec![at(1.5), at(2.0)]),
+            ]
+        );
+        // No sheet over anywhere.
+        let points = [(at(0.0), None), (at(1.0), None)];
+        assert_eq!(
+            over_pieces(&points, true),
+            vec![(None, vec![at(0.0), at(1.0), at(0.0)])]
+        );
+        assert!(over_pieces(&[], true).is_empty());
+        // One sheet over throughout a closed curve: the curve and its closing segment.
+        let points = [(at(0.0), Some(1)), (at(1.0), Some(1)), (at(2.0), None)];
+        assert_eq!(
+            over_pieces(&points, true),
+            vec![(Some(1), vec![at(0.0), at(1.0), at(2.0), at(0.0)])]
+        );
+    }
 }

@@ -2,8 +2,8 @@
 
 use super::Row;
 use crate::render::compare::Comparison;
+use crate::render::text::FAMILY;
 use plotters::prelude::*;
-use plotters::style::FontStyle;
 
 /// Why a plot could not be made.
 #[derive(Debug, thiserror::Error)]
@@ -16,19 +16,9 @@ pub enum PlotError {
     Draw(String),
 }
 
-/// The font of every label, embedded so that plots look the same on every machine
-/// (DejaVu Sans Mono; licence in `assets/fonts/DejaVu-LICENSE.txt`).
-const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSansMono.ttf");
-const FAMILY: &str = "halo4d-mono";
-
+/// Registers the labels' font ([`FAMILY`]).
 fn register_font() -> Result<(), PlotError> {
-    static DONE: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
-    DONE.get_or_init(|| {
-        plotters::style::register_font(FAMILY, FontStyle::Normal, FONT)
-            .map_err(|_| "the embedded plot font is not a valid font".to_string())
-    })
-    .clone()
-    .map_err(PlotError::Draw)
+    crate::render::text::register_font().map_err(PlotError::Draw)
 }
 
 const COLOURS: [RGBColor; 8] = [

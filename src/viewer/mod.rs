@@ -52,7 +52,7 @@ use crate::import::{ImportError, ImportedScene};
 use crate::limits::{
     FieldError, PICTURE_SIDE, SAMPLES, VIEWER_SLICES, VIEWER_TETRAHEDRA, VIEWER_TRIANGLES,
 };
-use crate::render::camera::Camera;
+use crate::render::camera::{Camera, Placement, bounding_radius};
 use crate::render::overlay::{AGREE, interior_edges};
 use crate::render::{CameraSettings, Colormap, RenderError};
 use glam::{DMat4, DVec3, DVec4};
@@ -274,6 +274,9 @@ pub struct Asset {
     pub camera: Option<CameraSettings>,
     /// The surfaces' bounding box (absolute), as the CPU renderer computes it.
     pub bounds: (DVec3, DVec3),
+    /// The surfaces' vertices (absolute, as the CPU renderer reads them), which a fitted
+    /// camera frames.
+    pub(crate) fit_points: Vec<DVec3>,
     /// The range of w over the surfaces.
     pub w_range: (f64, f64),
     /// The range of halo depth (eq. 3) the tetrahedra can reach, with the surfaces' w.
@@ -412,10 +415,26 @@ impl Asset {
             .map(|v| f64::from(v.d))
             .fold(w_range.0, f64::min);
         let depth_hi = depth_hi.max(w_range.1);
+        let fit_points = scene
+            .surfaces
+            .iter()
+            .flat_map(|s| {
+                let mut used = vec![false; s.positions.len()];
+                for &v in s.triangles.iter().flatten() {
+                    used[v as usize] = true;
+                }
+                s.positions
+                    .iter()
+                    .zip(used)
+                    .filter_map(|(&p, used)| used.then_some(p))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
         Ok(Asset {
             name,
             camera: scene.camera,
             bounds,
+            fit_points,
             w_range,
             depth_range: (depth_lo, depth_hi),
             vertices,
@@ -433,6 +452,20 @@ impl Asset {
     /// The centre of the bounding box (the origin of the GPU's coordinates).
     pub fn centre(&self) -> DVec3 {
         (self.bounds.0 + self.bounds.1) * 0.5
+    }
+
+    /// Where the eye of `camera` stands for a picture of `width` x `height` of the asset as
+    /// it is now, as the CPU renderer places it ([`Placement`]: the camera's distance, or
+    /// fitted to the vertices).
+    pub fn placement(&self, camera: &CameraSettings, width: u32, height: u32) -> Placement {
+        Placement::new(
+            camera,
+            self.bounds,
+            self.fit_points.iter().copied(),
+            width,
+            height,
+            &[0.0],
+        )
     }
 
     /// Surface triangles.
@@ -530,19 +563,22 @@ pub(crate) struct GpuCamera {
 }
 
 impl GpuCamera {
-    /// The camera of `settings` framing `bounds`, as the CPU renderer places it.
-    pub fn new(settings: &ViewSettings, bounds: (DVec3, DVec3)) -> Result<GpuCamera, ViewerError> {
+    /// The camera of `settings` framing `asset`, as the CPU renderer places it.
+    pub fn new(settings: &ViewSettings, asset: &Asset) -> Result<GpuCamera, ViewerError> {
+        let placement = asset.placement(&settings.camera, settings.width, settings.height);
         let cam = Camera::new(
             &settings.camera,
-            bounds,
+            &placement,
             settings.width,
             settings.height,
             0.0,
         )?;
+        let bounds = asset.bounds;
         let centre = (bounds.0 + bounds.1) * 0.5;
         let radius = bounding_radius(bounds);
         let eye = cam.eye - centre;
-        let dist = eye.length();
+        // The centre's depth along the view (a fitted camera may look past the centre).
+        let dist = (-eye).dot(cam.forward);
         let sx = 1.0 / (cam.half_height * cam.aspect);
         let sy = 1.0 / cam.half_height;
         // Rows of the clip matrix acting on (p, 1), p relative to the centre.
@@ -585,11 +621,6 @@ impl GpuCamera {
             far,
         })
     }
-}
-
-/// The radius of a box's bounding sphere, as the CPU renderer's camera takes it.
-pub(crate) fn bounding_radius((lo, hi): (DVec3, DVec3)) -> f64 {
-    ((hi - lo).length() * 0.5).max(f64::MIN_POSITIVE)
 }
 
 /// A rendered picture with, per pixel, the distance along the camera ray to the first

@@ -459,6 +459,7 @@ impl Renderer {
         self.asset.vertices = bytemuck::pod_collect_to_vec(&back[0]);
         self.asset.halo_vertices = bytemuck::pod_collect_to_vec(&back[1]);
         self.asset.bounds = framing.bounds;
+        self.asset.fit_points = framing.points;
         self.asset.w_range = framing.w_range;
         self.asset.depth_range = framing.depth_range;
         self.asset.curve_points.clear();
@@ -544,7 +545,7 @@ impl Renderer {
             ..*settings
         };
         self.ensure_targets(gpu, (settings.width, settings.height), k > 1);
-        let camera = GpuCamera::new(settings, self.asset.bounds)?;
+        let camera = GpuCamera::new(settings, &self.asset)?;
         let slabs = self.slabs(&camera, settings.slices);
         let uniform = self.uniform(&camera, settings, halos, slabs, self.grid.as_ref());
         gpu.queue
@@ -1045,7 +1046,7 @@ impl Renderer {
         };
         // Voxelization reads only the grid's placement, the depth normalization and the band
         // from the uniform block; any camera will do for the rest.
-        let camera = GpuCamera::new(&ViewSettings::default(), self.asset.bounds)?;
+        let camera = GpuCamera::new(&ViewSettings::default(), &self.asset)?;
         let mut uniform = self.uniform(
             &camera,
             &ViewSettings::default(),

@@ -244,6 +244,10 @@ impl App {
         self.last_good = self.settings;
         self.last_ms = times.frame_ms;
         let s = &self.settings;
+        let placement = state
+            .renderer
+            .asset()
+            .placement(&s.camera, s.width, s.height);
         let on = |b: bool| if b { "on" } else { "off" };
         let four = match self.drawn_view {
             None => String::new(),
@@ -265,7 +269,7 @@ impl App {
             ),
         };
         state.window.set_title(&format!(
-            "halo4d-view: {} | {} {} slices | {} spp | halos {} | curves {} | silhouettes {} | {} | colour {} | azimuth {:.0} elevation {:.0} distance {:.2} | {:.1} ms{}{four}",
+            "halo4d-view: {} | {} {} slices | {} spp | halos {} | curves {} | silhouettes {} | {} | colour {} | azimuth {:.0} elevation {:.0} distance {:.2}{} | {:.1} ms{}{four}",
             self.source.name(),
             s.mode.name(),
             s.slices,
@@ -277,7 +281,8 @@ impl App {
             if s.colour_by_w { "by w" } else { "grey" },
             s.camera.azimuth,
             s.camera.elevation,
-            s.camera.distance,
+            placement.distance,
+            if placement.fitted { " fitted" } else { "" },
             self.last_ms,
             times
                 .grid_ms
@@ -429,13 +434,15 @@ impl App {
         let (Some(view), Some(state)) = (&mut self.view, &self.state) else {
             return false;
         };
-        let Ok(camera) = crate::render::camera::Camera::new(
+        let asset = state.renderer.asset();
+        let (camera, width, height) = (
             &self.settings.camera,
-            state.renderer.asset().bounds,
             self.settings.width,
             self.settings.height,
-            0.0,
-        ) else {
+        );
+        let placement = asset.placement(camera, width, height);
+        let Ok(camera) = crate::render::camera::Camera::new(camera, &placement, width, height, 0.0)
+        else {
             return false;
         };
         let towards = camera.right * dx - camera.up * dy;
@@ -537,9 +544,18 @@ impl ApplicationHandler for App {
                     MouseScrollDelta::LineDelta(_, y) => f64::from(y),
                     MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
                 };
-                let c = &mut self.settings.camera;
-                c.distance = (c.distance * 0.9f64.powf(steps)).clamp(0.2, 50.0);
-                redraw = true;
+                // The wheel zooms from where the eye stands, fitted or not.
+                if let Some(state) = &self.state {
+                    let s = &self.settings;
+                    let from = state
+                        .renderer
+                        .asset()
+                        .placement(&s.camera, s.width, s.height)
+                        .distance;
+                    self.settings.camera.distance =
+                        Some((from * 0.9f64.powf(steps)).clamp(0.2, 50.0));
+                    redraw = true;
+                }
             }
             WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
                 redraw = self.key(&event.logical_key, event.physical_key, event_loop);
