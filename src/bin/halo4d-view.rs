@@ -4,7 +4,7 @@
 use clap::{Parser, ValueEnum};
 use halo4d::limits::FieldError;
 use halo4d::viewer::{self, Gpu, HaloMode, SLICE_COUNTS, Source, ViewSettings, ViewerError};
-use halo4d::{CameraProjection, CameraSettings, Colormap, View};
+use halo4d::{CameraProjection, CameraSettings, Colormap, Style, View};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -79,6 +79,10 @@ struct Args {
     /// The colour scale of w.
     #[arg(long, value_enum, default_value_t = Map::Diverging)]
     colormap: Map,
+    /// Shaded surfaces, or stipples (paper 003) on the first surface the halos leave
+    /// visible, with the scene's render.stipple (default: the scene's render.style).
+    #[arg(long, value_enum)]
+    style: Option<Style>,
     /// Render a fixed orbit for each mode and slice count (64, 128, 256, 512) offscreen
     /// and print milliseconds per frame.
     #[arg(long)]
@@ -193,6 +197,7 @@ fn run(args: &Args) -> Result<(), ViewerError> {
         }
     };
     let recorded = source.camera();
+    let render = source.render_settings();
     let settings = ViewSettings {
         width: args.size.0,
         height: args.size.1,
@@ -225,6 +230,8 @@ fn run(args: &Args) -> Result<(), ViewerError> {
             Map::Viridis => Colormap::Viridis,
             Map::Gray => Colormap::Gray,
         },
+        style: args.style.unwrap_or(render.style),
+        stipple: render.stipple,
     };
     settings.check()?;
     if let (Some(out), Source::Model(model), Some(view)) = (&args.save_scene, &source, &view) {
@@ -252,10 +259,14 @@ fn run(args: &Args) -> Result<(), ViewerError> {
             }
         })?;
         println!(
-            "{}: {}x{}, {} {} slices, {:.1} ms{} on {}",
+            "{}: {}x{}, {}, {} {} slices, {:.1} ms{} on {}",
             out.display(),
             settings.width,
             settings.height,
+            match settings.style {
+                Style::Shaded => "shaded",
+                Style::Stipple => "stipples",
+            },
             settings.mode.name(),
             settings.slices,
             frame.times.frame_ms,
@@ -303,6 +314,25 @@ fn bench(
     );
     println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
     let ms = |v: Option<f64>| v.map_or_else(|| "-".into(), |g| format!("{g:.1}"));
+    // The stipple rows, where the source has a 4D mesh to fix stipples to.
+    let clock = std::time::Instant::now();
+    let st = settings.stipple;
+    let stipples = match source.stipples(st.count, st.seed) {
+        Ok(set) => {
+            eprintln!(
+                "stipples: {} ({} per surface, seed {}) made on the CPU in {:.0} ms",
+                set.len(),
+                st.count,
+                st.seed,
+                clock.elapsed().as_secs_f64() * 1e3
+            );
+            Some(set)
+        }
+        Err(e) => {
+            eprintln!("note: no stipple rows: {e}");
+            None
+        }
+    };
     viewer::bench(
         &gpu,
         source,
@@ -310,10 +340,15 @@ fn bench(
         settings,
         &SLICE_COUNTS,
         frames,
+        stipples.as_ref(),
         &mut |r| {
             println!(
-                "| {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.1} |",
+                "| {}{} | {} | {} | {} | {} | {:.2} | {:.2} | {:.1} |",
                 r.motion.name(),
+                match r.style {
+                    Style::Shaded => "",
+                    Style::Stipple => ", stipples",
+                },
                 r.mode.name(),
                 r.slices,
                 ms(r.turn_ms),
