@@ -83,8 +83,9 @@ struct Args {
     /// visible, with the scene's render.stipple (default: the scene's render.style).
     #[arg(long, value_enum)]
     style: Option<Style>,
-    /// Render a fixed orbit for each mode and slice count (64, 128, 256, 512) offscreen
-    /// and print milliseconds per frame.
+    /// Render a fixed orbit (and for a scene a 4D turn) for each mode and slice count (64,
+    /// 128, 256, 512) offscreen, then in stipples in --mode at --slices, and print
+    /// milliseconds per frame (with --style, that style's rows only).
     #[arg(long)]
     bench: bool,
     /// Frames per orbit for --bench.
@@ -244,7 +245,7 @@ fn run(args: &Args) -> Result<(), ViewerError> {
         );
     }
     if args.bench {
-        return bench(&source, view.as_ref(), &settings, args.frames);
+        return bench(&source, view.as_ref(), &settings, args.frames, args.style);
     }
     if args.compare {
         return compare(&source, view.as_ref(), &settings);
@@ -290,6 +291,7 @@ fn bench(
     view: Option<&View>,
     settings: &ViewSettings,
     frames: u32,
+    style: Option<Style>,
 ) -> Result<(), ViewerError> {
     if frames == 0 {
         return Err(ViewerError::Setting(FieldError::new(
@@ -314,10 +316,18 @@ fn bench(
     );
     println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
     let ms = |v: Option<f64>| v.map_or_else(|| "-".into(), |g| format!("{g:.1}"));
-    // The stipple rows, where the source has a 4D mesh to fix stipples to.
+    // The stipple rows, where the source has a 4D mesh to fix stipples to; `--style` asks
+    // for one style's rows only.
     let clock = std::time::Instant::now();
     let st = settings.stipple;
-    let stipples = match source.stipples(st.count, st.seed) {
+    let made = match style {
+        Some(Style::Shaded) => Err(ViewerError::Setting(FieldError::new(
+            "--style",
+            "shaded rows only",
+        ))),
+        _ => source.stipples(st.count, st.seed),
+    };
+    let stipples = match made {
         Ok(set) => {
             eprintln!(
                 "stipples: {} ({} per surface, seed {}) made on the CPU in {:.0} ms",
@@ -338,7 +348,11 @@ fn bench(
         source,
         view,
         settings,
-        &SLICE_COUNTS,
+        if style == Some(Style::Stipple) {
+            &[]
+        } else {
+            &SLICE_COUNTS
+        },
         frames,
         stipples.as_ref(),
         &mut |r| {

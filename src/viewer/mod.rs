@@ -38,6 +38,10 @@
 //! Curves and silhouettes are bands of the CPU renderer's line width, drawn after the
 //! surfaces where their centre is in view: not behind the farthest surface within a pixel
 //! of it (by more than half the width).
+//!
+//! In the stipple style (paper 003) the surfaces are drawn white and each surface's ranked
+//! stipples, made once from the 4D mesh, are placed, thinned and tested against the
+//! surfaces' depth on the GPU (`stipple.rs`, [`StippleSet`]).
 
 mod gpu;
 mod renderer;
@@ -960,7 +964,7 @@ pub fn bench(
         };
         let grid_ms = renderer.render(gpu, &target, &s)?.grid_ms;
         let orbit = |f: u32| settings.camera.azimuth + 360.0 * f64::from(f) / f64::from(frames);
-        if n == slices[0] || style == Style::Stipple {
+        if slices.first() == Some(&n) || style == Style::Stipple {
             // A whole orbit first, untimed: drivers finish compiling shaders on the
             // first frames that need them (lavapipe does, over several frames).
             for f in 0..frames {

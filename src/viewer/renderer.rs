@@ -728,7 +728,7 @@ impl Renderer {
                     (17, self.triangles.as_entire_binding()),
                     (18, ratio.as_entire_binding()),
                 ],
-                (0..3, 0..*count),
+                (0..3 * *count, 0..1),
             );
         }
         // The transparency composite, then the lines.
