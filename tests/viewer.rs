@@ -915,3 +915,149 @@ fn supersampling_draws_what_the_cpu_renderer_draws_with_as_many_samples() {
         .is_err_and(|e| e.to_string().contains("samples"))
     );
 }
+
+// ---------------------------------------------------------------- stipples
+
+/// Side of the tiles whose ink the stipple comparisons measure.
+const TILE: usize = 32;
+
+/// Per `TILE` x `TILE` tile (row-major), the mean ink of a stipple picture: per pixel, how
+/// far its linear grey is from the white background towards the ink (0.02), in [0, 1].
+fn tile_ink(p: &halo4d::Picture) -> Vec<f64> {
+    let (w, h) = (p.width as usize, p.height as usize);
+    let linear = |c: u8| {
+        let c = f64::from(c) / 255.0;
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    let (tx, ty) = (w.div_ceil(TILE), h.div_ceil(TILE));
+    let mut sum = vec![(0.0, 0usize); tx * ty];
+    for y in 0..h {
+        for x in 0..w {
+            let i = 3 * (y * w + x);
+            let grey = (0..3).map(|c| linear(p.rgb[i + c])).sum::<f64>() / 3.0;
+            let tile = &mut sum[(y / TILE) * tx + x / TILE];
+            tile.0 += ((1.0 - grey) / 0.98).clamp(0.0, 1.0);
+            tile.1 += 1;
+        }
+    }
+    sum.into_iter().map(|(s, n)| s / n as f64).collect()
+}
+
+/// The largest difference of tile ink between the GPU's stipple picture of `scene` in the
+/// 4D `view` (its own when `None`, turned on the GPU) and the CPU renderer's (exact mode,
+/// built in that view), without lines, and the mean ink of the CPU's picture.
+fn stipple_tile_difference(scene: &Scene, view: Option<&halo4d::View>) -> (f64, f64) {
+    let mut scene = scene.clone();
+    scene.render.style = halo4d::Style::Stipple;
+    scene.render.curves = false;
+    scene.render.silhouettes = false;
+    scene.render.stipple.count = scene.render.stipple.count.min(100_000);
+    scene.outputs.glb = false;
+    scene.outputs.vtk = false;
+    scene.outputs.verify = Some(false);
+    let source = viewer::Source::Model(Model::new(scene.clone()).unwrap().into());
+    if let Some(v) = view {
+        scene.view = *v;
+    }
+    let built = halo4d::run(&scene, true).unwrap();
+    let cpu = built
+        .render(
+            &scene.halo,
+            &RenderSettings {
+                width: SIDE,
+                height: SIDE,
+                mode: RenderMode::Exact,
+                ..scene.render
+            },
+            &scene.camera,
+        )
+        .unwrap();
+    let gpu_frame = viewer::screenshot_of(
+        gpu(),
+        &source,
+        view,
+        &ViewSettings {
+            style: halo4d::Style::Stipple,
+            stipple: scene.render.stipple,
+            curves: false,
+            silhouettes: false,
+            ..settings(&scene, HaloMode::Grid, 256)
+        },
+    )
+    .unwrap_or_else(|e| panic!("{}: {e}", scene.name));
+    let (a, b) = (tile_ink(&cpu), tile_ink(&gpu_frame.picture));
+    let worst = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    (worst, a.iter().sum::<f64>() / a.len() as f64)
+}
+
+#[test]
+fn stipples_on_the_gpu_ink_every_tile_as_the_cpu_renderer_does() {
+    let mut worst = (0.0f64, String::new());
+    for name in ["default", "flat-torus", "klein-bottle-stipples"] {
+        let scene = Scene::load(&crate::common::fixture(&format!("scenes/{name}.json"))).unwrap();
+        let (differs, ink) = stipple_tile_difference(&scene, None);
+        eprintln!(
+            "{name:<24} mean ink {:.3}, largest tile difference {:.4}",
+            ink, differs
+        );
+        assert!(
+            ink > 0.02,
+            "{name}: the CPU's picture has almost no ink ({ink})"
+        );
+        assert!(
+            differs < 0.05,
+            "{name}: a {TILE}x{TILE} tile's ink differs by {differs:.3}"
+        );
+        if differs > worst.0 {
+            worst = (differs, name.into());
+        }
+    }
+    eprintln!("largest tile difference: {:.4} ({})", worst.0, worst.1);
+}
+
+#[test]
+fn stipples_turned_in_4d_on_the_gpu_ink_as_the_cpu_render_of_the_rotated_scene() {
+    // The stipples stay on the mesh's triangles: after a 4D turn on the GPU they are placed
+    // and thinned from the turned vertices as the CPU places them in the scene built in
+    // that view.
+    let scene = Scene::default_scene();
+    for rotation in seeded_rotations(7, 2) {
+        let mut view = scene.view;
+        for (name, a) in rotation.planes() {
+            *view.rotation.angle_mut(name).unwrap() += a;
+        }
+        let (differs, ink) = stipple_tile_difference(&scene, Some(&view));
+        eprintln!("turned {rotation:?}: mean ink {ink:.3}, largest tile difference {differs:.4}");
+        assert!(differs < 0.05, "turned {rotation:?}: {differs:.3}");
+    }
+}
+
+#[test]
+fn the_stipple_style_is_refused_for_a_glb_without_its_4d_mesh() {
+    let (scene, dir, _, _) = default_export();
+    let bytes = std::fs::read(dir.path().join(format!("{}.glb", scene.name))).unwrap();
+    let path = dir.path().join("without-4d.glb");
+    std::fs::write(&path, without_4d(&bytes)).unwrap();
+    let (source, _) = viewer::Source::open(Some(&path)).unwrap();
+    assert!(matches!(source, viewer::Source::Asset(_)));
+    let e = viewer::screenshot_of(
+        gpu(),
+        &source,
+        None,
+        &ViewSettings {
+            style: halo4d::Style::Stipple,
+            ..settings(&scene, HaloMode::Grid, 64)
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("stipple") && e.contains("4D mesh"), "{e}");
+}

@@ -4,7 +4,7 @@
 use clap::{Parser, ValueEnum};
 use halo4d::limits::FieldError;
 use halo4d::viewer::{self, Gpu, HaloMode, SLICE_COUNTS, Source, ViewSettings, ViewerError};
-use halo4d::{CameraProjection, CameraSettings, Colormap, View};
+use halo4d::{CameraProjection, CameraSettings, Colormap, Style, View};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -80,8 +80,13 @@ struct Args {
     /// The colour scale of w.
     #[arg(long, value_enum, default_value_t = Map::Diverging)]
     colormap: Map,
-    /// Render a fixed orbit for each mode and slice count (64, 128, 256, 512) offscreen
-    /// and print milliseconds per frame.
+    /// Shaded surfaces, or stipples (paper 003) on the first surface the halos leave
+    /// visible, with the scene's render.stipple (default: the scene's render.style).
+    #[arg(long, value_enum)]
+    style: Option<Style>,
+    /// Render a fixed orbit (and for a scene a 4D turn) for each mode and slice count (64,
+    /// 128, 256, 512) offscreen, then in stipples in --mode at --slices, and print
+    /// milliseconds per frame (with --style, that style's rows only).
     #[arg(long)]
     bench: bool,
     /// Frames per orbit for --bench.
@@ -194,6 +199,7 @@ fn run(args: &Args) -> Result<(), ViewerError> {
         }
     };
     let recorded = source.camera();
+    let render = source.render_settings();
     let settings = ViewSettings {
         width: args.size.0,
         height: args.size.1,
@@ -226,6 +232,8 @@ fn run(args: &Args) -> Result<(), ViewerError> {
             Map::Viridis => Colormap::Viridis,
             Map::Gray => Colormap::Gray,
         },
+        style: args.style.unwrap_or(render.style),
+        stipple: render.stipple,
     };
     settings.check()?;
     if let (Some(out), Source::Model(model), Some(view)) = (&args.save_scene, &source, &view) {
@@ -238,7 +246,7 @@ fn run(args: &Args) -> Result<(), ViewerError> {
         );
     }
     if args.bench {
-        return bench(&source, view.as_ref(), &settings, args.frames);
+        return bench(&source, view.as_ref(), &settings, args.frames, args.style);
     }
     if args.compare {
         return compare(&source, view.as_ref(), &settings);
@@ -253,10 +261,14 @@ fn run(args: &Args) -> Result<(), ViewerError> {
             }
         })?;
         println!(
-            "{}: {}x{}, {} {} slices, {:.1} ms{} on {}",
+            "{}: {}x{}, {}, {} {} slices, {:.1} ms{} on {}",
             out.display(),
             settings.width,
             settings.height,
+            match settings.style {
+                Style::Shaded => "shaded",
+                Style::Stipple => "stipples",
+            },
             settings.mode.name(),
             settings.slices,
             frame.times.frame_ms,
@@ -280,6 +292,7 @@ fn bench(
     view: Option<&View>,
     settings: &ViewSettings,
     frames: u32,
+    style: Option<Style>,
 ) -> Result<(), ViewerError> {
     if frames == 0 {
         return Err(ViewerError::Setting(FieldError::new(
@@ -304,17 +317,53 @@ fn bench(
     );
     println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
     let ms = |v: Option<f64>| v.map_or_else(|| "-".into(), |g| format!("{g:.1}"));
+    // The stipple rows, where the source has a 4D mesh to fix stipples to; `--style` asks
+    // for one style's rows only.
+    let clock = std::time::Instant::now();
+    let st = settings.stipple;
+    let made = match style {
+        Some(Style::Shaded) => Err(ViewerError::Setting(FieldError::new(
+            "--style",
+            "shaded rows only",
+        ))),
+        _ => source.stipples(st.count, st.seed),
+    };
+    let stipples = match made {
+        Ok(set) => {
+            eprintln!(
+                "stipples: {} ({} per surface, seed {}) made on the CPU in {:.0} ms",
+                set.len(),
+                st.count,
+                st.seed,
+                clock.elapsed().as_secs_f64() * 1e3
+            );
+            Some(set)
+        }
+        Err(e) => {
+            eprintln!("note: no stipple rows: {e}");
+            None
+        }
+    };
     viewer::bench(
         &gpu,
         source,
         view,
         settings,
-        &SLICE_COUNTS,
+        if style == Some(Style::Stipple) {
+            &[]
+        } else {
+            &SLICE_COUNTS
+        },
         frames,
+        stipples.as_ref(),
         &mut |r| {
             println!(
-                "| {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.1} |",
+                "| {}{} | {} | {} | {} | {} | {:.2} | {:.2} | {:.1} |",
                 r.motion.name(),
+                match r.style {
+                    Style::Shaded => "",
+                    Style::Stipple => ", stipples",
+                },
                 r.mode.name(),
                 r.slices,
                 ms(r.turn_ms),

@@ -38,14 +38,20 @@
 //! Curves and silhouettes are bands of the CPU renderer's line width, drawn after the
 //! surfaces where their centre is in view: not behind the farthest surface within a pixel
 //! of it (by more than half the width).
+//!
+//! In the stipple style (paper 003) the surfaces are drawn white and each surface's ranked
+//! stipples, made once from the 4D mesh, are placed, thinned and tested against the
+//! surfaces' depth on the GPU (`stipple.rs`, [`StippleSet`]).
 
 mod gpu;
 mod renderer;
+mod stipple;
 mod turn;
 pub mod window;
 
 pub use gpu::Gpu;
 pub use renderer::{FrameTimes, OFFSCREEN_FORMAT, Renderer};
+pub use stipple::StippleSet;
 pub use turn::{Framing, Model};
 
 use crate::import::{ImportError, ImportedScene};
@@ -54,7 +60,9 @@ use crate::limits::{
 };
 use crate::render::camera::{Camera, Placement, bounding_radius};
 use crate::render::overlay::{AGREE, interior_edges};
-use crate::render::{CameraSettings, Colormap, RenderError};
+use crate::render::{
+    CameraSettings, Colormap, RenderError, RenderSettings, StippleSettings, Style,
+};
 use glam::{DMat4, DVec3, DVec4};
 use std::path::Path;
 
@@ -110,6 +118,12 @@ pub struct ViewSettings {
     pub colour_by_w: bool,
     /// The colour scale of w.
     pub colormap: Colormap,
+    /// Shaded surfaces, or stipples on the first surface the halos leave visible (the
+    /// stipples must be given to the renderer: [`Renderer::set_stipples`]).
+    pub style: Style,
+    /// The stipples' size and colour, drawn per frame, and their count and seed, with which
+    /// the set is made ([`Source::stipples`]).
+    pub stipple: StippleSettings,
 }
 
 impl Default for ViewSettings {
@@ -127,6 +141,8 @@ impl Default for ViewSettings {
             transparent: false,
             colour_by_w: true,
             colormap: Colormap::Diverging,
+            style: Style::Shaded,
+            stipple: StippleSettings::default(),
         }
     }
 }
@@ -164,6 +180,18 @@ impl ViewSettings {
             return bad(
                 "samples",
                 format!("{} is not 1, 4, 9 or 16 (a square grid)", self.samples),
+            );
+        }
+        let size = crate::limits::STIPPLE_SIZE;
+        if !size.contains(&self.stipple.size) {
+            return bad(
+                "stipple.size",
+                format!(
+                    "must be {:?} to {:?} pixels (a stipple's diameter), got {}",
+                    size.start(),
+                    size.end(),
+                    self.stipple.size
+                ),
             );
         }
         self.camera
@@ -726,6 +754,70 @@ impl Source {
         }
     }
 
+    /// The picture settings the scene records (`render`: the style and the stipples' size,
+    /// count, seed and colour); the defaults where a `.glb` records no scene.
+    pub fn render_settings(&self) -> RenderSettings {
+        match self {
+            Source::Model(m) => m.scene.render,
+            Source::Asset(a) => {
+                a.0.scene
+                    .as_ref()
+                    .and_then(|json| crate::scene::Scene::parse(&json.to_string(), "scene").ok())
+                    .map_or_else(RenderSettings::default, |scene| scene.render)
+            }
+        }
+    }
+
+    /// Each surface's stipples (`count` per surface, random numbers from `seed`), made on the
+    /// CPU from the 4D mesh (a scene's sampled mesh, or the `.glb`'s 4D mesh); refused, with
+    /// the reason, for a `.glb` without its 4D mesh. Takes as long as a build's stipples: a
+    /// window makes them in the background.
+    pub fn stipples(&self, count: usize, seed: u64) -> Result<StippleSet, ViewerError> {
+        if !crate::limits::STIPPLES.contains(&count) {
+            return Err(ViewerError::Setting(FieldError::new(
+                "stipple.count",
+                format!(
+                    "must be {} to {} stipples per surface, got {count}",
+                    crate::limits::STIPPLES.start(),
+                    crate::limits::STIPPLES.end()
+                ),
+            )));
+        }
+        match self {
+            Source::Model(m) => {
+                let meshes: Vec<_> = m
+                    .surfaces
+                    .iter()
+                    .map(|(_, mesh)| (mesh.positions.as_slice(), mesh.triangles.as_slice()))
+                    .collect();
+                Ok(StippleSet::generate(&meshes, count, seed))
+            }
+            Source::Asset(a) => {
+                let meshes =
+                    a.0.surfaces
+                        .iter()
+                        .map(|s| match &s.mesh_4d {
+                            Ok(mesh) if mesh.triangles.len() == s.triangles.len() => {
+                                Ok((mesh.positions.as_slice(), mesh.triangles.as_slice()))
+                            }
+                            Ok(mesh) => Err(format!(
+                                "surface {}: its 4D mesh has {} triangles, its 3D mesh {}",
+                                s.name,
+                                mesh.triangles.len(),
+                                s.triangles.len()
+                            )),
+                            Err(e) => Err(format!(
+                                "{} carries no 4D mesh of surface {}: {e}",
+                                a.1.name, s.name
+                            )),
+                        })
+                        .collect::<Result<Vec<_>, String>>()
+                        .map_err(stipple::refused)?;
+                Ok(StippleSet::generate(&meshes, count, seed))
+            }
+        }
+    }
+
     /// The camera the scene records (the default where a `.glb` records none).
     pub fn camera(&self) -> CameraSettings {
         match self {
@@ -766,6 +858,10 @@ pub fn screenshot_of(
 ) -> Result<Frame, ViewerError> {
     settings.check()?;
     let mut renderer = source.renderer(gpu, view, settings.curves, renderer::OFFSCREEN_FORMAT)?;
+    if settings.style == Style::Stipple {
+        let st = settings.stipple;
+        renderer.set_stipples(gpu, &source.stipples(st.count, st.seed)?)?;
+    }
     renderer.read_frame(gpu, settings)
 }
 
@@ -828,11 +924,13 @@ impl BenchMotion {
     }
 }
 
-/// One line of [`bench()`]: a motion, a mode and a slice count.
+/// One line of [`bench()`]: a motion, a style, a mode and a slice count.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BenchRow {
     /// What moves.
     pub motion: BenchMotion,
+    /// Shaded surfaces or stipples.
+    pub style: Style,
     /// How the halo depth was sliced.
     pub mode: HaloMode,
     /// Slices.
@@ -853,7 +951,10 @@ pub struct BenchRow {
 /// Renders `frames` frames of each motion the source allows (a 3D orbit, azimuth in equal
 /// steps from the settings'; for a model also a 4D turn from `view`) for each mode and each
 /// of `slices`, offscreen, after one frame that is not counted (and before each mode's
-/// first slice count, a whole orbit that is not). `progress` hears of each row.
+/// first slice count, a whole orbit that is not), shaded; then, given `stipples`, the same
+/// motions in the stipple style in the settings' mode and slice count. `progress` hears of
+/// each row.
+#[allow(clippy::too_many_arguments)]
 pub fn bench(
     gpu: &Gpu,
     source: &Source,
@@ -861,10 +962,14 @@ pub fn bench(
     settings: &ViewSettings,
     slices: &[u32],
     frames: u32,
+    stipples: Option<&StippleSet>,
     progress: &mut dyn FnMut(&BenchRow),
 ) -> Result<Vec<BenchRow>, ViewerError> {
     settings.check()?;
     let mut renderer = source.renderer(gpu, view, settings.curves, renderer::OFFSCREEN_FORMAT)?;
+    if let Some(set) = stipples {
+        renderer.set_stipples(gpu, set)?;
+    }
     let target = renderer::frame_texture(
         gpu,
         "bench frame",
@@ -875,70 +980,77 @@ pub fn bench(
     let target = target.create_view(&Default::default());
     let mut rows = Vec::new();
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
-    for mode in [HaloMode::Grid, HaloMode::View] {
-        for &n in slices {
-            let mut s = ViewSettings {
-                mode,
-                slices: n,
-                ..*settings
-            };
-            let grid_ms = renderer.render(gpu, &target, &s)?.grid_ms;
-            let orbit = |f: u32| settings.camera.azimuth + 360.0 * f64::from(f) / f64::from(frames);
-            if n == slices[0] {
-                // A whole orbit first, untimed: drivers finish compiling shaders on the
-                // first frames that need them (lavapipe does, over several frames).
-                for f in 0..frames {
-                    s.camera.azimuth = orbit(f);
-                    renderer.render(gpu, &target, &s)?;
-                }
-            }
-            let mut times = Vec::with_capacity(frames as usize);
+    let shaded = [HaloMode::Grid, HaloMode::View]
+        .into_iter()
+        .flat_map(|mode| slices.iter().map(move |&n| (Style::Shaded, mode, n)));
+    let stippled = stipples
+        .is_some()
+        .then_some((Style::Stipple, settings.mode, settings.slices));
+    for (style, mode, n) in shaded.chain(stippled) {
+        let mut s = ViewSettings {
+            mode,
+            slices: n,
+            style,
+            ..*settings
+        };
+        let grid_ms = renderer.render(gpu, &target, &s)?.grid_ms;
+        let orbit = |f: u32| settings.camera.azimuth + 360.0 * f64::from(f) / f64::from(frames);
+        if slices.first() == Some(&n) || style == Style::Stipple {
+            // A whole orbit first, untimed: drivers finish compiling shaders on the
+            // first frames that need them (lavapipe does, over several frames).
             for f in 0..frames {
                 s.camera.azimuth = orbit(f);
-                times.push(renderer.render(gpu, &target, &s)?.frame_ms);
+                renderer.render(gpu, &target, &s)?;
             }
-            let row = BenchRow {
-                motion: BenchMotion::Orbit,
-                mode,
-                slices: n,
-                grid_ms,
-                turn_ms: None,
-                frames,
-                mean_ms: mean(&times),
-                median_ms: median(&mut times),
-            };
-            progress(&row);
-            rows.push(row);
-            let Source::Model(model) = source else {
-                continue;
-            };
-            let start = *view.unwrap_or(&model.scene.view);
-            s.camera = settings.camera;
-            let (mut times, mut turns, mut grids) = (Vec::new(), Vec::new(), Vec::new());
-            for f in 0..frames {
-                let mut v = start;
-                v.rotation.zw +=
-                    30.0 * (std::f64::consts::TAU * f64::from(f + 1) / f64::from(frames)).sin();
-                let clock = std::time::Instant::now();
-                turns.push(renderer.turn(gpu, model, &v)?);
-                let frame = renderer.render(gpu, &target, &s)?;
-                grids.push(frame.grid_ms.unwrap_or(0.0));
-                times.push(clock.elapsed().as_secs_f64() * 1e3);
-            }
-            renderer.turn(gpu, model, &start)?;
-            let row = BenchRow {
-                motion: BenchMotion::Turn4d,
-                mode,
-                slices: n,
-                grid_ms: (mode == HaloMode::Grid).then(|| mean(&grids)),
-                turn_ms: Some(mean(&turns)),
-                frames,
-                mean_ms: mean(&times),
-                median_ms: median(&mut times),
-            };
-            progress(&row);
-            rows.push(row);
         }
+        let mut times = Vec::with_capacity(frames as usize);
+        for f in 0..frames {
+            s.camera.azimuth = orbit(f);
+            times.push(renderer.render(gpu, &target, &s)?.frame_ms);
+        }
+        let row = BenchRow {
+            motion: BenchMotion::Orbit,
+            style,
+            mode,
+            slices: n,
+            grid_ms,
+            turn_ms: None,
+            frames,
+            mean_ms: mean(&times),
+            median_ms: median(&mut times),
+        };
+        progress(&row);
+        rows.push(row);
+        let Source::Model(model) = source else {
+            continue;
+        };
+        let start = *view.unwrap_or(&model.scene.view);
+        s.camera = settings.camera;
+        let (mut times, mut turns, mut grids) = (Vec::new(), Vec::new(), Vec::new());
+        for f in 0..frames {
+            let mut v = start;
+            v.rotation.zw +=
+                30.0 * (std::f64::consts::TAU * f64::from(f + 1) / f64::from(frames)).sin();
+            let clock = std::time::Instant::now();
+            turns.push(renderer.turn(gpu, model, &v)?);
+            let frame = renderer.render(gpu, &target, &s)?;
+            grids.push(frame.grid_ms.unwrap_or(0.0));
+            times.push(clock.elapsed().as_secs_f64() * 1e3);
+        }
+        renderer.turn(gpu, model, &start)?;
+        let row = BenchRow {
+            motion: BenchMotion::Turn4d,
+            style,
+            mode,
+            slices: n,
+            grid_ms: (mode == HaloMode::Grid).then(|| mean(&grids)),
+            turn_ms: Some(mean(&turns)),
+            frames,
+            mean_ms: mean(&times),
+            median_ms: median(&mut times),
+        };
+        progress(&row);
+        rows.push(row);
     }
     Ok(rows)
 }

@@ -1,5 +1,6 @@
 //! Pipelines, targets and the passes of a frame.
 
+use super::stipple::StippleSet;
 use super::turn::Turner;
 use super::{
     Asset, Frame, Gpu, GpuCamera, HaloMode, HaloVertex, Model, SurfaceVertex, ViewSettings,
@@ -7,7 +8,7 @@ use super::{
 };
 use crate::intersect::Curves;
 use crate::limits::FieldError;
-use crate::render::{Picture, shade};
+use crate::render::{Picture, Style, shade};
 use crate::view::View;
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
@@ -52,6 +53,7 @@ struct ViewUniform {
     band: [u32; 4],
     viewport: [f32; 4],
     depth_proj: [f32; 4],
+    stipple: [f32; 4],
     stops: [[f32; 4]; 8],
 }
 
@@ -120,6 +122,9 @@ pub struct Renderer {
     targets: Option<Targets>,
     /// The model's passes, when the renderer turns a model in 4D.
     turner: Option<Turner>,
+    stipple_pipeline: wgpu::RenderPipeline,
+    /// The stipples, once given: (per stipple, per triangle's area ratio, how many).
+    stipples: Option<(wgpu::Buffer, wgpu::Buffer, u32)>,
 }
 
 impl Renderer {
@@ -141,7 +146,7 @@ impl Renderer {
         let triangles = gpu.buffer(
             "surface triangles",
             bytemuck::cast_slice(&asset.triangles),
-            U::INDEX,
+            U::INDEX | storage,
         )?;
         let curve_points = gpu.buffer(
             "curve points",
@@ -334,6 +339,14 @@ impl Renderer {
             &opaque_targets(false),
             None,
         );
+        let stipple_pipeline = pipeline(
+            "stipples",
+            "stipple_vs",
+            "stipple_fs",
+            P::TriangleList,
+            &opaque_targets(false)[..1],
+            None,
+        );
         let cut = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("halo cuts"),
             layout: None,
@@ -411,7 +424,38 @@ impl Renderer {
             grid: None,
             targets: None,
             turner: None,
+            stipple_pipeline,
+            stipples: None,
         })
+    }
+
+    /// Uploads the stipples the stipple style draws (made for this renderer's asset or
+    /// model: [`Source::stipples`](super::Source::stipples)).
+    pub fn set_stipples(&mut self, gpu: &Gpu, set: &StippleSet) -> Result<(), ViewerError> {
+        if set.triangle_count() != self.asset.triangles.len() {
+            return Err(ViewerError::View(format!(
+                "stipples made for {} triangles, this scene has {}",
+                set.triangle_count(),
+                self.asset.triangles.len()
+            )));
+        }
+        let instances = gpu.buffer(
+            "stipples",
+            bytemuck::cast_slice(&set.instances),
+            wgpu::BufferUsages::STORAGE,
+        )?;
+        let ratio = gpu.buffer(
+            "stipple area ratios",
+            bytemuck::cast_slice(&set.area_ratio),
+            wgpu::BufferUsages::STORAGE,
+        )?;
+        self.stipples = Some((instances, ratio, set.len() as u32));
+        Ok(())
+    }
+
+    /// Whether the stipples have been given ([`Renderer::set_stipples`]).
+    pub fn has_stipples(&self) -> bool {
+        self.stipples.is_some()
     }
 
     /// Uploads `model` and draws it in the 4D `view`.
@@ -509,6 +553,13 @@ impl Renderer {
         settings: &ViewSettings,
     ) -> Result<FrameTimes, ViewerError> {
         settings.check()?;
+        let stipple = settings.style == Style::Stipple;
+        if stipple && self.stipples.is_none() {
+            return Err(ViewerError::Setting(FieldError::new(
+                "style",
+                "stipple: no stipples given to the renderer yet (Renderer::set_stipples)",
+            )));
+        }
         let start = Instant::now();
         let mut times = FrameTimes::default();
         let halos = settings.halos && !self.asset.tets.is_empty();
@@ -539,9 +590,11 @@ impl Renderer {
             )));
         }
         let final_target = target;
+        // Stipples lie on opaque white surfaces.
         let settings = &ViewSettings {
             width: settings.width * k,
             height: settings.height * k,
+            transparent: settings.transparent && !stipple,
             ..*settings
         };
         self.ensure_targets(gpu, (settings.width, settings.height), k > 1);
@@ -657,6 +710,27 @@ impl Renderer {
                     pass.draw_indexed(tris, 0, k as u32..k as u32 + 1);
                 }
             }
+        }
+        if let (true, Some((instances, ratio, count))) = (stipple, &self.stipples) {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("stipples"),
+                color_attachments: &[attachment(target, false, wgpu::Color::WHITE)],
+                ..Default::default()
+            });
+            self.draw(
+                gpu,
+                &mut pass,
+                &self.stipple_pipeline,
+                &[
+                    (1, self.vertices.as_entire_binding()),
+                    (13, self.face_normals.as_entire_binding()),
+                    (14, wgpu::BindingResource::TextureView(&targets.depth_view)),
+                    (16, instances.as_entire_binding()),
+                    (17, self.triangles.as_entire_binding()),
+                    (18, ratio.as_entire_binding()),
+                ],
+                (0..3 * *count, 0..1),
+            );
         }
         // The transparency composite, then the lines.
         let composite = settings.transparent;
@@ -892,9 +966,11 @@ impl Renderer {
             crate::render::CameraProjection::Orthographic => 1.0,
         };
         // Lines test the surfaces' depth, which transparent frames do not write.
+        let stipple = settings.style == Style::Stipple;
         let flags = u32::from(halos)
             | (u32::from(settings.colour_by_w) << 1)
-            | (u32::from(!settings.transparent) << 2);
+            | (u32::from(!settings.transparent) << 2)
+            | (u32::from(stipple) << 3);
         ViewUniform {
             clip: camera.clip.as_mat4().to_cols_array_2d(),
             eye: v4(
@@ -933,6 +1009,13 @@ impl Renderer {
                 settings.height as f32,
                 CURVE_WIDTH * 0.5 * settings.samples.isqrt() as f32,
                 (2.0 * cam.half_height / f64::from(settings.height)) as f32,
+            ],
+            // A stipple's size in pixels of the (supersampled) frame.
+            stipple: [
+                (settings.stipple.size * f64::from(settings.samples.isqrt())) as f32,
+                f32::from(u8::from(settings.stipple.colour)),
+                0.0,
+                0.0,
             ],
             stops: stop_array,
         }

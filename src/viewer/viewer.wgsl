@@ -21,7 +21,8 @@ struct View {
     slabs: vec4<f32>,
     // x, y, z: voxels; w: texels per row of the grid buffer.
     grid_dims: vec4<u32>,
-    // x: flags (1 halos, 2 colour by w, 4 lines test the surfaces' depth); y: colour stops;
+    // x: flags (1 halos, 2 colour by w, 4 lines test the surfaces' depth, 8 surfaces in the
+    // background's colour, for stipples); y: colour stops;
     // w: samples per pixel along each side.
     options: vec4<u32>,
     // Voxelization of one band of the grid: x: items; y: the band's first z layer.
@@ -31,6 +32,8 @@ struct View {
     viewport: vec4<f32>,
     // x, y: the view depths of depth 0 and 1.
     depth_proj: vec4<f32>,
+    // x: a stipple's diameter in pixels; y: 1 when stipples take the colour of their w.
+    stipple: vec4<f32>,
     stops: array<vec4<f32>, 8>,
 }
 
@@ -53,6 +56,11 @@ struct View {
 @group(0) @binding(13) var<storage, read> face_normals: array<vec4<f32>>;
 @group(0) @binding(14) var surface_depth: texture_depth_2d;
 @group(0) @binding(15) var samples_image: texture_2d<f32>;
+@group(0) @binding(16) var<storage, read> stipples: array<Stipple>;
+// The surfaces' triangles, three vertex indices each.
+@group(0) @binding(17) var<storage, read> triangle_indices: array<u32>;
+// Per triangle, its surface's 4D area over its own.
+@group(0) @binding(18) var<storage, read> area_ratio: array<f32>;
 
 const QUANTUM: f32 = 2147483648.0;
 const INK: vec3<f32> = vec3<f32>(0.02, 0.02, 0.02);
@@ -180,6 +188,9 @@ fn hidden_in_slab(in: SurfaceOut) -> bool {
 }
 
 fn surface_colour(in: SurfaceOut) -> vec3<f32> {
+    if (view.options.x & 8u) != 0u {
+        return view.background.rgb;
+    }
     var base = vec3<f32>(0.8);
     if (view.options.x & 2u) != 0u {
         base = colormap((in.w - view.w_norm.x) * view.w_norm.y);
@@ -544,4 +555,178 @@ fn cut_vs(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance:
 @fragment
 fn cut_fs(in: CutOut) -> @builtin(frag_depth) f32 {
     return clamp(normalized(halo_depth(in.t, in.d, in.delta.x, in.delta.y)), 0.0, 0.9999999);
+}
+
+// ---------------------------------------------------------------- stipples
+
+// A stipple of `render::stipple`: its triangle (all surfaces), its rank in its surface's
+// set and its first two barycentric coordinates.
+struct Stipple {
+    triangle: u32,
+    rank: u32,
+    bary: vec2<f32>,
+}
+
+struct StippleOut {
+    @builtin(position) clip: vec4<f32>,
+    // From the disc's centre, in pixels.
+    @location(0) offset: vec2<f32>,
+    @location(1) @interpolate(flat) colour: vec3<f32>,
+}
+
+// Pixels from the top left of clip position c.
+fn pixel_of(c: vec4<f32>) -> vec2<f32> {
+    let ndc = c.xy / c.w;
+    return vec2<f32>((ndc.x * 0.5 + 0.5) * view.viewport.x, (0.5 - ndc.y * 0.5) * view.viewport.y);
+}
+
+// render::stipple::luminance (Rec. 709).
+fn luminance(c: vec3<f32>) -> f32 {
+    return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
+}
+
+// render::stipple::density: stipples per square pixel that cover a share `tone` with discs
+// of diameter `size` pixels.
+fn density(tone: f32, size: f32) -> f32 {
+    let apart = 0.4;
+    let area = 3.14159265 * size * size / 4.0;
+    let t = clamp(tone, 0.0, 0.98);
+    var x = t;
+    if t > apart {
+        x = apart - (1.0 - apart) * log((1.0 - t) / (1.0 - apart));
+    }
+    return x / area;
+}
+
+// Vertex i of the stipples: corner i % 3 of stipple i / 3, a triangle whose incircle is the stipple's
+// disc, or nothing when the CPU renderer would not draw it. The CPU's decision: the tone of
+// a white surface under the shaded style's lights at the stipple (normal interpolated, the
+// face's where that vanishes), its density per square pixel, times the triangle's screen
+// area over its 4D area times the surface's 4D area: the stipple is drawn when its rank is
+// below that. Then it must lie on the first surface the halos leave visible at its pixel:
+// the depth buffer there (the surfaces' pass, which discards what the halos hide) holds
+// that surface's depth at the pixel's centre, up to 0.71 pixel from the stipple. So the
+// stipple's triangle's plane is met by the ray through the pixel's centre, and that depth
+// is compared: equal where the pixel's centre is on the same triangle, off by the sheet's
+// curvature where it is on a neighbour, which grows with the slope (the tangent of the
+// angle between the normal and the ray, capped at 20, beyond which the plane is not met
+// well and the stipple's own depth is compared). The tolerance is a quarter of a pixel
+// plus a fiftieth of a pixel per unit of slope, in scene units of a pixel at the stipple's
+// depth, plus 1e-5 of the scene's depth for the f32 depths: it scales with the scene, the
+// camera and the surface's slope. A sheet in front, or the stipple's own sheet hidden by a
+// halo while one behind shows, is farther off than that, and the stipple is culled. Where
+// two sheets cross at a small angle, both are within it along a band and both are stippled
+// there; the tolerance is the smallest measured that keeps the tests' tiles within 3% of
+// the CPU's (half a pixel plus a tenth per unit of slope let the default scene turned in
+// 4D, its inner ring edge-on, reach 7%).
+//
+// One draw of three vertices per stipple, not instances of three: a software rasterizer
+// (lavapipe) shades the vertices of one instance together, three lanes of its eight, and
+// the frame took four times as long.
+@vertex
+fn stipple_vs(@builtin(vertex_index) i: u32) -> StippleOut {
+    let index = i / 3u;
+    let vertex = i % 3u;
+    var out: StippleOut;
+    out.clip = NOTHING;
+    out.offset = vec2<f32>(0.0);
+    out.colour = INK;
+    let s = stipples[index];
+    let t = s.triangle;
+    let a = vertices[triangle_indices[3u * t]];
+    let b = vertices[triangle_indices[3u * t + 1u]];
+    let c = vertices[triangle_indices[3u * t + 2u]];
+    let ca = view.clip * vec4<f32>(a.pos, 1.0);
+    let cb = view.clip * vec4<f32>(b.pos, 1.0);
+    let cc = view.clip * vec4<f32>(c.pos, 1.0);
+    if ca.w <= 0.0 || cb.w <= 0.0 || cc.w <= 0.0 {
+        return out;
+    }
+    let pa = pixel_of(ca);
+    let pb = pixel_of(cb);
+    let pc = pixel_of(cc);
+    let screen = 0.5 * abs((pb.x - pa.x) * (pc.y - pa.y) - (pb.y - pa.y) * (pc.x - pa.x));
+    // Most stipples are beyond even the darkest tone's prefix: culled before the lighting.
+    let reach = area_ratio[t] * screen;
+    if !(f32(s.rank) < density(0.98, view.stipple.x) * reach) {
+        return out;
+    }
+    let l = vec3<f32>(s.bary, 1.0 - s.bary.x - s.bary.y);
+    let p = a.pos * l.x + b.pos * l.y + c.pos * l.z;
+    let dir = ray_dir(p);
+    let face = face_normals[t].xyz;
+    var n = a.normal * l.x + b.normal * l.y + c.normal * l.z;
+    if !(dot(n, n) > 1e-24) {
+        n = face;
+    }
+    let tone = clamp(1.0 - luminance(phong(vec3<f32>(1.0), normalize(n), dir)), 0.0, 1.0);
+    let prefix = density(tone, view.stipple.x) * reach;
+    if !(f32(s.rank) < prefix) {
+        return out;
+    }
+    let cp = view.clip * vec4<f32>(p, 1.0);
+    if cp.w <= 0.0 {
+        return out;
+    }
+    let centre = pixel_of(cp);
+    let size = vec2<i32>(view.viewport.xy);
+    let at = clamp(vec2<i32>(floor(centre)), vec2<i32>(0), size - 1);
+    let z = textureLoad(surface_depth, at, 0);
+    if z >= 1.0 {
+        return out;
+    }
+    // Where the ray through the pixel's centre meets the plane of the stipple's triangle.
+    let half_height = view.viewport.w * view.viewport.y * 0.5;
+    let half_width = half_height * view.viewport.x / view.viewport.y;
+    let ndc = vec2<f32>(
+        (f32(at.x) + 0.5) / view.viewport.x * 2.0 - 1.0,
+        1.0 - (f32(at.y) + 0.5) / view.viewport.y * 2.0,
+    );
+    let lateral = view.right.xyz * (ndc.x * half_width) + view.up.xyz * (ndc.y * half_height);
+    var origin = view.eye.xyz;
+    var ray = view.forward.xyz + lateral;
+    if view.eye.w < 0.5 {
+        origin += lateral;
+        ray = view.forward.xyz;
+    }
+    var depth = view_depth(p);
+    var slope = 20.0;
+    if dot(face, face) > 0.0 {
+        let nf = normalize(face);
+        let cosine = abs(dot(nf, normalize(ray)));
+        slope = min(sqrt(max(1.0 - cosine * cosine, 0.0)) / max(cosine, 1e-6), 20.0);
+        if slope < 20.0 {
+            // The depth along `ray` (whose forward component is 1) is its parameter.
+            depth = dot(nf, p - origin) / dot(nf, ray);
+        }
+    }
+    var pixel = view.viewport.w;
+    if view.eye.w > 0.5 {
+        pixel *= view_depth(p);
+    }
+    let tolerance = pixel * (0.25 + 0.02 * slope) + 1e-5 * view.slabs.w;
+    if abs(depth - depth_of(z)) > tolerance {
+        return out;
+    }
+    if view.stipple.y > 0.5 {
+        let w = a.w * l.x + b.w * l.y + c.w * l.z;
+        out.colour = colormap((w - view.w_norm.x) * view.w_norm.y) * 0.75;
+    }
+    let r = view.stipple.x * 0.5;
+    let corners = array<vec2<f32>, 3>(
+        vec2<f32>(0.0, 2.0), vec2<f32>(-1.7320508, -1.0), vec2<f32>(1.7320508, -1.0),
+    );
+    let offset = corners[vertex] * r;
+    out.offset = offset;
+    out.clip = vec4<f32>(cp.xy + offset / (view.viewport.xy * 0.5) * cp.w, 0.0, cp.w);
+    return out;
+}
+
+@fragment
+fn stipple_fs(in: StippleOut) -> @location(0) vec4<f32> {
+    let r = view.stipple.x * 0.5;
+    if dot(in.offset, in.offset) > r * r {
+        discard;
+    }
+    return vec4<f32>(in.colour, 1.0);
 }

@@ -6,8 +6,9 @@
 //! Drag with the left button to turn the camera (azimuth, elevation), wheel to zoom, `R` to
 //! reset the camera (the title shows it, in `halo4d render`'s terms), `S` to cycle the slice
 //! count (64, 128, 256, 512), `M` to switch between the grid and view-slice modes, `H` halos,
-//! `C` curves, `O` silhouettes (outlines), `T` transparency, `W` colour by w, `Escape` or `Q`
-//! to quit. In 4D (a scene file): Shift + drag turns the direction of the drag on the screen
+//! `C` curves, `O` silhouettes (outlines), `T` transparency, `W` colour by w, `D` shaded
+//! surfaces or stipples (dots; the stipples are made on the CPU in the background the first
+//! time, the title says so meanwhile), `Escape` or `Q` to quit. In 4D (a scene file): Shift + drag turns the direction of the drag on the screen
 //! towards w (Hanson's rolling ball); the keys `1` to `6` turn the planes xy, xz, xw, yz, yw
 //! and zw by 15 degrees (with Shift, back); `[` and `]` move the surfaces along w; `P`
 //! switches the 4D projection between orthographic and perspective; `V` resets the 4D view;
@@ -15,8 +16,9 @@
 //! builds it in the background (`exports/<name>-<k>/`), its verification in the title. The
 //! title shows the 4D view in the scene file's terms.
 
-use super::{Gpu, HaloMode, Renderer, SLICE_COUNTS, Source, ViewSettings, ViewerError};
+use super::{Gpu, HaloMode, Renderer, SLICE_COUNTS, Source, StippleSet, ViewSettings, ViewerError};
 use crate::intersect::Curves;
+use crate::render::Style;
 use crate::view::{Projection, View};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -28,7 +30,7 @@ use winit::keyboard::{Key, KeyCode, ModifiersState, NamedKey, PhysicalKey};
 use winit::window::{Window, WindowId};
 
 /// The window's help, printed when it opens.
-pub const HELP: &str = "drag: turn | wheel: zoom | R: reset camera | S: slices | M: grid/view mode | H: halos | C: curves | O: silhouettes | T: transparency | W: colour by w | Q/Esc: quit\n4D (a scene file): Shift+drag: turn towards w | 1-6: turn xy xz xw yz yw zw by 15 degrees (Shift: back) | [ ]: move along w | P: 4D perspective/orthographic | V: reset the 4D view | F: save the view as a scene | B: build the saved view";
+pub const HELP: &str = "drag: turn | wheel: zoom | R: reset camera | S: slices | M: grid/view mode | H: halos | C: curves | O: silhouettes | T: transparency | W: colour by w | D: shaded/stipples | Q/Esc: quit\n4D (a scene file): Shift+drag: turn towards w | 1-6: turn xy xz xw yz yw zw by 15 degrees (Shift: back) | [ ]: move along w | P: 4D perspective/orthographic | V: reset the 4D view | F: save the view as a scene | B: build the saved view";
 
 /// Degrees a plane key turns.
 const STEP: f64 = 15.0;
@@ -65,6 +67,7 @@ pub fn run(source: Source, view: Option<View>, settings: ViewSettings) -> Result
         saves: 0,
         build: None,
         note: String::new(),
+        stipples: None,
     };
     event_loop
         .run_app(&mut app)
@@ -115,6 +118,8 @@ struct App {
     build: Option<Receiver<String>>,
     /// The last message for the title (a save, a build's outcome, a refused view).
     note: String,
+    /// The stipples being made in the background, until the renderer has them.
+    stipples: Option<Receiver<Result<StippleSet, ViewerError>>>,
 }
 
 impl App {
@@ -212,6 +217,36 @@ impl App {
             self.note = outcome;
             self.build = None;
         }
+        // The stipples: made once, in the background; shaded until they are ready, and
+        // back to shaded, the reason in the title, where the source has no 4D mesh.
+        let stippled = self.settings.style == Style::Stipple;
+        if stippled && !state.renderer.has_stipples() {
+            match &self.stipples {
+                None => {
+                    let (tx, rx) = channel();
+                    let (source, window) = (self.source.clone(), Arc::clone(&state.window));
+                    let st = self.settings.stipple;
+                    std::thread::spawn(move || {
+                        let _ = tx.send(source.stipples(st.count, st.seed));
+                        window.request_redraw();
+                    });
+                    self.stipples = Some(rx);
+                }
+                Some(rx) => {
+                    if let Ok(made) = rx.try_recv() {
+                        self.stipples = None;
+                        match made {
+                            Ok(set) => state.renderer.set_stipples(&state.gpu, &set)?,
+                            Err(e) => {
+                                self.note = e.to_string();
+                                self.settings.style = Style::Shaded;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let making = self.settings.style == Style::Stipple && !state.renderer.has_stipples();
         let frame = match state.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(f)
             | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
@@ -225,7 +260,15 @@ impl App {
         self.settings.width = state.config.width;
         self.settings.height = state.config.height;
         let view = frame.texture.create_view(&Default::default());
-        let times = match state.renderer.render(&state.gpu, &view, &self.settings) {
+        let drawn = ViewSettings {
+            style: if making {
+                Style::Shaded
+            } else {
+                self.settings.style
+            },
+            ..self.settings
+        };
+        let times = match state.renderer.render(&state.gpu, &view, &drawn) {
             Ok(times) => times,
             // A setting this GPU cannot do (a grid too large, say): back to the last one
             // that rendered, with the reason in the title; anything else ends the viewer.
@@ -250,7 +293,8 @@ impl App {
             .placement(&s.camera, s.width, s.height);
         let on = |b: bool| if b { "on" } else { "off" };
         let four = match self.drawn_view {
-            None => String::new(),
+            None if self.note.is_empty() => String::new(),
+            None => format!(" | {}", self.note),
             Some(v) => format!(
                 " | 4D {}{}{} | {}",
                 describe(&v),
@@ -269,8 +313,13 @@ impl App {
             ),
         };
         state.window.set_title(&format!(
-            "halo4d-view: {} | {} {} slices | {} spp | halos {} | curves {} | silhouettes {} | {} | colour {} | azimuth {:.0} elevation {:.0} distance {:.2}{} | {:.1} ms{}{four}",
+            "halo4d-view: {} | {} | {} {} slices | {} spp | halos {} | curves {} | silhouettes {} | {} | colour {} | azimuth {:.0} elevation {:.0} distance {:.2}{} | {:.1} ms{}{four}",
             self.source.name(),
+            match (s.style, making) {
+                (Style::Shaded, _) => "shaded",
+                (Style::Stipple, false) => "stipples",
+                (Style::Stipple, true) => "making the stipples",
+            },
             s.mode.name(),
             s.slices,
             s.samples,
@@ -317,6 +366,12 @@ impl App {
                 "o" => s.silhouettes = !s.silhouettes,
                 "t" => s.transparent = !s.transparent,
                 "w" => s.colour_by_w = !s.colour_by_w,
+                "d" => {
+                    s.style = match s.style {
+                        Style::Shaded => Style::Stipple,
+                        Style::Stipple => Style::Shaded,
+                    }
+                }
                 _ => return false,
             },
             _ => return false,
