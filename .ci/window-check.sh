@@ -49,6 +49,9 @@ xdotool key c; expect "curves off"
 xdotool key o; expect "silhouettes off"
 xdotool key t; expect "transparent"
 xdotool key w; expect "colour grey"
+# D draws stipples (made once in the background from the file's 4D mesh), and back.
+xdotool key d; expect "| stipples |"
+xdotool key d; expect "| shaded |"
 xdotool mousemove --window "$w" 200 150 mousedown 1 mousemove --window "$w" 300 150 mouseup 1
 expect "azimuth 355"
 # The camera is fitted (the default scene's .glb records no distance: about 2.25
