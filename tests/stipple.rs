@@ -176,6 +176,7 @@ fn a_small_orbit_keeps_the_stipples_where_they_are() {
     let (a, b) = (ids(&before), ids(&after));
     let kept = a.intersection(&b).count();
     let share = kept as f64 / a.len() as f64;
+    eprintln!("{kept} of {} stipples kept after a 2-degree orbit", a.len());
     assert!(a.len() > 2000, "{} stipples drawn", a.len());
     assert!(
         share >= 0.9,
@@ -268,6 +269,13 @@ fn the_far_sheet_has_no_stipples_in_the_gap_and_has_them_beyond() {
     };
     let (gap_off, beyond_off) = classify(&off);
     let (gap_on, beyond_on) = classify(&on);
+    eprintln!(
+        "far stipples in the gaps: {} without halos, {} with; beyond: {} without, {} with",
+        gap_off.len(),
+        gap_on.len(),
+        beyond_off.len(),
+        beyond_off.intersection(&beyond_on).count()
+    );
     assert!(
         gap_off.len() >= 10,
         "without halos only {} far stipples in the gaps",
