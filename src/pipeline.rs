@@ -464,10 +464,10 @@ pub fn render_to(scene: &Scene, out: &Path, quiet: bool) -> Result<(Picture, f64
         let saturated = drawn.iter().filter(|d| d.saturated).count();
         if saturated * 100 > drawn.len() {
             eprintln!(
-                "warning: {saturated} of {} stipples are where the tone asks for more than render.stipple.count = {} ranks; those places are drawn lighter: raise the count (about 0.4 per pixel of the picture: {})",
+                "warning: {saturated} of {} stipples are where the tone asks for more than render.stipple.count = {} ranks; those places are drawn lighter: raise the count (about 0.6 per pixel of the picture: {})",
                 drawn.len(),
                 scene.render.stipple.count,
-                (0.4 * f64::from(scene.render.width) * f64::from(scene.render.height)).ceil()
+                (0.6 * f64::from(scene.render.width) * f64::from(scene.render.height)).ceil()
             );
         }
     }

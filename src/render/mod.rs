@@ -138,8 +138,8 @@ pub struct StippleSettings {
     /// A stipple's diameter in pixels.
     pub size: f64,
     /// Stipples ranked per surface: the most a picture can draw of each. A place where the
-    /// tone asks for more is drawn lighter (`halo4d render` warns); about 0.4 stipples per
-    /// pixel of the picture are enough for the darkest tones.
+    /// tone asks for more is drawn lighter (`halo4d render` warns); about 0.6 stipples per
+    /// pixel of the picture are enough for the darkest tones of a surface that fills it.
     pub count: usize,
     /// Seed of the stipples' random numbers.
     pub seed: u64,
@@ -152,7 +152,7 @@ impl Default for StippleSettings {
     fn default() -> Self {
         StippleSettings {
             size: 2.0,
-            count: 400_000,
+            count: 600_000,
             seed: 1,
             colour: false,
         }
