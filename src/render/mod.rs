@@ -645,7 +645,6 @@ pub struct Seen {
 /// Probes a picture: what the ray through an image point sees first that the halos do not
 /// hide (with the exact test), as [`render`] decides it for the first eye.
 pub struct Prober<'a> {
-    input: &'a Parts<'a>,
     scene: Scene<'a>,
     cam: Camera,
 }
@@ -665,7 +664,7 @@ impl<'a> Prober<'a> {
             settings.height,
             first_eye(settings),
         )?;
-        Ok(Prober { input, scene, cam })
+        Ok(Prober { scene, cam })
     }
 
     /// The camera of the first eye.
@@ -682,16 +681,8 @@ impl<'a> Prober<'a> {
         let mut hits = Vec::new();
         self.scene.trace(origin, dir, &mut hits);
         hits.iter().find_map(|hit| {
-            let surf = &self.input.surfaces[hit.surface as usize];
-            let tri = surf.triangles[hit.triangle as usize];
-            let x = origin + dir * hit.t;
-            let wd: f64 = (0..3).map(|i| hit.bary[i] * surf.w[tri[i] as usize]).sum();
-            let hidden = self
-                .scene
-                .halos
-                .as_ref()
-                .is_some_and(|index| index.hidden(x, wd, hit.surface, tri));
-            (!hidden).then_some(Seen {
+            let (x, wd, _) = self.scene.at_hit(origin, dir, hit);
+            (!self.scene.hidden_hit(origin, dir, hit)).then_some(Seen {
                 surface: hit.surface,
                 triangle: hit.triangle,
                 position: x,
@@ -929,6 +920,22 @@ impl<'a> Scene<'a> {
                 i == n / 2 && j == n / 2,
             )
         })
+    }
+
+    /// Where `hit` of the ray (`origin`, `dir`) is, its w and its triangle's vertices.
+    fn at_hit(&self, origin: DVec3, dir: DVec3, hit: &Hit) -> (DVec3, f64, [u32; 3]) {
+        let surf = &self.input.surfaces[hit.surface as usize];
+        let tri = surf.triangles[hit.triangle as usize];
+        let w = (0..3).map(|i| hit.bary[i] * surf.w[tri[i] as usize]).sum();
+        (origin + dir * hit.t, w, tri)
+    }
+
+    /// Whether the halos hide `hit` of the ray (`origin`, `dir`), asking the tetrahedra.
+    fn hidden_hit(&self, origin: DVec3, dir: DVec3, hit: &Hit) -> bool {
+        let (x, w, tri) = self.at_hit(origin, dir, hit);
+        self.halos
+            .as_ref()
+            .is_some_and(|index| index.hidden(x, w, hit.surface, tri))
     }
 
     /// One eye's image.

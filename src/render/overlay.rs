@@ -211,16 +211,7 @@ impl Scene<'_> {
         hits: &mut Vec<super::trace::Hit>,
     ) -> bool {
         let (origin, dir) = self.hits_before(cam, p, hits);
-        hits.iter().any(|hit| {
-            let surf = &self.input.surfaces[hit.surface as usize];
-            let tri = surf.triangles[hit.triangle as usize];
-            let x = origin + dir * hit.t;
-            let w: f64 = (0..3).map(|i| hit.bary[i] * surf.w[tri[i] as usize]).sum();
-            !self
-                .halos
-                .as_ref()
-                .is_some_and(|index| index.hidden(x, w, hit.surface, tri))
-        })
+        hits.iter().any(|hit| !self.hidden_hit(origin, dir, hit))
     }
 
     /// Traces the eye ray through `p` and keeps in `hits` the surfaces it meets before `p`

@@ -207,14 +207,13 @@ impl Scene<'_> {
                             triangle: triangle(d),
                         }];
                         probes.extend(hits.iter().map(|hit| {
-                            let surf = &self.input.surfaces[hit.surface as usize];
-                            let tri = surf.triangles[hit.triangle as usize];
+                            let (x, w, triangle) = self.at_hit(origin, dir, hit);
                             slices::Probe {
                                 pixel,
-                                x: origin + dir * hit.t,
-                                w: (0..3).map(|i| hit.bary[i] * surf.w[tri[i] as usize]).sum(),
+                                x,
+                                w,
                                 surface: hit.surface,
-                                triangle: tri,
+                                triangle,
                             }
                         }));
                         probes
@@ -309,16 +308,7 @@ impl Scene<'_> {
                 let (origin, dir) = cam.ray(sx, sy);
                 self.trace(origin, dir, hits);
                 hits.iter()
-                    .find(|hit| {
-                        let surf = &self.input.surfaces[hit.surface as usize];
-                        let tri = surf.triangles[hit.triangle as usize];
-                        let x = origin + dir * hit.t;
-                        let wd: f64 = (0..3).map(|i| hit.bary[i] * surf.w[tri[i] as usize]).sum();
-                        !self
-                            .halos
-                            .as_ref()
-                            .is_some_and(|index| index.hidden(x, wd, hit.surface, tri))
-                    })
+                    .find(|hit| !self.hidden_hit(origin, dir, hit))
                     .map_or(f64::INFINITY, |hit| hit.t)
             })
             .collect()
