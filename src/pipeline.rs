@@ -51,8 +51,11 @@ pub struct SurfaceProduct {
 pub struct Built {
     /// Per surface.
     pub surfaces: Vec<SurfaceProduct>,
-    /// The intersection curves of all surfaces together.
+    /// The intersection curves of all surfaces together, exact for the meshes: what the
+    /// halos are verified against.
     pub curves: Curves,
+    /// The same curves moved onto the analytic surfaces (`curves.refine`), when made.
+    pub refined: Option<Curves>,
     /// The halos checked against the curves.
     pub verification: Verification,
     /// Milliseconds per stage so far.
@@ -136,9 +139,20 @@ impl Built {
         out
     }
 
-    /// What the build produced, as the verification, the renderer and the viewer read it;
-    /// `halo` are the scene's halo parameters.
+    /// The curves the files and the picture show: the refined ones when made, else the
+    /// mesh's.
+    pub fn shown_curves(&self) -> &Curves {
+        self.refined.as_ref().unwrap_or(&self.curves)
+    }
+
+    /// What the build produced, as the renderer and the viewer read it, with the curves
+    /// the files show; `halo` are the scene's halo parameters.
     pub fn parts<'a>(&'a self, halo: &HaloParams) -> Parts<'a> {
+        parts(&self.surfaces, halo, self.shown_curves())
+    }
+
+    /// [`Built::parts`] with the mesh's curves, which the halos are verified against.
+    pub fn verified_parts<'a>(&'a self, halo: &HaloParams) -> Parts<'a> {
         parts(&self.surfaces, halo, &self.curves)
     }
 
@@ -304,6 +318,8 @@ pub struct Timings {
     pub halo: f64,
     /// Intersection curves, all surfaces together.
     pub curves: f64,
+    /// Moving the curves onto the analytic surfaces.
+    pub refine: f64,
     /// Verifying the halos against the curves.
     pub verify: f64,
     /// Ranking the stipples, all surfaces.
@@ -425,8 +441,17 @@ impl Report {
         }
         let t = self.timings_ms;
         out += &format!(
-            "sample {:.1} ms, audit {:.1} ms, view {:.1} ms, halo {:.1} ms, curves {:.1} ms, verify {:.1} ms, export {:.1} ms, render {:.1} ms, total {:.1} ms\n",
-            t.sample, t.audit, t.view, t.halo, t.curves, t.verify, t.export, t.render, t.total
+            "sample {:.1} ms, audit {:.1} ms, view {:.1} ms, halo {:.1} ms, curves {:.1} ms, refine {:.1} ms, verify {:.1} ms, export {:.1} ms, render {:.1} ms, total {:.1} ms\n",
+            t.sample,
+            t.audit,
+            t.view,
+            t.halo,
+            t.curves,
+            t.refine,
+            t.verify,
+            t.export,
+            t.render,
+            t.total
         );
         out += &format!(
             "memory: about {:.2} GB estimated from the halos on, limit {:.2} GB{}\n",
@@ -638,6 +663,22 @@ fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error
         timings.curves = ms(start);
     }
     bar.inc(1);
+    let refined = (stages.curves && scene.curves.refine).then(|| {
+        bar.set_message("refining the curves");
+        let start = Instant::now();
+        let none = Curves::default();
+        let analytic: Vec<intersect::Analytic> = products
+            .iter()
+            .map(|p| intersect::Analytic {
+                surface: &p.surface,
+                mesh: &p.mesh,
+            })
+            .collect();
+        let sheets = parts(&products, &scene.halo, &none).sheets();
+        let refined = intersect::refine(&curves, &sheets, &analytic, &scene.view, diagonal);
+        timings.refine = ms(start);
+        refined
+    });
     let mut verification = Verification::default();
     if stages.verify {
         bar.set_message("verifying halos");
@@ -655,6 +696,7 @@ fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error
             peak_gb: None,
         },
         curves,
+        refined,
         verification,
         timings,
         stages,
@@ -711,7 +753,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
             });
             let (text, bin) = export::glb_chunks(
                 &data,
-                &built.curves,
+                built.shown_curves(),
                 scene.outputs.curve_radius * built.diagonal,
                 &stipples,
                 &asset,
@@ -734,7 +776,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
                 write(format!("{name}.ply"), &export::to_ply(&data, name))?,
                 write(
                     format!("{name}-curves.ply"),
-                    &export::to_curves_ply(&built.curves, name),
+                    &export::to_curves_ply(built.shown_curves(), name),
                 )?,
             ])
         }));
@@ -793,6 +835,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
         + timings.view
         + timings.halo
         + timings.curves
+        + timings.refine
         + timings.verify
         + timings.stipples
         + timings.render
@@ -805,7 +848,10 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
             .map(|p| surface_report(p, built.stages.halos))
             .collect(),
         stages: built.stages,
-        curves: built.stages.curves.then(|| built.curves.report.clone()),
+        curves: built
+            .stages
+            .curves
+            .then(|| built.shown_curves().report.clone()),
         halo_verification: built.stages.verify.then(|| built.verification.clone()),
         timings_ms: timings,
         memory: MemoryReport {

@@ -6,6 +6,7 @@
 //! is allowed. No input makes the parser panic.
 
 use crate::halo::HaloParams;
+use crate::intersect::CurveSettings;
 use crate::limits::shorten;
 use crate::limits::{FieldError, NAME_LENGTH, SURFACES, TRIANGLES};
 use crate::render::{CameraSettings, RenderSettings};
@@ -38,6 +39,9 @@ pub struct Scene {
     /// Halo parameters.
     #[serde(default)]
     pub halo: HaloParams,
+    /// Which intersection curves the files and the picture show.
+    #[serde(default)]
+    pub curves: CurveSettings,
     /// The 3D camera of the picture.
     #[serde(default)]
     pub camera: CameraSettings,

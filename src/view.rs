@@ -14,6 +14,7 @@
 
 use crate::limits::FieldError;
 use crate::sample::Mesh4;
+use crate::surfaces::{Eval4, Jet};
 use glam::{DMat4, DVec3, DVec4};
 use serde::{Deserialize, Serialize};
 
@@ -336,6 +337,83 @@ impl View {
         }
         out.normals = vertex_normals(&out, &mesh.triangles);
         Ok(out)
+    }
+}
+
+/// A [`View`] ready to map many surface points: its rotation matrix computed once.
+#[derive(Clone, Copy, Debug)]
+pub struct ViewMap {
+    rotation: DMat4,
+    shift: DVec4,
+    projection: Projection,
+}
+
+/// A surface point mapped by a [`ViewMap`]: its 3D position, the images of its tangents, its
+/// w-depth.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mapped {
+    /// 3D position.
+    pub position: DVec3,
+    /// ∂/∂u and ∂/∂v of the 3D position.
+    pub tangents: [DVec3; 2],
+    /// w after rotation and translation.
+    pub w: f64,
+}
+
+impl ViewMap {
+    /// The 3D position, projected tangents and w-depth of a surface point with its
+    /// derivatives, in f64 (no rounding to the files' f32); `None` at or behind the eye.
+    pub fn map(&self, e: &Eval4) -> Option<Mapped> {
+        let p = self.rotation * e.p + self.shift;
+        let (position, jac) = self.projection.apply(p)?;
+        Some(Mapped {
+            position,
+            tangents: [jac(self.rotation * e.du), jac(self.rotation * e.dv)],
+            w: p.w,
+        })
+    }
+
+    /// The projected x, y, z and the w-depth of a surface point as jets in (u, v): exact
+    /// first and second derivatives of the projected surface, through the quotient of a
+    /// perspective projection. `None` at or behind the eye.
+    pub fn jets(&self, e: &Eval4) -> Option<[Jet; 4]> {
+        let coordinate = |i: usize| Jet {
+            v: e.p[i],
+            du: e.du[i],
+            dv: e.dv[i],
+            duu: e.duu[i],
+            duv: e.duv[i],
+            dvv: e.dvv[i],
+        };
+        let s = [0, 1, 2, 3].map(coordinate);
+        let row = |j: usize| {
+            (0..4).fold(Jet::constant(self.shift[j]), |acc, i| {
+                acc + s[i] * self.rotation.col(i)[j]
+            })
+        };
+        let [x, y, z, w] = [0, 1, 2, 3].map(row);
+        match self.projection {
+            Projection::Orthographic => Some([x, y, z, w]),
+            Projection::Perspective { eye_distance } => {
+                let depth = w + eye_distance;
+                if depth.v.is_nan() || depth.v <= 0.0 {
+                    return None;
+                }
+                let f = depth.recip() * eye_distance;
+                Some([x * f, y * f, z * f, w])
+            }
+        }
+    }
+}
+
+impl View {
+    /// The view ready to map many points ([`ViewMap`]).
+    pub fn map(&self) -> ViewMap {
+        ViewMap {
+            rotation: self.rotation.matrix(),
+            shift: DVec4::from_array(self.translation),
+            projection: self.projection,
+        }
     }
 }
 

@@ -22,9 +22,11 @@
 pub mod broad;
 mod chain;
 pub mod exact;
+pub mod refine;
 pub mod sos;
 
 pub use exact::Node;
+pub use refine::{Analytic, CurveSettings, Refinement, refine};
 use exact::{Pair, Segment, Soup};
 use glam::DVec3;
 use obvhs::aabb::Aabb;
@@ -81,6 +83,17 @@ impl CurvePoint {
     pub fn dw(&self) -> f64 {
         (self.w[0] - self.w[1]).abs()
     }
+}
+
+/// A point where three sheets cross.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriplePoint {
+    /// Where it is.
+    pub position: DVec3,
+    /// w-depth of the three sheets here.
+    pub w: [f64; 3],
+    /// A triangle of each sheet that contains the point.
+    pub faces: [Face; 3],
 }
 
 /// How an open curve ends.
@@ -163,6 +176,9 @@ pub struct CurvesReport {
     pub exact_ms: f64,
     /// Placing, chaining and counting.
     pub chain_ms: f64,
+    /// What moving the points onto the analytic surfaces did ([`refine`]), when it ran.
+    #[serde(flatten)]
+    pub refinement: Option<Refinement>,
 }
 
 impl CurvesReport {
@@ -178,12 +194,27 @@ impl CurvesReport {
         )]
     }
 
-    /// The one-line summary `halo4d build` and `halo4d check DIR` print.
+    /// The summary `halo4d build` and `halo4d check DIR` print: one line, and one more on
+    /// the refinement when it ran.
     pub fn summary(&self) -> String {
-        format!(
+        let mut out = format!(
             "curves: {} ({} closed, {} open), {} points, {} triple points, {} unresolved",
             self.count, self.closed, self.open, self.points, self.triple_points, self.unresolved
-        )
+        );
+        if let Some(r) = &self.refinement {
+            out += &format!(
+                "\ncurves refined onto the surfaces: {} points ({} cross-caps), {} not converged, {} pole ends kept; max residual {:.1e}, max shift {:.1e}; triple points {} refined, {} not",
+                r.refined,
+                r.cross_caps,
+                r.not_converged,
+                r.pole_ends,
+                r.max_residual,
+                r.max_shift,
+                r.triple_points_refined,
+                r.triple_points_not_converged
+            );
+        }
+        out
     }
 }
 
@@ -192,6 +223,8 @@ impl CurvesReport {
 pub struct Curves {
     /// The curves.
     pub curves: Vec<Curve>,
+    /// Where three sheets cross.
+    pub triple_points: Vec<TriplePoint>,
     /// Counts and timings.
     pub report: CurvesReport,
 }
@@ -368,12 +401,16 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
         }
     }
     report.count = curves.len();
-    let (triples, undecided) = triple_points(&soup, &segments);
-    report.triple_points = triples;
+    let (triple_points, undecided) = triple_points(&soup, &segments, face);
+    report.triple_points = triple_points.len();
     report.unresolved += undecided;
     report.chain_ms = ms(t);
     report.ms = ms(start);
-    Curves { curves, report }
+    Curves {
+        curves,
+        triple_points,
+        report,
+    }
 }
 
 /// Runs of triangles one task of the exact tests within runs takes.
@@ -499,11 +536,16 @@ impl BoundaryEdges {
 }
 
 /// Triple points: in a triangle A crossed by B and by C, the segments A∩B and A∩C cross
-/// where the ends of each lie on opposite sides of the other's plane. Counted once, in the
-/// triple's smallest triangle. The ends are constructed points, so a side that is exactly
-/// zero is not decided: it is returned as the second count. Triangles of a triple that
-/// share a vertex, or lie in one plane, are one sheet, and no triple point.
-fn triple_points(soup: &Soup, segments: &[Segment]) -> (usize, usize) {
+/// where the ends of each lie on opposite sides of the other's plane. Found once, in the
+/// triple's smallest triangle, and placed where A∩B crosses C's plane. The ends are
+/// constructed points, so a side that is exactly zero is not decided: it is returned as
+/// the count. Triangles of a triple that share a vertex, or lie in one plane, are one
+/// sheet, and no triple point.
+fn triple_points(
+    soup: &Soup,
+    segments: &[Segment],
+    face: impl Fn(u32) -> Face,
+) -> (Vec<TriplePoint>, usize) {
     let places: Vec<[DVec3; 2]> = segments
         .iter()
         .map(|s| s.ends.map(|n| soup.place(n).position))
@@ -539,7 +581,7 @@ fn triple_points(soup: &Soup, segments: &[Segment]) -> (usize, usize) {
             .iter()
             .all(|&v| sos::orient3d(f[0], f[1], f[2], soup.positions[v as usize]) == 0.0)
     };
-    let (mut triples, mut undecided) = (0, 0);
+    let (mut triples, mut undecided) = (Vec::new(), 0);
     let mut i = 0;
     while i < by_tri.len() {
         let mut j = i;
@@ -564,7 +606,21 @@ fn triple_points(soup: &Soup, segments: &[Segment]) -> (usize, usize) {
                     separated(c, places[sb as usize]),
                     separated(b, places[sc as usize]),
                 ) {
-                    (Some(true), Some(true)) => triples += 1,
+                    (Some(true), Some(true)) => {
+                        let [p, q] = places[sb as usize];
+                        let (sp, sq) = (side(c, p), side(c, q));
+                        let x = p + (q - p) * (sp / (sp - sq));
+                        let w = [a, b, c].map(|t| {
+                            let f = soup.tris[t as usize];
+                            let l = exact::barycentric(x, f.map(|v| soup.positions[v as usize]));
+                            (0..3).map(|k| l[k] * soup.w[f[k] as usize]).sum()
+                        });
+                        triples.push(TriplePoint {
+                            position: x,
+                            w,
+                            faces: [a, b, c].map(&face),
+                        });
+                    }
                     (Some(false), _) | (_, Some(false)) => {}
                     _ => undecided += 1,
                 }

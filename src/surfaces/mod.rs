@@ -425,6 +425,48 @@ impl Surface {
         dispatch!(self, s => s.min_cells())
     }
 
+    /// The parameters of the point that `(u, v)` of `patch` reaches when they may lie past
+    /// the patch's rectangle (a step of Newton's method near a seam): past a glued side, the
+    /// point as far inside the side it is glued to, in shares of each rectangle's extent
+    /// across the side (again for a corner). The flag says whether the result lies in its
+    /// patch's rectangle: past an open side or a pole the parameters are returned as they
+    /// are, with `false`. Overshoots below 1e-12 of the extent are rounding and count as in.
+    pub fn chart(&self, mut patch: usize, mut u: f64, mut v: f64) -> (usize, f64, f64, bool) {
+        const SLACK: f64 = 1e-12;
+        for _ in 0..4 {
+            let d = self.domain(patch);
+            let (eu, ev) = (d.u[1] - d.u[0], d.v[1] - d.v[0]);
+            let (su, sv) = ((u - d.u[0]) / eu, (v - d.v[0]) / ev);
+            let over = [-su, su - 1.0, -sv, sv - 1.0];
+            let (k, depth) = over
+                .iter()
+                .copied()
+                .enumerate()
+                .fold((0, f64::NEG_INFINITY), |m, (k, o)| if o > m.1 { (k, o) } else { m });
+            if !(depth > SLACK) {
+                return (patch, u, v, depth.is_finite());
+            }
+            let sigma = if k < 2 { sv } else { su }.clamp(0.0, 1.0);
+            let SideRule::Glued(pieces) = d.side(Side::ALL[k]) else {
+                return (patch, u, v, false);
+            };
+            let Some(g) = pieces.iter().find(|g| g.from <= sigma && sigma <= g.to) else {
+                return (patch, u, v, false);
+            };
+            let to = self.domain(g.patch);
+            let (u2, v2) = to.side_point(g.side, g.map(sigma));
+            let (eu2, ev2) = (to.u[1] - to.u[0], to.v[1] - to.v[0]);
+            (u, v) = match g.side {
+                Side::U0 => (u2 + depth * eu2, v2),
+                Side::U1 => (u2 - depth * eu2, v2),
+                Side::V0 => (u2, v2 + depth * ev2),
+                Side::V1 => (u2, v2 - depth * ev2),
+            };
+            patch = g.patch;
+        }
+        (patch, u, v, false)
+    }
+
     /// Checks the parameters: names the first bad field.
     pub fn check(&self) -> Result<(), FieldError> {
         dispatch!(self, s => s.check())

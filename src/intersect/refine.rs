@@ -1,0 +1,857 @@
+//! Curves on the true surfaces: the mesh's curve points moved by Newton's method onto the
+//! double curves of the analytic surfaces.
+//!
+//! Takes: the mesh [`Curves`], the sheets they were found on, each sheet's surface and 4D
+//! mesh (its triangles' patches and corner parameters) and the view. Gives: the same curves,
+//! point for point, each point where the projections of its two surfaces truly meet, with
+//! the exact w of both; curve ends at cross-caps moved onto them, curve ends on an open
+//! boundary onto the boundary; triple points on their three sheets.
+//!
+//! - A curve point is a pair of parameter points (u1, v1), (u2, v2) with
+//!   P(S1(u1, v1)) = P(S2(u2, v2)): three equations in four unknowns, and a fourth that keeps
+//!   the point in the plane through the mesh point across the curve (its normal is the cross
+//!   product of the two sheets' normals there), or, at a curve's end on an open boundary,
+//!   fixes the boundary's parameter. Newton's method starts from the point's barycentric
+//!   parameters on its two triangles and uses the exact Jacobians; parameters that step
+//!   across a glued side go on, by the glue rule, on the side it is glued to
+//!   ([`Surface::chart`]).
+//! - A cross-cap (a Whitney umbrella) is where the projected surface's differential drops
+//!   rank at a regular point of the surface: f_u × f_v = 0, three equations in two unknowns,
+//!   solved by Gauss-Newton with the exact second derivatives of f = P∘S, from the mesh
+//!   vertex where a curve ends.
+//! - A triple point solves P(S1) = P(S2) = P(S3): six equations in six unknowns.
+//!
+//! A point is kept where the mesh put it, and counted, when Newton does not reach rounding,
+//! or its solution leaves the triangles' neighbourhood (farther in R^4 than twice their
+//! longest edge), lies outside the surface's domain, or, on one surface, brings the two
+//! parameter points together (the trivial solution of a self-intersection): never a wrong
+//! point. Every point is refined on its own, on the cores, so the result does not depend on
+//! the number of threads.
+
+use super::{Curve, CurvePoint, Curves, End, Face, Node, Sheet, TriplePoint, exact};
+use crate::sample::Mesh4;
+use crate::surfaces::{Jet, Side, SideRule, Surface};
+use crate::view::{Mapped, View, ViewMap};
+use glam::{DVec3, DVec4};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+
+/// The scene's `curves`: which curves the files and the picture show.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CurveSettings {
+    /// Move the mesh's curve points onto the analytic surfaces' double curves (the files'
+    /// and the picture's curves); the halos are verified against the mesh's curves either
+    /// way.
+    pub refine: bool,
+}
+
+impl Default for CurveSettings {
+    fn default() -> Self {
+        CurveSettings { refine: true }
+    }
+}
+
+/// `report.json`'s `curves` fields of the refinement.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Refinement {
+    /// Curve points moved onto the surfaces' double curve (cross-cap ends included).
+    pub refined: usize,
+    /// Curve points kept where the mesh put them: Newton did not reach rounding, or reached
+    /// it out of the points' triangles' neighbourhood or domain, or at the trivial solution.
+    pub not_converged: usize,
+    /// The largest |P1 - P2| at the refined curve and triple points, in scene units.
+    pub max_residual: f64,
+    /// The largest distance from a mesh curve point to its refined point, across the
+    /// curve: the mesh curve's error (cross-cap ends not included, see
+    /// `max_cross_cap_shift`).
+    pub max_shift: f64,
+    /// Curve ends moved onto a cross-cap.
+    pub cross_caps: usize,
+    /// The largest distance a curve end moved onto its cross-cap.
+    pub max_cross_cap_shift: f64,
+    /// Curve points dropped: they failed between a curve's end moved onto its cross-cap
+    /// and the first refined point, beyond the true curve's end.
+    pub trimmed: usize,
+    /// Curve ends at a mesh vertex on a pole of the parametrization, kept there: a pole is
+    /// one point of the surface, and the mesh vertex is exactly on it.
+    pub pole_ends: usize,
+    /// Triple points moved onto the three surfaces' common point.
+    pub triple_points_refined: usize,
+    /// Triple points kept where the mesh put them.
+    pub triple_points_not_converged: usize,
+    /// Refined curve points where the sheet nearer in w is not the one the mesh says
+    /// (near-tangential contacts in w).
+    pub over_under_changed: usize,
+    /// Milliseconds.
+    pub refine_ms: f64,
+}
+
+/// The analytic surface behind a sheet and the 4D mesh the sheet projects.
+#[derive(Clone, Copy, Debug)]
+pub struct Analytic<'a> {
+    /// The surface.
+    pub surface: &'a Surface,
+    /// Its 4D mesh (the sheet's triangles, with their patches and corner parameters).
+    pub mesh: &'a Mesh4,
+}
+
+/// Newton steps at most.
+const MAX_STEPS: usize = 24;
+
+/// Accepted residual, a share of the scene's diagonal.
+const RESIDUAL: f64 = 1e-13;
+
+/// Accepted |f_u × f_v| at a cross-cap, a share of |S_u| |S_v| (the surface's own tangents
+/// in R^4, which a regular point keeps apart): the projection's rank drops where f_u and
+/// f_v are parallel or one of them vanishes.
+const CROSS_CAP_RANK: f64 = 1e-12;
+
+/// How far from the mesh vertex where a curve ends its cross-cap may be, in longest edges
+/// of the curve point's triangles (in R^4).
+const CROSS_CAP_REACH: f64 = 2.0;
+
+/// On one surface, the least distance in R^4 between the two parameter points of a
+/// solution, a share of their distance at the start: less is the trivial solution.
+const COLLAPSE: f64 = 0.1;
+
+/// The curves `curves` (found on `sheets`) with their points moved onto the analytic
+/// surfaces `analytic` (one per sheet, in order) in `view`; `diagonal` is the projected
+/// scene's, to which residuals are compared. The report's `refinement` says what was done.
+pub fn refine(
+    curves: &Curves,
+    sheets: &[Sheet],
+    analytic: &[Analytic],
+    view: &View,
+    diagonal: f64,
+) -> Curves {
+    let start = Instant::now();
+    let solver = Solver::new(sheets, analytic, view, diagonal);
+    let done: Vec<(Curve, Tally)> = curves
+        .curves
+        .par_iter()
+        .map(|c| solver.curve(c))
+        .collect();
+    let triples: Vec<(TriplePoint, Option<f64>)> = curves
+        .triple_points
+        .par_iter()
+        .map(|t| solver.triple(t))
+        .collect();
+    let mut tally = Tally::default();
+    let mut out = Curves {
+        curves: Vec::with_capacity(done.len()),
+        triple_points: Vec::with_capacity(triples.len()),
+        report: curves.report.clone(),
+    };
+    for (c, t) in done {
+        tally.add(&t);
+        out.curves.push(c);
+    }
+    let mut r = tally.report;
+    for (t, residual) in triples {
+        match residual {
+            Some(res) => {
+                r.triple_points_refined += 1;
+                r.max_residual = r.max_residual.max(res);
+            }
+            None => r.triple_points_not_converged += 1,
+        }
+        out.triple_points.push(t);
+    }
+    out.report.points -= r.trimmed;
+    r.refine_ms = start.elapsed().as_secs_f64() * 1e3;
+    out.report.refinement = Some(r);
+    out
+}
+
+/// What refining one curve did.
+#[derive(Default)]
+struct Tally {
+    report: Refinement,
+}
+
+impl Tally {
+    fn add(&mut self, o: &Tally) {
+        let (r, o) = (&mut self.report, &o.report);
+        r.refined += o.refined;
+        r.not_converged += o.not_converged;
+        r.max_residual = r.max_residual.max(o.max_residual);
+        r.max_shift = r.max_shift.max(o.max_shift);
+        r.cross_caps += o.cross_caps;
+        r.max_cross_cap_shift = r.max_cross_cap_shift.max(o.max_cross_cap_shift);
+        r.pole_ends += o.pole_ends;
+        r.trimmed += o.trimmed;
+        r.over_under_changed += o.over_under_changed;
+    }
+}
+
+/// A parameter point of a sheet's surface.
+#[derive(Clone, Copy, Debug)]
+struct Param {
+    sheet: usize,
+    patch: usize,
+    u: f64,
+    v: f64,
+}
+
+/// Where Newton starts on one sheet: the parameters, the 4D point the mesh gives there and
+/// how far the solution may be from it.
+#[derive(Clone, Copy, Debug)]
+struct Start {
+    param: Param,
+    mesh_point: DVec4,
+    /// The centre of the triangle in R^4.
+    centre: DVec4,
+    /// Its longest edge.
+    reach: f64,
+}
+
+/// A solved parameter point: where it maps, and its 4D point.
+#[derive(Clone, Copy, Debug)]
+struct Solved {
+    param: Param,
+    mapped: Mapped,
+    point: DVec4,
+    /// ∂/∂u and ∂/∂v of the 4D point.
+    tangents: [DVec4; 2],
+}
+
+/// A curve point refined: the point, its residual and its two parameter points.
+#[derive(Clone, Copy, Debug)]
+struct Pair {
+    point: CurvePoint,
+    residual: f64,
+    params: [Param; 2],
+}
+
+/// The equation that completes a curve point's three.
+#[derive(Clone, Copy, Debug)]
+enum Fourth {
+    /// The point of sheet 0 lies in the plane through `origin` with normal `normal`.
+    Plane { origin: DVec3, normal: DVec3 },
+    /// Unknown `index` (u1, v1, u2, v2) equals `value` (a boundary's parameter).
+    Fixed { index: usize, value: f64 },
+}
+
+struct Solver<'a> {
+    sheets: &'a [Sheet<'a>],
+    analytic: &'a [Analytic<'a>],
+    view: ViewMap,
+    /// Accepted residual, in scene units.
+    residual: f64,
+    /// First global triangle and vertex of each sheet (as the curves number them).
+    tri_start: Vec<u32>,
+    vertex_start: Vec<u32>,
+}
+
+impl<'a> Solver<'a> {
+    fn new(
+        sheets: &'a [Sheet<'a>],
+        analytic: &'a [Analytic<'a>],
+        view: &View,
+        diagonal: f64,
+    ) -> Self {
+        let starts = |len: &dyn Fn(&Sheet) -> usize| {
+            sheets
+                .iter()
+                .scan(0u32, |acc, s| {
+                    let at = *acc;
+                    *acc += len(s) as u32;
+                    Some(at)
+                })
+                .collect()
+        };
+        Solver {
+            sheets,
+            analytic,
+            view: view.map(),
+            residual: RESIDUAL * diagonal,
+            tri_start: starts(&|s| s.triangles.len()),
+            vertex_start: starts(&|s| s.positions.len()),
+        }
+    }
+
+    /// A curve with its points refined, and what was done. Each point starts from its
+    /// own triangles; a point that fails so starts again from the solution of a neighbour
+    /// along the curve (near a cross-cap, where the two sheets meet at a small angle and
+    /// the mesh's point is far off, the neighbour's solution is the better guess).
+    fn curve(&self, c: &Curve) -> (Curve, Tally) {
+        let mut tally = Tally::default();
+        let n = c.points.len();
+        let mut out = c.clone();
+        let end = |i: usize| match (c.closed, i) {
+            (true, _) => None,
+            (false, 0) => Some(c.ends[0]),
+            (false, i) if i + 1 == n => Some(c.ends[1]),
+            _ => None,
+        };
+        let neighbour = |i: usize, forward: bool| -> Option<usize> {
+            match (forward, i) {
+                (true, i) if i + 1 < n => Some(i + 1),
+                (true, _) => c.closed.then_some(0),
+                (false, 0) => c.closed.then(|| n - 1),
+                (false, i) => Some(i - 1),
+            }
+        };
+        let mut found: Vec<Option<Pair>> = vec![None; n];
+        let mut pairs = Vec::new();
+        for (i, p) in c.points.iter().enumerate() {
+            let r = &mut tally.report;
+            if let (Some(End::BranchPoint), Node::Vertex(v)) = (end(i), p.node) {
+                match self.cross_cap(v, p) {
+                    CrossCap::Found(q) => {
+                        r.refined += 1;
+                        r.cross_caps += 1;
+                        r.max_cross_cap_shift =
+                            r.max_cross_cap_shift.max(q.position.distance(p.position));
+                        out.points[i] = q;
+                    }
+                    CrossCap::Pole => r.pole_ends += 1,
+                    CrossCap::NotFound => r.not_converged += 1,
+                }
+                continue;
+            }
+            // The curve's direction from its neighbours, where the sheets' normals give none.
+            let at = |j: Option<usize>| j.map_or(p.position, |j| c.points[j].position);
+            let along = at(neighbour(i, true)) - at(neighbour(i, false));
+            let boundary = (end(i) == Some(End::Boundary))
+                .then(|| self.boundary(p))
+                .flatten();
+            pairs.push(i);
+            found[i] = self.pair(p, along, boundary, None);
+        }
+        for forward in [true, false] {
+            let order: Vec<usize> = if forward {
+                pairs.clone()
+            } else {
+                pairs.iter().rev().copied().collect()
+            };
+            for &i in &order {
+                if found[i].is_some() {
+                    continue;
+                }
+                let Some(from) = neighbour(i, !forward).and_then(|j| found[j].map(|f| f.params))
+                else {
+                    continue;
+                };
+                let p = &c.points[i];
+                let at = |j: Option<usize>| j.map_or(p.position, |j| c.points[j].position);
+                let along = at(neighbour(i, true)) - at(neighbour(i, false));
+                let boundary = (end(i) == Some(End::Boundary))
+                    .then(|| self.boundary(p))
+                    .flatten();
+                found[i] = self.pair(p, along, boundary, Some(from));
+            }
+        }
+        // Points that failed next to an end moved onto its cross-cap lie beyond the true
+        // curve's end (the mesh's cross-cap is at a vertex, up to a triangle away from the
+        // true one): they are dropped, and the curve goes from its last refined point to
+        // the cross-cap.
+        let mut keep = vec![true; n];
+        if !c.closed {
+            for (first, step) in [(0usize, 1isize), (n - 1, -1)] {
+                if out.points[first] == c.points[first] {
+                    continue;
+                }
+                let mut i = first as isize + step;
+                while (1..n as isize - 1).contains(&i) && found[i as usize].is_none()
+                {
+                    keep[i as usize] = false;
+                    i += step;
+                }
+            }
+        }
+        let r = &mut tally.report;
+        for &i in &pairs {
+            let p = &c.points[i];
+            match found[i] {
+                Some(f) => {
+                    r.refined += 1;
+                    r.max_residual = r.max_residual.max(f.residual);
+                    r.max_shift = r.max_shift.max(f.point.position.distance(p.position));
+                    if std::env::var("HALO4D_DEBUG_REFINE").is_ok() && f.point.position.distance(p.position) > 0.03 {
+                        eprintln!("big shift {} at i {i}/{n} closed {} pos {} -> {}", f.point.position.distance(p.position), c.closed, p.position, f.point.position);
+                    }
+                    r.over_under_changed +=
+                        usize::from(f.point.near() != p.near() && f.point.w[0] != f.point.w[1]);
+                    out.points[i] = f.point;
+                }
+                None if !keep[i] => r.trimmed += 1,
+                None => {
+                    if std::env::var("HALO4D_DEBUG_REFINE").is_ok() {
+                        eprintln!("pair fail: i {i}/{n} end {:?} closed {} faces {:?} pos {}", end(i), c.closed, p.faces, p.position);
+                    }
+                    r.not_converged += 1
+                }
+            }
+        }
+        if r.trimmed > 0 {
+            let mut k = 0;
+            out.points.retain(|_| {
+                k += 1;
+                keep[k - 1]
+            });
+        }
+        (out, tally)
+    }
+
+    /// The sheet and local index of a global vertex.
+    fn vertex(&self, global: u32) -> (usize, usize) {
+        let s = self.vertex_start.partition_point(|&v| v <= global) - 1;
+        (s, (global - self.vertex_start[s]) as usize)
+    }
+
+    /// Where Newton starts on `face` for the 3D point `x` of it.
+    fn start(&self, face: Face, x: DVec3) -> Start {
+        let (s, t) = (face.surface as usize, face.triangle as usize);
+        let tri = self.sheets[s].triangles[t];
+        let mesh = self.analytic[s].mesh;
+        let l = exact::barycentric(x, tri.map(|v| self.sheets[s].positions[v as usize]));
+        let uv = mesh.triangle_uv[t];
+        let corners = tri.map(|v| mesh.positions[v as usize]);
+        let longest = (0..3)
+            .map(|k| corners[k].distance(corners[(k + 1) % 3]))
+            .fold(0.0, f64::max);
+        Start {
+            param: Param {
+                sheet: s,
+                patch: mesh.triangle_patch[t] as usize,
+                u: (0..3).map(|k| l[k] * uv[k][0]).sum(),
+                v: (0..3).map(|k| l[k] * uv[k][1]).sum(),
+            },
+            mesh_point: (0..3).map(|k| corners[k] * l[k]).sum(),
+            centre: (corners[0] + corners[1] + corners[2]) / 3.0,
+            reach: longest,
+        }
+    }
+
+    /// The surface at a parameter point, mapped by the view.
+    fn eval(&self, p: &Param) -> Option<Solved> {
+        let e = self.analytic[p.sheet].surface.eval(p.patch, p.u, p.v);
+        let mapped = self.view.map(&e)?;
+        mapped.position.is_finite().then_some(
+            Solved {
+                param: *p,
+                mapped,
+                point: e.p,
+                tangents: [e.du, e.dv],
+            },
+        )
+    }
+
+    /// At a curve end on a mesh boundary: the parameter of the boundary its edge lies on,
+    /// as the fourth equation.
+    fn boundary(&self, p: &CurvePoint) -> Option<Fourth> {
+        let Node::Crossing { edge, face } = p.node else {
+            return None;
+        };
+        let label = p
+            .faces
+            .iter()
+            .position(|f| self.tri_start[f.surface as usize] + f.triangle != face)?;
+        let f = p.faces[label];
+        let (s, t) = (f.surface as usize, f.triangle as usize);
+        let base = self.vertex_start[s];
+        let tri = self.sheets[s].triangles[t].map(|v| v + base);
+        let mesh = self.analytic[s].mesh;
+        let uv = mesh.triangle_uv[t];
+        let corner = |g: u32| tri.iter().position(|&v| v == g);
+        let (a, b) = (uv[corner(edge[0])?], uv[corner(edge[1])?]);
+        let d = self.analytic[s].surface.domain(mesh.triangle_patch[t] as usize);
+        let on = |k: usize, ends: [f64; 2]| {
+            ends.into_iter()
+                .find(|&e| a[k] == e && b[k] == e)
+                .map(|value| Fourth::Fixed {
+                    index: 2 * label + k,
+                    value,
+                })
+        };
+        on(0, d.u).or_else(|| on(1, d.v))
+    }
+
+    /// A curve point refined: the point where its two surfaces' projections meet, with
+    /// the fourth equation `boundary` or the plane across the curve (`along` where the
+    /// sheets' normals give no direction), and the residual; `None` where Newton fails.
+    fn pair(
+        &self,
+        p: &CurvePoint,
+        along: DVec3,
+        boundary: Option<Fourth>,
+        from: Option<[Param; 2]>,
+    ) -> Option<Pair> {
+        let mut starts = p.faces.map(|f| self.start(f, p.position));
+        if let Some(from) = from {
+            starts[0].param = from[0];
+            starts[1].param = from[1];
+        }
+        let fourth = match boundary {
+            Some(b) => b,
+            None => {
+                let [a, b] = [self.eval(&starts[0].param)?, self.eval(&starts[1].param)?];
+                let normal = |s: &Solved| s.mapped.tangents[0].cross(s.mapped.tangents[1]);
+                let (na, nb) = (normal(&a), normal(&b));
+                let across = na.cross(nb);
+                let normal = if across.length() > 1e-8 * na.length() * nb.length() {
+                    across
+                } else {
+                    along
+                };
+                Fourth::Plane {
+                    origin: p.position,
+                    normal: normal.try_normalize()?,
+                }
+            }
+        };
+        let (solved, residual) = match self.newton::<4>(&starts, Some(fourth)) {
+            Ok(found) => found,
+            Err(Failure::Outside(edge)) if boundary.is_none() => {
+                self.newton::<4>(&starts, Some(edge)).ok()?
+            }
+            Err(_) => return None,
+        };
+        let [a, b] = [solved[0], solved[1]];
+        Some(Pair {
+            point: CurvePoint {
+                position: (a.mapped.position + b.mapped.position) * 0.5,
+                w: [a.mapped.w, b.mapped.w],
+                ..*p
+            },
+            residual,
+            params: [a.param, b.param],
+        })
+    }
+
+    /// A triple point refined, with its residual; as it was, with `None`, where Newton
+    /// fails.
+    fn triple(&self, t: &TriplePoint) -> (TriplePoint, Option<f64>) {
+        let starts = t.faces.map(|f| self.start(f, t.position));
+        match self.newton::<6>(&starts, None) {
+            Ok((s, residual)) => (
+                TriplePoint {
+                    position: (s[0].mapped.position + s[1].mapped.position + s[2].mapped.position)
+                        / 3.0,
+                    w: [s[0].mapped.w, s[1].mapped.w, s[2].mapped.w],
+                    ..*t
+                },
+                Some(residual),
+            ),
+            Err(_) => (*t, None),
+        }
+    }
+
+    /// Newton's method for `N / 2` parameter points (2 or 3) whose projections coincide,
+    /// from `starts`, with `fourth` completing the equations of two: the solved points and
+    /// the largest distance between their projections, or why not (see the module
+    /// documentation).
+    ///
+    /// Two points on one surface also meet trivially, wherever they coincide; the
+    /// equations are deflated there (Farrell, Birkisson and Funke 2015): multiplied by
+    /// 1 + (s / d)^2, d the points' distance in R^4 and s its value at the start, whose
+    /// Jacobian pushes Newton away from d = 0 and keeps every other root. A step is
+    /// shortened to move no point by more than half its reach.
+    fn newton<const N: usize>(
+        &self,
+        starts: &[Start],
+        fourth: Option<Fourth>,
+    ) -> Result<(Vec<Solved>, f64), Failure> {
+        let k = N / 2;
+        let mut params: Vec<Param> = starts.iter().map(|s| s.param).collect();
+        let mut inside = vec![true; k];
+        let mut solved: Vec<Solved> = Vec::with_capacity(k);
+        let mut residual = f64::INFINITY;
+        let mut polished = false;
+        // The pairs of points on one surface, with their distance at the start.
+        let same: Vec<(usize, usize, f64)> = (0..k)
+            .flat_map(|i| (i + 1..k).map(move |j| (i, j)))
+            .filter(|&(i, j)| starts[i].param.sheet == starts[j].param.sheet)
+            .map(|(i, j)| (i, j, starts[i].mesh_point.distance(starts[j].mesh_point)))
+            .collect();
+        for step in 0..=MAX_STEPS {
+            solved.clear();
+            for p in &params {
+                solved.push(self.eval(p).ok_or(Failure::Other)?);
+            }
+            let x0 = solved[0].mapped.position;
+            residual = (1..k)
+                .map(|i| x0.distance(solved[i].mapped.position))
+                .fold(0.0, f64::max);
+            // The equations: x0 - xi for each other point, then the fourth.
+            let mut jac = [[0.0; N]; N];
+            let mut rhs = [0.0; N];
+            for i in 1..k {
+                let d = x0 - solved[i].mapped.position;
+                for r in 0..3 {
+                    let row = 3 * (i - 1) + r;
+                    rhs[row] = -d[r];
+                    jac[row][0] = solved[0].mapped.tangents[0][r];
+                    jac[row][1] = solved[0].mapped.tangents[1][r];
+                    jac[row][2 * i] = -solved[i].mapped.tangents[0][r];
+                    jac[row][2 * i + 1] = -solved[i].mapped.tangents[1][r];
+                }
+            }
+            let mut fourth_ok = true;
+            if let Some(f) = fourth {
+                let last = N - 1;
+                match f {
+                    Fourth::Plane { origin, normal } => {
+                        let c = normal.dot(x0 - origin);
+                        rhs[last] = -c;
+                        jac[last][0] = normal.dot(solved[0].mapped.tangents[0]);
+                        jac[last][1] = normal.dot(solved[0].mapped.tangents[1]);
+                        fourth_ok = c.abs() <= self.residual;
+                    }
+                    Fourth::Fixed { index, value } => {
+                        let p = &params[index / 2];
+                        let current = if index % 2 == 0 { p.u } else { p.v };
+                        rhs[last] = value - current;
+                        jac[last][index] = 1.0;
+                        fourth_ok = current == value;
+                    }
+                }
+            }
+            // Within the limit, one more step reaches rounding.
+            if residual <= self.residual && fourth_ok {
+                if polished {
+                    break;
+                }
+                polished = true;
+            }
+            if step == MAX_STEPS {
+                break;
+            }
+            // Deflation: G = M F with M the product of the factors, so
+            // dG = M dF + F (dM)^T and dM = M sum(dm / m). -F is the right-hand side.
+            let mut grad = [0.0; N];
+            let mut factor = 1.0;
+            for &(i, j, s) in &same {
+                let d = solved[i].point - solved[j].point;
+                let d2 = d.length_squared();
+                if d2 == 0.0 || s == 0.0 {
+                    continue;
+                }
+                let m = 1.0 + s * s / d2;
+                // dm = -(s^2 / d2^2) d(d2), d(d2) = 2 d . (dPi, -dPj).
+                let c = -s * s / (d2 * d2) * 2.0 / m;
+                for t in 0..2 {
+                    grad[2 * i + t] += c * d.dot(solved[i].tangents[t]);
+                    grad[2 * j + t] -= c * d.dot(solved[j].tangents[t]);
+                }
+                factor *= m;
+            }
+            if factor != 1.0 {
+                // dG / M = dF + F grad^T (grad holding dM / M); G / M = F.
+                for r in 0..N {
+                    for c in 0..N {
+                        jac[r][c] -= rhs[r] * grad[c];
+                    }
+                }
+            }
+            let Some(mut delta) = solve(jac, rhs) else {
+                break;
+            };
+            // No point moves by more than half its reach.
+            let longest = (0..k)
+                .map(|i| {
+                    let t = solved[i].tangents;
+                    (t[0] * delta[2 * i] + t[1] * delta[2 * i + 1]).length()
+                        / (0.5 * starts[i].reach)
+                })
+                .fold(0.0, f64::max);
+            if longest > 1.0 {
+                delta.iter_mut().for_each(|d| *d /= longest);
+            }
+            for (i, p) in params.iter_mut().enumerate() {
+                let (patch, u, v, ok) = self.analytic[p.sheet].surface.chart(
+                    p.patch,
+                    p.u + delta[2 * i],
+                    p.v + delta[2 * i + 1],
+                );
+                (p.patch, p.u, p.v) = (patch, u, v);
+                inside[i] = ok;
+            }
+            if let Some(Fourth::Fixed { index, value }) = fourth {
+                // Exactly on the boundary, not a rounding off it.
+                let p = &mut params[index / 2];
+                if index % 2 == 0 {
+                    p.u = value;
+                } else {
+                    p.v = value;
+                }
+            }
+        }
+        let near = |i: usize| solved[i].point.distance(starts[i].centre) <= starts[i].reach;
+        let apart = |&(i, j, s): &(usize, usize, f64)| {
+            solved[i].point.distance(solved[j].point) >= COLLAPSE * s
+        };
+        if !(residual <= self.residual && (0..k).all(near) && same.iter().all(apart)) {
+            if std::env::var("HALO4D_DEBUG_REFINE").is_ok() {
+                eprintln!(
+                    "  newton: residual {residual:e} inside {inside:?} near {:?} dist {:?} reach {:?} sep {:?} start sep {:?}",
+                    (0..k).map(near).collect::<Vec<_>>(),
+                    (0..k).map(|i| solved[i].point.distance(starts[i].mesh_point)).collect::<Vec<_>>(),
+                    (0..k).map(|i| starts[i].reach).collect::<Vec<_>>(),
+                    solved[0].point.distance(solved[1].point),
+                    same,
+                );
+            }
+            return Err(Failure::Other);
+        }
+        // A point past an open side or a pole: on the surface's extension, not on it.
+        if let Some(i) = inside.iter().position(|&ok| !ok) {
+            let p = &params[i];
+            let d = self.analytic[p.sheet].surface.domain(p.patch);
+            let past = [
+                (p.u < d.u[0], 2 * i, d.u[0]),
+                (p.u > d.u[1], 2 * i, d.u[1]),
+                (p.v < d.v[0], 2 * i + 1, d.v[0]),
+                (p.v > d.v[1], 2 * i + 1, d.v[1]),
+            ];
+            return Err(match past.iter().find(|p| p.0) {
+                Some(&(_, index, value)) => Failure::Outside(Fourth::Fixed { index, value }),
+                None => Failure::Other,
+            });
+        }
+        Ok((solved.clone(), residual))
+    }
+
+    /// The cross-cap near the mesh vertex `global` where the curve point `p` ends its
+    /// curve.
+    fn cross_cap(&self, global: u32, p: &CurvePoint) -> CrossCap {
+        let (s, v) = self.vertex(global);
+        let a = &self.analytic[s];
+        let (mut patch, [mut u, mut w]) = (a.mesh.patch[v] as usize, a.mesh.uv[v]);
+        let d = a.surface.domain(patch);
+        let on_pole = |side: Side, at: bool| at && matches!(d.side(side), SideRule::Pole);
+        if on_pole(Side::U0, u == d.u[0])
+            || on_pole(Side::U1, u == d.u[1])
+            || on_pole(Side::V0, w == d.v[0])
+            || on_pole(Side::V1, w == d.v[1])
+        {
+            return CrossCap::Pole;
+        }
+        // How far the cross-cap may be: in longest edges of the faces at the vertex.
+        let reach = p
+            .faces
+            .iter()
+            .map(|f| self.start(*f, p.position).reach)
+            .fold(0.0, f64::max);
+        let origin = a.mesh.positions[v];
+        let mut inside = true;
+        for _ in 0..MAX_STEPS {
+            let e = a.surface.eval(patch, u, w);
+            let Some(j) = self.view.jets(&e) else {
+                return CrossCap::NotFound;
+            };
+            let f = |g: fn(&Jet) -> f64| DVec3::new(g(&j[0]), g(&j[1]), g(&j[2]));
+            let (fu, fv) = (f(|c| c.du), f(|c| c.dv));
+            let (fuu, fuv, fvv) = (f(|c| c.duu), f(|c| c.duv), f(|c| c.dvv));
+            let g = fu.cross(fv);
+            let scale = e.du.length() * e.dv.length();
+            // The surface itself must be regular here (not a parametrization singularity).
+            let area2 = e.du.length_squared() * e.dv.length_squared() - e.du.dot(e.dv).powi(2);
+            if !(area2 > 1e-12 * e.du.length_squared() * e.dv.length_squared()) {
+                if std::env::var("HALO4D_DEBUG_REFINE").is_ok() { eprintln!("cross-cap singular at {patch} {u} {w}"); }
+                return CrossCap::NotFound;
+            }
+            if g.length() <= 1e-3 * CROSS_CAP_RANK * scale {
+                break;
+            }
+            let gu = fuu.cross(fv) + fu.cross(fuv);
+            let gv = fuv.cross(fv) + fu.cross(fvv);
+            let Some([du, dw]) = solve(
+                [[gu.dot(gu), gu.dot(gv)], [gu.dot(gv), gv.dot(gv)]],
+                [-gu.dot(g), -gv.dot(g)],
+            ) else {
+                return CrossCap::NotFound;
+            };
+            let moved = (du.abs() / (1.0 + u.abs())).max(dw.abs() / (1.0 + w.abs()));
+            let next = a.surface.chart(patch, u + du, w + dw);
+            (patch, u, w, inside) = next;
+            if moved < 1e-15 {
+                break;
+            }
+        }
+        let e = a.surface.eval(patch, u, w);
+        let (Some(m), Some(j)) = (self.view.map(&e), self.view.jets(&e)) else {
+            return CrossCap::NotFound;
+        };
+        let fu = DVec3::new(j[0].du, j[1].du, j[2].du);
+        let fv = DVec3::new(j[0].dv, j[1].dv, j[2].dv);
+        let rank = fu.cross(fv).length() / (e.du.length() * e.dv.length());
+        if inside && rank <= CROSS_CAP_RANK && e.p.distance(origin) <= CROSS_CAP_REACH * reach {
+            CrossCap::Found(CurvePoint {
+                position: m.position,
+                w: [m.w, m.w],
+                ..*p
+            })
+        } else {
+            if std::env::var("HALO4D_DEBUG_REFINE").is_ok() {
+                eprintln!("cross-cap fail: inside {inside} rank {rank:e} dist {} reach {reach} start uv {:?} end uv {patch} {u} {w} pos {}", e.p.distance(origin), a.mesh.uv[v], p.position);
+            }
+            CrossCap::NotFound
+        }
+    }
+}
+
+/// Why Newton's method gave no point.
+enum Failure {
+    /// The solution lies past an open side or a pole of its patch: on the boundary, with
+    /// this equation, is where the curve leaves the surface.
+    Outside(Fourth),
+    /// Anything else: no convergence, out of reach, or the trivial solution.
+    Other,
+}
+
+/// What the search for a cross-cap at a curve's end found.
+enum CrossCap {
+    /// The curve end at the cross-cap.
+    Found(CurvePoint),
+    /// The end is a pole of the parametrization.
+    Pole,
+    /// Nothing within reach: the end stays.
+    NotFound,
+}
+
+/// Solves a x = b by Gaussian elimination with partial pivoting; `None` when `a` is
+/// singular or the solution is not finite.
+fn solve<const N: usize>(mut a: [[f64; N]; N], mut b: [f64; N]) -> Option<[f64; N]> {
+    for col in 0..N {
+        let pivot = (col..N).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if a[pivot][col] == 0.0 || !a[pivot][col].is_finite() {
+            return None;
+        }
+        a.swap(col, pivot);
+        b.swap(col, pivot);
+        for row in col + 1..N {
+            let f = a[row][col] / a[col][col];
+            for k in col..N {
+                a[row][k] -= f * a[col][k];
+            }
+            b[row] -= f * b[col];
+        }
+    }
+    let mut x = [0.0; N];
+    for row in (0..N).rev() {
+        let s: f64 = (row + 1..N).map(|k| a[row][k] * x[k]).sum();
+        x[row] = (b[row] - s) / a[row][row];
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solve_gives_the_exact_answer_of_a_small_system_and_refuses_a_singular_one() {
+        let a = [[2.0, 1.0, 0.0], [1.0, 3.0, 1.0], [0.0, 1.0, 4.0]];
+        let x = [1.0, -2.0, 0.5];
+        let b = [0, 1, 2].map(|r| (0..3).map(|c| a[r][c] * x[c]).sum::<f64>());
+        let got = solve(a, b).unwrap();
+        for k in 0..3 {
+            assert!((got[k] - x[k]).abs() < 1e-15, "{got:?}");
+        }
+        assert!(solve([[1.0, 2.0], [2.0, 4.0]], [1.0, 2.0]).is_none());
+    }
+}
