@@ -3,10 +3,14 @@
 //! core (`RAYON_NUM_THREADS=1` for one). Before the timed runs, prints how one run splits
 //! between building the BVH, traversing it with the exact tests (and the exact tests' time
 //! summed over the cores) and chaining.
+//!
+//! Refinement (`refine/...`): moving those curves onto the analytic surfaces, on the flat
+//! torus at 316 x 316 and on the default scene's spun trefoil on a grid of about 200,000
+//! triangles; before the timed runs, prints its time against the curve stage's.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use halo4d::{Scene, sample_uniform};
-use halo4d::{Sheet, curves};
+use halo4d::{Analytic, Curves, Mesh4, Projected, Scene, sample_uniform};
+use halo4d::{Sheet, curves, refine};
 use std::hint::black_box;
 use std::path::Path;
 
@@ -51,5 +55,59 @@ fn curve_costs(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, curve_costs);
+/// A scene's first surface on an n x n grid, projected: the mesh and its projection.
+fn grid(scene: &Scene, n: usize) -> (Mesh4, Projected) {
+    let mesh = sample_uniform(&scene.surfaces[0].surface, n, n);
+    let projected = scene.view.project(&mesh).expect("the view projects");
+    (mesh, projected)
+}
+
+fn refine_costs(c: &mut Criterion) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/scenes");
+    let mut group = c.benchmark_group("refine");
+    group.sample_size(10);
+    for (file, n) in [("flat-torus.json", 316), ("default.json", 316)] {
+        let scene = Scene::load(&dir.join(file)).expect("the fixture loads");
+        let (mesh, projected) = grid(&scene, n);
+        let sheets = [Sheet {
+            positions: &projected.positions,
+            w: &projected.w,
+            triangles: &mesh.triangles,
+        }];
+        let analytic = [Analytic {
+            surface: &scene.surfaces[0].surface,
+            mesh: &mesh,
+        }];
+        let (lo, hi) = projected.bounds().expect("a mesh");
+        let diagonal = (hi - lo).length();
+        let found: Curves = curves(&sheets);
+        let refined = refine(&found, &sheets, &analytic, &scene.view, diagonal);
+        let r = refined.report.refinement.as_ref().expect("refined");
+        eprintln!(
+            "{}: {} triangles, {} curve points: curves {:.1} ms, refinement {:.1} ms ({:.1}% of the curves); \
+             {} refined, {} not converged, {} trimmed, max shift {:.1e}, max residual {:.1e}",
+            scene.name,
+            mesh.triangles.len(),
+            found.report.points,
+            found.report.ms,
+            r.refine_ms,
+            100.0 * r.refine_ms / found.report.ms,
+            r.refined,
+            r.not_converged,
+            r.trimmed,
+            r.max_shift,
+            r.max_residual,
+        );
+        group.bench_with_input(
+            BenchmarkId::new(scene.name.clone(), mesh.triangles.len()),
+            &found,
+            |b, found| {
+                b.iter(|| refine(black_box(found), &sheets, &analytic, &scene.view, diagonal))
+            },
+        );
+    }
+    group.finish();
+}
+
+criterion_group!(benches, curve_costs, refine_costs);
 criterion_main!(benches);

@@ -7,6 +7,7 @@
 //! and projected by a [`View`] ([`Projected`]), thickened into a [`Halo`] of tetrahedra
 //! ([`build_halo`], checked by the independent [`check`]); the intersection [`curves`] of
 //! all surfaces are the ground truth the halos are verified against ([`verify`]), and
+//! [`refine`] moves them onto the analytic surfaces for the files and the picture;
 //! [`Parts`] hands what a scene produced to the verification and the renderer ([`render`]).
 //! The files are read back with [`read_halos`] and [`read_scene_glb`], and checked again
 //! with [`check_file`] and [`check_dir`]. [`limits`] holds every limit a user can meet;
@@ -49,7 +50,10 @@ pub use scene::{Outputs, Scene, SceneError, SceneSurface};
 // The stages, in the order of the pipeline.
 pub use check::{CheckStats, TetMesh, check};
 pub use halo::{Fold, Halo, HaloParams, HaloReport, build_halo};
-pub use intersect::{Curve, CurvePoint, Curves, CurvesReport, End, Face, Sheet, curves};
+pub use intersect::{
+    Analytic, Curve, CurvePoint, CurveSettings, Curves, CurvesReport, End, Face, Refinement, Sheet,
+    TriplePoint, curves, refine,
+};
 pub use parts::{HaloIndex, HaloPart, Parts, SurfacePart};
 pub use render::compare::Comparison;
 pub use render::{
@@ -65,7 +69,7 @@ pub use surfaces::{
     ProjectivePlane, Side, SideRule, SpunTrefoil, Surface, Topology, TwistSpunTrefoil,
 };
 pub use verify::{Ambiguous, Verification, verify};
-pub use view::{BehindEye, Projected, Projection, Rotation4, View};
+pub use view::{BehindEye, Mapped, Projected, Projection, Rotation4, View, ViewMap};
 
 // The files: written, read back and checked.
 pub use export::{StagedError, SurfaceData, to_curves_ply, to_obj, to_ply, write_vtk};

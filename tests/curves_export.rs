@@ -95,7 +95,7 @@ fn the_glb_curves_mesh_is_tubes_around_every_curve_and_carries_the_exact_polylin
     for scene in scenes() {
         let out = dir.path().join(&scene.name);
         let built = build(&scene, &out);
-        let curves = &built.curves;
+        let curves = built.shown_curves();
         let name = &scene.name;
         let points: Vec<_> = curves.curves.iter().flat_map(|c| &c.points).collect();
         assert!(!points.is_empty(), "{name}: no curves");
@@ -317,7 +317,7 @@ fn the_curves_ply_holds_the_same_points_and_edges() {
         let vertices = &ply.payload["vertex"];
         let edges = &ply.payload["edge"];
         let mut k = 0;
-        for (c, curve) in built.curves.curves.iter().enumerate() {
+        for (c, curve) in built.shown_curves().curves.iter().enumerate() {
             for p in &curve.points {
                 let v = &vertices[k];
                 let near = p.near();
@@ -335,7 +335,7 @@ fn the_curves_ply_holds_the_same_points_and_edges() {
             .iter()
             .map(|e| [int(&e["vertex1"]), int(&e["vertex2"])].map(|i| i as u32))
             .collect();
-        assert_eq!(got, expected_segments(&built.curves), "{name}");
+        assert_eq!(got, expected_segments(built.shown_curves()), "{name}");
     }
 }
 
@@ -441,7 +441,12 @@ fn a_scene_reads_back_from_its_glb_with_every_surface_and_its_halo() {
     // The curves' exact polylines, in halo4d's frame, as the viewer draws them; gone (and
     // no error) when another program re-used their accessors.
     let c = read.curves.as_ref().expect("the curves' polylines");
-    let points: Vec<_> = built.curves.curves.iter().flat_map(|c| &c.points).collect();
+    let points: Vec<_> = built
+        .shown_curves()
+        .curves
+        .iter()
+        .flat_map(|c| &c.points)
+        .collect();
     let want: Vec<DVec3> = points
         .iter()
         .map(|p| p.position.as_vec3().as_dvec3())

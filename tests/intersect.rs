@@ -458,7 +458,7 @@ fn flat_torus_build() -> halo4d::Built {
 }
 
 fn verify(built: &halo4d::Built, scene: &Scene) -> halo4d::Verification {
-    halo4d::verify(&built.parts(&scene.halo))
+    halo4d::verify(&built.verified_parts(&scene.halo))
 }
 
 #[test]

@@ -254,7 +254,7 @@ fn away_from_crossings_nothing_is_hidden() {
     let (w, h) = (torus.scene.render.width, torus.scene.render.height);
     let curves: Vec<DVec3> = torus
         .built
-        .curves
+        .shown_curves()
         .curves
         .iter()
         .flat_map(|c| c.points.iter().map(|p| p.position))
@@ -405,7 +405,7 @@ fn the_drawn_curves_lie_on_the_computed_curves_at_the_width_asked_for() {
     let (w, h) = (400usize, 400usize);
     // The computed curves, projected: one polyline per curve.
     let projected: Vec<Vec<[f64; 2]>> = built
-        .curves
+        .shown_curves()
         .curves
         .iter()
         .map(|c| {
@@ -829,7 +829,7 @@ fn inks_along_the_curves(
         })
     };
     built
-        .curves
+        .shown_curves()
         .curves
         .iter()
         .enumerate()

@@ -143,3 +143,45 @@ fn the_point_alone_is_the_point_of_the_full_evaluation() {
         }
     }
 }
+
+#[test]
+fn parameters_past_a_glued_side_continue_on_the_side_it_is_glued_to() {
+    use halo4d::{KleinBottle, Patches, ProjectivePlane};
+    let close = |s: &Surface, a: (usize, f64, f64), b: (usize, f64, f64)| {
+        let (p, q) = (s.point(a.0, a.1, a.2), s.point(b.0, b.1, b.2));
+        assert!(p.distance(q) < 1e-12, "{p} against {q}");
+    };
+    // The Klein bottle's u sides are glued with a flip of v; its formula continues past
+    // them to the same points.
+    let klein = Surface::KleinBottle(KleinBottle::default());
+    let (patch, u, v, inside) = klein.chart(0, -0.1, 1.0);
+    assert!(inside);
+    assert!((u - (std::f64::consts::TAU - 0.1)).abs() < 1e-12, "{u}");
+    assert!((v - (std::f64::consts::TAU - 1.0)).abs() < 1e-12, "{v}");
+    close(&klein, (0, -0.1, 1.0), (patch, u, v));
+    // Past a corner: both sides in turn.
+    let (patch, u, v, inside) = klein.chart(0, 6.4, -0.2);
+    assert!(
+        inside && (0.0..=std::f64::consts::TAU).contains(&u),
+        "{u} {v}"
+    );
+    close(&klein, (0, 6.4, -0.2), (patch, u, v));
+    // The projective plane's equator is glued to itself by a half turn: past it is the
+    // antipodal point, where the formula continues too.
+    let plane = Surface::ProjectivePlane(ProjectivePlane::default());
+    let (patch, u, v, inside) = plane.chart(0, std::f64::consts::FRAC_PI_2 + 0.05, 1.0);
+    assert!(inside && u < std::f64::consts::FRAC_PI_2, "{u}");
+    close(
+        &plane,
+        (0, std::f64::consts::FRAC_PI_2 + 0.05, 1.0),
+        (patch, u, v),
+    );
+    // Past a pole or an open side, nothing to continue on.
+    assert!(!plane.chart(0, -0.01, 1.0).3);
+    let patches = Surface::Patches(Patches::default());
+    let d = patches.domain(0);
+    assert!(!patches.chart(0, d.u[1] + 0.01, d.v[0]).3);
+    // Inside, or off by rounding, the parameters are returned as they are.
+    assert_eq!(klein.chart(0, 1.0, 2.0), (0, 1.0, 2.0, true));
+    assert!(patches.chart(0, d.u[0] - 1e-14, d.v[0]).3);
+}

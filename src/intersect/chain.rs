@@ -140,6 +140,7 @@ fn point(soup: &Soup, node: Node, sheets: [u32; 2], face: &impl Fn(u32) -> Face)
     };
     CurvePoint {
         position: placed.position,
+        on_mesh: placed.position,
         w,
         faces: sheets.map(face),
         node,

@@ -26,11 +26,11 @@ pub mod refine;
 pub mod sos;
 
 pub use exact::Node;
-pub use refine::{Analytic, CurveSettings, Refinement, refine};
 use exact::{Pair, Segment, Soup};
 use glam::DVec3;
 use obvhs::aabb::Aabb;
 use rayon::prelude::*;
+pub use refine::{Analytic, CurveSettings, Refinement, refine};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -59,6 +59,11 @@ pub struct Face {
 pub struct CurvePoint {
     /// Where it is.
     pub position: DVec3,
+    /// Where the mesh's curve has it: `position` for the mesh's own curves; for refined
+    /// ones, the mesh point it was moved from, on both sheets' triangles (the picture
+    /// decides there what hides the curve, so that a point moved off the mesh by its error
+    /// is not hidden by its own sheets).
+    pub on_mesh: DVec3,
     /// w-depth of the curve's two sheets here, labelled consistently along the curve.
     pub w: [f64; 2],
     /// A triangle of each sheet that contains the point.

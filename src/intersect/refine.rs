@@ -128,11 +128,7 @@ pub fn refine(
 ) -> Curves {
     let start = Instant::now();
     let solver = Solver::new(sheets, analytic, view, diagonal);
-    let done: Vec<(Curve, Tally)> = curves
-        .curves
-        .par_iter()
-        .map(|c| solver.curve(c))
-        .collect();
+    let done: Vec<(Curve, Tally)> = curves.curves.par_iter().map(|c| solver.curve(c)).collect();
     let triples: Vec<(TriplePoint, Option<f64>)> = curves
         .triple_points
         .par_iter()
@@ -355,8 +351,7 @@ impl<'a> Solver<'a> {
                     continue;
                 }
                 let mut i = first as isize + step;
-                while (1..n as isize - 1).contains(&i) && found[i as usize].is_none()
-                {
+                while (1..n as isize - 1).contains(&i) && found[i as usize].is_none() {
                     keep[i as usize] = false;
                     i += step;
                 }
@@ -370,20 +365,12 @@ impl<'a> Solver<'a> {
                     r.refined += 1;
                     r.max_residual = r.max_residual.max(f.residual);
                     r.max_shift = r.max_shift.max(f.point.position.distance(p.position));
-                    if std::env::var("HALO4D_DEBUG_REFINE").is_ok() && f.point.position.distance(p.position) > 0.03 {
-                        eprintln!("big shift {} at i {i}/{n} closed {} pos {} -> {}", f.point.position.distance(p.position), c.closed, p.position, f.point.position);
-                    }
                     r.over_under_changed +=
                         usize::from(f.point.near() != p.near() && f.point.w[0] != f.point.w[1]);
                     out.points[i] = f.point;
                 }
                 None if !keep[i] => r.trimmed += 1,
-                None => {
-                    if std::env::var("HALO4D_DEBUG_REFINE").is_ok() {
-                        eprintln!("pair fail: i {i}/{n} end {:?} closed {} faces {:?} pos {}", end(i), c.closed, p.faces, p.position);
-                    }
-                    r.not_converged += 1
-                }
+                None => r.not_converged += 1,
             }
         }
         if r.trimmed > 0 {
@@ -430,14 +417,12 @@ impl<'a> Solver<'a> {
     fn eval(&self, p: &Param) -> Option<Solved> {
         let e = self.analytic[p.sheet].surface.eval(p.patch, p.u, p.v);
         let mapped = self.view.map(&e)?;
-        mapped.position.is_finite().then_some(
-            Solved {
-                param: *p,
-                mapped,
-                point: e.p,
-                tangents: [e.du, e.dv],
-            },
-        )
+        mapped.position.is_finite().then_some(Solved {
+            param: *p,
+            mapped,
+            point: e.p,
+            tangents: [e.du, e.dv],
+        })
     }
 
     /// At a curve end on a mesh boundary: the parameter of the boundary its edge lies on,
@@ -458,7 +443,9 @@ impl<'a> Solver<'a> {
         let uv = mesh.triangle_uv[t];
         let corner = |g: u32| tri.iter().position(|&v| v == g);
         let (a, b) = (uv[corner(edge[0])?], uv[corner(edge[1])?]);
-        let d = self.analytic[s].surface.domain(mesh.triangle_patch[t] as usize);
+        let d = self.analytic[s]
+            .surface
+            .domain(mesh.triangle_patch[t] as usize);
         let on = |k: usize, ends: [f64; 2]| {
             ends.into_iter()
                 .find(|&e| a[k] == e && b[k] == e)
@@ -685,16 +672,6 @@ impl<'a> Solver<'a> {
             solved[i].point.distance(solved[j].point) >= COLLAPSE * s
         };
         if !(residual <= self.residual && (0..k).all(near) && same.iter().all(apart)) {
-            if std::env::var("HALO4D_DEBUG_REFINE").is_ok() {
-                eprintln!(
-                    "  newton: residual {residual:e} inside {inside:?} near {:?} dist {:?} reach {:?} sep {:?} start sep {:?}",
-                    (0..k).map(near).collect::<Vec<_>>(),
-                    (0..k).map(|i| solved[i].point.distance(starts[i].mesh_point)).collect::<Vec<_>>(),
-                    (0..k).map(|i| starts[i].reach).collect::<Vec<_>>(),
-                    solved[0].point.distance(solved[1].point),
-                    same,
-                );
-            }
             return Err(Failure::Other);
         }
         // A point past an open side or a pole: on the surface's extension, not on it.
@@ -751,7 +728,6 @@ impl<'a> Solver<'a> {
             // The surface itself must be regular here (not a parametrization singularity).
             let area2 = e.du.length_squared() * e.dv.length_squared() - e.du.dot(e.dv).powi(2);
             if !(area2 > 1e-12 * e.du.length_squared() * e.dv.length_squared()) {
-                if std::env::var("HALO4D_DEBUG_REFINE").is_ok() { eprintln!("cross-cap singular at {patch} {u} {w}"); }
                 return CrossCap::NotFound;
             }
             if g.length() <= 1e-3 * CROSS_CAP_RANK * scale {
@@ -786,9 +762,6 @@ impl<'a> Solver<'a> {
                 ..*p
             })
         } else {
-            if std::env::var("HALO4D_DEBUG_REFINE").is_ok() {
-                eprintln!("cross-cap fail: inside {inside} rank {rank:e} dist {} reach {reach} start uv {:?} end uv {patch} {u} {w} pos {}", e.p.distance(origin), a.mesh.uv[v], p.position);
-            }
             CrossCap::NotFound
         }
     }

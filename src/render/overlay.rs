@@ -44,10 +44,13 @@ pub(super) struct Lines {
 /// where they have the same sheet over, so a curve with one sheet over throughout is one
 /// piece, drawn as in a single ink). A curve whose sheets' w are equal everywhere is one
 /// piece with no sheet over.
-pub(crate) fn over_pieces(
-    points: &[(DVec3, Option<usize>)],
+pub(crate) fn over_pieces<T>(
+    points: &[(T, Option<usize>)],
     closed: bool,
-) -> Vec<(Option<usize>, Vec<DVec3>)> {
+) -> Vec<(Option<usize>, Vec<T>)>
+where
+    T: Copy + std::ops::Add<Output = T> + std::ops::Mul<f64, Output = T>,
+{
     let Some(&(first, _)) = points.first() else {
         return Vec::new();
     };
@@ -62,7 +65,7 @@ pub(crate) fn over_pieces(
     } else {
         first_over
     };
-    let mut resolved: Vec<(DVec3, usize)> = points
+    let mut resolved: Vec<(T, usize)> = points
         .iter()
         .map(|&(p, near)| {
             over = near.unwrap_or(over);
@@ -110,7 +113,7 @@ impl Scene<'_> {
             return Ok(Vec::new());
         }
         let (w, h) = (s.width, s.height);
-        let mut polylines: Vec<(InkClass, Vec<DVec3>)> = Vec::new();
+        let mut polylines: Vec<(InkClass, Vec<LinePoint>)> = Vec::new();
         if s.curves {
             for c in &self.input.curves.curves {
                 polylines.extend(curve_polylines(c, s.curve_colours));
@@ -120,7 +123,7 @@ impl Scene<'_> {
             polylines.extend(
                 self.silhouette_edges(cam)
                     .into_iter()
-                    .map(|[a, b]| (0, vec![a, b])),
+                    .map(|[a, b]| (0, vec![LinePoint::plain(a), LinePoint::plain(b)])),
             );
         }
         let depth_of = |p: DVec3| (p - cam.eye).dot(cam.forward);
@@ -153,7 +156,8 @@ impl Scene<'_> {
             };
             for pair in line.windows(2) {
                 let (a, b) = (pair[0], pair[1]);
-                let (Some((pa, _)), Some((pb, _))) = (cam.project(a, w, h), cam.project(b, w, h))
+                let (Some((pa, _)), Some((pb, _))) =
+                    (cam.project(a.at, w, h), cam.project(b.at, w, h))
                 else {
                     flush(&mut run)?;
                     continue;
@@ -163,7 +167,8 @@ impl Scene<'_> {
                     if k == 0 && !run.is_empty() {
                         continue;
                     }
-                    let p = a + (b - a) * (k as f64 / steps as f64);
+                    let f = k as f64 / steps as f64;
+                    let (p, seen) = (a.at + (b.at - a.at) * f, a.seen + (b.seen - a.seen) * f);
                     let Some((xy, _)) = cam.project(p, w, h) else {
                         flush(&mut run)?;
                         continue;
@@ -172,7 +177,7 @@ impl Scene<'_> {
                         && xy[1] >= 0.0
                         && xy[0] < f64::from(w)
                         && xy[1] < f64::from(h);
-                    let visible = inside && (see_through || !self.occluded(cam, p, &mut hits));
+                    let visible = inside && (see_through || !self.occluded(cam, seen, &mut hits));
                     if visible {
                         run.push((DVec2::new(xy[0], xy[1]), width_at(p)));
                     } else {
@@ -262,22 +267,61 @@ impl Scene<'_> {
     }
 }
 
+/// A point of a line: where it is drawn, and where its visibility is decided (the mesh's
+/// point of a refined curve point, [`crate::CurvePoint::on_mesh`]; the point itself
+/// otherwise).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct LinePoint {
+    at: DVec3,
+    seen: DVec3,
+}
+
+impl LinePoint {
+    fn plain(at: DVec3) -> Self {
+        LinePoint { at, seen: at }
+    }
+}
+
+impl std::ops::Add for LinePoint {
+    type Output = LinePoint;
+    fn add(self, o: LinePoint) -> LinePoint {
+        LinePoint {
+            at: self.at + o.at,
+            seen: self.seen + o.seen,
+        }
+    }
+}
+
+impl std::ops::Mul<f64> for LinePoint {
+    type Output = LinePoint;
+    fn mul(self, k: f64) -> LinePoint {
+        LinePoint {
+            at: self.at * k,
+            seen: self.seen * k,
+        }
+    }
+}
+
 /// A curve's polylines with the mask each is drawn into: the whole curve in the single ink,
 /// or its pieces in the ink of the sheet over them (a curve with no sheet over anywhere in
 /// the single ink).
-fn curve_polylines(c: &Curve, colours: bool) -> Vec<(InkClass, Vec<DVec3>)> {
+fn curve_polylines(c: &Curve, colours: bool) -> Vec<(InkClass, Vec<LinePoint>)> {
+    let point = |p: &crate::intersect::CurvePoint| LinePoint {
+        at: p.position,
+        seen: p.on_mesh,
+    };
     if colours {
-        let points: Vec<(DVec3, Option<usize>)> = c
+        let points: Vec<(LinePoint, Option<usize>)> = c
             .points
             .iter()
-            .map(|p| (p.position, (p.w[0] != p.w[1]).then(|| p.near())))
+            .map(|p| (point(p), (p.w[0] != p.w[1]).then(|| p.near())))
             .collect();
         over_pieces(&points, c.closed)
             .into_iter()
             .map(|(near, piece)| (near.map_or(0, |n| 1 + n), piece))
             .collect()
     } else {
-        let mut p: Vec<DVec3> = c.points.iter().map(|p| p.position).collect();
+        let mut p: Vec<LinePoint> = c.points.iter().map(point).collect();
         if c.closed && !p.is_empty() {
             p.push(p[0]);
         }

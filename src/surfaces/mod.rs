@@ -438,19 +438,25 @@ impl Surface {
             let (eu, ev) = (d.u[1] - d.u[0], d.v[1] - d.v[0]);
             let (su, sv) = ((u - d.u[0]) / eu, (v - d.v[0]) / ev);
             let over = [-su, su - 1.0, -sv, sv - 1.0];
-            let (k, depth) = over
-                .iter()
-                .copied()
-                .enumerate()
-                .fold((0, f64::NEG_INFINITY), |m, (k, o)| if o > m.1 { (k, o) } else { m });
+            let (k, depth) =
+                over.iter()
+                    .copied()
+                    .enumerate()
+                    .fold(
+                        (0, f64::NEG_INFINITY),
+                        |m, (k, o)| if o > m.1 { (k, o) } else { m },
+                    );
             if !(depth > SLACK) {
                 return (patch, u, v, depth.is_finite());
             }
-            let sigma = if k < 2 { sv } else { su }.clamp(0.0, 1.0);
+            // The piece is chosen at the side; past a corner the other coordinate carries
+            // its own overshoot across, for the next round.
+            let sigma = if k < 2 { sv } else { su };
+            let at = sigma.clamp(0.0, 1.0);
             let SideRule::Glued(pieces) = d.side(Side::ALL[k]) else {
                 return (patch, u, v, false);
             };
-            let Some(g) = pieces.iter().find(|g| g.from <= sigma && sigma <= g.to) else {
+            let Some(g) = pieces.iter().find(|g| g.from <= at && at <= g.to) else {
                 return (patch, u, v, false);
             };
             let to = self.domain(g.patch);
