@@ -65,7 +65,7 @@ pub use sample::{
 };
 pub use stipple::{Stipples, poisson_radius};
 pub use surfaces::{
-    Domain, Eval4, Fermat, FlatTorus, Glue, KleinBottle, Patches, ProductPolynomial,
+    Domain, Eval4, Fermat, FlatTorus, Glue, Jet, KleinBottle, Patches, ProductPolynomial,
     ProjectivePlane, Side, SideRule, SpunTrefoil, Surface, Topology, TwistSpunTrefoil,
 };
 pub use verify::{Ambiguous, Verification, verify};

@@ -141,3 +141,46 @@ fn normals_are_unit_and_fall_back_where_tangents_degenerate() {
         assert!((n.length() - 1.0).abs() < 1e-12, "{n}");
     }
 }
+
+#[test]
+fn the_view_maps_points_and_jets_with_the_exact_derivatives_of_the_projection() {
+    // A perspective view of the spun trefoil: the jets' first derivatives are the mapped
+    // tangents, and their second derivatives the tangents' own, by central differences.
+    let scene = halo4d::Scene::parse(
+        r#"{"name": "v", "surfaces": [{"surface": {"type": "spun_trefoil"}}],
+            "view": {"rotation": {"xw": 25, "yz": 40, "zw": -15}, "translation": [0.1, 0, 0, 0.3],
+                     "projection": {"type": "perspective", "eye_distance": 3.0}}}"#,
+        "test",
+    )
+    .unwrap();
+    let surface = &scene.surfaces[0].surface;
+    let map = scene.view.map();
+    let (u, v, h) = (0.7, 1.9, 1e-5);
+    let jets = map.jets(&surface.eval(0, u, v)).unwrap();
+    let mapped = map.map(&surface.eval(0, u, v)).unwrap();
+    let at = |f: fn(&halo4d::Jet) -> f64| DVec3::new(f(&jets[0]), f(&jets[1]), f(&jets[2]));
+    assert!(at(|j| j.v).distance(mapped.position) < 1e-15);
+    assert!(at(|j| j.du).distance(mapped.tangents[0]) < 1e-14);
+    assert!(at(|j| j.dv).distance(mapped.tangents[1]) < 1e-14);
+    assert!((jets[3].v - mapped.w).abs() < 1e-15);
+    let tangent =
+        |du: f64, dv: f64, k: usize| map.map(&surface.eval(0, u + du, v + dv)).unwrap().tangents[k];
+    let duu = (tangent(h, 0.0, 0) - tangent(-h, 0.0, 0)) / (2.0 * h);
+    let duv = (tangent(0.0, h, 0) - tangent(0.0, -h, 0)) / (2.0 * h);
+    let dvv = (tangent(0.0, h, 1) - tangent(0.0, -h, 1)) / (2.0 * h);
+    assert!(
+        at(|j| j.duu).distance(duu) < 1e-6,
+        "{} {duu}",
+        at(|j| j.duu)
+    );
+    assert!(
+        at(|j| j.duv).distance(duv) < 1e-6,
+        "{} {duv}",
+        at(|j| j.duv)
+    );
+    assert!(
+        at(|j| j.dvv).distance(dvv) < 1e-6,
+        "{} {dvv}",
+        at(|j| j.dvv)
+    );
+}

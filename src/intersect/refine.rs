@@ -128,7 +128,30 @@ pub fn refine(
 ) -> Curves {
     let start = Instant::now();
     let solver = Solver::new(sheets, analytic, view, diagonal);
-    let done: Vec<(Curve, Tally)> = curves.curves.par_iter().map(|c| solver.curve(c)).collect();
+    // Every point's first try on the cores, then each curve's second tries and trimming.
+    let points: Vec<(usize, usize)> = curves
+        .curves
+        .iter()
+        .enumerate()
+        .flat_map(|(k, c)| (0..c.points.len()).map(move |i| (k, i)))
+        .collect();
+    let mut tries: Vec<Try> = points
+        .par_iter()
+        .with_min_len(64)
+        .map(|&(k, i)| solver.first_try(&curves.curves[k], i))
+        .collect();
+    let mut per_curve = Vec::with_capacity(curves.curves.len());
+    for c in curves.curves.iter().rev() {
+        let rest = tries.len() - c.points.len();
+        per_curve.push(tries.split_off(rest));
+    }
+    per_curve.reverse();
+    let done: Vec<(Curve, Tally)> = curves
+        .curves
+        .par_iter()
+        .zip(per_curve)
+        .map(|(c, tries)| solver.finish(c, tries))
+        .collect();
     let triples: Vec<(TriplePoint, Option<f64>)> = curves
         .triple_points
         .par_iter()
@@ -268,76 +291,72 @@ impl<'a> Solver<'a> {
         }
     }
 
-    /// A curve with its points refined, and what was done. Each point starts from its
-    /// own triangles; a point that fails so starts again from the solution of a neighbour
-    /// along the curve (near a cross-cap, where the two sheets meet at a small angle and
-    /// the mesh's point is far off, the neighbour's solution is the better guess).
-    fn curve(&self, c: &Curve) -> (Curve, Tally) {
+    /// The first try at point `i` of curve `c`: a curve end at a mesh vertex looks for its
+    /// cross-cap, any other point starts Newton from its own triangles.
+    fn first_try(&self, c: &Curve, i: usize) -> Try {
+        let p = &c.points[i];
+        match (end(c, i), p.node) {
+            (Some(End::BranchPoint), Node::Vertex(v)) => Try::CrossCap(self.cross_cap(v, p)),
+            _ => Try::Pair(self.curve_point(c, i, None)),
+        }
+    }
+
+    /// Point `i` of curve `c` refined from `from` (its own triangles when `None`).
+    fn curve_point(&self, c: &Curve, i: usize, from: Option<[Param; 2]>) -> Option<Pair> {
+        let p = &c.points[i];
+        // The curve's direction from its neighbours, where the sheets' normals give none.
+        let at = |j: Option<usize>| j.map_or(p.position, |j| c.points[j].position);
+        let along = at(neighbour(c, i, true)) - at(neighbour(c, i, false));
+        let boundary = (end(c, i) == Some(End::Boundary))
+            .then(|| self.boundary(p))
+            .flatten();
+        self.pair(p, along, boundary, from)
+    }
+
+    /// A curve with its points refined from the first tries `tries` (one per point), and
+    /// what was done. A point whose first try failed starts again from the solution of a
+    /// neighbour along the curve, both ways (near a cross-cap, where the two sheets meet at
+    /// a small angle and the mesh's point is far off, the neighbour's solution is the
+    /// better guess).
+    fn finish(&self, c: &Curve, tries: Vec<Try>) -> (Curve, Tally) {
         let mut tally = Tally::default();
+        let r = &mut tally.report;
         let n = c.points.len();
         let mut out = c.clone();
-        let end = |i: usize| match (c.closed, i) {
-            (true, _) => None,
-            (false, 0) => Some(c.ends[0]),
-            (false, i) if i + 1 == n => Some(c.ends[1]),
-            _ => None,
-        };
-        let neighbour = |i: usize, forward: bool| -> Option<usize> {
-            match (forward, i) {
-                (true, i) if i + 1 < n => Some(i + 1),
-                (true, _) => c.closed.then_some(0),
-                (false, 0) => c.closed.then(|| n - 1),
-                (false, i) => Some(i - 1),
-            }
-        };
         let mut found: Vec<Option<Pair>> = vec![None; n];
         let mut pairs = Vec::new();
-        for (i, p) in c.points.iter().enumerate() {
-            let r = &mut tally.report;
-            if let (Some(End::BranchPoint), Node::Vertex(v)) = (end(i), p.node) {
-                match self.cross_cap(v, p) {
-                    CrossCap::Found(q) => {
-                        r.refined += 1;
-                        r.cross_caps += 1;
-                        r.max_cross_cap_shift =
-                            r.max_cross_cap_shift.max(q.position.distance(p.position));
-                        out.points[i] = q;
-                    }
-                    CrossCap::Pole => r.pole_ends += 1,
-                    CrossCap::NotFound => r.not_converged += 1,
+        for (i, t) in tries.into_iter().enumerate() {
+            match t {
+                Try::CrossCap(CrossCap::Found(q)) => {
+                    r.refined += 1;
+                    r.cross_caps += 1;
+                    r.max_cross_cap_shift = r
+                        .max_cross_cap_shift
+                        .max(q.position.distance(c.points[i].position));
+                    out.points[i] = q;
                 }
-                continue;
+                Try::CrossCap(CrossCap::Pole) => r.pole_ends += 1,
+                Try::CrossCap(CrossCap::NotFound) => r.not_converged += 1,
+                Try::Pair(pair) => {
+                    pairs.push(i);
+                    found[i] = pair;
+                }
             }
-            // The curve's direction from its neighbours, where the sheets' normals give none.
-            let at = |j: Option<usize>| j.map_or(p.position, |j| c.points[j].position);
-            let along = at(neighbour(i, true)) - at(neighbour(i, false));
-            let boundary = (end(i) == Some(End::Boundary))
-                .then(|| self.boundary(p))
-                .flatten();
-            pairs.push(i);
-            found[i] = self.pair(p, along, boundary, None);
         }
         for forward in [true, false] {
-            let order: Vec<usize> = if forward {
-                pairs.clone()
-            } else {
-                pairs.iter().rev().copied().collect()
-            };
-            for &i in &order {
+            for k in 0..pairs.len() {
+                let i = if forward {
+                    pairs[k]
+                } else {
+                    pairs[pairs.len() - 1 - k]
+                };
                 if found[i].is_some() {
                     continue;
                 }
-                let Some(from) = neighbour(i, !forward).and_then(|j| found[j].map(|f| f.params))
-                else {
-                    continue;
-                };
-                let p = &c.points[i];
-                let at = |j: Option<usize>| j.map_or(p.position, |j| c.points[j].position);
-                let along = at(neighbour(i, true)) - at(neighbour(i, false));
-                let boundary = (end(i) == Some(End::Boundary))
-                    .then(|| self.boundary(p))
-                    .flatten();
-                found[i] = self.pair(p, along, boundary, Some(from));
+                let from = neighbour(c, i, !forward).and_then(|j| found[j].map(|f| f.params));
+                if from.is_some() {
+                    found[i] = self.curve_point(c, i, from);
+                }
             }
         }
         // Points that failed next to an end moved onto its cross-cap lie beyond the true
@@ -357,7 +376,6 @@ impl<'a> Solver<'a> {
                 }
             }
         }
-        let r = &mut tally.report;
         for &i in &pairs {
             let p = &c.points[i];
             match found[i] {
@@ -765,6 +783,35 @@ impl<'a> Solver<'a> {
             CrossCap::NotFound
         }
     }
+}
+
+/// How curve point `i` of `c` ends the curve, if it does.
+fn end(c: &Curve, i: usize) -> Option<End> {
+    match (c.closed, i) {
+        (true, _) => None,
+        (false, 0) => Some(c.ends[0]),
+        (false, i) if i + 1 == c.points.len() => Some(c.ends[1]),
+        _ => None,
+    }
+}
+
+/// The point after (`forward`) or before point `i` along curve `c`, round a closed curve.
+fn neighbour(c: &Curve, i: usize, forward: bool) -> Option<usize> {
+    let n = c.points.len();
+    match (forward, i) {
+        (true, i) if i + 1 < n => Some(i + 1),
+        (true, _) => c.closed.then_some(0),
+        (false, 0) => c.closed.then(|| n - 1),
+        (false, i) => Some(i - 1),
+    }
+}
+
+/// A curve point's first try.
+enum Try {
+    /// At a curve end on a mesh vertex: the search for its cross-cap.
+    CrossCap(CrossCap),
+    /// Elsewhere: Newton from the point's own triangles.
+    Pair(Option<Pair>),
 }
 
 /// Why Newton's method gave no point.
