@@ -103,6 +103,9 @@ const MAX_STEPS: usize = 24;
 /// Accepted residual, a share of the scene's diagonal.
 const RESIDUAL: f64 = 1e-13;
 
+/// A residual at rounding, a share of the scene's diagonal: Newton stops there.
+const ROUNDING: f64 = 1e-15;
+
 /// Accepted |f_u × f_v| at a cross-cap, a share of |S_u| |S_v| (the surface's own tangents
 /// in R^4, which a regular point keeps apart): the projection's rank drops where f_u and
 /// f_v are parallel or one of them vanishes.
@@ -247,6 +250,10 @@ struct Pair {
 /// The equation that completes a curve point's three.
 #[derive(Clone, Copy, Debug)]
 enum Fourth {
+    /// The point of sheet 0 lies in the plane through `origin` across the curve: its normal
+    /// is the cross product of the two sheets' normals where Newton starts (`along`, the
+    /// curve's direction from its neighbours, where they are parallel).
+    Across { origin: DVec3, along: DVec3 },
     /// The point of sheet 0 lies in the plane through `origin` with normal `normal`.
     Plane { origin: DVec3, normal: DVec3 },
     /// Unknown `index` (u1, v1, u2, v2) equals `value` (a boundary's parameter).
@@ -259,6 +266,8 @@ struct Solver<'a> {
     view: ViewMap,
     /// Accepted residual, in scene units.
     residual: f64,
+    /// A residual at rounding, in scene units.
+    rounding: f64,
     /// First global triangle and vertex of each sheet (as the curves number them).
     tri_start: Vec<u32>,
     vertex_start: Vec<u32>,
@@ -286,6 +295,7 @@ impl<'a> Solver<'a> {
             analytic,
             view: view.map(),
             residual: RESIDUAL * diagonal,
+            rounding: ROUNDING * diagonal,
             tri_start: starts(&|s| s.triangles.len()),
             vertex_start: starts(&|s| s.positions.len()),
         }
@@ -490,24 +500,10 @@ impl<'a> Solver<'a> {
             starts[0].param = from[0];
             starts[1].param = from[1];
         }
-        let fourth = match boundary {
-            Some(b) => b,
-            None => {
-                let [a, b] = [self.eval(&starts[0].param)?, self.eval(&starts[1].param)?];
-                let normal = |s: &Solved| s.mapped.tangents[0].cross(s.mapped.tangents[1]);
-                let (na, nb) = (normal(&a), normal(&b));
-                let across = na.cross(nb);
-                let normal = if across.length() > 1e-8 * na.length() * nb.length() {
-                    across
-                } else {
-                    along
-                };
-                Fourth::Plane {
-                    origin: p.position,
-                    normal: normal.try_normalize()?,
-                }
-            }
-        };
+        let fourth = boundary.unwrap_or(Fourth::Across {
+            origin: p.position,
+            along,
+        });
         let (solved, residual) = match self.newton::<4>(&starts, Some(fourth)) {
             Ok(found) => found,
             Err(Failure::Outside(edge)) if boundary.is_none() => {
@@ -558,14 +554,14 @@ impl<'a> Solver<'a> {
     fn newton<const N: usize>(
         &self,
         starts: &[Start],
-        fourth: Option<Fourth>,
+        mut fourth: Option<Fourth>,
     ) -> Result<(Vec<Solved>, f64), Failure> {
         let k = N / 2;
         let mut params: Vec<Param> = starts.iter().map(|s| s.param).collect();
         let mut inside = vec![true; k];
         let mut solved: Vec<Solved> = Vec::with_capacity(k);
         let mut residual = f64::INFINITY;
-        let mut polished = false;
+        let mut previous = f64::INFINITY;
         // The pairs of points on one surface, with their distance at the start.
         let same: Vec<(usize, usize, f64)> = (0..k)
             .flat_map(|i| (i + 1..k).map(move |j| (i, j)))
@@ -595,10 +591,25 @@ impl<'a> Solver<'a> {
                     jac[row][2 * i + 1] = -solved[i].mapped.tangents[1][r];
                 }
             }
+            if let Some(Fourth::Across { origin, along }) = fourth {
+                let normal = |s: &Solved| s.mapped.tangents[0].cross(s.mapped.tangents[1]);
+                let (na, nb) = (normal(&solved[0]), normal(&solved[1]));
+                let across = na.cross(nb);
+                let normal = if across.length() > 1e-8 * na.length() * nb.length() {
+                    across
+                } else {
+                    along
+                };
+                fourth = Some(Fourth::Plane {
+                    origin,
+                    normal: normal.try_normalize().ok_or(Failure::Other)?,
+                });
+            }
             let mut fourth_ok = true;
             if let Some(f) = fourth {
                 let last = N - 1;
                 match f {
+                    Fourth::Across { .. } => unreachable!("made a plane above"),
                     Fourth::Plane { origin, normal } => {
                         let c = normal.dot(x0 - origin);
                         rhs[last] = -c;
@@ -615,13 +626,15 @@ impl<'a> Solver<'a> {
                     }
                 }
             }
-            // Within the limit, one more step reaches rounding.
-            if residual <= self.residual && fourth_ok {
-                if polished {
-                    break;
-                }
-                polished = true;
+            // Within the limit: done at rounding, or when a step no longer gains much
+            // (Newton's quadratic convergence gains orders of magnitude until rounding).
+            if residual <= self.residual
+                && fourth_ok
+                && (residual <= self.rounding || residual > 0.25 * previous)
+            {
+                break;
             }
+            previous = residual;
             if step == MAX_STEPS {
                 break;
             }
