@@ -4,8 +4,9 @@
 //! bottle and the flat torus, at relative tolerances 1e-2 to 1e-5, the adaptive sampler and
 //! the coarsest uniform grid that meets each tolerance, audited alike. It prints the table
 //! (with the ratio of uniform to adaptive triangles) and writes
-//! `exports/reports/speed_vs_error.csv` and `exports/reports/speed_vs_error.png`, the same
-//! files `halo4d sweep` writes for a scene. Then criterion times adaptive sampling plus
+//! `exports/reports/speed_vs_error.csv`, `exports/reports/speed_vs_error.png` and
+//! `exports/reports/curves_vs_error.png`, the same files `halo4d sweep` writes for a scene
+//! (each mesh's curves in the default scene's view). Then criterion times adaptive sampling plus
 //! audit at 1e-3 and 1e-4 for every surface, and at 1e-5 for the quartic Fermat.
 //!
 //! `cargo bench --bench speed_vs_error` (several minutes: the uniform grids that reach

@@ -35,8 +35,10 @@ enum Command {
         allow_unverified: bool,
     },
     /// Speed against error: for each surface of a scene, the adaptive sampler and the
-    /// coarsest uniform grid at relative tolerances 1e-2 to 1e-5, audited alike. Writes
-    /// speed_vs_error.csv and speed_vs_error.png.
+    /// coarsest uniform grid at relative tolerances 1e-2 to 1e-5, audited alike, each mesh
+    /// with its self-intersection curves in the scene's view (time, the mesh curve's error,
+    /// the refined curve's residual). Writes speed_vs_error.csv, speed_vs_error.png and
+    /// curves_vs_error.png.
     Sweep {
         /// Scene file (JSON) [default: the built-in default scene].
         scene: Option<PathBuf>,
@@ -241,6 +243,7 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
                 let settings = sweep::Settings {
                     tolerances,
                     max_triangles,
+                    view: scene.view,
                 };
                 let mut progress = |msg: &str| {
                     if !quiet {

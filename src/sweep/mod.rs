@@ -8,6 +8,14 @@
 //! patch's metric aspect ratio, and that ratio halved and doubled; the shape that needs the
 //! fewest triangles wins. Rows give triangles, sampling milliseconds (the final mesh only,
 //! not the search) and the audited errors relative to the diagonal.
+//!
+//! Every row's mesh (adaptive and uniform alike) also gets its intersection curves in the
+//! scene's view ([`Settings::view`]): the surface alone, as a one-sheet scene, projected,
+//! its self-intersections found by the exact curve stage ([`crate::curves`]) and moved onto
+//! the analytic surface by Newton's method, as a build refines them. The refinement's
+//! largest shift is the mesh curve's error, measured for free; its largest residual is the
+//! refined curve's. Both are relative to the projected mesh's 3D bounding diagonal. A
+//! surface whose projection does not cross itself has no curve: zero points, errors 0.
 
 mod picture;
 mod plot;
@@ -16,16 +24,23 @@ pub use picture::picture_sweep;
 pub use plot::PlotError;
 
 use crate::error::Error;
+use crate::intersect::{self, Analytic, Sheet};
 use crate::limits::{self, FieldError, GRID_CELLS, RELATIVE_TOLERANCE};
 use crate::render::RenderError;
-use crate::sample::{self, audit, bounding_diagonal, sample_adaptive, sample_uniform};
+use crate::sample::{self, Mesh4, audit, bounding_diagonal, sample_adaptive, sample_uniform};
+use crate::scene::Scene;
 use crate::surfaces::Surface;
+use crate::view::{BehindEye, View};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Relative tolerances of the default sweep, 1e-2 down to 1e-5.
 pub const TOLERANCES: [f64; 7] = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5];
+
+/// The floor of the log axis of `curves_vs_error.png`: a refined residual below it (about
+/// 1e-16 to 1e-13 where Newton reached rounding, exactly 0 at times) is drawn at it.
+pub const RESIDUAL_FLOOR: f64 = 1e-17;
 
 /// One line of the sweep.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -48,6 +63,23 @@ pub struct Row {
     pub met: bool,
     /// The grid, for uniform rows (cells along u and v per patch).
     pub grid: Option<[usize; 2]>,
+    /// Milliseconds of the exact curve stage on this mesh (its self-intersections, the
+    /// surface alone as a one-sheet scene, in [`Settings::view`]).
+    pub curve_ms: f64,
+    /// Milliseconds refining those curves onto the analytic surface.
+    pub refine_ms: f64,
+    /// The mesh curve's error: the largest distance from a mesh curve point to its refined
+    /// point (the refinement's `max_shift`; curve ends moved onto a cross-cap not
+    /// included), relative to the projected mesh's 3D bounding diagonal; 0 with no curve.
+    pub curve_error: f64,
+    /// The refined curve's largest |P1 - P2| (the refinement's `max_residual`), relative to
+    /// the same diagonal; 0 with no curve.
+    pub refined_residual: f64,
+    /// Points of the mesh's curves; 0: no curve (the projection does not cross itself).
+    pub curve_points: usize,
+    /// Curve points the refinement kept where the mesh put them (Newton did not converge
+    /// there: the refinement's `not_converged`); they count in neither error.
+    pub not_converged: usize,
 }
 
 /// Settings of a sweep.
@@ -57,13 +89,17 @@ pub struct Settings {
     pub tolerances: Vec<f64>,
     /// The most triangles any one mesh may have.
     pub max_triangles: usize,
+    /// The view in which each mesh's curves are found: the scene's.
+    pub view: View,
 }
 
 impl Default for Settings {
+    /// [`TOLERANCES`], [`limits::SWEEP_TRIANGLES`] and the default scene's view.
     fn default() -> Self {
         Settings {
             tolerances: TOLERANCES.to_vec(),
             max_triangles: limits::SWEEP_TRIANGLES,
+            view: Scene::default_scene().view,
         }
     }
 }
@@ -121,6 +157,14 @@ pub enum SweepError {
     /// A setting is out of range.
     #[error(transparent)]
     Setting(#[from] FieldError),
+    /// A mesh reaches the 4D eye of the view its curves are found in.
+    #[error("surface `{surface}`: {source}")]
+    View {
+        /// The surface.
+        surface: String,
+        /// The offending vertex.
+        source: BehindEye,
+    },
     /// The build the picture sweep draws failed.
     #[error(transparent)]
     Build(#[from] Error),
@@ -144,17 +188,23 @@ fn ms(since: Instant) -> f64 {
     since.elapsed().as_secs_f64() * 1e3
 }
 
-/// Sweeps one surface: an adaptive and a uniform row per tolerance. `progress` is told what
-/// is being done.
+/// Sweeps one surface: an adaptive and a uniform row per tolerance, each with its mesh's
+/// curves. `progress` is told what is being done.
 pub fn sweep_surface(
     name: &str,
     surface: &Surface,
     settings: &Settings,
     progress: &mut dyn FnMut(&str),
-) -> Vec<Row> {
+) -> Result<Vec<Row>, SweepError> {
     let diagonal = bounding_diagonal(surface);
     let mut rows = Vec::new();
     let mut grids = GridSearch::new(surface, diagonal, settings.max_triangles);
+    let curves = |mesh: &Mesh4| {
+        mesh_curves(surface, mesh, &settings.view).map_err(|source| SweepError::View {
+            surface: name.to_string(),
+            source,
+        })
+    };
     for &tolerance in &settings.tolerances {
         progress(&format!("{name}: adaptive at {tolerance:.0e}"));
         let start = Instant::now();
@@ -162,6 +212,10 @@ pub fn sweep_surface(
         let took = ms(start);
         let a = audit(surface, &out.mesh);
         let (max, rms) = a.relative(diagonal);
+        progress(&format!(
+            "{name}: curves of the adaptive mesh at {tolerance:.0e}"
+        ));
+        let c = curves(&out.mesh)?;
         rows.push(Row {
             surface: name.to_string(),
             method: "adaptive",
@@ -172,11 +226,86 @@ pub fn sweep_surface(
             rms_error: rms,
             met: out.complete && max <= tolerance,
             grid: None,
+            curve_ms: c.curve_ms,
+            refine_ms: c.refine_ms,
+            curve_error: c.curve_error,
+            refined_residual: c.refined_residual,
+            curve_points: c.curve_points,
+            not_converged: c.not_converged,
         });
+        drop(out);
         progress(&format!("{name}: uniform grids at {tolerance:.0e}"));
-        rows.push(grids.coarsest(name, tolerance));
+        let (m, met) = grids.coarsest(tolerance);
+        let start = Instant::now();
+        let mesh = sample_uniform(surface, m.cells[0], m.cells[1]);
+        let took = ms(start);
+        progress(&format!(
+            "{name}: curves of the uniform grid at {tolerance:.0e}"
+        ));
+        let c = curves(&mesh)?;
+        rows.push(Row {
+            surface: name.to_string(),
+            method: "uniform",
+            tolerance,
+            triangles: m.triangles,
+            ms: took,
+            max_error: m.max,
+            rms_error: m.rms,
+            met,
+            grid: Some(m.cells),
+            curve_ms: c.curve_ms,
+            refine_ms: c.refine_ms,
+            curve_error: c.curve_error,
+            refined_residual: c.refined_residual,
+            curve_points: c.curve_points,
+            not_converged: c.not_converged,
+        });
     }
-    rows
+    Ok(rows)
+}
+
+/// What a mesh's curves cost and how far they are from the surface's: [`Row`]'s curve
+/// columns.
+struct MeshCurves {
+    curve_ms: f64,
+    refine_ms: f64,
+    curve_error: f64,
+    refined_residual: f64,
+    curve_points: usize,
+    not_converged: usize,
+}
+
+/// The self-intersection curves of `mesh` (of `surface`) projected by `view`, as a
+/// one-sheet scene, and their refinement onto the surface; errors relative to the
+/// projected mesh's 3D bounding diagonal, as the build's refinement measures them.
+fn mesh_curves(surface: &Surface, mesh: &Mesh4, view: &View) -> Result<MeshCurves, BehindEye> {
+    let projected = view.project(mesh)?;
+    let diagonal = projected
+        .bounds()
+        .map_or(0.0, |(lo, hi)| (hi - lo).length());
+    let sheets = [Sheet {
+        positions: &projected.positions,
+        w: &projected.w,
+        triangles: &mesh.triangles,
+    }];
+    let curves = intersect::curves(&sheets);
+    let refined = intersect::refine(
+        &curves,
+        &sheets,
+        &[Analytic { surface, mesh }],
+        view,
+        diagonal,
+    );
+    let r = refined.report.refinement.unwrap_or_default();
+    let relative = |x: f64| if diagonal > 0.0 { x / diagonal } else { 0.0 };
+    Ok(MeshCurves {
+        curve_ms: curves.report.ms,
+        refine_ms: r.refine_ms,
+        curve_error: relative(r.max_shift),
+        refined_residual: relative(r.max_residual),
+        curve_points: curves.report.points,
+        not_converged: r.not_converged,
+    })
 }
 
 /// The triangles of the coarsest uniform grid the sweep tries on `surface` (the fewest
@@ -320,8 +449,9 @@ impl<'a> GridSearch<'a> {
         }
     }
 
-    /// The row of the coarsest grid (over three shapes) that meets `tolerance`.
-    fn coarsest(&mut self, name: &str, tolerance: f64) -> Row {
+    /// The coarsest grid (over three shapes) that meets `tolerance`, and whether it does
+    /// (else the finest within the budget).
+    fn coarsest(&mut self, tolerance: f64) -> (Measured, bool) {
         let mut best: Option<(Measured, bool)> = None;
         for f in [1.0, 0.5, 2.0] {
             let found = self.search(tolerance, self.aspect * f);
@@ -335,33 +465,22 @@ impl<'a> GridSearch<'a> {
                 },
             });
         }
-        let (m, met) = best.expect("three shapes were searched");
-        let start = Instant::now();
-        let mesh = sample_uniform(self.surface, m.cells[0], m.cells[1]);
-        let took = ms(start);
-        drop(mesh);
-        Row {
-            surface: name.to_string(),
-            method: "uniform",
-            tolerance,
-            triangles: m.triangles,
-            ms: took,
-            max_error: m.max,
-            rms_error: m.rms,
-            met,
-            grid: Some(m.cells),
-        }
+        best.expect("three shapes were searched")
     }
 }
 
-/// The rows as CSV: `surface,method,tolerance,triangles,ms,max_error,rms_error,met,grid`.
+/// The columns of [`to_csv`], in order.
+pub const CSV_HEADER: &str = "surface,method,tolerance,triangles,ms,max_error,rms_error,met,grid,\
+curve_ms,refine_ms,curve_error,refined_residual,curve_points,not_converged";
+
+/// The rows as CSV, the columns of [`CSV_HEADER`]: a [`Row`]'s fields in order, `grid` as
+/// `UxV` (empty for adaptive rows).
 pub fn to_csv(rows: &[Row]) -> String {
-    let mut out =
-        String::from("surface,method,tolerance,triangles,ms,max_error,rms_error,met,grid\n");
+    let mut out = format!("{CSV_HEADER}\n");
     for r in rows {
         let grid = r.grid.map_or(String::new(), |[u, v]| format!("{u}x{v}"));
         out.push_str(&format!(
-            "{},{},{:e},{},{:.3},{:.6e},{:.6e},{},{}\n",
+            "{},{},{:e},{},{:.3},{:.6e},{:.6e},{},{},{:.3},{:.3},{:.6e},{:.6e},{},{}\n",
             r.surface,
             r.method,
             r.tolerance,
@@ -370,7 +489,13 @@ pub fn to_csv(rows: &[Row]) -> String {
             r.max_error,
             r.rms_error,
             r.met,
-            grid
+            grid,
+            r.curve_ms,
+            r.refine_ms,
+            r.curve_error,
+            r.refined_residual,
+            r.curve_points,
+            r.not_converged
         ));
     }
     out
@@ -416,11 +541,25 @@ pub fn ratio(rows: &[Row], a: &Row) -> Ratio {
     }
 }
 
-/// A table for the terminal: per surface and tolerance, both methods and their ratio.
+/// A table for the terminal: per surface and tolerance, both methods and their ratio, then
+/// the adaptive mesh's curves: points, the mesh curve's error and the refined curve's
+/// residual (relative to the projected diagonal; `no curve` where the projection does not
+/// cross itself).
 pub fn table(rows: &[Row]) -> String {
     let mut out = format!(
-        "{:<22} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>7}\n",
-        "surface", "tolerance", "adaptive", "ms", "max err", "uniform", "ms", "max err", "ratio"
+        "{:<22} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>7} {:>8} {:>9} {:>9}\n",
+        "surface",
+        "tolerance",
+        "adaptive",
+        "ms",
+        "max err",
+        "uniform",
+        "ms",
+        "max err",
+        "ratio",
+        "crv pts",
+        "crv err",
+        "refined"
     );
     for a in rows.iter().filter(|r| r.method == "adaptive") {
         let u = rows.iter().find(|r| {
@@ -430,8 +569,16 @@ pub fn table(rows: &[Row]) -> String {
         let (ut, ums, uerr, umet) = u.map_or((0, 0.0, f64::NAN, false), |u| {
             (u.triangles, u.ms, u.max_error, u.met)
         });
+        let (err, residual) = if a.curve_points == 0 {
+            ("no curve".to_string(), "-".to_string())
+        } else {
+            (
+                format!("{:.2e}", a.curve_error),
+                format!("{:.1e}", a.refined_residual),
+            )
+        };
         out.push_str(&format!(
-            "{:<22} {:>9.0e} {:>10} {:>10.1} {:>9.2e}{} {:>10} {:>10.1} {:>9.2e}{} {:>7}\n",
+            "{:<22} {:>9.0e} {:>10} {:>10.1} {:>9.2e}{} {:>10} {:>10.1} {:>9.2e}{} {:>7} {:>8} {:>9} {:>9}\n",
             a.surface,
             a.tolerance,
             a.triangles,
@@ -443,14 +590,17 @@ pub fn table(rows: &[Row]) -> String {
             uerr,
             mark(umet),
             ratio(rows, a).to_string(),
+            a.curve_points,
+            err,
+            residual,
         ));
     }
-    out.push_str("(! = tolerance not met within the triangle budget)\n");
+    out.push_str("(! = tolerance not met within the triangle budget; crv = the adaptive mesh's curves: points, error and refined residual relative to the projected diagonal)\n");
     out
 }
 
-/// Sweeps the surfaces and writes `speed_vs_error.csv` and `speed_vs_error.png` into
-/// `out_dir`. Returns the rows and the paths written.
+/// Sweeps the surfaces and writes `speed_vs_error.csv`, `speed_vs_error.png` and
+/// `curves_vs_error.png` into `out_dir`. Returns the rows and the paths written.
 pub fn run(
     surfaces: &[(String, Surface)],
     settings: &Settings,
@@ -460,17 +610,22 @@ pub fn run(
     settings.check(surfaces)?;
     let mut rows = Vec::new();
     for (name, surface) in surfaces {
-        rows.extend(sweep_surface(name, surface, settings, progress));
+        rows.extend(sweep_surface(name, surface, settings, progress)?);
     }
     let png = plot::speed_vs_error_png(
         &rows,
         "halo4d: audited error against triangles, adaptive and uniform",
+    )?;
+    let curves_png = plot::curves_vs_error_png(
+        &rows,
+        "halo4d: intersection curve error against triangles, adaptive and uniform",
     )?;
     let written = write_files(
         out_dir,
         [
             ("speed_vs_error.csv", to_csv(&rows).into_bytes()),
             ("speed_vs_error.png", png),
+            ("curves_vs_error.png", curves_png),
         ],
     )?;
     Ok((rows, written))
@@ -496,4 +651,95 @@ fn write_files<const N: usize>(
         written.push(path);
     }
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surfaces::FlatTorus;
+    use crate::view::Projection;
+
+    fn flat_torus_rows(view: View) -> Vec<Row> {
+        let settings = Settings {
+            tolerances: vec![1e-2],
+            view,
+            ..Settings::default()
+        };
+        let surface = Surface::FlatTorus(FlatTorus::default());
+        sweep_surface("torus", &surface, &settings, &mut |_| {}).unwrap()
+    }
+
+    #[test]
+    fn sweep_of_an_embedded_projection_has_no_curve_and_errors_zero() {
+        // In perspective from w = -3 the flat torus is embedded in R^3: nothing crosses.
+        let view = View {
+            projection: Projection::Perspective { eye_distance: 3.0 },
+            ..View::default()
+        };
+        let rows = flat_torus_rows(view);
+        assert_eq!(rows.len(), 2);
+        for r in &rows {
+            assert_eq!(
+                (
+                    r.curve_points,
+                    r.not_converged,
+                    r.curve_error,
+                    r.refined_residual
+                ),
+                (0, 0, 0.0, 0.0),
+                "{r:?}"
+            );
+        }
+        assert!(table(&rows).contains("no curve"), "{}", table(&rows));
+    }
+
+    #[test]
+    fn sweep_rows_carry_the_curves_of_their_mesh_in_the_view() {
+        // The flat-torus fixture's view: two arcs ending at four cross-caps.
+        let view = View {
+            rotation: crate::view::Rotation4 {
+                yw: 30.0,
+                ..Default::default()
+            },
+            ..View::default()
+        };
+        let rows = flat_torus_rows(view);
+        for r in &rows {
+            assert!(r.curve_points > 0, "{r:?}");
+            assert!(r.curve_error > r.refined_residual, "{r:?}");
+            assert!(r.refined_residual < 1e-12, "{r:?}");
+            assert!(r.curve_ms >= 0.0 && r.refine_ms >= 0.0, "{r:?}");
+        }
+        // Every CSV line has the header's columns.
+        let csv = to_csv(&rows);
+        let columns = CSV_HEADER.split(',').count();
+        assert!(csv.starts_with(CSV_HEADER));
+        assert!(
+            csv.lines().all(|l| l.split(',').count() == columns),
+            "{csv}"
+        );
+    }
+
+    #[test]
+    fn sweep_of_a_view_behind_the_eye_names_the_surface() {
+        let view = View {
+            projection: Projection::Perspective { eye_distance: 0.5 },
+            ..View::default()
+        };
+        let settings = Settings {
+            tolerances: vec![1e-2],
+            view,
+            ..Settings::default()
+        };
+        let surface = Surface::FlatTorus(FlatTorus::default());
+        let err = sweep_surface("torus", &surface, &settings, &mut |_| {}).unwrap_err();
+        assert!(
+            matches!(err, SweepError::View { ref surface, .. } if surface == "torus"),
+            "{err}"
+        );
+        assert!(
+            err.to_string().starts_with("surface `torus`: vertex"),
+            "{err}"
+        );
+    }
 }

@@ -1,6 +1,6 @@
-//! PNG plots of the sweeps: audited error against triangles, log-log.
+//! PNG plots of the sweeps: audited error and curve error against triangles, log-log.
 
-use super::Row;
+use super::{RESIDUAL_FLOOR, Row};
 use crate::render::compare::Comparison;
 use crate::render::text::FAMILY;
 use plotters::prelude::*;
@@ -136,6 +136,180 @@ pub(super) fn speed_vs_error_png(rows: &[Row], title: &str) -> Result<Vec<u8>, P
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .position(SeriesLabelPosition::LowerLeft)
+            .draw()?;
+        root.present()?;
+        Ok(())
+    };
+    draw(&mut rgb).map_err(|e| PlotError::Draw(e.to_string()))?;
+    encode_png(&rgb, w, h)
+}
+
+/// The intersection curves' errors against triangles, log-log, relative to each mesh's
+/// projected diagonal: one colour per surface; the mesh curve's error as in
+/// [`speed_vs_error_png`] (solid with dots for the adaptive sampler, hollow where the mesh
+/// missed its tolerance; dashed with crosses for uniform grids), the refined curve's
+/// residual with triangles (filled for adaptive, hollow for uniform). Residuals
+/// below [`RESIDUAL_FLOOR`] are drawn on it (a grey dashed line); rows without a curve are
+/// left out, and when no row has one the axes say so.
+pub(super) fn curves_vs_error_png(rows: &[Row], title: &str) -> Result<Vec<u8>, PlotError> {
+    register_font()?;
+    let (w, h) = (1200u32, 800u32);
+    let mut rgb = vec![255u8; (w * h * 3) as usize];
+    let meshes: Vec<&Row> = rows.iter().filter(|r| r.triangles > 0).collect();
+    if meshes.is_empty() {
+        return Err(PlotError::Empty("no row has at least one triangle"));
+    }
+    let curved: Vec<&Row> = meshes
+        .iter()
+        .copied()
+        .filter(|r| r.curve_points > 0 && r.curve_error.is_finite())
+        .collect();
+    let residual = |r: &Row| {
+        if r.refined_residual.is_finite() {
+            r.refined_residual.max(RESIDUAL_FLOOR)
+        } else {
+            RESIDUAL_FLOOR
+        }
+    };
+    let error = |r: &Row| r.curve_error.max(RESIDUAL_FLOOR);
+    let (mut x0, mut x1) = (f64::MAX, 0.0f64);
+    for r in &meshes {
+        x0 = x0.min(r.triangles as f64);
+        x1 = x1.max(r.triangles as f64);
+    }
+    // Down to the floor, up to the largest error (the axes' decades when there is none).
+    let y1 = if curved.is_empty() {
+        1.0
+    } else {
+        curved
+            .iter()
+            .map(|r| error(r).max(residual(r)))
+            .fold(RESIDUAL_FLOOR * 10.0, f64::max)
+    };
+    let draw = |rgb: &mut [u8]| -> Result<(), Box<dyn std::error::Error>> {
+        let root = BitMapBackend::with_buffer(rgb, (w, h)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, (FAMILY, 26))
+            .margin(20)
+            .x_label_area_size(60)
+            .y_label_area_size(90)
+            .build_cartesian_2d(
+                (x0 / 1.5..x1 * 1.5).log_scale(),
+                (RESIDUAL_FLOOR / 10.0..y1 * 10.0).log_scale(),
+            )?;
+        chart
+            .configure_mesh()
+            .x_desc("triangles")
+            .y_desc("curve error / projected 3D bounding diagonal")
+            .label_style((FAMILY, 16))
+            .axis_desc_style((FAMILY, 18))
+            .x_label_formatter(&|x| format!("{x:.0e}"))
+            .y_label_formatter(&|y| format!("{y:.0e}"))
+            .draw()?;
+        if curved.is_empty() {
+            chart.draw_series(std::iter::once(Text::new(
+                "no curve: no surface's projection crosses itself in this view",
+                (x0, 1e-3),
+                (FAMILY, 20),
+            )))?;
+        }
+        let grey = RGBColor(127, 127, 127);
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(x0 / 1.5, RESIDUAL_FLOOR), (x1 * 1.5, RESIDUAL_FLOOR)],
+                6,
+                6,
+                grey.stroke_width(1),
+            ))?
+            .label(format!(
+                "floor {RESIDUAL_FLOOR:.0e}: smaller residuals drawn on it"
+            ))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 8, y)], grey.stroke_width(1)));
+        let mut surfaces: Vec<&str> = Vec::new();
+        for r in &meshes {
+            if !surfaces.contains(&r.surface.as_str()) {
+                surfaces.push(&r.surface);
+            }
+        }
+        for (i, surface) in surfaces.iter().enumerate() {
+            let colour = COLOURS[i % COLOURS.len()];
+            for method in ["adaptive", "uniform"] {
+                let mut mine: Vec<&Row> = curved
+                    .iter()
+                    .copied()
+                    .filter(|r| r.surface == *surface && r.method == method)
+                    .collect();
+                if mine.is_empty() {
+                    continue;
+                }
+                mine.sort_by_key(|r| r.triangles);
+                let adaptive = method == "adaptive";
+                for (quantity, value) in [
+                    ("curve error", &error as &dyn Fn(&Row) -> f64),
+                    ("refined residual", &residual),
+                ] {
+                    let pts: Vec<(f64, f64, bool)> = mine
+                        .iter()
+                        .map(|r| (r.triangles as f64, value(r), r.met))
+                        .collect();
+                    let line = pts.iter().map(|p| (p.0, p.1));
+                    let label = format!("{surface} {quantity} ({method})");
+                    let series = if adaptive {
+                        chart.draw_series(LineSeries::new(line, colour.stroke_width(2)))?
+                    } else {
+                        chart.draw_series(DashedLineSeries::new(
+                            line,
+                            8,
+                            5,
+                            colour.stroke_width(1),
+                        ))?
+                    };
+                    // The legend's line as in `speed_vs_error_png`, with the marker on it.
+                    let (length, width) = if adaptive { (24, 2) } else { (8, 1) };
+                    let style = colour.stroke_width(2);
+                    let entry = move |(x, y): (i32, i32)| {
+                        EmptyElement::at((x, y))
+                            + PathElement::new(
+                                vec![(0, 0), (length, 0)],
+                                colour.stroke_width(width),
+                            )
+                    };
+                    let mid = (length / 2, 0);
+                    let series = series.label(label);
+                    match (quantity, adaptive) {
+                        ("curve error", true) => {
+                            series
+                                .legend(move |at| entry(at) + Circle::new(mid, 4, style.filled()));
+                            chart.draw_series(
+                                pts.iter()
+                                    .map(|p| Circle::new((p.0, p.1), 4, style.filled_if(p.2))),
+                            )?;
+                        }
+                        ("curve error", false) => {
+                            series.legend(move |at| entry(at) + Cross::new(mid, 5, style));
+                            chart.draw_series(
+                                pts.iter().map(|p| Cross::new((p.0, p.1), 5, style)),
+                            )?;
+                        }
+                        (_, filled) => {
+                            series.legend(move |at| {
+                                entry(at) + TriangleMarker::new(mid, 5, style.filled_if(filled))
+                            });
+                            chart.draw_series(pts.iter().map(|p| {
+                                TriangleMarker::new((p.0, p.1), 5, style.filled_if(filled))
+                            }))?;
+                        }
+                    }
+                }
+            }
+        }
+        chart
+            .configure_series_labels()
+            .label_font((FAMILY, 15))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::MiddleRight)
             .draw()?;
         root.present()?;
         Ok(())
