@@ -758,7 +758,9 @@ impl<'a> Solver<'a> {
             let scale = e.du.length() * e.dv.length();
             // The surface itself must be regular here (not a parametrization singularity).
             let area2 = e.du.length_squared() * e.dv.length_squared() - e.du.dot(e.dv).powi(2);
-            if !(area2 > 1e-12 * e.du.length_squared() * e.dv.length_squared()) {
+            if area2.partial_cmp(&(1e-12 * e.du.length_squared() * e.dv.length_squared()))
+                != Some(std::cmp::Ordering::Greater)
+            {
                 return CrossCap::NotFound;
             }
             if g.length() <= 1e-3 * CROSS_CAP_RANK * scale {
@@ -858,8 +860,9 @@ fn solve<const N: usize>(mut a: [[f64; N]; N], mut b: [f64; N]) -> Option<[f64; 
         b.swap(col, pivot);
         for row in col + 1..N {
             let f = a[row][col] / a[col][col];
-            for k in col..N {
-                a[row][k] -= f * a[col][k];
+            let pivot_row = a[col];
+            for (x, p) in a[row][col..].iter_mut().zip(&pivot_row[col..]) {
+                *x -= f * p;
             }
             b[row] -= f * b[col];
         }

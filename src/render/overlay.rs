@@ -422,7 +422,7 @@ mod tests {
             over_pieces(&points, true),
             vec![(None, vec![at(0.0), at(1.0), at(0.0)])]
         );
-        assert!(over_pieces(&[], true).is_empty());
+        assert!(over_pieces::<DVec3>(&[], true).is_empty());
         // One sheet over throughout a closed curve: the curve and its closing segment.
         let points = [(at(0.0), Some(1)), (at(1.0), Some(1)), (at(2.0), None)];
         assert_eq!(

@@ -446,7 +446,7 @@ impl Surface {
                         (0, f64::NEG_INFINITY),
                         |m, (k, o)| if o > m.1 { (k, o) } else { m },
                     );
-            if !(depth > SLACK) {
+            if depth.partial_cmp(&SLACK) != Some(std::cmp::Ordering::Greater) {
                 return (patch, u, v, depth.is_finite());
             }
             // The piece is chosen at the side; past a corner the other coordinate carries
