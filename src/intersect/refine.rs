@@ -149,7 +149,7 @@ pub fn refine(
         per_curve.push(tries.split_off(rest));
     }
     per_curve.reverse();
-    let done: Vec<(Curve, Tally)> = curves
+    let done: Vec<(Curve, Refinement)> = curves
         .curves
         .par_iter()
         .zip(per_curve)
@@ -160,17 +160,16 @@ pub fn refine(
         .par_iter()
         .map(|t| solver.triple(t))
         .collect();
-    let mut tally = Tally::default();
+    let mut r = Refinement::default();
     let mut out = Curves {
         curves: Vec::with_capacity(done.len()),
         triple_points: Vec::with_capacity(triples.len()),
         report: curves.report.clone(),
     };
     for (c, t) in done {
-        tally.add(&t);
+        r.add(&t);
         out.curves.push(c);
     }
-    let mut r = tally.report;
     for (t, residual) in triples {
         match residual {
             Some(res) => {
@@ -187,24 +186,18 @@ pub fn refine(
     out
 }
 
-/// What refining one curve did.
-#[derive(Default)]
-struct Tally {
-    report: Refinement,
-}
-
-impl Tally {
-    fn add(&mut self, o: &Tally) {
-        let (r, o) = (&mut self.report, &o.report);
-        r.refined += o.refined;
-        r.not_converged += o.not_converged;
-        r.max_residual = r.max_residual.max(o.max_residual);
-        r.max_shift = r.max_shift.max(o.max_shift);
-        r.cross_caps += o.cross_caps;
-        r.max_cross_cap_shift = r.max_cross_cap_shift.max(o.max_cross_cap_shift);
-        r.pole_ends += o.pole_ends;
-        r.trimmed += o.trimmed;
-        r.over_under_changed += o.over_under_changed;
+impl Refinement {
+    /// Adds the counts of another curve's refinement, keeps the larger maxima.
+    fn add(&mut self, o: &Refinement) {
+        self.refined += o.refined;
+        self.not_converged += o.not_converged;
+        self.max_residual = self.max_residual.max(o.max_residual);
+        self.max_shift = self.max_shift.max(o.max_shift);
+        self.cross_caps += o.cross_caps;
+        self.max_cross_cap_shift = self.max_cross_cap_shift.max(o.max_cross_cap_shift);
+        self.pole_ends += o.pole_ends;
+        self.trimmed += o.trimmed;
+        self.over_under_changed += o.over_under_changed;
     }
 }
 
@@ -328,9 +321,8 @@ impl<'a> Solver<'a> {
     /// neighbour along the curve, both ways (near a cross-cap, where the two sheets meet at
     /// a small angle and the mesh's point is far off, the neighbour's solution is the
     /// better guess).
-    fn finish(&self, c: &Curve, tries: Vec<Try>) -> (Curve, Tally) {
-        let mut tally = Tally::default();
-        let r = &mut tally.report;
+    fn finish(&self, c: &Curve, tries: Vec<Try>) -> (Curve, Refinement) {
+        let mut r = Refinement::default();
         let n = c.points.len();
         let mut out = c.clone();
         let mut found: Vec<Option<Pair>> = vec![None; n];
@@ -408,7 +400,7 @@ impl<'a> Solver<'a> {
                 keep[k - 1]
             });
         }
-        (out, tally)
+        (out, r)
     }
 
     /// The sheet and local index of a global vertex.

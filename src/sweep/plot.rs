@@ -68,24 +68,13 @@ pub(super) fn speed_vs_error_png(rows: &[Row], title: &str) -> Result<Vec<u8>, P
     let draw = |rgb: &mut [u8]| -> Result<(), Box<dyn std::error::Error>> {
         let root = BitMapBackend::with_buffer(rgb, (w, h)).into_drawing_area();
         root.fill(&WHITE)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, (FAMILY, 26))
-            .margin(20)
-            .x_label_area_size(60)
-            .y_label_area_size(90)
-            .build_cartesian_2d(
-                (x0 / 1.5..x1 * 1.5).log_scale(),
-                (y0 / 2.0..y1 * 2.0).log_scale(),
-            )?;
-        chart
-            .configure_mesh()
-            .x_desc("triangles")
-            .y_desc("audited max error / 4D bounding diagonal")
-            .label_style((FAMILY, 16))
-            .axis_desc_style((FAMILY, 18))
-            .x_label_formatter(&|x| format!("{x:.0e}"))
-            .y_label_formatter(&|y| format!("{y:.0e}"))
-            .draw()?;
+        let mut chart = log_log_chart(
+            &root,
+            title,
+            x0 / 1.5..x1 * 1.5,
+            y0 / 2.0..y1 * 2.0,
+            "audited max error / 4D bounding diagonal",
+        )?;
         let mut surfaces: Vec<&str> = Vec::new();
         for r in &finite {
             if !surfaces.contains(&r.surface.as_str()) {
@@ -189,24 +178,13 @@ pub(super) fn curves_vs_error_png(rows: &[Row], title: &str) -> Result<Vec<u8>, 
     let draw = |rgb: &mut [u8]| -> Result<(), Box<dyn std::error::Error>> {
         let root = BitMapBackend::with_buffer(rgb, (w, h)).into_drawing_area();
         root.fill(&WHITE)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, (FAMILY, 26))
-            .margin(20)
-            .x_label_area_size(60)
-            .y_label_area_size(90)
-            .build_cartesian_2d(
-                (x0 / 1.5..x1 * 1.5).log_scale(),
-                (RESIDUAL_FLOOR / 10.0..y1 * 10.0).log_scale(),
-            )?;
-        chart
-            .configure_mesh()
-            .x_desc("triangles")
-            .y_desc("curve error / projected 3D bounding diagonal")
-            .label_style((FAMILY, 16))
-            .axis_desc_style((FAMILY, 18))
-            .x_label_formatter(&|x| format!("{x:.0e}"))
-            .y_label_formatter(&|y| format!("{y:.0e}"))
-            .draw()?;
+        let mut chart = log_log_chart(
+            &root,
+            title,
+            x0 / 1.5..x1 * 1.5,
+            RESIDUAL_FLOOR / 10.0..y1 * 10.0,
+            "curve error / projected 3D bounding diagonal",
+        )?;
         if curved.is_empty() {
             chart.draw_series(std::iter::once(Text::new(
                 "no curve: no surface's projection crosses itself in this view",
@@ -456,4 +434,35 @@ impl FilledIf for ShapeStyle {
     fn filled_if(self, filled: bool) -> ShapeStyle {
         if filled { self.filled() } else { self }
     }
+}
+
+/// A chart with log axes both ways.
+type LogLogChart<'a, 'b> =
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+
+/// A titled chart with triangles along a log x axis and an error (`y_desc`) along a log y
+/// axis, its mesh drawn: the frame the sweep's two error plots share.
+fn log_log_chart<'a, 'b>(
+    root: &'a DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>,
+    title: &str,
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+    y_desc: &str,
+) -> Result<LogLogChart<'a, 'b>, Box<dyn std::error::Error>> {
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, (FAMILY, 26))
+        .margin(20)
+        .x_label_area_size(60)
+        .y_label_area_size(90)
+        .build_cartesian_2d(x.log_scale(), y.log_scale())?;
+    chart
+        .configure_mesh()
+        .x_desc("triangles")
+        .y_desc(y_desc)
+        .label_style((FAMILY, 16))
+        .axis_desc_style((FAMILY, 18))
+        .x_label_formatter(&|x| format!("{x:.0e}"))
+        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .draw()?;
+    Ok(chart)
 }
