@@ -21,7 +21,7 @@ fn curve_costs(c: &mut Criterion) {
     let mut group = c.benchmark_group("curves/flat_torus");
     group.sample_size(10);
     for n in [316, 708] {
-        let mesh = sample_uniform(&scene.surfaces[0].surface, n, n);
+        let mesh = sample_uniform(scene.surfaces[0].surface.parametric().unwrap(), n, n);
         let projected = scene.view.project(&mesh).expect("the view projects");
         let sheets = [Sheet {
             positions: &projected.positions,
@@ -57,7 +57,7 @@ fn curve_costs(c: &mut Criterion) {
 
 /// A scene's first surface on an n x n grid, projected: the mesh and its projection.
 fn grid(scene: &Scene, n: usize) -> (Mesh4, Projected) {
-    let mesh = sample_uniform(&scene.surfaces[0].surface, n, n);
+    let mesh = sample_uniform(scene.surfaces[0].surface.parametric().unwrap(), n, n);
     let projected = scene.view.project(&mesh).expect("the view projects");
     (mesh, projected)
 }
@@ -75,7 +75,7 @@ fn refine_costs(c: &mut Criterion) {
             triangles: &mesh.triangles,
         }];
         let analytic = [Analytic {
-            surface: &scene.surfaces[0].surface,
+            surface: scene.surfaces[0].surface.parametric(),
             mesh: &mesh,
         }];
         let (lo, hi) = projected.bounds().expect("a mesh");

@@ -15,7 +15,7 @@ fn halos(c: &mut Criterion) {
     let scene =
         Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/scenes/flat-torus.json"))
             .expect("the flat-torus fixture loads");
-    let mesh = sample_uniform(&scene.surfaces[0].surface, 708, 708);
+    let mesh = sample_uniform(scene.surfaces[0].surface.parametric().unwrap(), 708, 708);
     let projected = scene.view.project(&mesh).expect("the view projects");
     let (lo, hi) = projected.bounds().expect("a mesh");
     let rho = scene.halo.rho * (hi - lo).length();

@@ -237,9 +237,16 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
                     .map_err(flag_names)?
                     .1
             } else {
-                let surfaces: Vec<_> = (0..scene.surfaces.len())
-                    .map(|i| (scene.surface_name(i), scene.surfaces[i].surface.clone()))
-                    .collect();
+                let surfaces = (0..scene.surfaces.len())
+                    .map(|i| match &scene.surfaces[i].surface {
+                        halo4d::Source::Parametric(s) => Ok((scene.surface_name(i), s.clone())),
+                        halo4d::Source::Mesh(m) => Err(format!(
+                            "surface `{}` is a mesh file ({}): the sweep samples parametric surfaces at several tolerances; sweep the pictures (`--slices`) instead",
+                            scene.surface_name(i),
+                            halo4d::limits::shorten(&m.path)
+                        )),
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
                 let settings = sweep::Settings {
                     tolerances,
                     max_triangles,

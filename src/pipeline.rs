@@ -10,10 +10,10 @@ use crate::intersect::{self, Curves, CurvesReport};
 use crate::limits::{MAX_COORDINATE, MIN_EXTENT};
 use crate::parts::{HaloPart, Parts, SurfacePart};
 use crate::render::{self, CameraSettings, Picture, RenderError, RenderSettings, Style};
-use crate::sample::{self, Audit, Mesh4, MeshStats, Sampling, audit};
+use crate::sample::{self, Audit, Mesh4, MeshStats, Sampling, Source, audit};
 use crate::scene::Scene;
 use crate::stipple::Stipples;
-use crate::surfaces::{Surface, Topology};
+use crate::surfaces::Topology;
 use crate::verify::{self, Verification};
 use crate::view::Projected;
 use glam::DVec3;
@@ -29,7 +29,7 @@ pub struct SurfaceProduct {
     /// Name in the outputs.
     pub name: String,
     /// The surface.
-    pub surface: Surface,
+    pub surface: Source,
     /// Its 4D mesh.
     pub mesh: Mesh4,
     /// The mesh's statistics.
@@ -176,7 +176,8 @@ fn parts<'a>(surfaces: &'a [SurfaceProduct], halo: &HaloParams, curves: &'a Curv
                 positions: &p.projected.positions,
                 w: &p.projected.w,
                 normals: &p.projected.normals,
-                uv: Some(&p.mesh.uv),
+                // A mesh file's vertices have no parameters.
+                uv: p.surface.parametric().map(|_| p.mesh.uv.as_slice()),
                 triangles: &p.mesh.triangles,
                 stipples: p.stipples.as_ref(),
             })
@@ -202,7 +203,8 @@ fn parts<'a>(surfaces: &'a [SurfaceProduct], halo: &HaloParams, curves: &'a Curv
 /// How a surface was sampled, and the audit of the mesh (`report.json`'s `sampling`).
 #[derive(Clone, Debug, Serialize)]
 pub struct SamplingReport {
-    /// `adaptive` or `uniform`.
+    /// `adaptive`, `uniform`, or `file` for a mesh read from a file (not sampled, not
+    /// audited: the mesh is the surface, its errors are 0).
     pub method: &'static str,
     /// The absolute tolerance the adaptive sampler aimed at.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -242,6 +244,7 @@ pub struct SamplingReport {
 
 impl SamplingReport {
     fn new(
+        method: &'static str,
         sampling: &Sampling,
         sampled: &sample::Sampled,
         audit: &Audit,
@@ -251,10 +254,12 @@ impl SamplingReport {
     ) -> Self {
         let (max_rel, rms_rel) = audit.relative(sampled.diagonal);
         SamplingReport {
-            method: sampling.method(),
+            method,
             max_triangles: match *sampling {
-                Sampling::Adaptive { max_triangles, .. } => Some(max_triangles),
-                Sampling::Uniform { .. } => None,
+                Sampling::Adaptive { max_triangles, .. } if method == "adaptive" => {
+                    Some(max_triangles)
+                }
+                _ => None,
             },
             tolerance: sampled.tolerance,
             relative_tolerance: sampled.tolerance.map(|t| t / sampled.diagonal),
@@ -546,19 +551,32 @@ fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error
         bar.set_message(format!("sampling {name}"));
         let sampling = scene.surface_sampling(i);
         let start = Instant::now();
-        let sampled = sample::sample(&entry.surface, sampling);
+        let sampled = entry.surface.sample(sampling);
         let sample_ms = ms(start);
         timings.sample += sample_ms;
         let start = Instant::now();
-        let audited = audit(&entry.surface, &sampled.mesh);
+        // A mesh file is the surface: nothing to audit.
+        let audited = match &entry.surface {
+            Source::Parametric(surface) => audit(surface, &sampled.mesh),
+            Source::Mesh(_) => Audit::default(),
+        };
         // Stopped by its budget: the uniform grid of as many triangles to compare with,
         // audited too (and timed with the audit).
-        let uniform = (!sampled.complete)
-            .then(|| sample::uniform_error(&entry.surface, sampled.mesh.triangles.len()));
+        let uniform = match &entry.surface {
+            Source::Parametric(surface) if !sampled.complete => {
+                Some(sample::uniform_error(surface, sampled.mesh.triangles.len()))
+            }
+            _ => None,
+        };
         let audit_ms = ms(start);
         timings.audit += audit_ms;
-        let report =
-            SamplingReport::new(sampling, &sampled, &audited, uniform, sample_ms, audit_ms);
+        let method = match entry.surface {
+            Source::Parametric(_) => sampling.method(),
+            Source::Mesh(_) => "file",
+        };
+        let report = SamplingReport::new(
+            method, sampling, &sampled, &audited, uniform, sample_ms, audit_ms,
+        );
         if let Some(w) = report.warning(&name) {
             bar.suspend(|| eprintln!("warning: {w}"));
         }
@@ -670,7 +688,7 @@ fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error
         let analytic: Vec<intersect::Analytic> = products
             .iter()
             .map(|p| intersect::Analytic {
-                surface: &p.surface,
+                surface: p.surface.parametric(),
                 mesh: &p.mesh,
             })
             .collect();

@@ -10,8 +10,7 @@ use crate::intersect::CurveSettings;
 use crate::limits::shorten;
 use crate::limits::{FieldError, NAME_LENGTH, SURFACES, TRIANGLES};
 use crate::render::{CameraSettings, RenderSettings};
-use crate::sample::Sampling;
-use crate::surfaces::Surface;
+use crate::sample::{Sampling, Source};
 use crate::view::View;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -61,9 +60,10 @@ pub struct SceneSurface {
     /// unique in the scene.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
-    /// The surface and its parameters.
-    pub surface: Surface,
-    /// Sampling for this surface, overriding the scene's.
+    /// The surface and its parameters: a parametric surface (the catalogue's or a formula)
+    /// or a 4D mesh from a file.
+    pub surface: Source,
+    /// Sampling for this surface, overriding the scene's (not for a mesh file).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sampling: Option<Sampling>,
 }
@@ -186,7 +186,8 @@ pub enum SceneError {
 }
 
 impl Scene {
-    /// Reads and validates a scene file.
+    /// Reads and validates a scene file, and the mesh files it names (relative to its
+    /// folder).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let file = path.display().to_string();
         let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
@@ -201,7 +202,8 @@ impl Scene {
         Scene::parse(DEFAULT_SCENE, "<default scene>").expect("the embedded default scene is valid")
     }
 
-    /// Parses and validates scene text; `file` names it in errors.
+    /// Parses and validates scene text; `file` names it in errors, and its folder is where
+    /// the paths of mesh files start.
     pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
         let syntax = |field: String, inner: serde_json::Error| SceneError::Syntax {
             file: file.to_string(),
@@ -220,6 +222,19 @@ impl Scene {
         })?;
         de.end()
             .map_err(|e| syntax("(after the scene)".into(), e))?;
+        let mut scene = scene;
+        let folder = Path::new(file).parent().unwrap_or(Path::new(""));
+        let invalid = |FieldError { field, message }| SceneError::Invalid {
+            file: file.to_string(),
+            field,
+            message,
+        };
+        for (i, s) in scene.surfaces.iter_mut().enumerate() {
+            if let Source::Mesh(m) = &mut s.surface {
+                m.load(folder)
+                    .map_err(|e| invalid(e.within(&format!("surfaces[{i}].surface"))))?;
+            }
+        }
         scene
             .validate()
             .map_err(|FieldError { field, message }| SceneError::Invalid {
@@ -264,6 +279,12 @@ impl Scene {
             s.surface
                 .check()
                 .map_err(|e| e.within(&format!("surfaces[{i}].surface")))?;
+            if let (Source::Mesh(_), Some(_)) = (&s.surface, &s.sampling) {
+                return Err(FieldError::new(
+                    format!("surfaces[{i}].sampling"),
+                    "a mesh file is taken as it is, not sampled; remove `sampling`",
+                ));
+            }
             if let Some(sampling) = &s.sampling {
                 sampling
                     .check()
@@ -286,29 +307,35 @@ impl Scene {
             } else {
                 "sampling".into()
             };
+            let surface = match &s.surface {
+                Source::Parametric(surface) => surface,
+                Source::Mesh(m) => {
+                    triangles = triangles.saturating_add(m.mesh.triangles.len());
+                    continue;
+                }
+            };
             if let Sampling::Uniform { u, v } = *sampling {
-                let [min_u, min_v] = s.surface.min_cells();
+                let [min_u, min_v] = surface.min_cells();
                 if u < min_u || v < min_v {
                     return Err(FieldError::new(
                         field,
                         format!(
                             "{} needs at least {min_u} x {min_v} cells, got {u} x {v}",
-                            s.surface.type_name()
+                            surface.type_name()
                         ),
                     ));
                 }
             }
             // Adaptive budgets are bounded one by one in `Sampling::check`.
             if let Sampling::Uniform { .. } = sampling {
-                triangles =
-                    triangles.saturating_add(sampling.max_triangles(s.surface.patch_count()));
+                triangles = triangles.saturating_add(sampling.max_triangles(surface.patch_count()));
             }
         }
         if triangles > *TRIANGLES.end() {
             return Err(FieldError::new(
                 "sampling",
                 format!(
-                    "the scene's grids make {triangles} triangles, more than the limit of {}; lower u and v",
+                    "the scene's grids and mesh files make {triangles} triangles, more than the limit of {}; lower u and v",
                     TRIANGLES.end()
                 ),
             ));

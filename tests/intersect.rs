@@ -5,7 +5,7 @@ use crate::common::{Rng, fixture, fixture_scenes};
 use glam::DVec3;
 use halo4d::internals::{BroadPhase, Node, curves_with};
 use halo4d::{Curves, End, Sheet, curves};
-use halo4d::{Sampling, Scene, sample, sample_uniform};
+use halo4d::{Sampling, Scene, sample_uniform};
 
 /// A mesh in the intersection stage's terms.
 struct Soup {
@@ -32,7 +32,7 @@ fn flat_torus(n: usize, alpha: f64) -> Soup {
             "view": {{"rotation": {{"yw": {alpha}}}}}}}"#
     );
     let scene = Scene::parse(&text, "test").unwrap();
-    let mesh = sample_uniform(&scene.surfaces[0].surface, n, n);
+    let mesh = sample_uniform(scene.surfaces[0].surface.parametric().unwrap(), n, n);
     let p = scene.view.project(&mesh).unwrap();
     Soup {
         positions: p.positions,
@@ -180,7 +180,7 @@ fn every_fixture_at_low_resolution_agrees_with_all_pairs() {
             .surfaces
             .iter()
             .map(|s| {
-                let mesh = sample(&s.surface, &Sampling::Uniform { u: 14, v: 14 }).mesh;
+                let mesh = s.surface.sample(&Sampling::Uniform { u: 14, v: 14 }).mesh;
                 let p = scene.view.project(&mesh).unwrap();
                 Soup {
                     positions: p.positions,
@@ -670,7 +670,7 @@ fn the_curves_do_not_depend_on_the_number_of_threads() {
     // the parallel descent, and curves that end at branch points.
     let mut scene = Scene::load(&fixture("scenes/twist-spun-trefoil.json")).unwrap();
     scene.sampling = Sampling::Uniform { u: 100, v: 100 };
-    let mesh = sample(&scene.surfaces[0].surface, &scene.sampling).mesh;
+    let mesh = scene.surfaces[0].surface.sample(&scene.sampling).mesh;
     let projected = scene.view.project(&mesh).unwrap();
     let sheets = [Sheet {
         positions: &projected.positions,

@@ -11,6 +11,7 @@ mod halo;
 mod halo_export;
 mod intersect;
 mod lines;
+mod own;
 mod refine;
 mod render;
 mod sample;

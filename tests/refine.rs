@@ -4,8 +4,8 @@
 
 use crate::common::{fixture, fixture_scenes};
 use glam::DVec3;
+use halo4d::sample_uniform;
 use halo4d::{Analytic, Curves, End, Mesh4, Projected, Scene, Sheet, curves, refine};
-use halo4d::{sample, sample_uniform};
 
 /// The mesh curves and the refined ones of one surface in its scene's view.
 fn refined(scene: &Scene, mesh: &Mesh4) -> (Curves, Curves) {
@@ -17,7 +17,7 @@ fn refined(scene: &Scene, mesh: &Mesh4) -> (Curves, Curves) {
     }];
     let (lo, hi) = p.bounds().unwrap();
     let analytic = [Analytic {
-        surface: &scene.surfaces[0].surface,
+        surface: scene.surfaces[0].surface.parametric(),
         mesh,
     }];
     let mesh_curves = curves(&sheets);
@@ -100,7 +100,7 @@ fn refined_flat_torus_curves_lie_on_the_analytic_curve_at_every_grid_and_angle()
         let scene = torus_scene(alpha);
         let mut previous = f64::INFINITY;
         for n in [24, 48, 96, 192] {
-            let mesh = sample_uniform(&scene.surfaces[0].surface, n, n);
+            let mesh = sample_uniform(scene.surfaces[0].surface.parametric().unwrap(), n, n);
             let (mesh_curves, refined) = refined(&scene, &mesh);
             let what = format!("alpha {alpha}, {n} x {n}");
             let mesh_error = check_torus(alpha, &mesh_curves, &refined, &what);
@@ -130,10 +130,9 @@ fn refined_flat_torus_curves_lie_on_the_analytic_curve_at_every_grid_and_angle()
 fn refined_flat_torus_curves_of_adaptive_meshes_end_at_the_true_cross_caps() {
     let scene = torus_scene(30.0);
     for tolerance in [1e-2, 1e-3, 1e-4] {
-        let sampled = sample(
-            &scene.surfaces[0].surface,
-            &halo4d::Sampling::adaptive(tolerance),
-        );
+        let sampled = scene.surfaces[0]
+            .surface
+            .sample(&halo4d::Sampling::adaptive(tolerance));
         let (mesh_curves, refined) = refined(&scene, &sampled.mesh);
         check_torus(
             30.0,
@@ -204,7 +203,7 @@ fn the_roman_surface_refines_to_its_axes_six_cross_caps_and_one_triple_point() {
         "test",
     )
     .unwrap();
-    let sampled = sample(&scene.surfaces[0].surface, &scene.sampling);
+    let sampled = scene.surfaces[0].surface.sample(&scene.sampling);
     let (mesh_curves, refined) = refined(&scene, &sampled.mesh);
     let r = refined.report.refinement.as_ref().unwrap();
     assert_eq!((r.not_converged, r.cross_caps), (0, 6), "{r:?}");

@@ -153,7 +153,7 @@ fn the_view_maps_points_and_jets_with_the_exact_derivatives_of_the_projection() 
         "test",
     )
     .unwrap();
-    let surface = &scene.surfaces[0].surface;
+    let surface = scene.surfaces[0].surface.parametric().unwrap();
     let map = scene.view.map();
     let (u, v, h) = (0.7, 1.9, 1e-5);
     let jets = map.jets(&surface.eval(0, u, v)).unwrap();

@@ -84,6 +84,9 @@ pub struct Refinement {
     /// Refined curve points where the sheet nearer in w is not the one the mesh says
     /// (near-tangential contacts in w).
     pub over_under_changed: usize,
+    /// Curve and triple points on a surface read from a mesh file, kept where the mesh
+    /// puts them: that mesh is the surface.
+    pub on_meshes: usize,
     /// Milliseconds.
     pub refine_ms: f64,
 }
@@ -91,8 +94,8 @@ pub struct Refinement {
 /// The analytic surface behind a sheet and the 4D mesh the sheet projects.
 #[derive(Clone, Copy, Debug)]
 pub struct Analytic<'a> {
-    /// The surface.
-    pub surface: &'a Surface,
+    /// The surface; `None` for a mesh read from a file, whose curve points stay as they are.
+    pub surface: Option<&'a Surface>,
     /// Its 4D mesh (the sheet's triangles, with their patches and corner parameters).
     pub mesh: &'a Mesh4,
 }
@@ -131,11 +134,24 @@ pub fn refine(
 ) -> Curves {
     let start = Instant::now();
     let solver = Solver::new(sheets, analytic, view, diagonal);
+    // Only points whose surfaces all have a parametrization move; the rest (on a mesh read
+    // from a file) stay, the mesh being the surface.
+    let parametric = |faces: &[Face]| {
+        faces
+            .iter()
+            .all(|f| analytic[f.surface as usize].surface.is_some())
+    };
+    let refinable: Vec<bool> = curves
+        .curves
+        .iter()
+        .map(|c| c.points.iter().all(|p| parametric(&p.faces)))
+        .collect();
     // Every point's first try on the cores, then each curve's second tries and trimming.
     let points: Vec<(usize, usize)> = curves
         .curves
         .iter()
         .enumerate()
+        .filter(|&(k, _)| refinable[k])
         .flat_map(|(k, c)| (0..c.points.len()).map(move |i| (k, i)))
         .collect();
     let mut tries: Vec<Try> = points
@@ -144,8 +160,8 @@ pub fn refine(
         .map(|&(k, i)| solver.first_try(&curves.curves[k], i))
         .collect();
     let mut per_curve = Vec::with_capacity(curves.curves.len());
-    for c in curves.curves.iter().rev() {
-        let rest = tries.len() - c.points.len();
+    for (c, &refinable) in curves.curves.iter().zip(&refinable).rev() {
+        let rest = tries.len() - if refinable { c.points.len() } else { 0 };
         per_curve.push(tries.split_off(rest));
     }
     per_curve.reverse();
@@ -153,12 +169,30 @@ pub fn refine(
         .curves
         .par_iter()
         .zip(per_curve)
-        .map(|(c, tries)| solver.finish(c, tries))
+        .zip(&refinable)
+        .map(|((c, tries), &refinable)| {
+            if refinable {
+                solver.finish(c, tries)
+            } else {
+                let r = Refinement {
+                    on_meshes: c.points.len(),
+                    ..Refinement::default()
+                };
+                (c.clone(), r)
+            }
+        })
         .collect();
-    let triples: Vec<(TriplePoint, Option<f64>)> = curves
+    let triples: Vec<(TriplePoint, Option<Option<f64>>)> = curves
         .triple_points
         .par_iter()
-        .map(|t| solver.triple(t))
+        .map(|t| {
+            if parametric(&t.faces) {
+                let (t, residual) = solver.triple(t);
+                (t, Some(residual))
+            } else {
+                (t.clone(), None)
+            }
+        })
         .collect();
     let mut r = Refinement::default();
     let mut out = Curves {
@@ -172,11 +206,12 @@ pub fn refine(
     }
     for (t, residual) in triples {
         match residual {
-            Some(res) => {
+            Some(Some(res)) => {
                 r.triple_points_refined += 1;
                 r.max_residual = r.max_residual.max(res);
             }
-            None => r.triple_points_not_converged += 1,
+            Some(None) => r.triple_points_not_converged += 1,
+            None => r.on_meshes += 1,
         }
         out.triple_points.push(t);
     }
@@ -198,6 +233,7 @@ impl Refinement {
         self.pole_ends += o.pole_ends;
         self.trimmed += o.trimmed;
         self.over_under_changed += o.over_under_changed;
+        self.on_meshes += o.on_meshes;
     }
 }
 
@@ -403,6 +439,14 @@ impl<'a> Solver<'a> {
         (out, r)
     }
 
+    /// The parametric surface of sheet `s`: [`refine`] only hands the solver points whose
+    /// sheets all have one.
+    fn surface(&self, s: usize) -> &'a Surface {
+        self.analytic[s]
+            .surface
+            .expect("only points on parametric surfaces are refined")
+    }
+
     /// The sheet and local index of a global vertex.
     fn vertex(&self, global: u32) -> (usize, usize) {
         let s = self.vertex_start.partition_point(|&v| v <= global) - 1;
@@ -435,7 +479,7 @@ impl<'a> Solver<'a> {
 
     /// The surface at a parameter point, mapped by the view.
     fn eval(&self, p: &Param) -> Option<Solved> {
-        let e = self.analytic[p.sheet].surface.eval(p.patch, p.u, p.v);
+        let e = self.surface(p.sheet).eval(p.patch, p.u, p.v);
         let mapped = self.view.map(&e)?;
         mapped.position.is_finite().then_some(Solved {
             param: *p,
@@ -463,9 +507,7 @@ impl<'a> Solver<'a> {
         let uv = mesh.triangle_uv[t];
         let corner = |g: u32| tri.iter().position(|&v| v == g);
         let (a, b) = (uv[corner(edge[0])?], uv[corner(edge[1])?]);
-        let d = self.analytic[s]
-            .surface
-            .domain(mesh.triangle_patch[t] as usize);
+        let d = self.surface(s).domain(mesh.triangle_patch[t] as usize);
         let on = |k: usize, ends: [f64; 2]| {
             ends.into_iter()
                 .find(|&e| a[k] == e && b[k] == e)
@@ -672,7 +714,7 @@ impl<'a> Solver<'a> {
                 delta.iter_mut().for_each(|d| *d /= longest);
             }
             for (i, p) in params.iter_mut().enumerate() {
-                let (patch, u, v, ok) = self.analytic[p.sheet].surface.chart(
+                let (patch, u, v, ok) = self.surface(p.sheet).chart(
                     p.patch,
                     p.u + delta[2 * i],
                     p.v + delta[2 * i + 1],
@@ -700,7 +742,7 @@ impl<'a> Solver<'a> {
         // A point past an open side or a pole: on the surface's extension, not on it.
         if let Some(i) = inside.iter().position(|&ok| !ok) {
             let p = &params[i];
-            let d = self.analytic[p.sheet].surface.domain(p.patch);
+            let d = self.surface(p.sheet).domain(p.patch);
             let past = [
                 (p.u < d.u[0], 2 * i, d.u[0]),
                 (p.u > d.u[1], 2 * i, d.u[1]),
@@ -719,9 +761,9 @@ impl<'a> Solver<'a> {
     /// curve.
     fn cross_cap(&self, global: u32, p: &CurvePoint) -> CrossCap {
         let (s, v) = self.vertex(global);
-        let a = &self.analytic[s];
-        let (mut patch, [mut u, mut w]) = (a.mesh.patch[v] as usize, a.mesh.uv[v]);
-        let d = a.surface.domain(patch);
+        let (mesh, surface) = (self.analytic[s].mesh, self.surface(s));
+        let (mut patch, [mut u, mut w]) = (mesh.patch[v] as usize, mesh.uv[v]);
+        let d = surface.domain(patch);
         let on_pole = |side: Side, at: bool| at && matches!(d.side(side), SideRule::Pole);
         if on_pole(Side::U0, u == d.u[0])
             || on_pole(Side::U1, u == d.u[1])
@@ -736,10 +778,10 @@ impl<'a> Solver<'a> {
             .iter()
             .map(|f| self.start(*f, p.position).reach)
             .fold(0.0, f64::max);
-        let origin = a.mesh.positions[v];
+        let origin = mesh.positions[v];
         let mut inside = true;
         for _ in 0..MAX_STEPS {
-            let e = a.surface.eval(patch, u, w);
+            let e = surface.eval(patch, u, w);
             let Some(j) = self.view.jets(&e) else {
                 return CrossCap::NotFound;
             };
@@ -767,13 +809,13 @@ impl<'a> Solver<'a> {
                 return CrossCap::NotFound;
             };
             let moved = (du.abs() / (1.0 + u.abs())).max(dw.abs() / (1.0 + w.abs()));
-            let next = a.surface.chart(patch, u + du, w + dw);
+            let next = surface.chart(patch, u + du, w + dw);
             (patch, u, w, inside) = next;
             if moved < 1e-15 {
                 break;
             }
         }
-        let e = a.surface.eval(patch, u, w);
+        let e = surface.eval(patch, u, w);
         let (Some(m), Some(j)) = (self.view.map(&e), self.view.jets(&e)) else {
             return CrossCap::NotFound;
         };

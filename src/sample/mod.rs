@@ -16,10 +16,14 @@
 
 mod adaptive;
 mod audit;
+mod file;
+mod source;
 mod uniform;
 
 pub use adaptive::{metric_aspect, sample_adaptive};
 pub use audit::{AUDIT_POINTS, Audit, audit};
+pub use file::{MeshData4, MeshFileError, read_mesh4, write_4off};
+pub use source::{MeshSurface, Source, mesh_from_data, mesh_tangents};
 pub use uniform::sample_uniform;
 
 use crate::limits::{FieldError, GRID_CELLS, RELATIVE_TOLERANCE, TRIANGLES};

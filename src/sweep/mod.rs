@@ -292,7 +292,10 @@ fn mesh_curves(surface: &Surface, mesh: &Mesh4, view: &View) -> Result<MeshCurve
     let refined = intersect::refine(
         &curves,
         &sheets,
-        &[Analytic { surface, mesh }],
+        &[Analytic {
+            surface: Some(surface),
+            mesh,
+        }],
         view,
         diagonal,
     );

@@ -69,8 +69,7 @@ impl Model {
         let surfaces: Vec<(String, Mesh4)> = (0..scene.surfaces.len())
             .into_par_iter()
             .map(|i| {
-                let sampled =
-                    crate::sample::sample(&scene.surfaces[i].surface, scene.surface_sampling(i));
+                let sampled = scene.surfaces[i].surface.sample(scene.surface_sampling(i));
                 (scene.surface_name(i), sampled.mesh)
             })
             .collect();

@@ -1,0 +1,153 @@
+//! Surfaces users bring: 4D meshes from files, built like the catalogue's.
+
+use crate::common::fixture;
+use halo4d::{MeshData4, Scene, Source, write_4off};
+
+/// A scene of one surface in the oblique view the curve tests use, on a grid.
+fn scene_json(surface: &str, sampling: &str) -> String {
+    format!(
+        r#"{{"name": "own", "surfaces": [{{"surface": {surface}}}], {sampling}
+            "view": {{"rotation": {{"yw": 30, "xz": 10}}, "projection": {{"type": "orthographic"}}}},
+            "outputs": {{"glb": false, "ply": false, "vtk": false, "png": false, "report": false, "verify": true}}}}"#
+    )
+}
+
+#[test]
+fn a_4off_of_a_catalogue_mesh_builds_the_same_curves_and_verifies() {
+    let dir = tempfile::tempdir().unwrap();
+    for (surface, file) in [
+        (r#"{"type": "flat_torus"}"#, "torus.4off"),
+        (r#"{"type": "klein_bottle"}"#, "klein.4off"),
+    ] {
+        let grid = r#""sampling": {"method": "uniform", "u": 48, "v": 48},"#;
+        let scene = Scene::parse(&scene_json(surface, grid), "catalogue.json").unwrap();
+        let catalogue = halo4d::run(&scene, true).unwrap();
+        let mesh = &catalogue.surfaces[0].mesh;
+        let data = MeshData4 {
+            positions: mesh.positions.clone(),
+            triangles: mesh.triangles.clone(),
+        };
+        std::fs::write(dir.path().join(file), write_4off(&data)).unwrap();
+        let path = dir.path().join("scene.json");
+        let text = scene_json(&format!(r#"{{"type": "mesh", "path": "{file}"}}"#), "");
+        std::fs::write(&path, text).unwrap();
+        let scene = Scene::load(&path).unwrap();
+        let Source::Mesh(m) = &scene.surfaces[0].surface else {
+            panic!("a mesh source")
+        };
+        assert_eq!(m.mesh.positions, mesh.positions, "{file}: points read back");
+        assert_eq!(
+            m.mesh.triangles, mesh.triangles,
+            "{file}: triangles read back"
+        );
+        let built = halo4d::run(&scene, true).unwrap();
+
+        // The curves depend on the projected mesh only: the same, point for point.
+        let (a, b) = (&catalogue.curves, &built.curves);
+        assert!(a.report.points > 20, "{file}: the view has curves");
+        assert_eq!(a.curves.len(), b.curves.len(), "{file}");
+        for (ca, cb) in a.curves.iter().zip(&b.curves) {
+            let pa: Vec<_> = ca.points.iter().map(|p| p.position).collect();
+            let pb: Vec<_> = cb.points.iter().map(|p| p.position).collect();
+            assert_eq!(pa, pb, "{file}");
+        }
+        // The halos' normals come from the mesh instead of the parametrization: the
+        // verification passes as the catalogue's does, on as many samples.
+        for (what, v) in [
+            ("catalogue", &catalogue.verification),
+            ("file", &built.verification),
+        ] {
+            assert_eq!(v.wrong, 0, "{file} ({what}): {v:?}");
+            assert!(v.correct > 0, "{file} ({what})");
+        }
+        assert_eq!(
+            catalogue.verification.curve_samples,
+            built.verification.curve_samples
+        );
+        // The file's curves are not moved: that mesh is the surface.
+        let r = built
+            .refined
+            .as_ref()
+            .and_then(|c| c.report.refinement.clone())
+            .unwrap();
+        assert_eq!((r.refined, r.not_converged), (0, 0), "{file}");
+        assert_eq!(
+            r.on_meshes,
+            b.report.points + b.triple_points.len(),
+            "{file}"
+        );
+        // The topology the mesh's combinatorics give is the catalogue surface's.
+        assert_eq!(
+            scene.surfaces[0].surface.topology(),
+            catalogue.surfaces[0].surface.topology(),
+            "{file}"
+        );
+    }
+}
+
+#[test]
+fn a_mesh_surface_refuses_sampling_and_names_a_missing_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.json");
+    std::fs::write(
+        &path,
+        scene_json(r#"{"type": "mesh", "path": "nowhere.4off"}"#, ""),
+    )
+    .unwrap();
+    let err = Scene::load(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("surfaces[0].surface.path") && err.contains("nowhere.4off"),
+        "{err}"
+    );
+    std::fs::copy(
+        fixture("meshes/tetrahedron.4off"),
+        dir.path().join("t.4off"),
+    )
+    .unwrap();
+    let text = r#"{"name": "own", "surfaces": [{"surface": {"type": "mesh", "path": "t.4off"},
+        "sampling": {"method": "uniform", "u": 8, "v": 8}}]}"#;
+    std::fs::write(&path, text).unwrap();
+    let err = Scene::load(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("surfaces[0].sampling") && err.contains("not sampled"),
+        "{err}"
+    );
+}
+
+#[test]
+fn tangents_from_a_mesh_approach_the_surface_s_and_keep_its_orientation() {
+    // The Klein bottle's tangent plane against the planes the mesh gives, on grids of
+    // growing size: the largest angle about halves with the cells (first order: a grid's
+    // cells split along one diagonal make one-rings that are not symmetric), and u ∧ v
+    // points the way the parametrization's does wherever the mesh's winding agrees.
+    let surface = halo4d::Surface::KleinBottle(Default::default());
+    let mut worst = Vec::new();
+    for n in [16, 32, 64] {
+        let mesh = halo4d::sample_uniform(&surface, n, n);
+        let (tu, tv) = halo4d::mesh_tangents(&mesh.positions, &mesh.triangles);
+        let mut largest = 0.0f64;
+        for i in 0..mesh.positions.len() {
+            let e1 = mesh.tangent_u[i].normalize();
+            let e2 = (mesh.tangent_v[i] - e1 * e1.dot(mesh.tangent_v[i])).normalize();
+            for t in [tu[i], tv[i]] {
+                let off = (t - e1 * e1.dot(t) - e2 * e2.dot(t)).length();
+                largest = largest.max(off);
+            }
+            let orient = tu[i].dot(e1) * tv[i].dot(e2) - tu[i].dot(e2) * tv[i].dot(e1);
+            // On the seam glued with a flip the triangles on its two sides wind against each
+            // other: either way is right there.
+            let u = mesh.uv[i][0];
+            let seam = u == 0.0 || u == std::f64::consts::TAU;
+            assert!(
+                orient > 0.99 || (seam && orient < -0.99),
+                "{n}: vertex {i} at u = {u}: {orient}"
+            );
+        }
+        worst.push(largest);
+    }
+    assert!(worst[2] < 0.02, "{worst:?}");
+    assert!(
+        worst[0] > 1.8 * worst[1] && worst[1] > 1.8 * worst[2],
+        "{worst:?}"
+    );
+}
