@@ -113,6 +113,148 @@ impl Jet {
         let r = 1.0 / self.v;
         self.chain(r, -r * r, 2.0 * r * r * r)
     }
+
+    /// Applies a function of two variables `f(self, o)` with value `f`, gradient `g` and
+    /// Hessian `h = [f_aa, f_ab, f_bb]` (taken at `(self.v, o.v)`) by the chain rule.
+    pub fn chain2(self, o: Jet, f: f64, g: [f64; 2], h: [f64; 3]) -> Self {
+        let (a, b) = (self, o);
+        let second = |ai: f64, aj: f64, bi: f64, bj: f64, aij: f64, bij: f64| {
+            h[0] * ai * aj + h[1] * (ai * bj + bi * aj) + h[2] * bi * bj + g[0] * aij + g[1] * bij
+        };
+        Jet {
+            v: f,
+            du: g[0] * a.du + g[1] * b.du,
+            dv: g[0] * a.dv + g[1] * b.dv,
+            duu: second(a.du, a.du, b.du, b.du, a.duu, b.duu),
+            duv: second(a.du, a.dv, b.du, b.dv, a.duv, b.duv),
+            dvv: second(a.dv, a.dv, b.dv, b.dv, a.dvv, b.dvv),
+        }
+    }
+
+    /// tan.
+    pub fn tan(self) -> Self {
+        let t = self.v.tan();
+        let d = 1.0 + t * t;
+        self.chain(t, d, 2.0 * t * d)
+    }
+
+    /// asin (NaN outside [-1, 1], infinite derivatives at ±1).
+    pub fn asin(self) -> Self {
+        let x = self.v;
+        let q = 1.0 - x * x;
+        let d = 1.0 / q.sqrt();
+        self.chain(x.asin(), d, x * d / q)
+    }
+
+    /// acos (NaN outside [-1, 1], infinite derivatives at ±1).
+    pub fn acos(self) -> Self {
+        let x = self.v;
+        let q = 1.0 - x * x;
+        let d = 1.0 / q.sqrt();
+        self.chain(x.acos(), -d, -x * d / q)
+    }
+
+    /// atan.
+    pub fn atan(self) -> Self {
+        let x = self.v;
+        let d = 1.0 / (1.0 + x * x);
+        self.chain(x.atan(), d, -2.0 * x * d * d)
+    }
+
+    /// The angle of the point (x, y) = (`x`, `self`), in (-π, π], as `f64::atan2`. Its
+    /// derivatives are those of the angle, smooth away from the origin (the jump across the
+    /// negative x axis is not seen by derivatives).
+    pub fn atan2(self, x: Jet) -> Self {
+        let (a, b) = (self.v, x.v);
+        let r2 = a * a + b * b;
+        let q = 1.0 / (r2 * r2);
+        self.chain2(
+            x,
+            a.atan2(b),
+            [b / r2, -a / r2],
+            [-2.0 * a * b * q, (a * a - b * b) * q, 2.0 * a * b * q],
+        )
+    }
+
+    /// sinh.
+    pub fn sinh(self) -> Self {
+        let (s, c) = (self.v.sinh(), self.v.cosh());
+        self.chain(s, c, s)
+    }
+
+    /// cosh.
+    pub fn cosh(self) -> Self {
+        let (s, c) = (self.v.sinh(), self.v.cosh());
+        self.chain(c, s, c)
+    }
+
+    /// tanh.
+    pub fn tanh(self) -> Self {
+        let t = self.v.tanh();
+        let d = 1.0 - t * t;
+        self.chain(t, d, -2.0 * t * d)
+    }
+
+    /// exp.
+    pub fn exp(self) -> Self {
+        let e = self.v.exp();
+        self.chain(e, e, e)
+    }
+
+    /// The natural logarithm (NaN for negative numbers, -∞ at 0).
+    pub fn ln(self) -> Self {
+        let r = 1.0 / self.v;
+        self.chain(self.v.ln(), r, -r * r)
+    }
+
+    /// Square root (NaN for negative numbers, infinite derivatives at 0).
+    pub fn sqrt(self) -> Self {
+        let s = self.v.sqrt();
+        let d = 0.5 / s;
+        self.chain(s, d, -0.5 * d / self.v)
+    }
+
+    /// Absolute value; at 0 the derivatives are those of the identity (one-sided).
+    pub fn abs(self) -> Self {
+        if self.v < 0.0 { -self } else { self }
+    }
+
+    /// The jet of the smaller value (the first on a tie).
+    pub fn min(self, o: Jet) -> Self {
+        if o.v < self.v { o } else { self }
+    }
+
+    /// The jet of the larger value (the first on a tie).
+    pub fn max(self, o: Jet) -> Self {
+        if o.v > self.v { o } else { self }
+    }
+
+    /// An integer power (any base, negative ones included; 0 to a negative power is
+    /// infinite).
+    pub fn powi(self, n: i32) -> Self {
+        let x = self.v;
+        let k = f64::from(n);
+        // A zero coefficient stays zero where the power beside it is infinite (x^1 at 0).
+        let term = |c: f64, e: i32| if c == 0.0 { 0.0 } else { c * x.powi(e) };
+        self.chain(
+            x.powi(n),
+            term(k, n.saturating_sub(1)),
+            term(k * (k - 1.0), n.saturating_sub(2)),
+        )
+    }
+
+    /// A constant real power x^k (NaN for negative x unless k is an integer: use
+    /// [`Jet::powi`] for those).
+    pub fn powf(self, k: f64) -> Self {
+        let x = self.v;
+        let term = |c: f64, e: f64| if c == 0.0 { 0.0 } else { c * x.powf(e) };
+        self.chain(x.powf(k), term(k, k - 1.0), term(k * (k - 1.0), k - 2.0))
+    }
+
+    /// A power with a varying exponent, exp(y ln x): defined for positive bases.
+    pub fn pow(self, y: Jet) -> Self {
+        (y * self.ln()).exp()
+    }
 }
 
 impl From<f64> for Jet {
@@ -227,6 +369,132 @@ mod tests {
         let f = u.sqr() * v.cube();
         assert_eq!((f.v, f.du, f.dv), (108.0, 108.0, 108.0));
         assert_eq!((f.duu, f.duv, f.dvv), (54.0, 108.0, 72.0));
+    }
+
+    /// Checks a one-variable function's jet at `x` (taken as u) against its closed-form
+    /// value and first two derivatives.
+    fn against(name: &str, f: fn(Jet) -> Jet, x: f64, exact: [f64; 3]) {
+        let j = f(Jet::u(x));
+        for (k, (got, want)) in [j.v, j.du, j.duu].into_iter().zip(exact).enumerate() {
+            assert!(
+                (got - want).abs() <= 1e-14 * want.abs().max(1.0),
+                "{name} at {x}: derivative {k} is {got}, expected {want}"
+            );
+        }
+        assert_eq!((j.dv, j.duv, j.dvv), (0.0, 0.0, 0.0), "{name}");
+    }
+
+    #[test]
+    fn elementary_functions_against_closed_forms() {
+        let x = 0.3f64;
+        let c = x.cos();
+        against(
+            "tan",
+            Jet::tan,
+            x,
+            [x.tan(), 1.0 / (c * c), 2.0 * x.sin() / (c * c * c)],
+        );
+        let q = 1.0 - x * x;
+        against(
+            "asin",
+            Jet::asin,
+            x,
+            [x.asin(), q.powf(-0.5), x * q.powf(-1.5)],
+        );
+        against(
+            "acos",
+            Jet::acos,
+            x,
+            [x.acos(), -q.powf(-0.5), -x * q.powf(-1.5)],
+        );
+        let p = 1.0 + x * x;
+        against(
+            "atan",
+            Jet::atan,
+            x,
+            [x.atan(), 1.0 / p, -2.0 * x / (p * p)],
+        );
+        against("sinh", Jet::sinh, x, [x.sinh(), x.cosh(), x.sinh()]);
+        against("cosh", Jet::cosh, x, [x.cosh(), x.sinh(), x.cosh()]);
+        let s2 = 1.0 / (x.cosh() * x.cosh());
+        against("tanh", Jet::tanh, x, [x.tanh(), s2, -2.0 * x.tanh() * s2]);
+        against("exp", Jet::exp, x, [x.exp(), x.exp(), x.exp()]);
+        against("ln", Jet::ln, x, [x.ln(), 1.0 / x, -1.0 / (x * x)]);
+        against(
+            "sqrt",
+            Jet::sqrt,
+            x,
+            [x.sqrt(), 0.5 / x.sqrt(), -0.25 * x.powf(-1.5)],
+        );
+        against("abs", Jet::abs, -x, [x, -1.0, 0.0]);
+        against("abs", Jet::abs, x, [x, 1.0, 0.0]);
+        against(
+            "powi",
+            |j| j.powi(3),
+            -x,
+            [-x * x * x, 3.0 * x * x, -6.0 * x],
+        );
+        against(
+            "powi",
+            |j| j.powi(-2),
+            -x,
+            [1.0 / (x * x), 2.0 / (x * x * x), 6.0 / x.powi(4)],
+        );
+        against("powi", |j| j.powi(1), 0.0, [0.0, 1.0, 0.0]);
+        against("powi", |j| j.powi(0), 0.0, [1.0, 0.0, 0.0]);
+        against(
+            "powf",
+            |j| j.powf(2.5),
+            x,
+            [x.powf(2.5), 2.5 * x.powf(1.5), 3.75 * x.sqrt()],
+        );
+        against("powf", |j| j.powf(1.0), 0.0, [0.0, 1.0, 0.0]);
+        // x^x = exp(x ln x): (x^x)' = x^x (ln x + 1), (x^x)'' = x^x ((ln x + 1)^2 + 1/x).
+        let l = x.ln() + 1.0;
+        let xx = x.powf(x);
+        against("pow", |j| j.pow(j), x, [xx, xx * l, xx * (l * l + 1.0 / x)]);
+    }
+
+    #[test]
+    fn two_argument_functions_follow_both_jets() {
+        // atan2(v, u) is the polar angle: derivatives -v/r², u/r², 2uv/r⁴, (v²-u²)/r⁴,
+        // -2uv/r⁴.
+        let (u, v) = (0.7f64, -0.4f64);
+        let a = Jet::v(v).atan2(Jet::u(u));
+        let r2 = u * u + v * v;
+        let q = r2 * r2;
+        let want = [
+            v.atan2(u),
+            -v / r2,
+            u / r2,
+            2.0 * u * v / q,
+            (v * v - u * u) / q,
+            -2.0 * u * v / q,
+        ];
+        let got = [a.v, a.du, a.dv, a.duu, a.duv, a.dvv];
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() < 1e-14, "{got:?} against {want:?}");
+        }
+        // u^v = exp(v ln u): d/du = v u^(v-1), d/dv = u^v ln u, d²/du dv = u^(v-1) (1 + v ln u).
+        let p = Jet::u(u).pow(Jet::v(v));
+        let l = u.ln();
+        let want = [
+            u.powf(v),
+            v * u.powf(v - 1.0),
+            u.powf(v) * l,
+            v * (v - 1.0) * u.powf(v - 2.0),
+            u.powf(v - 1.0) * (1.0 + v * l),
+            u.powf(v) * l * l,
+        ];
+        let got = [p.v, p.du, p.dv, p.duu, p.duv, p.dvv];
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() < 1e-14, "{got:?} against {want:?}");
+        }
+        // min and max keep the whole jet of the chosen argument.
+        let (a, b) = (Jet::u(1.0), Jet::v(2.0));
+        assert_eq!(a.min(b), a);
+        assert_eq!(a.max(b), b);
+        assert_eq!(b.min(a), a);
     }
 
     #[test]
