@@ -66,8 +66,9 @@ pub use sample::{
 };
 pub use stipple::{Stipples, poisson_radius};
 pub use surfaces::{
-    Domain, Eval4, Fermat, FlatTorus, Glue, Jet, KleinBottle, Patches, ProductPolynomial,
-    ProjectivePlane, Side, SideRule, SpunTrefoil, Surface, Topology, TwistSpunTrefoil,
+    Domain, Eval4, Fermat, FlatTorus, Formula, FormulaEdge, FormulaSeam, FormulaSides,
+    FormulaSource, Glue, Jet, KleinBottle, Patches, ProductPolynomial, ProjectivePlane, Side,
+    SideRule, SpunTrefoil, Surface, Topology, TwistSpunTrefoil,
 };
 pub use verify::{Ambiguous, Verification, verify};
 pub use view::{BehindEye, Mapped, Projected, Projection, Rotation4, View, ViewMap};

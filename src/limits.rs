@@ -93,6 +93,31 @@ pub const BRANCH_REACH: f64 = 2.0;
 /// catalogue's halos stay below 1e-13).
 pub const VOLUME_DEFECT: f64 = 1e-9;
 
+/// The longest formula of a `formula` surface, in bytes.
+pub const FORMULA_LENGTH: usize = 4096;
+
+/// How deep a formula may nest parentheses, powers and signs: the parser recurses once per
+/// level, and hostile input like `((((...` must not overflow the stack.
+pub const FORMULA_DEPTH: usize = 256;
+
+/// The largest size of a constant exponent in a formula (`x^k`). x^k changes by a factor e
+/// when x changes by 1/k of itself, so beyond 1e6 its features are narrower than the
+/// shortest edge the sampler splits ([`MIN_EDGE`]): `sin(u)^1e9` is a spike of width 3e-5
+/// rad that the check grid misses and no mesh resolves.
+pub const FORMULA_EXPONENT: f64 = 1e6;
+
+/// The largest bend of a formula surface at a point of its check grid: a second derivative
+/// times the squared extent of its parameter ranges, in bounding diagonals. A grid of
+/// parameter step s (a share of the range) has a chordal error of about this bend times
+/// s²/8 diagonals, so at 1e8 the default tolerance (1e-3) already needs steps of 1e-5 of
+/// the domain, ten times the sampler's shortest edge ([`MIN_EDGE`]); beyond, the sampler
+/// would stop at its floor with a wrong surface.
+pub const FORMULA_BEND: f64 = 1e8;
+
+/// How close, relative to a formula surface's bounding diagonal, two points that its side
+/// rules glue (or a pole's points) must be: rounding of the formulas, never a gap.
+pub const FORMULA_GLUE: f64 = 1e-9;
+
 /// The most bytes of one run of text without whitespace an error message echoes.
 pub const ECHO_RUN: usize = 60;
 
@@ -254,6 +279,31 @@ pub fn table() -> String {
             "a projected scene's bounding diagonal",
             format!("at least {MIN_EXTENT:e}"),
             "scene units",
+        ),
+        (
+            "a formula's length (`surfaces[i].surface.x`, ...)",
+            format!("up to {FORMULA_LENGTH}"),
+            "bytes",
+        ),
+        (
+            "a formula's nesting of parentheses, powers and signs",
+            format!("up to {FORMULA_DEPTH}"),
+            "levels",
+        ),
+        (
+            "a constant exponent in a formula",
+            format!("up to {FORMULA_EXPONENT:e}"),
+            "in size",
+        ),
+        (
+            "a formula surface's second derivative times its squared parameter extent",
+            format!("up to {FORMULA_BEND:e}"),
+            "bounding diagonals",
+        ),
+        (
+            "the gap between points a formula surface's sides glue",
+            format!("at most {FORMULA_GLUE:e}"),
+            "of the bounding diagonal",
         ),
         (
             "a curve sample the halos do not explain is ambiguous, not wrong, this near a branch point or a boundary end",

@@ -11,11 +11,13 @@
 //! finite everywhere except at the isolated branch points of the Fermat parametrization, where
 //! the parametrization (not the surface) is singular.
 
+mod formula;
 mod holomorphic;
 mod jet;
 mod knots;
 mod simple;
 
+pub use formula::{Formula, FormulaEdge, FormulaSeam, FormulaSides, FormulaSource};
 pub use holomorphic::{Fermat, ProductPolynomial};
 pub use jet::Jet;
 pub use knots::{SpunTrefoil, TwistSpunTrefoil};
@@ -223,7 +225,8 @@ pub struct Topology {
 }
 
 /// A surface of the catalogue with its parameters, as written in a scene file
-/// (`{"type": "spun_trefoil", "scale": 0.5}`). Every parameter has a default.
+/// (`{"type": "spun_trefoil", "scale": 0.5}`), or the user's own [`Formula`]. Every
+/// parameter of a catalogue entry has a default.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(tag = "type", rename_all = "snake_case")]
 pub enum Surface {
@@ -243,6 +246,8 @@ pub enum Surface {
     ProductPolynomial(ProductPolynomial),
     /// The test scene of paper 000 fig. 1: planar patches at different w crossing a white one.
     Patches(Patches),
+    /// The user's own surface: four formulas in (u, v) with side rules.
+    Formula(Formula),
 }
 
 /// Reads `{"type": ..., params}` in two steps so that an error in a parameter names it
@@ -274,11 +279,18 @@ impl<'de> Deserialize<'de> for Surface {
             "fermat" => Surface::Fermat(read(params)?),
             "product_polynomial" => Surface::ProductPolynomial(read(params)?),
             "patches" => Surface::Patches(read(params)?),
+            // Parsed in two steps too: a formula's error names its own field (`x: cannot
+            // read the formula ...`) with a caret, which a path prefix would only repeat.
+            "formula" => {
+                let source: FormulaSource = read(params)?;
+                Surface::Formula(Formula::new(source).map_err(D::Error::custom)?)
+            }
             _ => {
-                let known: Vec<&str> = Surface::catalogue()
+                let mut known: Vec<&str> = Surface::catalogue()
                     .iter()
                     .map(Surface::type_name)
                     .collect();
+                known.push("formula");
                 return Err(D::Error::custom(format!(
                     "unknown surface type `{ty}`, expected one of {}",
                     known.join(", ")
@@ -319,12 +331,14 @@ macro_rules! dispatch {
             Surface::Fermat($s) => $e,
             Surface::ProductPolynomial($s) => $e,
             Surface::Patches($s) => $e,
+            Surface::Formula($s) => $e,
         }
     };
 }
 
 impl Surface {
-    /// One default-parametrized instance of every catalogue entry.
+    /// One default-parametrized instance of every catalogue entry (a [`Formula`] has no
+    /// default: see [`Formula::example`]).
     pub fn catalogue() -> Vec<Surface> {
         vec![
             Surface::FlatTorus(FlatTorus::default()),
@@ -355,6 +369,13 @@ impl Surface {
                 params
             );
         }
+        let example = Surface::Formula(Formula::example());
+        out += &format!("{:<20} {}\n", example.type_name(), example.description());
+        out += &format!(
+            "{:<20} example: {}\n",
+            "",
+            serde_json::to_value(&example).unwrap_or_default()
+        );
         out
     }
 
@@ -369,6 +390,7 @@ impl Surface {
             Surface::Fermat(_) => "fermat",
             Surface::ProductPolynomial(_) => "product_polynomial",
             Surface::Patches(_) => "patches",
+            Surface::Formula(_) => "formula",
         }
     }
 
@@ -390,6 +412,9 @@ impl Surface {
             Surface::ProductPolynomial(_) => "product polynomial z1^2 z2^2 = 1 (two sheets)",
             Surface::Patches(_) => {
                 "paper 000 fig. 1: planar patches at different w crossing a white one"
+            }
+            Surface::Formula(_) => {
+                "your own surface: formulas x, y, z, w in u, v, pi, e and `parameters` (+ - * / ^, sin cos tan asin acos atan atan2 sinh cosh tanh exp log sqrt abs min max), ranges `u`, `v` and `sides` (u, v: open, periodic, flip; u_min, u_max, v_min, v_max: open, pole, half_turn)"
             }
         }
     }
