@@ -114,3 +114,36 @@ pub fn assert_unreadable(out: &Output, what: &str, words: &[&str]) {
     }
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// Formula surfaces with every kind of side rule, each with a geometry those rules fit:
+/// the example torus, a Klein bottle flipped across v, a projective plane with its pole
+/// and half turn on the v sides, and a round sphere with two poles.
+pub fn formula_surfaces() -> Vec<halo4d::Surface> {
+    let tau = std::f64::consts::TAU;
+    let read = |json: serde_json::Value| -> halo4d::Surface {
+        serde_json::from_value(json).unwrap_or_else(|e| panic!("{e}"))
+    };
+    vec![
+        halo4d::Surface::Formula(halo4d::Formula::example()),
+        read(serde_json::json!({
+            "type": "formula",
+            "x": "(1 + 0.5*cos(u))*cos(v)", "y": "(1 + 0.5*cos(u))*sin(v)",
+            "z": "0.5*sin(u)*cos(v/2)", "w": "0.5*sin(u)*sin(v/2)",
+            "u": [0.0, tau], "v": [0.0, tau],
+            "sides": {"u": "periodic", "v": "flip"}
+        })),
+        read(serde_json::json!({
+            "type": "formula",
+            "x": "cos(v)*sin(v)*cos(u)", "y": "cos(v)*sin(v)*sin(u)",
+            "z": "(sin(v)*cos(u))^2 - (sin(v)*sin(u))^2", "w": "2*sin(v)^2*cos(u)*sin(u)",
+            "u": [0.0, tau], "v": [0.0, std::f64::consts::FRAC_PI_2],
+            "sides": {"u": "periodic", "v_min": "pole", "v_max": "half_turn"}
+        })),
+        read(serde_json::json!({
+            "type": "formula",
+            "x": "sin(u)*cos(v)", "y": "sin(u)*sin(v)", "z": "cos(u)", "w": "0.3*sin(u)^2*cos(v)",
+            "u": [0.0, std::f64::consts::PI], "v": [0.0, tau],
+            "sides": {"u_min": "pole", "u_max": "pole", "v": "periodic"}
+        })),
+    ]
+}

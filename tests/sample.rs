@@ -13,6 +13,9 @@ fn closed_surfaces_are_closed_oriented_manifolds_with_their_euler_characteristic
         scale: 1.0,
         twists: 3,
     }));
+    // Formula surfaces: their topology comes from the side rules, their mesh from the
+    // domain those rules build; the two must agree.
+    surfaces.extend(crate::common::formula_surfaces());
     for s in surfaces.into_iter().filter(|s| s.topology().closed) {
         let topo = s.topology();
         let [min_u, min_v] = s.min_cells();
@@ -40,6 +43,7 @@ fn non_orientable_surfaces_cannot_be_oriented() {
     // plane must then show conflicts along its flipped seam, which proves the seam is welded.
     for s in Surface::catalogue()
         .into_iter()
+        .chain(crate::common::formula_surfaces())
         .filter(|s| !s.topology().orientable)
     {
         let stats = sample_uniform(&s, 8, 8).validate();

@@ -16,6 +16,7 @@ fn surfaces_under_test() -> Vec<Surface> {
         scale: 0.7,
         twists: 5,
     }));
+    all.extend(crate::common::formula_surfaces());
     all
 }
 
@@ -184,4 +185,16 @@ fn parameters_past_a_glued_side_continue_on_the_side_it_is_glued_to() {
     // Inside, or off by rounding, the parameters are returned as they are.
     assert_eq!(klein.chart(0, 1.0, 2.0), (0, 1.0, 2.0, true));
     assert!(patches.chart(0, d.u[0] - 1e-14, d.v[0]).3);
+}
+
+#[test]
+fn formula_surfaces_pass_their_check_and_count_their_topology() {
+    let chi: Vec<Option<i64>> = crate::common::formula_surfaces()
+        .iter()
+        .map(|s| {
+            assert_eq!(s.check(), Ok(()), "{}", serde_json::to_string(s).unwrap());
+            s.topology().euler_characteristic
+        })
+        .collect();
+    assert_eq!(chi, [Some(0), Some(0), Some(1), Some(2)]);
 }
