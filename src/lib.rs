@@ -66,7 +66,7 @@ pub use sample::{
 };
 pub use stipple::{Stipples, poisson_radius};
 pub use surfaces::{
-    Domain, Eval4, Fermat, FlatTorus, Formula, FormulaEdge, FormulaSeam, FormulaSides,
+    Bound, Domain, Eval4, Fermat, FlatTorus, Formula, FormulaEdge, FormulaSeam, FormulaSides,
     FormulaSource, Glue, Jet, KleinBottle, Patches, ProductPolynomial, ProjectivePlane, Side,
     SideRule, SpunTrefoil, Surface, Topology, TwistSpunTrefoil,
 };

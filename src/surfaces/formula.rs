@@ -44,16 +44,59 @@ pub struct FormulaSource {
     pub z: String,
     /// The fourth coordinate.
     pub w: String,
-    /// The range of u, `[min, max]`, finite with min < max.
-    pub u: [f64; 2],
+    /// The range of u, `[min, max]`, finite with min < max: numbers, or formulas of numbers,
+    /// `pi`, `e` and the parameters (`[0, "2*pi"]`).
+    pub u: [Bound; 2],
     /// The range of v.
-    pub v: [f64; 2],
+    pub v: [Bound; 2],
     /// The rules of the sides of the parameter rectangle; all open when omitted.
     #[serde(default, skip_serializing_if = "FormulaSides::all_open")]
     pub sides: FormulaSides,
     /// Named constants the formulas may use.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub parameters: BTreeMap<String, f64>,
+}
+
+/// An end of a parameter range: a number, or a formula without u and v (`"2*pi"`, `"pi/a"`),
+/// so that a period is exactly the f64 nearest 2π and not a rounded one.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Bound {
+    /// A number.
+    Number(f64),
+    /// A formula of numbers, `pi`, `e` and the parameters.
+    Formula(String),
+}
+
+impl From<f64> for Bound {
+    fn from(x: f64) -> Self {
+        Bound::Number(x)
+    }
+}
+
+impl From<&str> for Bound {
+    fn from(text: &str) -> Self {
+        Bound::Formula(text.to_string())
+    }
+}
+
+impl Bound {
+    /// The value, or what is wrong with the formula.
+    fn value(&self, parameters: &BTreeMap<String, f64>) -> Result<f64, String> {
+        match self {
+            Bound::Number(x) => Ok(*x),
+            Bound::Formula(text) => {
+                let program = Program::compile(text, parameters)?;
+                if program.ops.iter().any(|op| matches!(op, Op::U | Op::V)) {
+                    return Err(format!(
+                        "`{}`: a range's end may use numbers, pi, e and the parameters, not u or v",
+                        shorten(text)
+                    ));
+                }
+                Ok(program.run(0.0, 0.0))
+            }
+        }
+    }
 }
 
 /// The rules of a formula surface's sides: `{"u": "periodic", "v_min": "pole"}`. `u` sets
@@ -162,6 +205,10 @@ enum Kind {
 pub struct Formula {
     // Boxed: a `Surface` is as large as its largest variant.
     source: Box<FormulaSource>,
+    /// The ranges of u and v, evaluated.
+    ranges: [[f64; 2]; 2],
+    /// The four programs as one, for points and jets.
+    shared: Box<Shared>,
     programs: Box<[Program; 4]>,
 }
 
@@ -192,7 +239,14 @@ impl Formula {
     /// error names the field (`x`, `u`, `parameters.a`, `sides.u_min`) and, for a formula
     /// that does not parse, shows where with a caret.
     pub fn new(source: FormulaSource) -> Result<Formula, FieldError> {
-        for (field, r) in [("u", source.u), ("v", source.v)] {
+        let mut ranges = [[0.0; 2]; 2];
+        for (k, (field, bounds)) in [("u", &source.u), ("v", &source.v)].into_iter().enumerate() {
+            for (end, b) in bounds.iter().enumerate() {
+                ranges[k][end] = b
+                    .value(&source.parameters)
+                    .map_err(|m| FieldError::new(format!("{field}[{end}]"), m))?;
+            }
+            let r = ranges[k];
             if !(r[0].is_finite() && r[1].is_finite() && r[0] < r[1] && (r[1] - r[0]).is_finite()) {
                 return Err(FieldError::new(
                     field,
@@ -241,6 +295,8 @@ impl Formula {
             .map_err(|_| FieldError::new("x", "four formulas expected"))?;
         Ok(Formula {
             source: Box::new(source),
+            ranges,
+            shared: Box::new(Shared::new(&programs)),
             programs: Box::new(programs),
         })
     }
@@ -259,8 +315,8 @@ impl Formula {
             y: "(R + r*cos(v))*sin(u)".into(),
             z: "r*sin(v)*cos(n*u)".into(),
             w: "r*sin(v)*sin(n*u)".into(),
-            u: [0.0, TAU],
-            v: [0.0, TAU],
+            u: [0.0.into(), "2*pi".into()],
+            v: [0.0.into(), "2*pi".into()],
             sides: FormulaSides {
                 u: Some(FormulaSeam::Periodic),
                 v: Some(FormulaSeam::Periodic),
@@ -279,8 +335,7 @@ impl Formula {
     }
 
     fn jets(&self, u: f64, v: f64) -> [Jet; 4] {
-        let (u, v) = (Jet::u(u), Jet::v(v));
-        [0, 1, 2, 3].map(|k| self.programs[k].run(u, v))
+        self.shared.run(Jet::u(u), Jet::v(v))
     }
 
     /// The points of the check grid with their jets: a regular grid with the sides, then
@@ -288,7 +343,7 @@ impl Formula {
     /// that fits the regular grid (sin(1e5 u) over [0, 2π] is 0 at all its points) does
     /// not hide from the check.
     fn check_grid(&self) -> Vec<(f64, f64, [Jet; 4])> {
-        let (du, dv) = (self.source.u, self.source.v);
+        let [du, dv] = self.ranges;
         let cells = (CHECK_GRID - 1) as f64;
         let at = |r: [f64; 2], i: usize, shift: f64| {
             if i == CHECK_GRID - 1 && shift == 0.0 {
@@ -342,8 +397,7 @@ impl Formula {
     /// Finite derivatives inside the domain; on its sides, finite derivatives just inside
     /// (where the sampler takes a vertex's tangents when those at the side are not finite).
     fn check_derivatives(&self, grid: &[(f64, f64, [Jet; 4])]) -> Result<(), FieldError> {
-        let [u0, u1] = self.source.u;
-        let [v0, v1] = self.source.v;
+        let [[u0, u1], [v0, v1]] = self.ranges;
         let finite = |j: &Jet| {
             [j.du, j.dv, j.duu, j.duv, j.dvv]
                 .iter()
@@ -396,8 +450,8 @@ impl Formula {
     /// Second derivatives times the squared parameter extents within [`FORMULA_BEND`]
     /// bounding diagonals.
     fn check_bend(&self, grid: &[(f64, f64, [Jet; 4])], diagonal: f64) -> Result<(), FieldError> {
-        let lu = self.source.u[1] - self.source.u[0];
-        let lv = self.source.v[1] - self.source.v[0];
+        let lu = self.ranges[0][1] - self.ranges[0][0];
+        let lv = self.ranges[1][1] - self.ranges[1][0];
         for (u, v, jets) in grid {
             for (k, j) in jets.iter().enumerate() {
                 let c = COMPONENTS[k];
@@ -481,7 +535,7 @@ impl Parametric for Formula {
 
     fn domain(&self, _: usize) -> Domain {
         let kinds = self.kinds();
-        let mut d = Domain::open(self.source.u, self.source.v);
+        let mut d = Domain::open(self.ranges[0], self.ranges[1]);
         for (side, kind) in Side::ALL.into_iter().zip(kinds) {
             let partner = match side {
                 Side::U0 => Side::U1,
@@ -514,8 +568,7 @@ impl Parametric for Formula {
     }
 
     fn point(&self, _: usize, u: f64, v: f64) -> DVec4 {
-        let [x, y, z, w] = [0, 1, 2, 3].map(|k| self.programs[k].run(u, v));
-        DVec4::new(x, y, z, w)
+        DVec4::from_array(self.shared.run(u, v))
     }
 
     fn topology(&self) -> Topology {
@@ -856,38 +909,15 @@ impl Number for Jet {
 
 /// Runs one instruction on the stack `s` whose first `sp` entries are live.
 fn exec<T: Number>(op: Op, s: &mut [T], sp: &mut usize, u: T, v: T) {
-    let top = sp.wrapping_sub(1);
-    match op {
-        Op::Const(x) => {
-            s[*sp] = T::constant(x);
-            *sp += 1;
-        }
-        Op::U => {
-            s[*sp] = u;
-            *sp += 1;
-        }
-        Op::V => {
-            s[*sp] = v;
-            *sp += 1;
-        }
-        Op::Neg => s[top] = -s[top],
-        Op::PowI(n) => s[top] = s[top].int_power(n),
-        Op::PowF(k) => s[top] = s[top].real_power(k),
-        Op::Call(f) if f.arity() == 1 => s[top] = T::call1(f, s[top]),
-        _ => {
-            let (a, b) = (s[top - 1], s[top]);
-            s[top - 1] = match op {
-                Op::Add => a + b,
-                Op::Sub => a - b,
-                Op::Mul => a * b,
-                Op::Div => a / b,
-                Op::Pow => a.power(b),
-                Op::Call(f) => T::call2(f, a, b),
-                _ => a,
-            };
-            *sp -= 1;
-        }
-    }
+    let n = op.arity();
+    let (a, b) = match n {
+        0 => (u, v),
+        1 => (s[*sp - 1], s[*sp - 1]),
+        _ => (s[*sp - 2], s[*sp - 1]),
+    };
+    *sp -= n;
+    s[*sp] = apply(op, a, b, u, v);
+    *sp += 1;
 }
 
 /// A compiled formula: a postfix program with every name resolved (u and v to their
@@ -902,6 +932,97 @@ struct Program {
     text: Vec<char>,
     /// The deepest the stack gets.
     depth: usize,
+}
+
+/// The four programs as one list of nodes, each computed once for all four coordinates
+/// (`cos(u)` in x and in y is one node: the built-in surfaces share such values by hand),
+/// in an order where every node reads earlier ones.
+#[derive(Clone, Debug)]
+struct Shared {
+    /// Each node's instruction and the nodes it reads (as many as the instruction takes).
+    nodes: Vec<(Op, [u32; 2])>,
+    /// The nodes of x, y, z and w.
+    outputs: [u32; 4],
+}
+
+/// Nodes this many live on the machine stack during a run; more allocate.
+const SMALL_NODES: usize = 48;
+
+impl Shared {
+    fn new(programs: &[Program; 4]) -> Shared {
+        use std::collections::HashMap;
+        let key = |op: Op| -> (u8, u64) {
+            match op {
+                Op::Const(x) => (0, x.to_bits()),
+                Op::U => (1, 0),
+                Op::V => (2, 0),
+                Op::Neg => (3, 0),
+                Op::Add => (4, 0),
+                Op::Sub => (5, 0),
+                Op::Mul => (6, 0),
+                Op::Div => (7, 0),
+                Op::PowI(n) => (8, u64::from(n as u32)),
+                Op::PowF(k) => (9, k.to_bits()),
+                Op::Pow => (10, 0),
+                Op::Call(f) => (11, f as u64),
+            }
+        };
+        let mut nodes: Vec<(Op, [u32; 2])> = Vec::new();
+        let mut seen: HashMap<((u8, u64), [u32; 2]), u32> = HashMap::new();
+        let mut outputs = [0; 4];
+        for (k, program) in programs.iter().enumerate() {
+            let mut stack: Vec<u32> = Vec::with_capacity(program.depth);
+            for op in &program.ops {
+                let mut args = [0; 2];
+                for i in (0..op.arity()).rev() {
+                    args[i] = stack.pop().unwrap_or_default();
+                }
+                let id = *seen.entry((key(*op), args)).or_insert_with(|| {
+                    nodes.push((*op, args));
+                    (nodes.len() - 1) as u32
+                });
+                stack.push(id);
+            }
+            outputs[k] = stack.pop().unwrap_or_default();
+        }
+        Shared { nodes, outputs }
+    }
+
+    fn run<T: Number>(&self, u: T, v: T) -> [T; 4] {
+        fn go<T: Number>(nodes: &[(Op, [u32; 2])], r: &mut [T], u: T, v: T) {
+            for (i, &(op, [a, b])) in nodes.iter().enumerate() {
+                r[i] = apply(op, r[a as usize], r[b as usize], u, v);
+            }
+        }
+        if self.nodes.len() <= SMALL_NODES {
+            let mut r = [T::constant(0.0); SMALL_NODES];
+            go(&self.nodes, &mut r, u, v);
+            self.outputs.map(|o| r[o as usize])
+        } else {
+            let mut r = vec![T::constant(0.0); self.nodes.len()];
+            go(&self.nodes, &mut r, u, v);
+            self.outputs.map(|o| r[o as usize])
+        }
+    }
+}
+
+/// One instruction on its operands (`a` and `b`, as many as it takes).
+fn apply<T: Number>(op: Op, a: T, b: T, u: T, v: T) -> T {
+    match op {
+        Op::Const(x) => T::constant(x),
+        Op::U => u,
+        Op::V => v,
+        Op::Neg => -a,
+        Op::Add => a + b,
+        Op::Sub => a - b,
+        Op::Mul => a * b,
+        Op::Div => a / b,
+        Op::PowI(n) => a.int_power(n),
+        Op::PowF(k) => a.real_power(k),
+        Op::Pow => a.power(b),
+        Op::Call(f) if f.arity() == 1 => T::call1(f, a),
+        Op::Call(f) => T::call2(f, a, b),
+    }
 }
 
 /// A stack this deep lives on the machine stack; deeper programs allocate.
@@ -1537,8 +1658,8 @@ mod tests {
             y: xyzw[1].into(),
             z: xyzw[2].into(),
             w: xyzw[3].into(),
-            u,
-            v,
+            u: u.map(Bound::from),
+            v: v.map(Bound::from),
             sides: FormulaSides::default(),
             parameters: BTreeMap::new(),
         }

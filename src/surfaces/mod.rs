@@ -17,7 +17,7 @@ mod jet;
 mod knots;
 mod simple;
 
-pub use formula::{Formula, FormulaEdge, FormulaSeam, FormulaSides, FormulaSource};
+pub use formula::{Bound, Formula, FormulaEdge, FormulaSeam, FormulaSides, FormulaSource};
 pub use holomorphic::{Fermat, ProductPolynomial};
 pub use jet::Jet;
 pub use knots::{SpunTrefoil, TwistSpunTrefoil};
