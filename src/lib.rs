@@ -61,8 +61,9 @@ pub use render::{
     RibbonAxis, Ribbons, StippleSettings, Style, render,
 };
 pub use sample::{
-    Audit, Mesh4, MeshData4, MeshFileError, MeshStats, MeshSurface, Sampling, Source, audit,
-    mesh_from_data, mesh_tangents, read_mesh4, sample, sample_adaptive, sample_uniform, write_4off,
+    Audit, Mesh4, MeshData4, MeshFileError, MeshFileLocation, MeshFormat, MeshStats, MeshSurface,
+    Sampling, Source, audit, mesh_from_data, mesh_tangents, parse_mesh4, read_mesh4, sample,
+    sample_adaptive, sample_uniform, write_4off,
 };
 pub use stipple::{Stipples, poisson_radius};
 pub use surfaces::{

@@ -22,7 +22,9 @@ mod uniform;
 
 pub use adaptive::{metric_aspect, sample_adaptive};
 pub use audit::{AUDIT_POINTS, Audit, audit};
-pub use file::{MeshData4, MeshFileError, read_mesh4, write_4off};
+pub use file::{
+    MeshData4, MeshFileError, MeshFileLocation, MeshFormat, parse_mesh4, read_mesh4, write_4off,
+};
 pub use source::{MeshSurface, Source, mesh_from_data, mesh_tangents};
 pub use uniform::sample_uniform;
 
