@@ -152,6 +152,8 @@ fn broken_scenes_get_errors_naming_file_and_field() {
     let mut files: Vec<String> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        // The broken mesh files (`mesh-*`) have their test next to the mesh reader.
+        .filter(|f| f.ends_with(".json"))
         .collect();
     files.sort();
     let mut listed: Vec<String> = BROKEN.iter().map(|(f, _)| f.to_string()).collect();
