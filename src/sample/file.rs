@@ -134,6 +134,8 @@ pub fn read_mesh4(path: &Path) -> std::result::Result<MeshData4, MeshFileError> 
 }
 
 /// Reads a triangle mesh in R^4 from the bytes of a file; `file` names it in errors.
+/// Polygons become fans of triangles around their first vertex; the module documentation
+/// says what each format may hold.
 pub fn parse_mesh4(
     bytes: &[u8],
     file: &str,
