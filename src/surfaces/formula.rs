@@ -26,7 +26,7 @@ use crate::limits::{
 use glam::DVec4;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::f64::consts::{E, PI, TAU};
+use std::f64::consts::{E, PI};
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
 /// A surface given by four formulas, as written in a scene:
@@ -803,6 +803,9 @@ trait Number:
     fn int_power(self, n: i32) -> Self;
     fn real_power(self, k: f64) -> Self;
     fn power(self, y: Self) -> Self;
+    fn scale(self, k: f64) -> Self;
+    fn shift(self, k: f64) -> Self;
+    fn over(self, k: f64) -> Self;
     fn call1(f: Fun, a: Self) -> Self;
     fn call2(f: Fun, a: Self, b: Self) -> Self;
 }
@@ -819,6 +822,15 @@ impl Number for f64 {
     }
     fn power(self, y: Self) -> Self {
         (y * self.ln()).exp()
+    }
+    fn scale(self, k: f64) -> Self {
+        self * k
+    }
+    fn shift(self, k: f64) -> Self {
+        self + k
+    }
+    fn over(self, k: f64) -> Self {
+        self / k
     }
     fn call1(f: Fun, a: Self) -> Self {
         match f {
@@ -879,6 +891,22 @@ impl Number for Jet {
     fn power(self, y: Self) -> Self {
         self.pow(y)
     }
+    fn scale(self, k: f64) -> Self {
+        Jet::scale(self, k)
+    }
+    fn shift(self, k: f64) -> Self {
+        self + k
+    }
+    fn over(self, k: f64) -> Self {
+        Jet {
+            v: self.v / k,
+            du: self.du / k,
+            dv: self.dv / k,
+            duu: self.duu / k,
+            duv: self.duv / k,
+            dvv: self.dvv / k,
+        }
+    }
     fn call1(f: Fun, a: Self) -> Self {
         match f {
             Fun::Sin => a.sin(),
@@ -936,38 +964,53 @@ struct Program {
 
 /// The four programs as one list of nodes, each computed once for all four coordinates
 /// (`cos(u)` in x and in y is one node: the built-in surfaces share such values by hand),
-/// in an order where every node reads earlier ones.
+/// in an order where every node reads earlier ones. An operation with a constant operand
+/// becomes one on the other operand alone (`r*cos(v)` scales, as the built-in surfaces
+/// write it), which over [`Jet`]s skips the derivatives of the constant.
 #[derive(Clone, Debug)]
 struct Shared {
-    /// Each node's instruction and the nodes it reads (as many as the instruction takes).
-    nodes: Vec<(Op, [u32; 2])>,
+    /// Each node and the nodes it reads (as many as it takes).
+    nodes: Vec<(Node, [u32; 2])>,
     /// The nodes of x, y, z and w.
     outputs: [u32; 4],
 }
 
-/// Nodes this many live on the machine stack during a run; more allocate.
-const SMALL_NODES: usize = 48;
+/// A node of [`Shared`].
+#[derive(Clone, Copy, Debug)]
+enum Node {
+    /// An instruction of the programs.
+    Op(Op),
+    /// The operand times a constant.
+    Scale(f64),
+    /// The operand plus a constant.
+    Shift(f64),
+    /// The operand divided by a constant.
+    Over(f64),
+}
 
 impl Shared {
     fn new(programs: &[Program; 4]) -> Shared {
         use std::collections::HashMap;
-        let key = |op: Op| -> (u8, u64) {
-            match op {
-                Op::Const(x) => (0, x.to_bits()),
-                Op::U => (1, 0),
-                Op::V => (2, 0),
-                Op::Neg => (3, 0),
-                Op::Add => (4, 0),
-                Op::Sub => (5, 0),
-                Op::Mul => (6, 0),
-                Op::Div => (7, 0),
-                Op::PowI(n) => (8, u64::from(n as u32)),
-                Op::PowF(k) => (9, k.to_bits()),
-                Op::Pow => (10, 0),
-                Op::Call(f) => (11, f as u64),
+        let key = |node: Node| -> (u8, u64) {
+            match node {
+                Node::Op(Op::Const(x)) => (0, x.to_bits()),
+                Node::Op(Op::U) => (1, 0),
+                Node::Op(Op::V) => (2, 0),
+                Node::Op(Op::Neg) => (3, 0),
+                Node::Op(Op::Add) => (4, 0),
+                Node::Op(Op::Sub) => (5, 0),
+                Node::Op(Op::Mul) => (6, 0),
+                Node::Op(Op::Div) => (7, 0),
+                Node::Op(Op::PowI(n)) => (8, u64::from(n as u32)),
+                Node::Op(Op::PowF(k)) => (9, k.to_bits()),
+                Node::Op(Op::Pow) => (10, 0),
+                Node::Op(Op::Call(f)) => (11, f as u64),
+                Node::Scale(k) => (12, k.to_bits()),
+                Node::Shift(k) => (13, k.to_bits()),
+                Node::Over(k) => (14, k.to_bits()),
             }
         };
-        let mut nodes: Vec<(Op, [u32; 2])> = Vec::new();
+        let mut nodes: Vec<(Node, [u32; 2])> = Vec::new();
         let mut seen: HashMap<((u8, u64), [u32; 2]), u32> = HashMap::new();
         let mut outputs = [0; 4];
         for (k, program) in programs.iter().enumerate() {
@@ -977,8 +1020,23 @@ impl Shared {
                 for i in (0..op.arity()).rev() {
                     args[i] = stack.pop().unwrap_or_default();
                 }
-                let id = *seen.entry((key(*op), args)).or_insert_with(|| {
-                    nodes.push((*op, args));
+                let constant = |id: u32| match nodes.get(id as usize) {
+                    Some((Node::Op(Op::Const(c)), _)) => Some(*c),
+                    _ => None,
+                };
+                let (a, b) = (constant(args[0]), constant(args[1]));
+                let node = match (op, a, b) {
+                    (Op::Mul, Some(c), None) => (Node::Scale(c), [args[1], 0]),
+                    (Op::Mul, None, Some(c)) => (Node::Scale(c), [args[0], 0]),
+                    (Op::Add, Some(c), None) => (Node::Shift(c), [args[1], 0]),
+                    (Op::Add, None, Some(c)) => (Node::Shift(c), [args[0], 0]),
+                    // a - c is a + (-c), exactly.
+                    (Op::Sub, None, Some(c)) => (Node::Shift(-c), [args[0], 0]),
+                    (Op::Div, None, Some(c)) => (Node::Over(c), [args[0], 0]),
+                    _ => (Node::Op(*op), args),
+                };
+                let id = *seen.entry((key(node.0), node.1)).or_insert_with(|| {
+                    nodes.push(node);
                     (nodes.len() - 1) as u32
                 });
                 stack.push(id);
@@ -989,24 +1047,48 @@ impl Shared {
     }
 
     fn run<T: Number>(&self, u: T, v: T) -> [T; 4] {
-        fn go<T: Number>(nodes: &[(Op, [u32; 2])], r: &mut [T], u: T, v: T) {
-            for (i, &(op, [a, b])) in nodes.iter().enumerate() {
-                r[i] = apply(op, r[a as usize], r[b as usize], u, v);
+        // The registers live on the machine stack, in the smallest of a few sizes, filled
+        // as the nodes go (an array of jets set to zero first costs as much as the nodes).
+        match self.nodes.len() {
+            0..=16 => self.run_in::<T, 16>(u, v),
+            17..=32 => self.run_in::<T, 32>(u, v),
+            33..=64 => self.run_in::<T, 64>(u, v),
+            n => {
+                let mut r = Vec::with_capacity(n);
+                for &(node, args) in &self.nodes {
+                    r.push(node_value(node, args, &r, u, v));
+                }
+                self.outputs.map(|o| r[o as usize])
             }
         }
-        if self.nodes.len() <= SMALL_NODES {
-            let mut r = [T::constant(0.0); SMALL_NODES];
-            go(&self.nodes, &mut r, u, v);
-            self.outputs.map(|o| r[o as usize])
-        } else {
-            let mut r = vec![T::constant(0.0); self.nodes.len()];
-            go(&self.nodes, &mut r, u, v);
-            self.outputs.map(|o| r[o as usize])
+    }
+
+    fn run_in<T: Number, const N: usize>(&self, u: T, v: T) -> [T; 4] {
+        let mut r = arrayvec::ArrayVec::<T, N>::new();
+        for &(node, args) in &self.nodes {
+            r.push(node_value(node, args, &r, u, v));
         }
+        self.outputs.map(|o| r[o as usize])
+    }
+}
+
+/// A node's value from the registers of the nodes before it.
+#[inline]
+fn node_value<T: Number>(node: Node, [a, b]: [u32; 2], r: &[T], u: T, v: T) -> T {
+    match node {
+        Node::Op(op) => match op.arity() {
+            0 => apply(op, u, v, u, v),
+            1 => apply(op, r[a as usize], r[a as usize], u, v),
+            _ => apply(op, r[a as usize], r[b as usize], u, v),
+        },
+        Node::Scale(k) => r[a as usize].scale(k),
+        Node::Shift(k) => r[a as usize].shift(k),
+        Node::Over(k) => r[a as usize].over(k),
     }
 }
 
 /// One instruction on its operands (`a` and `b`, as many as it takes).
+#[inline]
 fn apply<T: Number>(op: Op, a: T, b: T, u: T, v: T) -> T {
     match op {
         Op::Const(x) => T::constant(x),
@@ -1632,7 +1714,7 @@ fn edit_distance(a: &str, b: &str) -> usize {
 mod tests {
     use super::super::{KleinBottle, ProjectivePlane};
     use super::*;
-    use std::f64::consts::FRAC_PI_2;
+    use std::f64::consts::{FRAC_PI_2, TAU};
 
     fn params(list: &[(&str, f64)]) -> BTreeMap<String, f64> {
         list.iter().map(|(n, x)| (n.to_string(), *x)).collect()
