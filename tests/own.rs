@@ -1,7 +1,106 @@
-//! Surfaces users bring: 4D meshes from files, built like the catalogue's.
+//! Surfaces users bring: formulas and 4D meshes from files, built like the catalogue's.
 
-use crate::common::fixture;
+use crate::common::{Rng, fixture};
 use halo4d::{MeshData4, Scene, Source, write_4off};
+
+/// A fixture scene with its pictures off (the builds compare meshes, curves and halos).
+fn fixture_scene(name: &str) -> Scene {
+    let mut scene = Scene::load(&fixture(&format!("scenes/{name}.json"))).unwrap();
+    scene.outputs.png = false;
+    scene
+}
+
+#[test]
+fn catalogue_surfaces_as_formulas_give_the_same_points_derivatives_and_builds() {
+    let mut rng = Rng(21);
+    for name in ["flat-torus", "klein-bottle", "projective-plane"] {
+        let (a, b) = (
+            fixture_scene(name),
+            fixture_scene(&format!("formula-{name}")),
+        );
+        let (Source::Parametric(sa), Source::Parametric(sb)) =
+            (&a.surfaces[0].surface, &b.surfaces[0].surface)
+        else {
+            panic!("{name}: parametric surfaces")
+        };
+        assert_eq!(sb.type_name(), "formula");
+        assert_eq!(sa.domain(0), sb.domain(0), "{name}: domain and side rules");
+        assert_eq!(sa.topology(), sb.topology(), "{name}");
+        assert_eq!(sa.min_cells(), sb.min_cells(), "{name}");
+        let d = sa.domain(0);
+        for _ in 0..2000 {
+            let u = d.u[0] + (d.u[1] - d.u[0]) * rng.unit();
+            let v = d.v[0] + (d.v[1] - d.v[0]) * rng.unit();
+            let (ea, eb) = (sa.eval(0, u, v), sb.eval(0, u, v));
+            for (what, x, y) in [
+                ("point", ea.p, eb.p),
+                ("d/du", ea.du, eb.du),
+                ("d/dv", ea.dv, eb.dv),
+                ("d2/du2", ea.duu, eb.duu),
+                ("d2/dudv", ea.duv, eb.duv),
+                ("d2/dv2", ea.dvv, eb.dvv),
+            ] {
+                assert!(
+                    (x - y).abs().max_element() <= 1e-12,
+                    "{name}: {what} at ({u}, {v}): {x} against {y}"
+                );
+            }
+            assert!((sa.point(0, u, v) - sb.point(0, u, v)).abs().max_element() <= 1e-12);
+        }
+
+        let (ba, bb) = (
+            halo4d::run(&a, true).unwrap(),
+            halo4d::run(&b, true).unwrap(),
+        );
+        let (ma, mb) = (&ba.surfaces[0].mesh, &bb.surfaces[0].mesh);
+        assert_eq!(ma.triangles, mb.triangles, "{name}: the same mesh");
+        for (p, q) in ma.positions.iter().zip(&mb.positions) {
+            assert!(
+                (*p - *q).abs().max_element() <= 1e-12,
+                "{name}: {p} against {q}"
+            );
+        }
+        assert_eq!(ba.surfaces[0].stats, bb.surfaces[0].stats, "{name}");
+        for (ca, cb) in [
+            (&ba.curves, &bb.curves),
+            (ba.shown_curves(), bb.shown_curves()),
+        ] {
+            assert_eq!(ca.curves.len(), cb.curves.len(), "{name}: curves");
+            for (x, y) in ca.curves.iter().zip(&cb.curves) {
+                assert_eq!(x.points.len(), y.points.len(), "{name}: curve points");
+                for (p, q) in x.points.iter().zip(&y.points) {
+                    assert!(p.position.distance(q.position) <= 1e-12, "{name}");
+                }
+            }
+        }
+        let (ha, hb) = (&ba.surfaces[0].halo_report, &bb.surfaces[0].halo_report);
+        assert_eq!(
+            (
+                ha.prisms,
+                ha.tets,
+                ha.inverted,
+                ha.shrunk_vertices,
+                ha.twisted_prisms
+            ),
+            (
+                hb.prisms,
+                hb.tets,
+                hb.inverted,
+                hb.shrunk_vertices,
+                hb.twisted_prisms
+            ),
+            "{name}: halos"
+        );
+        assert!((ha.rho - hb.rho).abs() <= 1e-12 * ha.rho, "{name}");
+        let (va, vb) = (&ba.verification, &bb.verification);
+        assert_eq!(
+            (va.curve_samples, va.correct, va.wrong, va.ambiguous),
+            (vb.curve_samples, vb.correct, vb.wrong, vb.ambiguous),
+            "{name}: verification"
+        );
+        assert_eq!(vb.wrong, 0, "{name}");
+    }
+}
 
 /// A scene of one surface in the oblique view the curve tests use, on a grid.
 fn scene_json(surface: &str, sampling: &str) -> String {

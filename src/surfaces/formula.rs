@@ -2324,10 +2324,24 @@ mod tests {
         };
         let mut s = source(["u", "v", "0", "0"], [1.0, 1.0], [0.0, 1.0]);
         assert_eq!(err(s.clone()).field, "u");
-        s.u = [0.0, 1.0];
-        s.v = [0.0, f64::INFINITY];
+        s.u = [0.0.into(), 1.0.into()];
+        s.v = [0.0.into(), f64::INFINITY.into()];
         assert_eq!(err(s.clone()).field, "v");
-        s.v = [0.0, 1.0];
+        // A range's ends as formulas: constants and parameters, not u or v.
+        s.v = [0.0.into(), "2*pi/n".into()];
+        s.parameters = params(&[("n", 4.0)]);
+        let f = Formula::new(s.clone()).unwrap();
+        assert_eq!(f.domain(0).v, [0.0, TAU / 4.0]);
+        s.v = [0.0.into(), "1 + u".into()];
+        let e = err(s.clone());
+        assert_eq!(e.field, "v[1]");
+        assert!(e.message.contains("not u or v"), "{}", e.message);
+        s.v = [0.0.into(), "2*pii".into()];
+        let e = err(s.clone());
+        assert_eq!(e.field, "v[1]");
+        assert!(e.message.contains("`pi`"), "{}", e.message);
+        s.v = [0.0.into(), 1.0.into()];
+        s.parameters = BTreeMap::new();
         for bad in ["pi", "u", "sin", "2x", "a b", ""] {
             let mut t = s.clone();
             t.parameters = params(&[(bad, 1.0)]);
