@@ -144,6 +144,280 @@ const BROKEN: &[(&str, &[&str])] = &[
         "projective-plane-too-coarse.json",
         &["sampling", "projective_plane needs at least 4 x 6 cells"],
     ),
+    (
+        "formula-bad-range.json",
+        &["surfaces[0].surface: u", "min < max, got [1, 0]"],
+    ),
+    (
+        "formula-bends-too-sharply.json",
+        &["surfaces[0].surface.x", "bends too sharply", "(u, v) = ("],
+    ),
+    (
+        "formula-constant.json",
+        &["surfaces[0].surface.x", "a single point"],
+    ),
+    (
+        "formula-coordinate-too-large.json",
+        &["surfaces[0].surface.x", "beyond the 1e30"],
+    ),
+    (
+        "formula-deep-nesting.json",
+        &["surfaces[0].surface: x", "character 257", "deeper than 256"],
+    ),
+    (
+        "formula-divide-by-zero.json",
+        &[
+            "surfaces[0].surface.x",
+            "(u, v) = (0, 0)",
+            "`1/(u-u)` divides by zero",
+        ],
+    ),
+    (
+        "formula-empty.json",
+        &["surfaces[0].surface: w", "character 1", "found the end"],
+    ),
+    (
+        "formula-flip-sides-apart.json",
+        &[
+            "surfaces[0].surface.sides.u",
+            "do not meet",
+            "7.654e-1 away",
+        ],
+    ),
+    (
+        "formula-function-without-call.json",
+        &[
+            "surfaces[0].surface: w",
+            "write `sin(...)`",
+            "\n  sin*v\n  ^",
+        ],
+    ),
+    (
+        "formula-half-turn-apart.json",
+        &["surfaces[0].surface.sides.v_min", "2.000e0 away"],
+    ),
+    (
+        "formula-huge-power.json",
+        &[
+            "surfaces[0].surface: x",
+            "character 8",
+            "exponent 1e9",
+            "\n  sin(u)^1e9\n         ^",
+        ],
+    ),
+    (
+        "formula-log-of-negative.json",
+        &[
+            "surfaces[0].surface.z",
+            "logarithm of the negative number -10",
+        ],
+    ),
+    (
+        "formula-missing-w.json",
+        &["surfaces[0].surface", "missing field `w`"],
+    ),
+    (
+        "formula-not-a-number.json",
+        &[
+            "surfaces[0].surface.w",
+            "square root of the negative number -1",
+        ],
+    ),
+    (
+        "formula-number-overflow.json",
+        &["surfaces[0].surface: y", "`1e999` is too large"],
+    ),
+    (
+        "formula-overflow.json",
+        &["surfaces[0].surface.x", "reaches", "beyond the 1e30"],
+    ),
+    (
+        "formula-parameter-shadows-u.json",
+        &["surfaces[0].surface: parameters.u", "choose another"],
+    ),
+    (
+        "formula-parse-error.json",
+        &[
+            "surfaces[0].surface: x",
+            "character 7",
+            "unmatched `)`",
+            "\n  cos(u))\n        ^",
+        ],
+    ),
+    (
+        "formula-periodic-sides-apart.json",
+        &["surfaces[0].surface.sides.u", "6.283e0 away"],
+    ),
+    (
+        "formula-pole-not-a-point.json",
+        &["surfaces[0].surface.sides.u_min", "pole's first point"],
+    ),
+    (
+        "formula-range-with-u.json",
+        &["surfaces[0].surface: v[1]", "not u or v"],
+    ),
+    (
+        "formula-sides-conflict.json",
+        &["surfaces[0].surface: sides.u_min", "not both"],
+    ),
+    (
+        "formula-too-long.json",
+        &["surfaces[0].surface: x", "4199 bytes long"],
+    ),
+    (
+        "formula-trailing-operator.json",
+        &["surfaces[0].surface: z", "character 9", "found the end"],
+    ),
+    (
+        "formula-unclosed-parenthesis.json",
+        &["surfaces[0].surface: y", "to close the `(` at character 4"],
+    ),
+    (
+        "formula-unknown-function.json",
+        &[
+            "surfaces[0].surface: y",
+            "unknown name `sine`; did you mean `sin`?",
+        ],
+    ),
+    (
+        "formula-unknown-key.json",
+        &["surfaces[0].surface: t", "unknown field `t`"],
+    ),
+    (
+        "formula-unknown-name.json",
+        &[
+            "surfaces[0].surface: x",
+            "unknown name `R`; did you mean `r`?",
+        ],
+    ),
+    (
+        "formula-unknown-side-rule.json",
+        &["surfaces[0].surface: sides.u", "unknown variant `periodik`"],
+    ),
+    (
+        "formula-wrong-arity.json",
+        &["surfaces[0].surface: z", "`atan2` takes 2 arguments, got 1"],
+    ),
+    (
+        "mesh-3d-off.json",
+        &[
+            "surfaces[0].surface.path",
+            "mesh-3d-off.off:1:",
+            "use the header `4OFF`",
+        ],
+    ),
+    (
+        "mesh-binary-truncated.json",
+        &[
+            "surfaces[0].surface.path",
+            "mesh-binary-truncated.off: byte 56:",
+            "2 of 4 vertices",
+        ],
+    ),
+    (
+        "mesh-empty.json",
+        &[
+            "surfaces[0].surface.path",
+            "mesh-empty.off:6:",
+            "no triangles",
+        ],
+    ),
+    (
+        "mesh-huge-count.json",
+        &[
+            "surfaces[0].surface.path",
+            "mesh-huge-count.off:2:",
+            "1000000000000 vertices",
+        ],
+    ),
+    (
+        "mesh-index-out-of-range.json",
+        &[
+            "surfaces[0].surface.path",
+            "mesh-index-out-of-range.off:9:",
+            "face 2 refers to vertex 40",
+        ],
+    ),
+    (
+        "mesh-nan.json",
+        &[
+            "surfaces[0].surface.path",
+            "mesh-nan.off:4:",
+            "coordinate w is nan",
+        ],
+    ),
+    (
+        "mesh-obj-bad-face.json",
+        &[
+            "surfaces[0].surface.path",
+            "mesh-obj-bad-face.obj:4:",
+            "`3/a` is not a vertex reference",
+        ],
+    ),
+    (
+        "mesh-obj-three-coords.json",
+        &[
+            "surfaces[0].surface.path",
+            "mesh-obj-three-coords.obj:2:",
+            "needs the fourth coordinate w",
+        ],
+    ),
+    (
+        "mesh-ply-bad-list.json",
+        &[
+            "surfaces[0].surface.path",
+            "mesh-ply-bad-list.ply:14:",
+            "`vertex_indices` is missing",
+        ],
+    ),
+    (
+        "mesh-ply-huge-count.json",
+        &[
+            "surfaces[0].surface.path",
+            "mesh-ply-huge-count.ply:3:",
+            "1000000000000 vertices",
+        ],
+    ),
+    (
+        "mesh-ply-no-w.json",
+        &[
+            "surfaces[0].surface.path",
+            "mesh-ply-no-w.ply:3:",
+            "no property `w`",
+        ],
+    ),
+    (
+        "mesh-trailing-text.json",
+        &[
+            "surfaces[0].surface.path",
+            "mesh-trailing-text.off:11:",
+            "text after the 4 vertices",
+        ],
+    ),
+    (
+        "mesh-truncated.json",
+        &[
+            "surfaces[0].surface.path",
+            "mesh-truncated.off:14:",
+            "12 of 36 vertices",
+        ],
+    ),
+    (
+        "mesh-missing-file.json",
+        &[
+            "surfaces[0].surface.path",
+            "mesh-no-such-file.4off",
+            "cannot read",
+        ],
+    ),
+    (
+        "mesh-with-sampling.json",
+        &["surfaces[0].sampling", "not sampled; remove `sampling`"],
+    ),
+    (
+        "mesh-collapsed-triangle.json",
+        &["surfaces[0].surface.path", "two corners at the same point"],
+    ),
 ];
 
 #[test]
@@ -152,7 +426,7 @@ fn broken_scenes_get_errors_naming_file_and_field() {
     let mut files: Vec<String> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        // The broken mesh files (`mesh-*`) have their test next to the mesh reader.
+        // The broken mesh files themselves have their test next to the mesh reader.
         .filter(|f| f.ends_with(".json"))
         .collect();
     files.sort();

@@ -2400,6 +2400,7 @@ mod tests {
             .filter(|p| {
                 p.file_name()
                     .is_some_and(|n| n.to_string_lossy().starts_with("mesh-"))
+                    && p.extension().is_some_and(|e| e != "json")
             })
             .collect();
         files.sort();

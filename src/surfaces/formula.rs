@@ -456,9 +456,24 @@ impl Formula {
             for (k, j) in jets.iter().enumerate() {
                 let c = COMPONENTS[k];
                 let bends = [
-                    (j.duu, lu * lu, format!("∂²{c}/∂u²"), "u range"),
-                    (j.duv, lu * lv, format!("∂²{c}/∂u∂v"), "u and v ranges"),
-                    (j.dvv, lv * lv, format!("∂²{c}/∂v²"), "v range"),
+                    (
+                        j.duu,
+                        lu * lu,
+                        format!("∂²{c}/∂u²"),
+                        "the square of the u range",
+                    ),
+                    (
+                        j.duv,
+                        lu * lv,
+                        format!("∂²{c}/∂u∂v"),
+                        "the product of the u and v ranges",
+                    ),
+                    (
+                        j.dvv,
+                        lv * lv,
+                        format!("∂²{c}/∂v²"),
+                        "the square of the v range",
+                    ),
                 ];
                 for (d, extent, name, ranges) in bends {
                     let bend = d.abs() * extent / diagonal;
@@ -467,7 +482,7 @@ impl Formula {
                         return Err(FieldError::new(
                             c,
                             format!(
-                                "bends too sharply to be sampled at (u, v) = ({u}, {v}): {name} = {d:e}, times the product of the {ranges} ({extent:.3e}), is {bend:.1e} times the surface's bounding diagonal ({diagonal:.3e}), more than {FORMULA_BEND:e}; narrow the ranges or smooth the formula"
+                                "bends too sharply to be sampled at (u, v) = ({u}, {v}): {name} = {d:e}, times {ranges} ({extent:.3e}), is {bend:.1e} times the surface's bounding diagonal ({diagonal:.3e}), more than {FORMULA_BEND:e}; narrow the ranges or smooth the formula"
                             ),
                         ));
                     }
@@ -1218,7 +1233,9 @@ fn failure(op: Op, inputs: &[f64], out: f64, snippet: &str) -> String {
 /// around `at`, with `...` where it is cut. Whitespace and control characters show as
 /// spaces so that the caret stays under its character.
 fn caret(chars: &[char], at: usize) -> String {
-    const WINDOW: usize = 60;
+    // With the `...` at both cuts, within the 60 bytes without whitespace that `shorten`
+    // leaves whole (for ASCII).
+    const WINDOW: usize = 50;
     let (mut start, mut end) = (0, chars.len());
     if chars.len() > WINDOW + 10 {
         start = at.saturating_sub(WINDOW / 2);
@@ -1677,9 +1694,14 @@ impl<'a> Parser<'a> {
             .chain(self.parameters.keys().map(String::as_str))
             .chain(["pi", "e"])
             .chain(FUNCTIONS.iter().map(|(n, _)| *n));
+        // A name that differs only in case comes first (`R` for the parameter `r`).
         let best = known
-            .map(|k| (edit_distance(name, k), k))
-            .min_by_key(|(d, _)| *d);
+            .map(|k| {
+                let case = !k.eq_ignore_ascii_case(name);
+                (edit_distance(name, k), case, k)
+            })
+            .min_by_key(|&(d, case, _)| (d, case))
+            .map(|(d, _, k)| (d, k));
         match best {
             Some((d, k)) if d <= name.chars().count().div_ceil(2).max(1) => {
                 format!("unknown name `{shown}`; did you mean `{k}`?")

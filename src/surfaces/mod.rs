@@ -267,8 +267,10 @@ impl<'de> Deserialize<'de> for Surface {
         };
         let params = serde_json::Value::Object(map);
         fn read<T: serde::de::DeserializeOwned, E: Error>(v: serde_json::Value) -> Result<T, E> {
-            serde_path_to_error::deserialize(v)
-                .map_err(|e| E::custom(format!("{}: {}", e.path(), e.inner())))
+            serde_path_to_error::deserialize(v).map_err(|e| match e.path().to_string().as_str() {
+                "." => E::custom(e.inner()),
+                path => E::custom(format!("{path}: {}", e.inner())),
+            })
         }
         Ok(match ty.as_str() {
             "flat_torus" => Surface::FlatTorus(read(params)?),
@@ -291,6 +293,9 @@ impl<'de> Deserialize<'de> for Surface {
                     .map(Surface::type_name)
                     .collect();
                 known.push("formula");
+                // A scene's surface may also be a mesh file (`sample::Source` reads that
+                // type before it asks the catalogue).
+                known.push("mesh");
                 return Err(D::Error::custom(format!(
                     "unknown surface type `{ty}`, expected one of {}",
                     known.join(", ")
