@@ -4,7 +4,7 @@ use clap::{Parser, Subcommand};
 use halo4d::Comparison;
 use halo4d::limits::{self, FieldError};
 use halo4d::{RenderMode, Style};
-use halo4d::{Scene, Surface, sweep};
+use halo4d::{Scene, sweep};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -268,7 +268,7 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
             Ok(ExitCode::SUCCESS)
         }
         Command::List => {
-            print!("{}", Surface::catalogue_listing());
+            print!("{}", halo4d::Source::listing());
             Ok(ExitCode::SUCCESS)
         }
         Command::Check { file } => {

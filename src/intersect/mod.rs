@@ -218,6 +218,12 @@ impl CurvesReport {
                 r.triple_points_refined,
                 r.triple_points_not_converged
             );
+            if r.on_meshes > 0 {
+                out += &format!(
+                    "; {} points on mesh files kept (the mesh is the surface)",
+                    r.on_meshes
+                );
+            }
         }
         out
     }

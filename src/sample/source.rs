@@ -106,6 +106,17 @@ impl<'de> Deserialize<'de> for Source {
 }
 
 impl Source {
+    /// What `halo4d list` prints: the catalogue, the formula type and the mesh type, each
+    /// with its parameters or an example.
+    pub fn listing() -> String {
+        format!(
+            "{}{:<20} a 4D triangle mesh from a file, not sampled: Geomview 4OFF or nOFF with dimension 4 (ASCII or BINARY), OBJ with `v x y z w`, PLY with vertex properties x y z w; the path relative to the scene file\n{:<20} example: {{\"type\":\"mesh\",\"path\":\"torus.4off\"}}\n",
+            Surface::catalogue_listing(),
+            "mesh",
+            ""
+        )
+    }
+
     /// The `type` name used in scene files.
     pub fn type_name(&self) -> &'static str {
         match self {
