@@ -190,7 +190,7 @@ pub fn refine(
                 let (t, residual) = solver.triple(t);
                 (t, Some(residual))
             } else {
-                (t.clone(), None)
+                (*t, None)
             }
         })
         .collect();

@@ -1003,6 +1003,16 @@ enum Node {
     Over(f64),
 }
 
+impl Node {
+    /// How many nodes it reads.
+    fn arity(self) -> usize {
+        match self {
+            Node::Op(op) => op.arity(),
+            Node::Scale(_) | Node::Shift(_) | Node::Over(_) => 1,
+        }
+    }
+}
+
 impl Shared {
     fn new(programs: &[Program; 4]) -> Shared {
         use std::collections::HashMap;
@@ -1025,8 +1035,13 @@ impl Shared {
                 Node::Over(k) => (14, k.to_bits()),
             }
         };
-        let mut nodes: Vec<(Node, [u32; 2])> = Vec::new();
-        let mut seen: HashMap<((u8, u64), [u32; 2]), u32> = HashMap::new();
+        // Nodes 0 and 1 are u and v: a run starts with them in its registers.
+        let mut nodes: Vec<(Node, [u32; 2])> =
+            vec![(Node::Op(Op::U), [0, 0]), (Node::Op(Op::V), [0, 0])];
+        let mut seen: HashMap<((u8, u64), [u32; 2]), u32> = HashMap::from([
+            ((key(nodes[0].0), [0, 0]), 0),
+            ((key(nodes[1].0), [0, 0]), 1),
+        ]);
         let mut outputs = [0; 4];
         for (k, program) in programs.iter().enumerate() {
             let mut stack: Vec<u32> = Vec::with_capacity(program.depth);
@@ -1058,47 +1073,88 @@ impl Shared {
             }
             outputs[k] = stack.pop().unwrap_or_default();
         }
-        Shared { nodes, outputs }
+        // Constants folded into scale, shift and division nodes are read by no node: drop
+        // what the outputs do not need, renumbering the rest.
+        let mut live = vec![false; nodes.len()];
+        live[..2].fill(true);
+        for o in outputs {
+            live[o as usize] = true;
+        }
+        for i in (0..nodes.len()).rev() {
+            if live[i] {
+                let (node, args) = nodes[i];
+                for &a in &args[..node.arity()] {
+                    live[a as usize] = true;
+                }
+            }
+        }
+        let mut renumber = vec![0u32; nodes.len()];
+        let mut kept = Vec::with_capacity(nodes.len());
+        for (i, (node, args)) in nodes.into_iter().enumerate() {
+            if live[i] {
+                renumber[i] = kept.len() as u32;
+                kept.push((node, args.map(|a| renumber[a as usize])));
+            }
+        }
+        Shared {
+            nodes: kept,
+            outputs: outputs.map(|o| renumber[o as usize]),
+        }
     }
 
     fn run<T: Number>(&self, u: T, v: T) -> [T; 4] {
-        // The registers live on the machine stack, in the smallest of a few sizes, filled
-        // as the nodes go (an array of jets set to zero first costs as much as the nodes).
+        // The registers live on the machine stack, in the smallest of a few sizes (filling
+        // them first costs little against the nodes: measured as fast as filling them as
+        // the nodes go).
         match self.nodes.len() {
             0..=16 => self.run_in::<T, 16>(u, v),
             17..=32 => self.run_in::<T, 32>(u, v),
             33..=64 => self.run_in::<T, 64>(u, v),
             n => {
-                let mut r = Vec::with_capacity(n);
-                for &(node, args) in &self.nodes {
-                    r.push(node_value(node, args, &r, u, v));
-                }
-                self.outputs.map(|o| r[o as usize])
+                let mut r = vec![T::constant(0.0); n];
+                self.run_on(&mut r, u, v)
             }
         }
     }
 
     fn run_in<T: Number, const N: usize>(&self, u: T, v: T) -> [T; 4] {
-        let mut r = arrayvec::ArrayVec::<T, N>::new();
-        for &(node, args) in &self.nodes {
-            r.push(node_value(node, args, &r, u, v));
+        self.run_on(&mut [T::constant(0.0); N], u, v)
+    }
+
+    /// Runs the nodes on registers `r` (at least one per node).
+    fn run_on<T: Number>(&self, r: &mut [T], u: T, v: T) -> [T; 4] {
+        (r[0], r[1]) = (u, v);
+        for (i, &(node, args)) in self.nodes.iter().enumerate().skip(2) {
+            r[i] = node_value(node, args, &r[..i]);
         }
         self.outputs.map(|o| r[o as usize])
     }
 }
 
 /// A node's value from the registers of the nodes before it.
-#[inline]
-fn node_value<T: Number>(node: Node, [a, b]: [u32; 2], r: &[T], u: T, v: T) -> T {
+#[inline(always)]
+fn node_value<T: Number>(node: Node, [a, b]: [u32; 2], r: &[T]) -> T {
+    // One match over every kind of node (no second dispatch on the instruction).
+    let x = || r[a as usize];
+    let y = || r[b as usize];
     match node {
-        Node::Op(op) => match op.arity() {
-            0 => apply(op, u, v, u, v),
-            1 => apply(op, r[a as usize], r[a as usize], u, v),
-            _ => apply(op, r[a as usize], r[b as usize], u, v),
-        },
-        Node::Scale(k) => r[a as usize].scale(k),
-        Node::Shift(k) => r[a as usize].shift(k),
-        Node::Over(k) => r[a as usize].over(k),
+        Node::Op(Op::Const(c)) => T::constant(c),
+        // Registers 0 and 1, set before the nodes run.
+        Node::Op(Op::U) => r[0],
+        Node::Op(Op::V) => r[1],
+        Node::Op(Op::Neg) => -x(),
+        Node::Op(Op::Add) => x() + y(),
+        Node::Op(Op::Sub) => x() - y(),
+        Node::Op(Op::Mul) => x() * y(),
+        Node::Op(Op::Div) => x() / y(),
+        Node::Op(Op::PowI(n)) => x().int_power(n),
+        Node::Op(Op::PowF(k)) => x().real_power(k),
+        Node::Op(Op::Pow) => x().power(y()),
+        Node::Op(Op::Call(f)) if f.arity() == 1 => T::call1(f, x()),
+        Node::Op(Op::Call(f)) => T::call2(f, x(), y()),
+        Node::Scale(k) => x().scale(k),
+        Node::Shift(k) => x().shift(k),
+        Node::Over(k) => x().over(k),
     }
 }
 
