@@ -555,25 +555,20 @@ fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error
         let sample_ms = ms(start);
         timings.sample += sample_ms;
         let start = Instant::now();
-        // A mesh file is the surface: nothing to audit.
-        let audited = match &entry.surface {
-            Source::Parametric(surface) => audit(surface, &sampled.mesh),
-            Source::Mesh(_) => Audit::default(),
-        };
         // Stopped by its budget: the uniform grid of as many triangles to compare with,
-        // audited too (and timed with the audit).
-        let uniform = match &entry.surface {
-            Source::Parametric(surface) if !sampled.complete => {
-                Some(sample::uniform_error(surface, sampled.mesh.triangles.len()))
-            }
-            _ => None,
+        // audited too (and timed with the audit). A mesh file is the surface: nothing to
+        // audit.
+        let (audited, uniform, method) = match &entry.surface {
+            Source::Parametric(surface) => (
+                audit(surface, &sampled.mesh),
+                (!sampled.complete)
+                    .then(|| sample::uniform_error(surface, sampled.mesh.triangles.len())),
+                sampling.method(),
+            ),
+            Source::Mesh(_) => (Audit::default(), None, "file"),
         };
         let audit_ms = ms(start);
         timings.audit += audit_ms;
-        let method = match entry.surface {
-            Source::Parametric(_) => sampling.method(),
-            Source::Mesh(_) => "file",
-        };
         let report = SamplingReport::new(
             method, sampling, &sampled, &audited, uniform, sample_ms, audit_ms,
         );

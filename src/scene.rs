@@ -213,7 +213,7 @@ impl Scene {
             column: inner.column(),
         };
         let mut de = serde_json::Deserializer::from_str(text);
-        let scene: Scene = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        let mut scene: Scene = serde_path_to_error::deserialize(&mut de).map_err(|e| {
             let field = match e.path().to_string() {
                 p if p == "." => "(top level)".to_string(),
                 p => p,
@@ -222,7 +222,6 @@ impl Scene {
         })?;
         de.end()
             .map_err(|e| syntax("(after the scene)".into(), e))?;
-        let mut scene = scene;
         let folder = Path::new(file).parent().unwrap_or(Path::new(""));
         let invalid = |FieldError { field, message }| SceneError::Invalid {
             file: file.to_string(),
@@ -235,13 +234,7 @@ impl Scene {
                     .map_err(|e| invalid(e.within(&format!("surfaces[{i}].surface"))))?;
             }
         }
-        scene
-            .validate()
-            .map_err(|FieldError { field, message }| SceneError::Invalid {
-                file: file.to_string(),
-                field,
-                message,
-            })?;
+        scene.validate().map_err(invalid)?;
         Ok(scene)
     }
 
