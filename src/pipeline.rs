@@ -294,6 +294,18 @@ impl SamplingReport {
     }
 }
 
+/// The warning a build prints for a mesh file that is not a manifold (the sampler's meshes
+/// always are): what the halos and curves meet there is what the file gives.
+fn mesh_file_warning(surface: &str, source: &Source, stats: &MeshStats) -> Option<String> {
+    if !matches!(source, Source::Mesh(_)) || stats.is_manifold() {
+        return None;
+    }
+    Some(format!(
+        "surface `{surface}`: the mesh file is not a manifold: {} edges in more than two triangles, {} triangles of zero area; halos and curves follow the triangles as they are, and verification may call samples there ambiguous",
+        stats.non_manifold_edges, stats.degenerate_triangles
+    ))
+}
+
 impl SurfaceProduct {
     /// The view the writers take; `halo_params` are the scene's.
     pub fn data<'a>(&'a self, halo_params: &'a HaloParams) -> SurfaceData<'a> {
@@ -577,6 +589,9 @@ fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error
         }
         let mesh = sampled.mesh;
         let stats = mesh.validate();
+        if let Some(w) = mesh_file_warning(&name, &entry.surface, &stats) {
+            bar.suspend(|| eprintln!("warning: {w}"));
+        }
         bar.inc(1);
 
         bar.set_message(format!("projecting {name}"));
@@ -873,7 +888,10 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
         },
         warnings: products
             .iter()
-            .filter_map(|p| p.sampling.warning(&p.name))
+            .flat_map(|p| {
+                let file = mesh_file_warning(&p.name, &p.surface, &p.stats);
+                p.sampling.warning(&p.name).into_iter().chain(file)
+            })
             .collect(),
         verified: failures.is_empty(),
         failures,

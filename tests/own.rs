@@ -250,3 +250,37 @@ fn tangents_from_a_mesh_approach_the_surface_s_and_keep_its_orientation() {
         "{worst:?}"
     );
 }
+
+#[test]
+fn a_mesh_file_that_is_not_a_manifold_builds_with_a_warning() {
+    // Edge 0-1 in three triangles, and triangle 0 1 2 along one line.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("bad.4off"),
+        "4OFF\n5 4 0\n0 0 0 0\n1 0 0 0\n2 0 0 0\n0 1 0 0\n0 0 1 0.5\n3 0 1 3\n3 0 1 2\n3 0 1 4\n3 1 3 4\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("s.json"),
+        r#"{"name": "edge", "surfaces": [{"surface": {"type": "mesh", "path": "bad.4off"}}],
+            "outputs": {"png": false}}"#,
+    )
+    .unwrap();
+    let out = crate::common::halo4d(&["build", "s.json", "--out", "out", "--quiet"], dir.path());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(
+            "not a manifold: 1 edges in more than two triangles, 1 triangles of zero area"
+        ),
+        "{stderr}"
+    );
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("out/report.json")).unwrap())
+            .unwrap();
+    assert_eq!(
+        report["warnings"].as_array().map(Vec::len),
+        Some(1),
+        "{report}"
+    );
+    assert_eq!(report["surfaces"][0]["sampling"]["method"], "file");
+}
