@@ -925,7 +925,11 @@ fn surface_report(p: &SurfaceProduct, halo: bool) -> SurfaceReport {
         sampling: p.sampling.clone(),
         vertices: p.mesh.vertex_count(),
         triangles: p.mesh.triangles.len(),
-        topology: p.surface.topology(),
+        // A mesh file's from the statistics already measured, not by validating it again.
+        topology: match &p.surface {
+            Source::Parametric(s) => s.topology(),
+            Source::Mesh(_) => sample::mesh_topology(&p.stats),
+        },
         mesh: p.stats,
         bounds_4d: p.mesh.bounds().map(|(lo, hi)| Bounds {
             min: lo.to_array().to_vec(),

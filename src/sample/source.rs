@@ -8,7 +8,7 @@
 //! triangles' winding. Its vertices all get patch 0 and parameters (0, 0).
 
 use super::file::{MeshData4, read_mesh4};
-use super::{Mesh4, Sampled, Sampling};
+use super::{Mesh4, MeshStats, Sampled, Sampling};
 use crate::limits::FieldError;
 use crate::surfaces::{Surface, Topology};
 use glam::DVec4;
@@ -56,17 +56,22 @@ impl MeshSurface {
         Ok(())
     }
 
-    /// What the mesh's combinatorics say of the surface: closed when no edge is on one
-    /// triangle only, orientable when the triangles' windings agree across every edge (the
-    /// file's winding, as written), and V - E + F.
+    /// What the mesh's combinatorics say of the surface ([`mesh_topology`] of its
+    /// statistics).
     pub fn topology(&self) -> Topology {
-        let stats = self.mesh.validate();
-        let closed = stats.boundary_edges == 0;
-        Topology {
-            closed,
-            orientable: stats.orientation_conflicts == 0,
-            euler_characteristic: closed.then_some(stats.euler_characteristic),
-        }
+        mesh_topology(&self.mesh.validate())
+    }
+}
+
+/// What a mesh's statistics say of its surface: closed when no edge is on one triangle
+/// only, orientable when the triangles' windings agree across every edge (as written),
+/// and V - E + F.
+pub fn mesh_topology(stats: &MeshStats) -> Topology {
+    let closed = stats.boundary_edges == 0;
+    Topology {
+        closed,
+        orientable: stats.orientation_conflicts == 0,
+        euler_characteristic: closed.then_some(stats.euler_characteristic),
     }
 }
 
