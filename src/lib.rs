@@ -15,6 +15,8 @@
 //! module graph.
 #![warn(missing_docs)]
 
+mod animate;
+mod animation;
 mod check;
 mod convention;
 mod error;
@@ -42,10 +44,18 @@ pub mod viewer;
 // The scene, the build and what it gives.
 pub use error::Error;
 pub use pipeline::{
-    Bounds, Built, MemoryReport, Report, SamplingReport, Stages, SurfaceProduct, SurfaceReport,
-    Timings, build, render_to, run, run_for_picture, write,
+    Bounds, Built, MemoryReport, Report, Samples, SamplingReport, Stages, SurfaceProduct,
+    SurfaceReport, Timings, build, glb_bytes, render_to, run, run_for_picture, run_sampled,
+    sample_scene, write,
 };
 pub use scene::{Outputs, Scene, SceneError, SceneSurface};
+
+// Animations: a path through 4D views, and its frames.
+pub use animate::{
+    AnimateError, Assembled, FrameRange, FrameRecord, FrameTimings, Request, Shard, Status,
+    Summary, animate, assemble, status,
+};
+pub use animation::{Animation, CameraKey, Keyframe, RotationKey, ViewKey};
 
 // The stages, in the order of the pipeline.
 pub use check::{CheckStats, TetMesh, check};

@@ -118,6 +118,15 @@ pub const FORMULA_BEND: f64 = 1e8;
 /// rules glue (or a pole's points) must be: rounding of the formulas, never a gap.
 pub const FORMULA_GLUE: f64 = 1e-9;
 
+/// Frames of an animation (`animation.frames`): frame files are numbered with five digits.
+pub const ANIMATION_FRAMES: RangeInclusive<u32> = 1..=99_999;
+
+/// Keyframes of an animation (`animation.keyframes`).
+pub const KEYFRAMES: RangeInclusive<usize> = 1..=10_000;
+
+/// Frames per second of an assembled animation (`animation.fps`).
+pub const FPS: RangeInclusive<u32> = 1..=240;
+
 /// The most bytes of one run of text without whitespace an error message echoes.
 pub const ECHO_RUN: usize = 60;
 
@@ -280,6 +289,13 @@ pub fn table() -> String {
             format!("at least {MIN_EXTENT:e}"),
             "scene units",
         ),
+        (
+            "`animation.frames`, `halo4d animate --frames`",
+            range(&ANIMATION_FRAMES),
+            "frames",
+        ),
+        ("`animation.keyframes`", range(&KEYFRAMES), "keyframes"),
+        ("`animation.fps`", range(&FPS), "frames per second"),
         (
             "a formula's length (`surfaces[i].surface.x`, ...)",
             format!("up to {FORMULA_LENGTH}"),

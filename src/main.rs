@@ -1,8 +1,8 @@
 //! The `halo4d` command line.
 
 use clap::{Parser, Subcommand};
-use halo4d::Comparison;
 use halo4d::limits::{self, FieldError};
+use halo4d::{Comparison, FrameRange, Shard};
 use halo4d::{RenderMode, Style};
 use halo4d::{Scene, sweep};
 use std::path::{Path, PathBuf};
@@ -93,6 +93,52 @@ enum Command {
         /// No progress bar.
         #[arg(long, short)]
         quiet: bool,
+    },
+    /// Animate a scene: the frames of its `animation`, each the build of the scene in that
+    /// frame's 4D view and camera, its halos verified against its curves, its picture
+    /// (frame-00042.png) and record (frame-00042.json: view, counts, verification,
+    /// timings). The surfaces are sampled once. A rerun makes only the frames without a
+    /// record; any number of processes may fill one folder side by side (`--shard`).
+    ///
+    /// Exit status 0 when every frame of the run is verified, 3 when one is not (its
+    /// record says why), 1 on an error. With --status: 0 when every frame of the folder is
+    /// done and verified, 1 when not, 2 when the folder is not an animation's. With
+    /// --assemble: 0 when the animation was written, 1 when frames are missing or not
+    /// verified (listed) or the folder is unreadable.
+    Animate {
+        /// Scene file (JSON) with an `animation`.
+        #[arg(required_unless_present_any = ["assemble", "status"])]
+        scene: Option<PathBuf>,
+        /// Folder of the frames [default: exports/<scene name>/frames/].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Only these frames: A..B (A to B - 1), A..=B, or A.
+        #[arg(long, value_name = "A..B")]
+        frames: Option<FrameRange>,
+        /// Only the frames whose index modulo N is I: task I of N of a batch engine's array
+        /// (`--shard $SLURM_ARRAY_TASK_ID/N`, `--shard $JOB_COMPLETION_INDEX/N`).
+        #[arg(long, value_name = "I/N")]
+        shard: Option<Shard>,
+        /// Picture width in pixels [default: the scene's render.width].
+        #[arg(long)]
+        width: Option<u32>,
+        /// Picture height in pixels [default: the scene's render.height].
+        #[arg(long)]
+        height: Option<u32>,
+        /// Write each frame's .glb too (frame-00042.glb).
+        #[arg(long)]
+        glb: bool,
+        /// No progress output.
+        #[arg(long, short)]
+        quiet: bool,
+        /// Instead: check that every frame of the folder DIR is done and verified (else
+        /// list those that are not), write frames.jsonl and the animated PNG animation.png,
+        /// and print the ffmpeg command line for an MP4.
+        #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "status", "frames", "shard", "glb", "out"])]
+        assemble: Option<PathBuf>,
+        /// Instead: print where the frames of the folder DIR stand (done, failed, missing).
+        #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "frames", "shard", "glb", "out"])]
+        status: Option<PathBuf>,
     },
     /// List the surface catalogue with each surface's parameters and defaults.
     List,
@@ -267,6 +313,90 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
             }
             Ok(ExitCode::SUCCESS)
         }
+        Command::Animate {
+            scene,
+            out,
+            frames,
+            shard,
+            width,
+            height,
+            glb,
+            quiet,
+            assemble,
+            status,
+        } => {
+            if let Some(dir) = status {
+                return Ok(match halo4d::status(&dir) {
+                    Ok(s) => {
+                        print!("{}", s.text());
+                        if s.complete() {
+                            ExitCode::SUCCESS
+                        } else {
+                            ExitCode::FAILURE
+                        }
+                    }
+                    Err(e) => {
+                        eprintln!("error: {e}");
+                        ExitCode::from(2)
+                    }
+                });
+            }
+            if let Some(dir) = assemble {
+                let a = halo4d::assemble(&dir)?;
+                eprintln!(
+                    "{} frames assembled into an animated PNG of {:.1} MB",
+                    a.frames,
+                    a.bytes as f64 / 1e6
+                );
+                eprintln!(
+                    "an MP4 with ffmpeg{}:\n  {}",
+                    if a.ffmpeg_found {
+                        ""
+                    } else {
+                        " (not found on this machine; install it, e.g. apt-get install ffmpeg)"
+                    },
+                    a.ffmpeg
+                );
+                println!("{}", a.path.display());
+                return Ok(ExitCode::SUCCESS);
+            }
+            let mut scene = load(scene)?;
+            let r = &mut scene.render;
+            r.width = width.unwrap_or(r.width);
+            r.height = height.unwrap_or(r.height);
+            scene
+                .render
+                .check()
+                .map_err(|e| flag_field(e.field.as_str(), e.message))?;
+            let out = out.unwrap_or_else(|| Path::new("exports").join(&scene.name).join("frames"));
+            let summary = halo4d::animate(&halo4d::Request {
+                scene: &scene,
+                out: &out,
+                frames,
+                shard: shard.unwrap_or(Shard::ALL),
+                glb,
+                quiet,
+            })?;
+            if !quiet {
+                eprintln!(
+                    "{} frames in this run: {} made, {} done before; {} not verified; {:.1} s",
+                    summary.selected,
+                    summary.made,
+                    summary.skipped,
+                    summary.failed.len(),
+                    summary.ms / 1e3
+                );
+            }
+            for (k, why) in &summary.failed {
+                eprintln!("UNVERIFIED frame {k}: {why}");
+            }
+            println!("{}", out.display());
+            Ok(if summary.failed.is_empty() {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(UNVERIFIED)
+            })
+        }
         Command::List => {
             print!("{}", halo4d::Source::listing());
             Ok(ExitCode::SUCCESS)
@@ -293,6 +423,11 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
             }
         }
     }
+}
+
+/// A render setting's error named by its flag (`width` is `--width`).
+fn flag_field(field: &str, message: String) -> FieldError {
+    FieldError::new(format!("--{}", field.replace('_', "-")), message)
 }
 
 /// A sweep's setting error named by its flag (`max_triangles` is `--max-triangles`).

@@ -555,9 +555,65 @@ pub fn run_for_picture(scene: &Scene, quiet: bool) -> Result<Built, Error> {
 
 fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error> {
     let bar = progress(scene.surfaces.len() * 3 + 2, quiet);
+    let samples = sample_with(scene, &bar);
+    let built = in_view(scene, samples, stages, &bar);
+    bar.finish_and_clear();
+    built
+}
+
+/// A scene's surfaces sampled (or read from their files) and audited: what a build makes
+/// before the view, which an animation makes once for all its frames ([`sample_scene`],
+/// [`run_sampled`]).
+#[derive(Clone, Debug)]
+pub struct Samples {
+    surfaces: Vec<Sample>,
+    /// The sampling and audit times (the other stages 0).
+    timings: Timings,
+}
+
+#[derive(Clone, Debug)]
+struct Sample {
+    name: String,
+    mesh: Mesh4,
+    stats: MeshStats,
+    report: SamplingReport,
+}
+
+impl Samples {
+    /// Triangles of all surfaces.
+    pub fn triangles(&self) -> usize {
+        self.surfaces.iter().map(|s| s.mesh.triangles.len()).sum()
+    }
+
+    /// Milliseconds spent sampling and auditing.
+    pub fn ms(&self) -> f64 {
+        self.timings.sample + self.timings.audit
+    }
+}
+
+/// Samples (or reads) and audits every surface of the scene, printing the warnings a build
+/// prints.
+pub fn sample_scene(scene: &Scene) -> Samples {
+    sample_with(scene, &ProgressBar::hidden())
+}
+
+/// The build of `scene` from its `samples` ([`sample_scene`] of a scene with the same
+/// surfaces and sampling): the view, the stages a picture needs, and the halos verified
+/// against the curves whatever files the scene writes; the sampling times are those of
+/// `samples`.
+pub fn run_sampled(scene: &Scene, samples: Samples) -> Result<Built, Error> {
+    let stages = Stages {
+        halos: true,
+        curves: true,
+        verify: true,
+        ..Stages::with_picture(scene, true)
+    };
+    in_view(scene, samples, stages, &ProgressBar::hidden())
+}
+
+fn sample_with(scene: &Scene, bar: &ProgressBar) -> Samples {
     let mut timings = Timings::default();
-    let mut products = Vec::with_capacity(scene.surfaces.len());
-    let mut projections = Vec::with_capacity(scene.surfaces.len());
+    let mut surfaces = Vec::with_capacity(scene.surfaces.len());
     for (i, entry) in scene.surfaces.iter().enumerate() {
         let name = scene.surface_name(i);
         bar.set_message(format!("sampling {name}"));
@@ -593,7 +649,33 @@ fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error
             bar.suspend(|| eprintln!("warning: {w}"));
         }
         bar.inc(1);
+        surfaces.push(Sample {
+            name,
+            mesh,
+            stats,
+            report,
+        });
+    }
+    Samples { surfaces, timings }
+}
 
+/// The stages from the view on, from the scene's samples.
+fn in_view(
+    scene: &Scene,
+    samples: Samples,
+    stages: Stages,
+    bar: &ProgressBar,
+) -> Result<Built, Error> {
+    let mut timings = samples.timings;
+    let mut products = Vec::with_capacity(scene.surfaces.len());
+    let mut projections = Vec::with_capacity(scene.surfaces.len());
+    for (entry, sample) in scene.surfaces.iter().zip(samples.surfaces) {
+        let Sample {
+            name,
+            mesh,
+            stats,
+            report,
+        } = sample;
         bar.set_message(format!("projecting {name}"));
         let start = Instant::now();
         let projected = scene.view.project(&mesh).map_err(|source| Error::View {
@@ -714,7 +796,6 @@ fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error
         verification = verify::verify(&parts(&products, &scene.halo, &curves));
         timings.verify = ms(start);
     }
-    bar.finish_and_clear();
     Ok(Built {
         surfaces: products,
         diagonal,
@@ -752,17 +833,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     };
     let name = &scene.name;
     let failures = built.failures();
-    // The stipples of the picture, for the files that carry them.
-    let stipples = if scene.outputs.stipples {
-        render::stipples_drawn(&built.parts(&scene.halo), &scene.render, &scene.camera).map_err(
-            |source| Error::Render {
-                scene: scene.name.clone(),
-                source,
-            },
-        )?
-    } else {
-        Vec::new()
-    };
+    let stipples = file_stipples(scene, built)?;
     // The files are made on the cores side by side, each written as it is made (a halo's
     // `.vtk` streamed, the `.glb`'s chunks written as they are, with no copy of the whole
     // file in memory); the report lists them in this order.
@@ -770,26 +841,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     let mut jobs: Vec<Job> = Vec::new();
     if scene.outputs.glb {
         jobs.push(Box::new(|| {
-            let scene_json = serde_json::to_value(scene).map_err(|e| Error::Internal {
-                stage: "export",
-                message: e.to_string(),
-            })?;
-            let asset = serde_json::json!({
-                "scene": scene_json,
-                "verified": failures.is_empty(),
-                "failures": failures,
-            });
-            let (text, bin) = export::glb_chunks(
-                &data,
-                built.shown_curves(),
-                scene.outputs.curve_radius * built.diagonal,
-                &stipples,
-                &asset,
-            )
-            .map_err(|message| Error::Internal {
-                stage: "export",
-                message,
-            })?;
+            let (text, bin) = glb_chunks(scene, built, &data, &stipples, &failures)?;
             let file = staged
                 .stream(format!("{name}.glb"), |w| {
                     export::write_glb_container(w, &text, &bin)
@@ -907,6 +959,63 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     }
     staged.commit().map_err(staged_error)?;
     Ok(report)
+}
+
+/// The stipples of the picture, for the files that carry them (`outputs.stipples`; none
+/// otherwise).
+fn file_stipples(scene: &Scene, built: &Built) -> Result<Vec<render::stipple::Drawn>, Error> {
+    if !scene.outputs.stipples {
+        return Ok(Vec::new());
+    }
+    render::stipples_drawn(&built.parts(&scene.halo), &scene.render, &scene.camera).map_err(
+        |source| Error::Render {
+            scene: scene.name.clone(),
+            source,
+        },
+    )
+}
+
+/// The JSON and binary chunks of the scene's `.glb`: the surfaces, halos, shown curves and
+/// `stipples`, with the scene and the build's verdict (`failures`) in the asset's extras.
+fn glb_chunks(
+    scene: &Scene,
+    built: &Built,
+    data: &[SurfaceData],
+    stipples: &[render::stipple::Drawn],
+    failures: &[String],
+) -> Result<(Vec<u8>, Vec<u8>), Error> {
+    let internal = |message: String| Error::Internal {
+        stage: "export",
+        message,
+    };
+    let scene_json = serde_json::to_value(scene).map_err(|e| internal(e.to_string()))?;
+    let asset = serde_json::json!({
+        "scene": scene_json,
+        "verified": failures.is_empty(),
+        "failures": failures,
+    });
+    export::glb_chunks(
+        data,
+        built.shown_curves(),
+        scene.outputs.curve_radius * built.diagonal,
+        stipples,
+        &asset,
+    )
+    .map_err(internal)
+}
+
+/// The bytes of the `.glb` a build of `scene` writes (with its stipples when
+/// `outputs.stipples`), for a file written on its own.
+pub fn glb_bytes(scene: &Scene, built: &Built) -> Result<Vec<u8>, Error> {
+    let stipples = file_stipples(scene, built)?;
+    let data: Vec<SurfaceData> = built.surfaces.iter().map(|p| p.data(&scene.halo)).collect();
+    let (text, bin) = glb_chunks(scene, built, &data, &stipples, &built.failures())?;
+    let mut out = Vec::new();
+    export::write_glb_container(&mut out, &text, &bin).map_err(|e| Error::Internal {
+        stage: "export",
+        message: e.to_string(),
+    })?;
+    Ok(out)
 }
 
 /// A [`export::StagedError`] as the pipeline's error.

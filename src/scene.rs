@@ -5,6 +5,7 @@
 //! range; every error names the file and the field (`surfaces[0].surface.n`) and says what
 //! is allowed. No input makes the parser panic.
 
+use crate::animation::Animation;
 use crate::halo::HaloParams;
 use crate::intersect::CurveSettings;
 use crate::limits::shorten;
@@ -50,6 +51,10 @@ pub struct Scene {
     /// Which files to write.
     #[serde(default)]
     pub outputs: Outputs,
+    /// A path through 4D views for `halo4d animate`: frames, keyframes of the view and the
+    /// camera.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub animation: Option<Animation>,
 }
 
 /// One surface of a scene.
@@ -238,6 +243,19 @@ impl Scene {
         Ok(scene)
     }
 
+    /// The scene of frame `k` of its animation: its view and camera those of the frame, no
+    /// animation. `None` without an animation or beyond its frames.
+    pub fn frame(&self, k: u32) -> Option<Scene> {
+        let a = self.animation.as_ref().filter(|a| k < a.frames)?;
+        let (view, camera) = a.frame(k, &self.view, &self.camera);
+        Some(Scene {
+            view,
+            camera,
+            animation: None,
+            ..self.clone()
+        })
+    }
+
     /// The name of surface `i` in the outputs.
     pub fn surface_name(&self, i: usize) -> String {
         self.surfaces[i]
@@ -338,6 +356,10 @@ impl Scene {
         self.camera.check().map_err(|e| e.within("camera"))?;
         self.render.check().map_err(|e| e.within("render"))?;
         self.outputs.check().map_err(|e| e.within("outputs"))?;
+        if let Some(a) = &self.animation {
+            a.check(&self.view, &self.camera)
+                .map_err(|e| e.within("animation"))?;
+        }
         Ok(())
     }
 }

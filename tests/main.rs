@@ -1,6 +1,7 @@
 //! Integration tests, one module per stage.
 
 mod adaptive;
+mod animate;
 mod architecture;
 mod cli;
 mod common;

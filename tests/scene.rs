@@ -418,6 +418,58 @@ const BROKEN: &[(&str, &[&str])] = &[
         "mesh-collapsed-triangle.json",
         &["surfaces[0].surface.path", "two corners at the same point"],
     ),
+    (
+        "animation-no-frames.json",
+        &["animation.frames", "1 to 99999", "got 0"],
+    ),
+    (
+        "animation-times-out-of-order.json",
+        &[
+            "animation.keyframes[1].time",
+            "later than",
+            "0.5",
+            "order of time",
+        ],
+    ),
+    (
+        "animation-elevation.json",
+        &[
+            "animation.keyframes[1].camera.elevation",
+            "-89 to 89",
+            "120",
+        ],
+    ),
+    (
+        "animation-fitted-and-set-distance.json",
+        &[
+            "animation.keyframes[1].camera.distance",
+            "fitted",
+            "in the scene too",
+        ],
+    ),
+    (
+        "animation-unknown-plane.json",
+        &[
+            "animation.keyframes[1].view.rotation.yv",
+            "unknown field `yv`",
+            "yw",
+        ],
+    ),
+    (
+        "animation-projection-type.json",
+        &[
+            "animation.keyframes[0].view.projection",
+            "the scene's view.projection type",
+        ],
+    ),
+    (
+        "animation-angle-overflow.json",
+        &["animation.keyframes[0].view.rotation.xw", "out of range"],
+    ),
+    (
+        "animation-unknown-key.json",
+        &["animation.speed", "unknown field `speed`", "keyframes"],
+    ),
 ];
 
 #[test]

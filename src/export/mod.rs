@@ -61,6 +61,20 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     })
 }
 
+/// [`write_atomic`] for a file that several processes may write at once (the shards of one
+/// animation, each writing the same bytes), streamed from `fill`: the temporary name
+/// carries the process id (`.<file name>.<pid>.partial`), so that each process renames a
+/// whole file of its own.
+pub fn write_atomic_shared(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let tmp = write_partial_as(path, &format!("{}.partial", std::process::id()), fill)?;
+    std::fs::rename(&tmp, path).inspect_err(|_| {
+        let _ = std::fs::remove_file(&tmp);
+    })
+}
+
 /// Writes what `fill` writes, buffered and synced, to the temporary name of `path`
 /// (`.<file name>.partial` in its folder) and returns that name; on failure removes what it
 /// wrote.
@@ -68,11 +82,20 @@ fn write_partial(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> std::io::Result<std::path::PathBuf> {
+    write_partial_as(path, "partial", fill)
+}
+
+/// [`write_partial`] to `.<file name>.<suffix>`.
+fn write_partial_as(
+    path: &Path,
+    suffix: &str,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> std::io::Result<std::path::PathBuf> {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.partial"));
+    let tmp = path.with_file_name(format!(".{name}.{suffix}"));
     std::fs::File::create(&tmp)
         .and_then(|f| {
             let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
