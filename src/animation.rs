@@ -115,17 +115,6 @@ impl RotationKey {
     fn is_empty(&self) -> bool {
         *self == RotationKey::default()
     }
-
-    fn planes(&self) -> [(&'static str, Option<f64>); 6] {
-        [
-            ("xy", self.xy),
-            ("xz", self.xz),
-            ("xw", self.xw),
-            ("yz", self.yz),
-            ("yw", self.yw),
-            ("zw", self.zw),
-        ]
-    }
 }
 
 /// The fields of a [`CameraSettings`] a keyframe sets.
