@@ -436,3 +436,23 @@ fn bad_requests_get_clear_errors() {
     assert!(stderr(&out).contains("another scene"), "{}", stderr(&out));
     assert!(stderr(&out).contains("`render`"), "{}", stderr(&out));
 }
+
+/// The animation fixtures load, and follow their keys: the default scene's turn in xw is
+/// at its halfway point halfway through, with the camera swung out to its key.
+#[test]
+fn the_animation_fixtures_follow_their_keys() {
+    let files = crate::common::scenes_in("animations");
+    assert!(!files.is_empty());
+    for file in &files {
+        let scene = halo4d::Scene::load(file).unwrap_or_else(|e| panic!("{e}"));
+        assert!(scene.animation.is_some(), "{}", file.display());
+    }
+    let scene = halo4d::Scene::load(&fixture("animations/spun-trefoil-xw.json")).unwrap();
+    let first = scene.frame(0).unwrap();
+    assert_eq!((first.view, first.camera), (scene.view, scene.camera));
+    let half = scene.frame(180).unwrap();
+    assert!((half.view.rotation.xw - 200.0).abs() < 1e-9);
+    assert_eq!(half.view.rotation.yw, 35.0);
+    assert_eq!(half.camera.azimuth, 80.0);
+    assert!(scene.frame(360).is_none());
+}
