@@ -8,7 +8,7 @@ set -euo pipefail
 halo4d=$(realpath "$1")
 out=$(realpath "$2")
 python=$3
-scene=$PWD/fixtures/scenes/flat-torus-turn.json
+scene=$PWD/fixtures/animations/flat-torus-turn.json
 frames=$(grep -o '"frames": [0-9]*' "$scene" | grep -o '[0-9]*$')
 
 same_frames() { # FOLDER: every frame's picture as one process's, and the folder assembles

@@ -52,8 +52,8 @@ pub use scene::{Outputs, Scene, SceneError, SceneSurface};
 
 // Animations: a path through 4D views, and its frames.
 pub use animate::{
-    AnimateError, Assembled, FrameRange, FrameRecord, FrameTimings, Request, Shard, Status,
-    Summary, animate, assemble, status,
+    AnimateError, Assembled, FrameRange, FrameRecord, Request, Shard, Status, Summary, animate,
+    assemble, status,
 };
 pub use animation::{Animation, CameraKey, Keyframe, RotationKey, ViewKey};
 

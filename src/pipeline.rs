@@ -323,7 +323,7 @@ impl SurfaceProduct {
 }
 
 /// Milliseconds spent in each stage.
-#[derive(Clone, Copy, Debug, Default, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct Timings {
     /// Sampling, all surfaces.
     pub sample: f64,

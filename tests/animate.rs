@@ -10,7 +10,7 @@ use std::process::{Command, Output, Stdio};
 const FRAMES: u32 = 24;
 
 fn turn() -> PathBuf {
-    fixture("scenes/flat-torus-turn.json")
+    fixture("animations/flat-torus-turn.json")
 }
 
 fn stderr(out: &Output) -> String {

@@ -32,7 +32,7 @@ pub use assemble::{Assembled, Status, assemble, status};
 use crate::error::Error;
 use crate::export;
 use crate::limits::FieldError;
-use crate::pipeline::{self, Samples};
+use crate::pipeline::{self, Samples, Timings};
 use crate::render::CameraSettings;
 use crate::scene::Scene;
 use crate::view::View;
@@ -223,29 +223,6 @@ impl Manifest {
     }
 }
 
-/// Milliseconds of a frame's stages.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct FrameTimings {
-    /// Rotation and projection.
-    pub view: f64,
-    /// Halos.
-    pub halo: f64,
-    /// Intersection curves.
-    pub curves: f64,
-    /// Refining the curves.
-    pub refine: f64,
-    /// Verifying the halos.
-    pub verify: f64,
-    /// Stipples.
-    pub stipples: f64,
-    /// The picture.
-    pub render: f64,
-    /// Encoding and writing the frame's files.
-    pub files: f64,
-    /// All of the frame (its share of the sampling not included).
-    pub total: f64,
-}
-
 /// One frame's record (`frame-00042.json`, a line of `frames.jsonl`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FrameRecord {
@@ -272,8 +249,9 @@ pub struct FrameRecord {
     pub curve_points: usize,
     /// The halos' verification against the curves (`report.json`'s `halo_verification`).
     pub verification: Option<serde_json::Value>,
-    /// Milliseconds per stage.
-    pub timings_ms: FrameTimings,
+    /// Milliseconds per stage: `export` is writing the frame's files, `total` the whole
+    /// frame; `sample` and `audit` are 0, the surfaces being sampled once per process.
+    pub timings_ms: Timings,
     /// Its files in the folder, the record's own last.
     pub files: Vec<String>,
 }
@@ -468,7 +446,7 @@ fn make_frame(
         curves: 0,
         curve_points: 0,
         verification: None,
-        timings_ms: FrameTimings::default(),
+        timings_ms: Timings::default(),
         files: Vec::new(),
     };
     let made = pipeline::run_sampled(&frame, samples.clone()).and_then(|built| {
@@ -504,17 +482,13 @@ fn make_frame(
         write_frame_file(dir, &name, &bytes)?;
         record.files.push(name);
     }
-    let t = built.timings;
-    record.timings_ms = FrameTimings {
-        view: t.view,
-        halo: t.halo,
-        curves: t.curves,
-        refine: t.refine,
-        verify: t.verify,
-        stipples: t.stipples,
+    record.timings_ms = Timings {
+        sample: 0.0,
+        audit: 0.0,
         render: render_ms,
-        files: ms(files_start),
+        export: ms(files_start),
         total: ms(start),
+        ..built.timings
     };
     record.failures = built.failures();
     record.verified = record.failures.is_empty();
