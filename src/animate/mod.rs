@@ -417,10 +417,15 @@ pub fn read_manifest(dir: &Path) -> Result<Manifest, AnimateError> {
 
 /// Frame `k`'s record, when it is done: its record reads, and its picture is there.
 pub fn read_record(dir: &Path, k: u32) -> Option<FrameRecord> {
+    read_done(dir, k).map(|(record, _)| record)
+}
+
+/// [`read_record`] with the record's bytes as written.
+fn read_done(dir: &Path, k: u32) -> Option<(FrameRecord, Vec<u8>)> {
     let text = std::fs::read(dir.join(frame_file(k, "json"))).ok()?;
     let record: FrameRecord = serde_json::from_slice(&text).ok()?;
     let whole = record.frame == k && record.files.iter().all(|f| dir.join(f).is_file());
-    whole.then_some(record)
+    whole.then_some((record, text))
 }
 
 /// Makes frame `k`: its build from the samples in its view, its files, its record last.
@@ -527,11 +532,10 @@ fn write_record(dir: &Path, mut record: FrameRecord) -> Result<FrameRecord, Anim
 fn gather(dir: &Path, frames: u32) -> Result<bool, AnimateError> {
     let mut lines = Vec::new();
     for k in 0..frames {
-        let path = dir.join(frame_file(k, "json"));
-        if read_record(dir, k).is_none() {
+        let Some((_, text)) = read_done(dir, k) else {
             return Ok(false);
-        }
-        lines.extend(std::fs::read(&path).map_err(io(&path))?);
+        };
+        lines.extend(text);
     }
     let path = dir.join(RECORDS);
     export::write_atomic_shared(&path, |w| w.write_all(&lines)).map_err(io(&path))?;
