@@ -1101,16 +1101,11 @@ impl<'a> Scene<'a> {
             if first.is_infinite() {
                 first = hit.t;
             }
-            let mut n = DVec3::new(
-                mix(&|v| surf.normals[v].x),
-                mix(&|v| surf.normals[v].y),
-                mix(&|v| surf.normals[v].z),
+            let n = shade::shading_normal(
+                tri.map(|v| surf.positions[v as usize]),
+                tri.map(|v| surf.normals[v as usize]),
+                b,
             );
-            if n.length_squared() <= 1e-24 || !n.is_finite() {
-                let p = tri.map(|v| surf.positions[v as usize]);
-                n = (p[1] - p[0]).cross(p[2] - p[0]);
-            }
-            let n = n.normalize_or_zero();
             let depth = (w - w0) / span;
             let base = shade::colormap(s.colormap, depth);
             let lit = shade::phong(base, n, dir, cam.right, cam.up);

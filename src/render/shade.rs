@@ -71,6 +71,28 @@ pub fn phong(base: DVec3, n: DVec3, view: DVec3, right: DVec3, up: DVec3) -> DVe
     c.clamp(DVec3::ZERO, DVec3::ONE)
 }
 
+/// The shading normal at barycentric point `bary` of the triangle with corners `p` and
+/// vertex normals `n`: each vertex normal turned to the side of the triangle's own normal
+/// before they are interpolated, then normalized; the triangle's normal where they cancel.
+///
+/// Vertex normals of one triangle can point to opposite sides: across the line where a
+/// non-orientable surface (the Klein bottle, the projective plane) turns over, and around
+/// cross-caps of a projection. Interpolated as they are, they pass through zero inside the
+/// triangle and its shading jumps from light to dark along a jagged line of mesh edges.
+/// Shading is two-sided ([`phong`]), so the side a normal points to carries nothing else.
+pub fn shading_normal(p: [DVec3; 3], n: [DVec3; 3], bary: [f64; 3]) -> DVec3 {
+    let face = (p[1] - p[0]).cross(p[2] - p[0]);
+    let mut mixed = DVec3::ZERO;
+    for k in 0..3 {
+        let side = if n[k].dot(face) < 0.0 { -1.0 } else { 1.0 };
+        mixed += n[k] * (side * bary[k]);
+    }
+    if mixed.length_squared() <= 1e-24 || !mixed.is_finite() {
+        return face.normalize_or_zero();
+    }
+    mixed.normalize()
+}
+
 /// Paper 001's silhouette opacity: a surface of opacity `alpha` seen at |cos| = `d`
 /// between the eye ray and its normal covers 1 - (1 - alpha)^(1/d), as a sheet of that
 /// opacity would when crossed obliquely: rims become opaque, faces stay clear.
@@ -92,6 +114,28 @@ mod tests {
             assert!(a.is_finite() && b.is_finite() && (a - b).length() > 0.3);
             assert_eq!(colormap(map, f64::NAN), colormap(map, 0.5));
         }
+    }
+
+    #[test]
+    fn shading_normals_of_opposite_vertices_keep_to_the_triangles_side() {
+        let p = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        // A Klein bottle's seam: one corner's normal points down, the others up.
+        let n = [DVec3::Z, -DVec3::Z, (DVec3::Z + DVec3::X).normalize()];
+        let steps = 20;
+        for i in 0..=steps {
+            for j in 0..=steps - i {
+                let (a, b) = (i as f64 / steps as f64, j as f64 / steps as f64);
+                let m = shading_normal(p, n, [a, b, 1.0 - a - b]);
+                assert!((m.length() - 1.0).abs() < 1e-12);
+                assert!(m.z > 0.7, "{m} at ({a}, {b})");
+            }
+        }
+        // Interpolated as they are, they cancel at the middle of the first edge.
+        let raw = (n[0] + n[1]) * 0.5;
+        assert!(raw.length() < 1e-12);
+        // Normals that cancel even when turned: the triangle's own.
+        let flat = shading_normal(p, [DVec3::X, -DVec3::X, DVec3::X], [0.5, 0.5, 0.0]);
+        assert_eq!(flat, DVec3::Z);
     }
 
     #[test]

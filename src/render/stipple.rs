@@ -131,12 +131,12 @@ impl Scene<'_> {
                         return None;
                     }
                     let dir = cam.ray_to(x).1;
-                    let mut n = set.mix(k, surf.triangles, surf.normals);
-                    if n.length_squared() <= 1e-24 || !n.is_finite() {
-                        let p = tri.map(|v| surf.positions[v as usize]);
-                        n = (p[1] - p[0]).cross(p[2] - p[0]);
-                    }
-                    let tone = tone(n.normalize_or_zero(), dir, cam);
+                    let n = super::shade::shading_normal(
+                        tri.map(|v| surf.positions[v as usize]),
+                        tri.map(|v| surf.normals[v as usize]),
+                        set.bary[k],
+                    );
+                    let tone = tone(n, dir, cam);
                     let prefix = density(tone, s.stipple.size) * scale[ti];
                     ((k as f64) < prefix).then(|| Drawn {
                         surface: index as u32,
