@@ -40,8 +40,16 @@ use std::time::Instant;
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct HaloParams {
-    /// Half-width of the halo, relative to the diagonal of the projected scene's bounding box.
-    pub rho: f64,
+    /// Half-width of the halo, relative to the diagonal of the projected scene's bounding
+    /// box; when absent, the half-width is set by `gap_px` from the scene's picture.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rho: Option<f64>,
+    /// Half-width of the halo in pixels of the scene's picture, at the depth of the point
+    /// the camera looks at: about the width of the gap the halo cuts into the sheet
+    /// passing under on each side of a crossing ([`DEFAULT_GAP_PX`] when neither this nor
+    /// `rho` is given). One of `rho` and `gap_px`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gap_px: Option<f64>,
     /// Depth increment delta_d at the halo's outer surfaces (eq. 3), in w units.
     pub delta_d: f64,
     /// Dead zone delta_t in [0, 1) of |2t - 1| before the depth starts to grow (eq. 3).
@@ -66,7 +74,8 @@ pub enum Fold {
 impl Default for HaloParams {
     fn default() -> Self {
         HaloParams {
-            rho: 0.01,
+            rho: None,
+            gap_px: None,
             delta_d: 0.5,
             delta_t: 0.3,
             split: Split::default(),
@@ -79,16 +88,54 @@ impl Default for HaloParams {
 /// resolves about 6e-8 of it, and the halo needs its two offsets apart.
 pub const MIN_RHO: f64 = 1e-6;
 
+/// The largest `rho`, a share of the scene's diagonal (so that a halo is thinner than the
+/// scene it hides parts of).
+pub const MAX_RHO: f64 = 0.49;
+
+/// The gap a halo cuts on each side of a crossing, in pixels of the scene's picture, when a
+/// scene gives neither `halo.rho` nor `halo.gap_px`: wide enough to read at a glance beside
+/// a curve line of the default width (2.5 px).
+pub const DEFAULT_GAP_PX: f64 = 8.0;
+
+/// The widest `gap_px`, in pixels.
+pub const MAX_GAP_PX: f64 = 1000.0;
+
 impl HaloParams {
+    /// The halo's half-width in scene units, for a projected scene of bounding `diagonal`
+    /// whose picture has pixels of side `pixel_size` (scene units) at the depth the camera
+    /// looks at; no larger than [`MAX_RHO`] of the diagonal.
+    pub fn half_width(&self, diagonal: f64, pixel_size: f64) -> f64 {
+        match self.rho {
+            Some(rho) => rho * diagonal,
+            None => (self.gap_px.unwrap_or(DEFAULT_GAP_PX) * pixel_size)
+                .clamp(MIN_RHO * diagonal, MAX_RHO * diagonal),
+        }
+    }
+
     /// Checks the numbers: names the first bad field.
     pub fn check(&self) -> Result<(), FieldError> {
-        if !(self.rho.is_finite() && self.rho >= MIN_RHO && self.rho < 0.5) {
+        if self.rho.is_some() && self.gap_px.is_some() {
+            return Err(FieldError::new(
+                "gap_px",
+                "give one of halo.rho (a share of the scene's diagonal) and halo.gap_px (pixels of the picture), not both".to_string(),
+            ));
+        }
+        if let Some(rho) = self.rho
+            && !(rho.is_finite() && rho >= MIN_RHO && rho <= MAX_RHO)
+        {
             return Err(FieldError::new(
                 "rho",
                 format!(
-                    "must be greater than 0: at least {MIN_RHO:e} (below that the two offsets round to one point in f32, which the files store), and less than 0.5 (a share of the scene's diagonal), got {:?}",
-                    self.rho
+                    "must be greater than 0: at least {MIN_RHO:e} (below that the two offsets round to one point in f32, which the files store), and at most {MAX_RHO} (a share of the scene's diagonal), got {rho:?}"
                 ),
+            ));
+        }
+        if let Some(gap) = self.gap_px
+            && !(gap.is_finite() && gap > 0.0 && gap <= MAX_GAP_PX)
+        {
+            return Err(FieldError::new(
+                "gap_px",
+                format!("must be more than 0 and at most {MAX_GAP_PX} pixels, got {gap:?}"),
             ));
         }
         if !(self.delta_d.is_finite() && self.delta_d >= 0.0) {

@@ -63,6 +63,11 @@ pub struct Built {
     /// The diagonal of the projected scene's bounding box, of which `halo.rho` and
     /// `outputs.curve_radius` are shares, at least [`MIN_EXTENT`].
     pub diagonal: f64,
+    /// The side of a pixel of the scene's picture at the depth its camera looks at, in
+    /// scene units, of which `halo.gap_px` is a multiple.
+    pub pixel_size: f64,
+    /// The halos' half-width asked for, in scene units (less where a halo was shrunk).
+    pub rho: f64,
     /// The memory the stages from the halos on were estimated to need, and the limit.
     pub memory: MemoryReport,
     /// Which stages after the projection ran.
@@ -391,6 +396,22 @@ pub struct SurfaceReport {
     pub stipples: Option<usize>,
 }
 
+/// `report.json`'s `picture`: how to reproduce the picture's projection, the halos' width in
+/// it, and the share of the curves it shows ([`render::visible`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct PictureReport {
+    /// The camera, in the projected scene's coordinates.
+    #[serde(flatten)]
+    pub camera: render::visible::PictureCamera,
+    /// The halos' half-width asked for, in scene units.
+    pub rho: f64,
+    /// The same in pixels at the depth the camera looks at.
+    pub gap_px: f64,
+    /// The curves' projected length and the share of it in view.
+    #[serde(flatten)]
+    pub curves: render::visible::CurveVisibility,
+}
+
 /// `report.json`.
 #[derive(Clone, Debug, Serialize)]
 pub struct Report {
@@ -412,6 +433,10 @@ pub struct Report {
     pub memory: MemoryReport,
     /// Warnings, also printed on stderr.
     pub warnings: Vec<String>,
+    /// The picture: its camera, halo width and how much of the curves it shows (absent when
+    /// no picture was drawn).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub picture: Option<PictureReport>,
     /// Whether the build is verified: [`Built::failures`] found nothing in the stages that
     /// ran.
     pub verified: bool,
@@ -710,7 +735,18 @@ fn in_view(
             ),
         });
     }
-    let rho = scene.halo.rho * diagonal;
+    let pixel = render::picture_pixel_size(
+        projections
+            .iter()
+            .map(|p| (p.5.positions.as_slice(), p.2.triangles.as_slice())),
+        &scene.render,
+        &scene.camera,
+    )
+    .map_err(|source| Error::Render {
+        scene: scene.name.clone(),
+        source,
+    })?;
+    let rho = scene.halo.half_width(diagonal, pixel);
     let triangles: usize = projections.iter().map(|p| p.2.triangles.len()).sum();
     let needed = if stages.halos || stages.curves {
         triangles as f64 * crate::memory::BUILD_BYTES_PER_TRIANGLE
@@ -799,6 +835,8 @@ fn in_view(
     Ok(Built {
         surfaces: products,
         diagonal,
+        pixel_size: pixel,
+        rho,
         memory: MemoryReport {
             estimate_gb: needed / crate::memory::GB,
             limit_gb: limit / crate::memory::GB,
@@ -896,6 +934,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     let written: Result<Vec<Vec<String>>, Error> = jobs.into_par_iter().map(|job| job()).collect();
     let mut files: Vec<String> = written?.into_iter().flatten().collect();
     timings.export = ms(export_start);
+    let mut picture_report = None;
     if scene.outputs.png {
         let start = Instant::now();
         let picture = built
@@ -906,6 +945,21 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
             })?;
         timings.render = ms(start);
         files.push(write(format!("{name}.png"), &picture.png())?);
+        let (camera, curves) = render::visible::curve_visibility(
+            &built.parts(&scene.halo),
+            &scene.render,
+            &scene.camera,
+        )
+        .map_err(|source| Error::Render {
+            scene: scene.name.clone(),
+            source,
+        })?;
+        picture_report = Some(PictureReport {
+            camera,
+            rho: built.rho,
+            gap_px: built.rho / built.pixel_size,
+            curves,
+        });
     }
     if scene.outputs.report {
         files.push("report.json".into());
@@ -945,6 +999,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
                 p.sampling.warning(&p.name).into_iter().chain(file)
             })
             .collect(),
+        picture: picture_report,
         verified: failures.is_empty(),
         failures,
         files,

@@ -411,7 +411,7 @@ fn cross_caps_between_vertices_and_rho_beyond_the_curvature_stay_valid() {
     for (u, rho) in [(95, 0.01), (31, 0.01), (48, 0.3), (95, 0.3)] {
         let products = run_fixture("flat-torus", |scene| {
             scene.sampling = Sampling::Uniform { u, v: u };
-            scene.halo.rho = rho;
+            scene.halo.rho = Some(rho);
         });
         let r = &products[0].halo_report;
         let what = format!("{u}x{u}, rho {rho}: {r:?}");
@@ -430,7 +430,7 @@ fn cross_caps_between_vertices_and_rho_beyond_the_curvature_stay_valid() {
     }
     // Without shrinking, the same halo is reported with its inverted tetrahedra.
     let products = run_fixture("flat-torus", |scene| {
-        scene.halo.rho = 0.3;
+        scene.halo.rho = Some(0.3);
         scene.halo.fold = Fold::Report;
     });
     let r = &products[0].halo_report;
@@ -532,7 +532,7 @@ fn every_surface_point_is_in_its_own_prism_at_t_one_half() {
     // their own prism, and 38 crossings the halo did not explain.)
     type Edit = fn(&mut Scene);
     let cases: [(&str, Edit); 2] = [
-        ("default", |s| s.halo.rho = 0.05),
+        ("default", |s| s.halo.rho = Some(0.05)),
         ("product-polynomial", |s| {
             s.sampling = Sampling::Uniform { u: 4, v: 1024 }
         }),

@@ -20,6 +20,7 @@ pub mod slices;
 pub mod stipple;
 pub(crate) mod text;
 pub mod trace;
+pub mod visible;
 
 use crate::limits::{FieldError, PICTURE_SIDE, SAMPLES, SLICES};
 use crate::parts::{HaloIndex, Parts};
@@ -747,6 +748,34 @@ fn prepare<'a>(
     Ok((placement, Scene::new(input, settings, bounds)))
 }
 
+/// The side of a pixel of the picture of the projected surfaces (positions, triangles),
+/// in scene units at the depth of the point its camera looks at: what `halo.gap_px`
+/// multiplies. The settings are checked first.
+pub fn picture_pixel_size<'a>(
+    surfaces: impl Iterator<Item = (&'a [DVec3], &'a [[u32; 3]])> + Clone,
+    settings: &RenderSettings,
+    camera: &CameraSettings,
+) -> Result<f64, RenderError> {
+    settings
+        .check()
+        .map_err(|e| RenderError::Setting(e.within("render")))?;
+    camera
+        .check()
+        .map_err(|e| RenderError::Setting(e.within("camera")))?;
+    let bounds = triangle_bounds(surfaces.clone()).ok_or(RenderError::Empty)?;
+    let corners = surfaces.flat_map(|(positions, triangles)| {
+        triangles
+            .iter()
+            .flatten()
+            .map(move |&v| positions[v as usize])
+    });
+    let (w, h) = (settings.width, settings.height);
+    let placement = camera::Placement::new(camera, bounds, corners, w, h, &eyes(settings));
+    let cam = Camera::new(camera, &placement, w, h, first_eye(settings))?;
+    let depth = (placement.target - cam.eye).dot(cam.forward);
+    Ok(visible::pixel_size(&cam, depth, h))
+}
+
 /// The box around every vertex of a triangle of the surfaces (positions, triangles), which
 /// the camera frames; `None` when there is no triangle.
 pub fn triangle_bounds<'a>(
@@ -1109,10 +1138,7 @@ impl<'a> Scene<'a> {
             let depth = (w - w0) / span;
             let base = shade::colormap(s.colormap, depth);
             let lit = shade::phong(base, n, dir, cam.right, cam.up);
-            let mut a = match s.opacity_far {
-                Some(far) => s.opacity + (far - s.opacity) * depth.clamp(0.0, 1.0),
-                None => s.opacity,
-            };
+            let mut a = self.opacity_at(hit);
             if s.silhouette_opacity {
                 a = shade::silhouette_opacity(a, n.dot(dir));
             }

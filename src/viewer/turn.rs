@@ -29,6 +29,7 @@
 use super::{HaloVertex, SurfaceVertex, ViewerError};
 use crate::intersect::{Curves, Sheet};
 use crate::limits::{MAX_COORDINATE, MIN_EXTENT};
+use crate::render::camera::FIT_MARGIN;
 use crate::sample::Mesh4;
 use crate::scene::Scene;
 use crate::tets::{self, Corners, Split};
@@ -229,7 +230,12 @@ impl Model {
                 w_range.0,
                 w_range.1 + (1.0 - halo.delta_t).max(0.0) * halo.delta_d.max(0.0),
             ),
-            rho: halo.rho * diagonal,
+            // The explorer's window changes size: the gap is that of the scene's own
+            // picture, whose fitted camera spans about the bounding sphere.
+            rho: halo.half_width(
+                diagonal,
+                diagonal / (f64::from(self.scene.render.height) * (1.0 - 2.0 * FIT_MARGIN)),
+            ),
         })
     }
 

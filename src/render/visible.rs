@@ -1,0 +1,196 @@
+//! What a picture shows of the double curves, and where its camera stands.
+//!
+//! The share of the curves in view is measured along their projected length: every segment
+//! of every curve is cut into pieces at most one pixel long in the picture, and each piece
+//! counts with the transmittance of the eye ray to its middle, cast against the surfaces as
+//! they are drawn: the product of 1 - opacity (by w, as the picture composites it) over the
+//! surfaces the ray meets before the point and the halos leave visible, 0 when one of them
+//! is opaque. Pieces outside the picture count 0; pieces behind a perspective eye are left
+//! out of the length too. The point a ray aims at is the curve's point on the mesh
+//! ([`crate::CurvePoint::on_mesh`]), as for the drawn lines, so that the sheets through it
+//! never hide it.
+
+use super::camera::Camera;
+use super::trace::Hit;
+use super::{CameraProjection, CameraSettings, RenderError, Scene};
+use crate::parts::Parts;
+use glam::DVec3;
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// The double curves' projected length and how much of it a picture shows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct CurveVisibility {
+    /// The curves' length in the picture's pixels, in view or not (without what lies
+    /// behind a perspective eye).
+    pub curves_projected_px: f64,
+    /// The length the picture shows, each piece weighted by the transmittance of the eye ray
+    /// to it.
+    pub curves_visible_px: f64,
+    /// `curves_visible_px / curves_projected_px`; 0 without curves.
+    pub visible_curve_share: f64,
+}
+
+/// The camera of a picture in the coordinates of the projected scene (the `.ply` files'
+/// frame), so that any program can reproduce it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct PictureCamera {
+    /// Width in pixels (of one eye).
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Perspective or orthographic.
+    pub projection: CameraProjection,
+    /// Where the eye stands.
+    pub eye: [f64; 3],
+    /// The point at the picture's centre.
+    pub target: [f64; 3],
+    /// The picture's up direction (unit).
+    pub up: [f64; 3],
+    /// Vertical field of view in degrees (perspective).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fov_deg: Option<f64>,
+    /// Half the picture's height in scene units (orthographic).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub half_height: Option<f64>,
+    /// The side of a pixel in scene units at the target's depth.
+    pub pixel_size: f64,
+}
+
+impl PictureCamera {
+    fn of(cam: &Camera, target: DVec3, width: u32, height: u32) -> Self {
+        let depth = (target - cam.eye).dot(cam.forward);
+        let perspective = cam.projection == CameraProjection::Perspective;
+        PictureCamera {
+            width,
+            height,
+            projection: cam.projection,
+            eye: cam.eye.to_array(),
+            target: (cam.eye + cam.forward * depth).to_array(),
+            up: cam.up.to_array(),
+            fov_deg: perspective.then(|| 2.0 * cam.half_height.atan().to_degrees()),
+            half_height: (!perspective).then_some(cam.half_height),
+            pixel_size: pixel_size(cam, depth, height),
+        }
+    }
+}
+
+/// The side of a pixel of a picture `height` pixels high, in scene units, at `depth` along
+/// the view direction.
+pub(crate) fn pixel_size(cam: &Camera, depth: f64, height: u32) -> f64 {
+    let half = match cam.projection {
+        CameraProjection::Perspective => depth * cam.half_height,
+        CameraProjection::Orthographic => cam.half_height,
+    };
+    2.0 * half / f64::from(height)
+}
+
+/// The camera of the picture of `input` (its first eye) and how much of the curves it shows.
+pub fn curve_visibility(
+    input: &Parts,
+    settings: &super::RenderSettings,
+    camera: &CameraSettings,
+) -> Result<(PictureCamera, CurveVisibility), RenderError> {
+    let (placement, scene) = super::prepare(input, settings, camera)?;
+    let cam = Camera::new(
+        camera,
+        &placement,
+        settings.width,
+        settings.height,
+        super::first_eye(settings),
+    )?;
+    Ok((
+        PictureCamera::of(&cam, placement.target, settings.width, settings.height),
+        scene.curve_visibility(&cam),
+    ))
+}
+
+impl Scene<'_> {
+    /// How much of the curves the picture through `cam` shows.
+    pub(super) fn curve_visibility(&self, cam: &Camera) -> CurveVisibility {
+        let (w, h) = (self.settings.width, self.settings.height);
+        let mut segments: Vec<[(DVec3, DVec3); 2]> = Vec::new();
+        for c in &self.input.curves.curves {
+            let points: Vec<(DVec3, DVec3)> =
+                c.points.iter().map(|p| (p.position, p.on_mesh)).collect();
+            segments.extend(points.windows(2).map(|s| [s[0], s[1]]));
+            if c.closed && points.len() > 2 {
+                segments.push([points[points.len() - 1], points[0]]);
+            }
+        }
+        // Per segment on the cores, summed in order: the same total on any number of threads.
+        let pieces: Vec<(f64, f64)> = segments
+            .par_iter()
+            .map_init(Vec::new, |hits, &[(a, sa), (b, sb)]| {
+                let (Some((pa, _)), Some((pb, _))) = (cam.project(a, w, h), cam.project(b, w, h))
+                else {
+                    return (0.0, 0.0);
+                };
+                let length = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
+                let steps = (length.ceil() as usize).clamp(1, 4096);
+                let piece = length / steps as f64;
+                let mut seen = 0.0;
+                for k in 0..steps {
+                    let f = (k as f64 + 0.5) / steps as f64;
+                    let (p, s) = (a + (b - a) * f, sa + (sb - sa) * f);
+                    let Some((xy, _)) = cam.project(p, w, h) else {
+                        continue;
+                    };
+                    let inside = xy[0] >= 0.0
+                        && xy[1] >= 0.0
+                        && xy[0] < f64::from(w)
+                        && xy[1] < f64::from(h);
+                    if inside {
+                        seen += piece * self.transmittance(cam, s, hits);
+                    }
+                }
+                (length, seen)
+            })
+            .collect();
+        let (projected, visible) = pieces
+            .iter()
+            .fold((0.0, 0.0), |(p, v), &(a, b)| (p + a, v + b));
+        CurveVisibility {
+            curves_projected_px: projected,
+            curves_visible_px: visible,
+            visible_curve_share: if projected > 0.0 {
+                visible / projected
+            } else {
+                0.0
+            },
+        }
+    }
+
+    /// The share of light from `p` that reaches the eye through the surfaces in front of it
+    /// that the halos leave visible.
+    pub(super) fn transmittance(&self, cam: &Camera, p: DVec3, hits: &mut Vec<Hit>) -> f64 {
+        let (origin, dir) = self.hits_before(cam, p, hits);
+        let mut through = 1.0;
+        for hit in hits.iter() {
+            if self.hidden_hit(origin, dir, hit) {
+                continue;
+            }
+            through *= 1.0 - self.opacity_at(hit);
+            if through <= 0.0 {
+                return 0.0;
+            }
+        }
+        through
+    }
+
+    /// The opacity of the surface at `hit`, by its w (paper 001's opacity by w).
+    pub(super) fn opacity_at(&self, hit: &Hit) -> f64 {
+        let s = self.settings;
+        match s.opacity_far {
+            Some(far) => {
+                let surf = &self.input.surfaces[hit.surface as usize];
+                let tri = surf.triangles[hit.triangle as usize];
+                let w: f64 = (0..3).map(|i| hit.bary[i] * surf.w[tri[i] as usize]).sum();
+                let (w0, w1) = self.w_range;
+                let span = if w1 > w0 { w1 - w0 } else { 1.0 };
+                s.opacity + (far - s.opacity) * ((w - w0) / span).clamp(0.0, 1.0)
+            }
+            None => s.opacity,
+        }
+    }
+}
