@@ -28,7 +28,7 @@
 //! are counted. Vertices are rounded to f32, what the files store, before they are checked.
 
 use crate::check::{CheckStats, TetMesh, check_parts};
-use crate::limits::FieldError;
+use crate::limits::{FieldError, MAX_GAP_PX};
 use crate::tets::{self, Corners, Split, SplitStats};
 use crate::view::Projected;
 use glam::DVec3;
@@ -96,9 +96,6 @@ pub const MAX_RHO: f64 = 0.49;
 /// scene gives neither `halo.rho` nor `halo.gap_px`: wide enough to read at a glance beside
 /// a curve line of the default width (2.5 px).
 pub const DEFAULT_GAP_PX: f64 = 8.0;
-
-/// The widest `gap_px`, in pixels.
-pub const MAX_GAP_PX: f64 = 1000.0;
 
 impl HaloParams {
     /// The halo's half-width in scene units, for a projected scene of bounding `diagonal`

@@ -40,6 +40,7 @@ mod verify;
 mod view;
 #[cfg(feature = "viewer")]
 pub mod viewer;
+mod viewsearch;
 
 // The scene, the build and what it gives.
 pub use error::Error;
@@ -48,7 +49,8 @@ pub use pipeline::{
     SurfaceReport, Timings, build, glb_bytes, render_to, run, run_for_picture, run_sampled,
     sample_scene, write,
 };
-pub use scene::{Outputs, Scene, SceneError, SceneSurface};
+pub use scene::{DEFAULT_SCENE, Outputs, Scene, SceneError, SceneSurface};
+pub use viewsearch::{Found, SearchError, search as search_view};
 
 // Animations: a path through 4D views, and its frames.
 pub use animate::{

@@ -38,6 +38,16 @@ pub const NAME_LENGTH: RangeInclusive<usize> = 1..=64;
 /// gigabytes.
 pub const PICTURE_SIDE: RangeInclusive<u32> = 1..=8192;
 
+/// Triangles of all surfaces together on the coarse grid the view search measures views
+/// on (`halo4d view`).
+pub const SEARCH_TRIANGLES: usize = 6000;
+
+/// The most 4D views the view search evaluates (each with several camera orbits).
+pub const SEARCH_VIEWS: usize = 160;
+
+/// The widest `halo.gap_px`, in pixels.
+pub const MAX_GAP_PX: f64 = 1000.0;
+
 /// Samples per pixel: a square grid.
 pub const SAMPLES: [u32; 4] = [1, 4, 9, 16];
 
@@ -247,6 +257,21 @@ pub fn table() -> String {
             "`render.width`, `render.height`, the viewer's size",
             range(&PICTURE_SIDE),
             "pixels",
+        ),
+        (
+            "`halo.gap_px`",
+            format!("more than 0, up to {MAX_GAP_PX}"),
+            "pixels",
+        ),
+        (
+            "the view search's mesh (`halo4d view`)",
+            format!("about {SEARCH_TRIANGLES}"),
+            "triangles",
+        ),
+        (
+            "4D views the view search evaluates",
+            format!("up to {SEARCH_VIEWS}"),
+            "4D views",
         ),
         (
             "`render.samples`, the viewer's samples",

@@ -158,6 +158,21 @@ enum Command {
     /// curve is resolved and the verification finds no wrong curve sample and no spurious
     /// hidden sample (a build's own verdict), 1 when something failed (a `FAILED` line says
     /// what), 2 when the folder or its .glb cannot be read.
+    /// Search the 4D view and camera orbit that show the most of a scene's double curves
+    /// (their visible length in the picture times the share visible, by rays from the
+    /// eye), on a coarse grid of the surfaces; prints what it found and writes the scene
+    /// with that view (`view.rotation`, `camera.azimuth` and `camera.elevation`; the rest
+    /// of the file as it was) to --out.
+    View {
+        /// Scene file (JSON) [default: the built-in default scene].
+        scene: Option<PathBuf>,
+        /// The scene file to write with the view found; without it, nothing is written.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// No progress bar.
+        #[arg(long, short)]
+        quiet: bool,
+    },
     Check {
         /// A .glb (every mesh with `halo` extras) or legacy .vtk (with `surface_vertices`
         /// field data) file, or a folder with one scene .glb, as `halo4d build` writes them.
@@ -220,6 +235,49 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
             } else {
                 ExitCode::from(UNVERIFIED)
             })
+        }
+        Command::View { scene, out, quiet } => {
+            let text = match &scene {
+                Some(path) => std::fs::read_to_string(path)
+                    .map_err(|e| format!("{}: cannot read the scene: {e}", path.display()))?,
+                None => halo4d::DEFAULT_SCENE.to_string(),
+            };
+            let parsed = load(scene)?;
+            let found = halo4d::search_view(&parsed, quiet)?;
+            eprintln!(
+                "view search: {} 4D views on {} triangles in {:.1} s; visible share of the curves {:.3} (the scene's own view: {:.3}), score {:.0} ({:.0})",
+                found.views,
+                found.triangles,
+                found.ms / 1e3,
+                found.visible_curve_share,
+                found.start_share,
+                found.score,
+                found.start_score
+            );
+            let mut json: serde_json::Value = serde_json::from_str(&text)?;
+            let rotation = serde_json::to_value(found.rotation)?;
+            let object = json
+                .as_object_mut()
+                .ok_or("the scene is not a JSON object")?;
+            let view = object
+                .entry("view")
+                .or_insert_with(|| serde_json::json!({}));
+            view["rotation"] = rotation;
+            let camera = object
+                .entry("camera")
+                .or_insert_with(|| serde_json::json!({}));
+            camera["azimuth"] = serde_json::json!(found.azimuth);
+            camera["elevation"] = serde_json::json!(found.elevation);
+            let text = serde_json::to_string_pretty(&json)? + "\n";
+            match out {
+                Some(out) => {
+                    halo4d::internals::write_atomic(&out, text.as_bytes())
+                        .map_err(|e| format!("{}: cannot write the scene: {e}", out.display()))?;
+                    println!("{}", out.display());
+                }
+                None => print!("{text}"),
+            }
+            Ok(ExitCode::SUCCESS)
         }
         Command::Render {
             scene,

@@ -29,6 +29,10 @@ pub struct CurveVisibility {
     pub curves_visible_px: f64,
     /// `curves_visible_px / curves_projected_px`; 0 without curves.
     pub visible_curve_share: f64,
+    /// The visible length with each piece weighted also by the sine of the angle between
+    /// the two sheets there (1 where they cross at right angles, 0 where they touch): how
+    /// much of the picture's crossings read as crossings.
+    pub transversal_visible_px: f64,
 }
 
 /// The camera of a picture in the coordinates of the projected scene (the `.ply` files'
@@ -109,22 +113,27 @@ impl Scene<'_> {
     /// How much of the curves the picture through `cam` shows.
     pub(super) fn curve_visibility(&self, cam: &Camera) -> CurveVisibility {
         let (w, h) = (self.settings.width, self.settings.height);
-        let mut segments: Vec<[(DVec3, DVec3); 2]> = Vec::new();
+        // Each segment with the sine of the sheets' angle at its first point.
+        let mut segments: Vec<([(DVec3, DVec3); 2], f64)> = Vec::new();
         for c in &self.input.curves.curves {
-            let points: Vec<(DVec3, DVec3)> =
-                c.points.iter().map(|p| (p.position, p.on_mesh)).collect();
-            segments.extend(points.windows(2).map(|s| [s[0], s[1]]));
+            let points: Vec<((DVec3, DVec3), f64)> = c
+                .points
+                .iter()
+                .map(|p| ((p.position, p.on_mesh), self.crossing_sine(p.faces)))
+                .collect();
+            segments.extend(points.windows(2).map(|s| ([s[0].0, s[1].0], s[0].1)));
             if c.closed && points.len() > 2 {
-                segments.push([points[points.len() - 1], points[0]]);
+                let last = points[points.len() - 1];
+                segments.push(([last.0, points[0].0], last.1));
             }
         }
         // Per segment on the cores, summed in order: the same total on any number of threads.
-        let pieces: Vec<(f64, f64)> = segments
+        let pieces: Vec<(f64, f64, f64)> = segments
             .par_iter()
-            .map_init(Vec::new, |hits, &[(a, sa), (b, sb)]| {
+            .map_init(Vec::new, |hits, &([(a, sa), (b, sb)], sine)| {
                 let (Some((pa, _)), Some((pb, _))) = (cam.project(a, w, h), cam.project(b, w, h))
                 else {
-                    return (0.0, 0.0);
+                    return (0.0, 0.0, 0.0);
                 };
                 let length = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
                 let steps = (length.ceil() as usize).clamp(1, 4096);
@@ -144,12 +153,14 @@ impl Scene<'_> {
                         seen += piece * self.transmittance(cam, s, hits);
                     }
                 }
-                (length, seen)
+                (length, seen, seen * sine)
             })
             .collect();
-        let (projected, visible) = pieces
+        let (projected, visible, transversal) = pieces
             .iter()
-            .fold((0.0, 0.0), |(p, v), &(a, b)| (p + a, v + b));
+            .fold((0.0, 0.0, 0.0), |(p, v, t), &(a, b, c)| {
+                (p + a, v + b, t + c)
+            });
         CurveVisibility {
             curves_projected_px: projected,
             curves_visible_px: visible,
@@ -158,7 +169,19 @@ impl Scene<'_> {
             } else {
                 0.0
             },
+            transversal_visible_px: transversal,
         }
+    }
+
+    /// The sine of the angle between the planes of the two triangles `faces` (0 where one
+    /// is degenerate).
+    fn crossing_sine(&self, faces: [crate::intersect::Face; 2]) -> f64 {
+        let normal = |f: crate::intersect::Face| {
+            let surf = &self.input.surfaces[f.surface as usize];
+            let p = surf.triangles[f.triangle as usize].map(|v| surf.positions[v as usize]);
+            (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero()
+        };
+        normal(faces[0]).cross(normal(faces[1])).length().min(1.0)
     }
 
     /// The share of light from `p` that reaches the eye through the surfaces in front of it
