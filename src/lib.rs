@@ -104,6 +104,7 @@ pub mod internals {
     pub use crate::render::compare::verdict_differs;
     pub use crate::render::overlay::{INK, OVER_INKS};
     pub use crate::render::stipple::{Drawn, density, luminance, tone};
+    pub use crate::render::visible::{CurveVisibility, PictureCamera, curve_visibility};
     pub use crate::render::{Prober, Seen, line_coverage, render_with_depth, stipples_drawn};
     pub use crate::sample::{bounding_diagonal, uniform_error};
 

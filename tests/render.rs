@@ -1053,3 +1053,101 @@ fn pictures_of_non_orientable_surfaces_have_no_shading_seam() {
         );
     }
 }
+
+/// The distance along the ray (`o`, unit `d`) to the triangle `p`, when it crosses it
+/// (Möller and Trumbore).
+fn ray_triangle(o: DVec3, d: DVec3, p: [DVec3; 3]) -> Option<f64> {
+    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+    let h = d.cross(e2);
+    let det = e1.dot(h);
+    if det.abs() < 1e-300 {
+        return None;
+    }
+    let s = o - p[0];
+    let u = s.dot(h) / det;
+    let q = s.cross(e1);
+    let v = d.dot(q) / det;
+    (u >= 0.0 && v >= 0.0 && u + v <= 1.0).then(|| e2.dot(q) / det)
+}
+
+#[test]
+fn the_visible_share_of_the_curves_is_that_of_a_brute_force_ray_cast() {
+    // The flat torus turned in yw on a coarse grid, seen from where a sheet hides part of
+    // each arc: every piece of curve cast against every triangle.
+    let mut scene = Scene::load(&fixture("scenes/flat-torus.json")).unwrap();
+    scene.sampling = halo4d::Sampling::Uniform { u: 24, v: 24 };
+    (scene.render.width, scene.render.height) = (160, 120);
+    (scene.camera.azimuth, scene.camera.elevation) = (20.0, 10.0);
+    let built = halo4d::run(&scene, true).unwrap();
+    let parts = built.parts(&scene.halo);
+    let (camera, seen) =
+        halo4d::internals::curve_visibility(&parts, &scene.render, &scene.camera).unwrap();
+    let prober = Prober::new(&parts, &scene.render, &scene.camera).unwrap();
+    let cam = prober.camera();
+    let index = halo4d::HaloIndex::new(&parts.halos);
+    let (w, h) = (scene.render.width, scene.render.height);
+    let (mut projected, mut visible) = (0.0, 0.0);
+    for c in &parts.curves.curves {
+        let mut points: Vec<_> = c.points.iter().map(|p| (p.position, p.on_mesh)).collect();
+        if c.closed {
+            points.push(points[0]);
+        }
+        for pair in points.windows(2) {
+            let [(a, sa), (b, sb)] = [pair[0], pair[1]];
+            let (pa, _) = cam.project(a, w, h).unwrap();
+            let (pb, _) = cam.project(b, w, h).unwrap();
+            let length = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
+            let steps = length.ceil().max(1.0) as usize;
+            projected += length;
+            for k in 0..steps {
+                let f = (k as f64 + 0.5) / steps as f64;
+                let (x, target) = (a + (b - a) * f, sa + (sb - sa) * f);
+                let (xy, _) = cam.project(x, w, h).unwrap();
+                if !(xy[0] >= 0.0 && xy[1] >= 0.0 && xy[0] < f64::from(w) && xy[1] < f64::from(h)) {
+                    continue;
+                }
+                let (o, d) = cam.ray_to(target);
+                let t_p = cam.ray_distance(target);
+                let blocked = parts.surfaces.iter().enumerate().any(|(si, s)| {
+                    s.triangles.iter().any(|&tri| {
+                        let p = tri.map(|v| s.positions[v as usize]);
+                        ray_triangle(o, d, p).is_some_and(|t| {
+                            if !(t > 0.0 && t < t_p * (1.0 - 1e-7)) {
+                                return false;
+                            }
+                            let hit = o + d * t;
+                            // The hit's w from its barycentric weights.
+                            let area = |q: [DVec3; 3]| (q[1] - q[0]).cross(q[2] - q[0]).length();
+                            let total = area(p);
+                            let l = [
+                                area([hit, p[1], p[2]]) / total,
+                                area([p[0], hit, p[2]]) / total,
+                                area([p[0], p[1], hit]) / total,
+                            ];
+                            let wd: f64 = (0..3).map(|i| l[i] * s.w[tri[i] as usize]).sum();
+                            !index.hidden(hit, wd, si as u32, tri)
+                        })
+                    })
+                });
+                if !blocked {
+                    visible += length / steps as f64;
+                }
+            }
+        }
+    }
+    assert!((seen.curves_projected_px - projected).abs() <= 1e-9 * projected);
+    assert!(
+        seen.visible_curve_share > 0.2 && seen.visible_curve_share < 0.9,
+        "a view that hides part of the curves: {seen:?}"
+    );
+    assert!(
+        (seen.curves_visible_px - visible).abs() <= 0.01 * projected,
+        "BVH {} px, brute force {visible} px of {projected}",
+        seen.curves_visible_px
+    );
+    // The camera reproduces the picture: the target projects to the picture's centre.
+    let target = DVec3::from(camera.target);
+    let (centre, _) = cam.project(target, w, h).unwrap();
+    assert!((centre[0] - 80.0).abs() < 1e-6 && (centre[1] - 60.0).abs() < 1e-6);
+    assert_eq!((camera.width, camera.height), (w, h));
+}

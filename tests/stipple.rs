@@ -200,7 +200,7 @@ fn the_far_sheet_has_no_stipples_in_the_gap_and_has_them_beyond() {
     let mut scene = Scene::load(&fixture("scenes/flat-torus.json")).unwrap();
     scene.render.style = Style::Stipple;
     (scene.render.width, scene.render.height) = (800, 800);
-    scene.halo.rho = 0.03;
+    scene.halo.rho = Some(0.03);
     let built = halo4d::run(&scene, true).unwrap();
     let parts = built.parts(&scene.halo);
     let without = RenderSettings {

@@ -29,7 +29,6 @@
 use super::{HaloVertex, SurfaceVertex, ViewerError};
 use crate::intersect::{Curves, Sheet};
 use crate::limits::{MAX_COORDINATE, MIN_EXTENT};
-use crate::render::camera::FIT_MARGIN;
 use crate::sample::Mesh4;
 use crate::scene::Scene;
 use crate::tets::{self, Corners, Split};
@@ -221,6 +220,24 @@ impl Model {
                 "the projected surfaces are {diagonal:.3e} across in this view, less than {MIN_EXTENT:e}"
             )));
         }
+        // The gap in pixels is that of the scene's own picture in this view, as a build
+        // of the scene makes it: one rho for both.
+        let mut start = 0;
+        let sheets: Vec<(&[DVec3], &[[u32; 3]])> = self
+            .surfaces
+            .iter()
+            .map(|(_, mesh)| {
+                let n = mesh.positions.len();
+                start += n;
+                (&points[start - n..start], mesh.triangles.as_slice())
+            })
+            .collect();
+        let pixel = crate::render::picture_pixel_size(
+            sheets.iter().copied(),
+            &self.scene.render,
+            &self.scene.camera,
+        )
+        .map_err(|e| ViewerError::View(e.to_string()))?;
         let halo = &self.scene.halo;
         Ok(Framing {
             bounds: (lo, hi),
@@ -230,12 +247,7 @@ impl Model {
                 w_range.0,
                 w_range.1 + (1.0 - halo.delta_t).max(0.0) * halo.delta_d.max(0.0),
             ),
-            // The explorer's window changes size: the gap is that of the scene's own
-            // picture, whose fitted camera spans about the bounding sphere.
-            rho: halo.half_width(
-                diagonal,
-                diagonal / (f64::from(self.scene.render.height) * (1.0 - 2.0 * FIT_MARGIN)),
-            ),
+            rho: halo.half_width(diagonal, pixel),
         })
     }
 
