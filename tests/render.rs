@@ -84,6 +84,9 @@ impl Torus {
     fn new() -> Torus {
         let mut scene = Scene::load(&fixture("scenes/flat-torus.json")).unwrap();
         small(&mut scene);
+        // A halo a hundredth of the diagonal wide: 8 px of this small picture would be
+        // a fifth of the torus's tube, within which other sheets pass.
+        scene.halo.rho = Some(0.01);
         let built = halo4d::run(&scene, true).unwrap();
         Torus { scene, built }
     }
