@@ -118,7 +118,7 @@ impl HaloParams {
             ));
         }
         if let Some(rho) = self.rho
-            && !(rho.is_finite() && rho >= MIN_RHO && rho <= MAX_RHO)
+            && !(rho.is_finite() && (MIN_RHO..=MAX_RHO).contains(&rho))
         {
             return Err(FieldError::new(
                 "rho",
