@@ -67,6 +67,7 @@ pub use intersect::{
     TriplePoint, curves, refine,
 };
 pub use parts::{HaloIndex, HaloPart, Parts, SurfacePart};
+pub use render::clip::{Clip, ClipPlane};
 pub use render::compare::Comparison;
 pub use render::{
     CameraProjection, CameraSettings, Colormap, Picture, RenderError, RenderMode, RenderSettings,
@@ -102,7 +103,7 @@ pub mod internals {
     pub use crate::intersect::{BroadPhase, Node, curves_with};
     pub use crate::render::camera::{Camera, Placement};
     pub use crate::render::compare::verdict_differs;
-    pub use crate::render::overlay::{INK, OVER_INKS};
+    pub use crate::render::overlay::{INK, OVER_BANDS, OVER_SHADE, curve_ink};
     pub use crate::render::stipple::{Drawn, density, luminance, tone};
     pub use crate::render::visible::{CurveVisibility, PictureCamera, curve_visibility};
     pub use crate::render::{Prober, Seen, line_coverage, render_with_depth, stipples_drawn};

@@ -94,7 +94,7 @@ pub struct Stages {
 impl Stages {
     /// The stages `scene`'s outputs need.
     pub fn of(scene: &Scene) -> Stages {
-        Stages::with_picture(scene, scene.outputs.png)
+        Stages::with_picture(scene, scene.outputs.png || scene.outputs.svg)
     }
 
     /// The stages `scene`'s outputs need, with a picture's when `picture` whatever the scene
@@ -403,6 +403,10 @@ pub struct PictureReport {
     /// The camera, in the projected scene's coordinates.
     #[serde(flatten)]
     pub camera: render::visible::PictureCamera,
+    /// The cutaway (`render.clip`), when set: the points where `normal · p > offset` holds
+    /// for every plane are removed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub clip: Option<render::clip::Clip>,
     /// The halos' half-width asked for, in scene units.
     pub rho: f64,
     /// The same in pixels at the depth the camera looks at.
@@ -935,27 +939,35 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     let mut files: Vec<String> = written?.into_iter().flatten().collect();
     timings.export = ms(export_start);
     let mut picture_report = None;
-    if scene.outputs.png {
+    if scene.outputs.png || scene.outputs.svg {
         let start = Instant::now();
-        let picture = built
-            .render(&scene.halo, &scene.render, &scene.camera)
-            .map_err(|source| Error::Render {
-                scene: scene.name.clone(),
-                source,
-            })?;
-        timings.render = ms(start);
-        files.push(write(format!("{name}.png"), &picture.png())?);
-        let (camera, curves) = render::visible::curve_visibility(
-            &built.parts(&scene.halo),
-            &scene.render,
-            &scene.camera,
-        )
-        .map_err(|source| Error::Render {
+        let render_error = |source| Error::Render {
             scene: scene.name.clone(),
             source,
-        })?;
+        };
+        let parts = built.parts(&scene.halo);
+        let (picture, svg) = if scene.outputs.svg {
+            let (picture, svg) = render::render_with_svg(&parts, &scene.render, &scene.camera)
+                .map_err(render_error)?;
+            (picture, Some(svg))
+        } else {
+            let picture =
+                render::render(&parts, &scene.render, &scene.camera).map_err(render_error)?;
+            (picture, None)
+        };
+        timings.render = ms(start);
+        if scene.outputs.png {
+            files.push(write(format!("{name}.png"), &picture.png())?);
+        }
+        if let Some(svg) = svg {
+            files.push(write(format!("{name}.svg"), svg.as_bytes())?);
+        }
+        let (camera, curves) =
+            render::visible::curve_visibility(&parts, &scene.render, &scene.camera)
+                .map_err(render_error)?;
         picture_report = Some(PictureReport {
             camera,
+            clip: scene.render.clip,
             rho: built.rho,
             gap_px: built.rho / built.pixel_size,
             curves,

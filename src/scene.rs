@@ -90,6 +90,10 @@ pub struct Outputs {
     pub report: bool,
     /// `<name>.png`: the picture of the `render` settings through the `camera`.
     pub png: bool,
+    /// `<name>.svg`: the picture's lines as line art (silhouettes, cut edges, double curves
+    /// in their inks, broken edges of the sheets passing under), the same lines the PNG
+    /// draws, scalable for papers and slides.
+    pub svg: bool,
     /// Whether the halos are checked against the intersection curves. Always when a halo
     /// file is written (`glb`, `vtk`; the default then), and on request without one (the
     /// verdict in `report.json` and the exit status).
@@ -146,6 +150,7 @@ impl Default for Outputs {
             vtk: true,
             report: true,
             png: true,
+            svg: false,
             curve_radius: CURVE_RADIUS,
             verify: None,
             stipples: false,

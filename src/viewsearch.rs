@@ -6,7 +6,9 @@
 //! weighted by the sine of the angle at which its two sheets cross (a tangential contact
 //! makes long curves that read as nothing), times the share of their length that is
 //! visible ([`crate::render::visible`]: eye rays to the curves
-//! against the surfaces as drawn), everything else of the scene kept. The surfaces are
+//! against the surfaces as drawn), plus a tenth of the picture's side for every branch point
+//! and triple point in view, scaled down in proportion where less than half of the curves'
+//! length is visible; everything else of the scene kept. The surfaces are
 //! sampled once on a coarse uniform grid ([`SEARCH_TRIANGLES`] triangles in all; a mesh file
 //! as it is); each 4D view projects it and finds its exact curves ([`crate::intersect`]),
 //! then tries several camera orbits on them, which cost only the rays.
@@ -35,6 +37,14 @@ const SEARCH_SIDE: u32 = 256;
 const AZIMUTHS: [f64; 8] = [0.0, 45.0, 90.0, 135.0, 180.0, 225.0, 270.0, 315.0];
 /// ... and elevations.
 const ELEVATIONS: [f64; 3] = [-30.0, 15.0, 50.0];
+
+/// What a branch point or a triple point in view adds to the objective, as a share of the
+/// picture's side in pixels: they are where the structure of a double curve shows.
+const MARK_SHARE: f64 = 0.1;
+
+/// The visible share of the curves below which a view's objective is scaled down in
+/// proportion: a picture should show at least half of its curves.
+const SHARE_WANTED: f64 = 0.5;
 
 /// 4D views drawn from the Halton sequence before the pattern search.
 const GLOBAL_VIEWS: usize = 96;
@@ -310,7 +320,10 @@ fn evaluate_view(
                 ..scene.camera
             };
             let (_, seen) = render::visible::curve_visibility(&parts, settings, &camera).ok()?;
-            let score = seen.transversal_visible_px * seen.visible_curve_share;
+            let marks = seen.branch_points_visible + seen.triple_points_visible;
+            let score = (seen.transversal_visible_px * seen.visible_curve_share
+                + MARK_SHARE * f64::from(SEARCH_SIDE) * marks as f64)
+                * (seen.visible_curve_share / SHARE_WANTED).min(1.0);
             Some((
                 Candidate {
                     angles,

@@ -328,11 +328,11 @@ fn a_killed_build_leaves_the_previous_build_and_its_lock_is_taken_over() {
     assert!(out.status.success());
     let o = dir.path().join("o");
     let before = folder(&o);
-    // The same scene with another rho: every file would differ. Killed as soon as it takes
+    // The same scene with another halo width: every file would differ. Killed as soon as it takes
     // the folder's lock, i.e. while it writes its files (the picture alone takes a second).
     let mut other: serde_json::Value =
         serde_json::from_slice(&std::fs::read(fixture("scenes/default.json")).unwrap()).unwrap();
-    other["halo"]["rho"] = 0.012.into();
+    other["halo"]["gap_px"] = 10.into();
     std::fs::write(
         dir.path().join("other.json"),
         serde_json::to_vec(&other).unwrap(),

@@ -175,11 +175,13 @@ fn every_fixture_builds_and_reads_back() {
             json["surfaces"][0]["triangles"],
             products[0].mesh.triangles.len()
         );
-        // .glb, .ply, -curves.ply, .obj, .png, report.json, a .vtk per halo and
-        // -stipples.ply where the scene asks.
+        // .glb, .ply, -curves.ply, .obj, .png, report.json, a .vtk per halo, and
+        // -stipples.ply and .svg where the scene asks.
         assert_eq!(
             report.files.len(),
-            6 + products.len() + usize::from(scene.outputs.stipples)
+            6 + products.len()
+                + usize::from(scene.outputs.stipples)
+                + usize::from(scene.outputs.svg)
         );
         assert!(
             !text.contains("NaN") && !text.contains("null,"),
@@ -282,6 +284,21 @@ fn assert_only_finite_numbers(path: &std::path::Path) {
                     finite(x.parse().unwrap(), line);
                 }
             }
+        }
+        "svg" => {
+            // Every number of the line art finite (the paths' points and widths).
+            let text = String::from_utf8(bytes).unwrap();
+            assert!(
+                text.contains("<svg") && text.trim_end().ends_with("</svg>"),
+                "{what}"
+            );
+            let numbers = text
+                .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+                .filter_map(|t| t.parse::<f64>().ok());
+            for x in numbers {
+                finite(x, "a path");
+            }
+            assert!(!text.contains("NaN") && !text.contains("inf"), "{what}");
         }
         "png" | "mtl" => {}
         other => panic!("{what}: a file of unknown kind {other:?}"),

@@ -428,7 +428,15 @@ fn the_stipples_files_hold_the_pictures_stipples() {
 
 #[test]
 fn coloured_stipples_take_the_w_colours() {
-    let (mut scene, built) = default_scene();
+    // The spun trefoil turned so that both ends of the w scale face the camera.
+    let mut scene = Scene::default_scene();
+    scene.view.rotation = halo4d::Rotation4::default();
+    *scene.view.rotation.angle_mut("xw").unwrap() = 20.0;
+    *scene.view.rotation.angle_mut("yw").unwrap() = 35.0;
+    scene.camera = halo4d::CameraSettings::default();
+    (scene.render.width, scene.render.height) = (400, 400);
+    scene.render.style = Style::Stipple;
+    let built = halo4d::run(&scene, true).unwrap();
     scene.render.stipple.colour = true;
     (scene.render.curves, scene.render.silhouettes) = (false, false);
     let picture = built

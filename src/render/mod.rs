@@ -12,12 +12,15 @@
 //! width broadened through the FFT (paper 002, [`lines`]). Renders are deterministic.
 
 pub mod camera;
+pub mod clip;
 pub mod compare;
+mod contour;
 pub mod lines;
 pub(crate) mod overlay;
 pub mod shade;
 pub mod slices;
 pub mod stipple;
+mod svg;
 pub(crate) mod text;
 pub mod trace;
 pub mod visible;
@@ -199,15 +202,23 @@ pub struct RenderSettings {
     /// Ribbons.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ribbons: Option<Ribbons>,
+    /// A cutaway: one plane `{"normal": [x, y, z], "offset": d}` or a list of two (a
+    /// wedge), removing the points of the projected scene where `normal · p > d` holds for
+    /// every plane ([`clip`]); the cut edges are drawn as lines.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub clip: Option<clip::Clip>,
     /// Draw the self-intersection curves.
     pub curves: bool,
-    /// Draw each piece of a curve in the ink of the sheet that passes over it (nearer in
-    /// w): dark red (sRGB 170, 20, 28) where the curve's sheet 0 does, dark blue (sRGB 25,
-    /// 61, 170) where its sheet 1 does, the sheets labelled as in [`crate::CurvePoint`];
-    /// `false` draws the curves in the silhouettes' near-black ink.
+    /// Draw each piece of a curve in a dark shade of the colour of the sheet that passes
+    /// over it (nearer in w; [`overlay::curve_ink`]), so that the reader sees which sheet
+    /// is over and which is broken; `false` draws the curves in the silhouettes'
+    /// near-black ink.
     pub curve_colours: bool,
     /// Draw silhouettes (where the eye ray lies in the tangent plane).
     pub silhouettes: bool,
+    /// Draw the broken edges of the sheets passing under: the outline, in the picture, of
+    /// where a halo hides the first surface (the gaps' edges), thinner than the curves.
+    pub broken_edges: bool,
     /// Line width in pixels.
     pub line_width: f64,
     /// Line width at the far side of the scene, for lines that thin with distance; the
@@ -240,9 +251,11 @@ impl Default for RenderSettings {
             legend: false,
             hither: None,
             ribbons: None,
+            clip: None,
             curves: true,
             curve_colours: true,
             silhouettes: true,
+            broken_edges: true,
             line_width: 2.5,
             line_width_far: None,
             stereo: false,
@@ -346,6 +359,9 @@ impl RenderSettings {
                     format!("must be in (0, 1), got {}", r.gap),
                 ));
             }
+        }
+        if let Some(c) = &self.clip {
+            c.check().map_err(|e| e.within("clip"))?;
         }
         let side = self.width.min(self.height);
         let max_width = (f64::from(side) / 4.0).max(0.5);
@@ -501,6 +517,9 @@ impl Picture {
 struct View {
     rgb: Vec<DVec3>,
     front: Vec<f64>,
+    /// Per pixel, whether a halo hides the first surface along its centre ray (empty where
+    /// not known): its outline is the broken edges of the sheets passing under.
+    gap: Vec<bool>,
 }
 
 /// Renders a picture.
@@ -509,7 +528,7 @@ pub fn render(
     settings: &RenderSettings,
     camera: &CameraSettings,
 ) -> Result<Picture, RenderError> {
-    Ok(render_eyes(input, settings, camera, false)?.0)
+    Ok(render_eyes(input, settings, camera, false, false)?.0)
 }
 
 /// [`render`], and per pixel of the first eye the ray distance of the first surface the
@@ -520,20 +539,37 @@ pub fn render_with_depth(
     settings: &RenderSettings,
     camera: &CameraSettings,
 ) -> Result<(Picture, Vec<f64>), RenderError> {
-    render_eyes(input, settings, camera, true)
+    let (picture, depth, _) = render_eyes(input, settings, camera, true, false)?;
+    Ok((picture, depth))
 }
 
-/// The picture, and the first eye's distances when `depth` asks for them (the stipple style
-/// traces them apart; empty otherwise).
+/// [`render`], and the first eye's lines as an SVG document: the same runs the picture's
+/// lines are drawn from ([`svg`]).
+pub fn render_with_svg(
+    input: &Parts,
+    settings: &RenderSettings,
+    camera: &CameraSettings,
+) -> Result<(Picture, String), RenderError> {
+    let (picture, _, svg) = render_eyes(input, settings, camera, false, true)?;
+    Ok((
+        picture,
+        svg.ok_or_else(|| RenderError::Internal("the first eye made no line art".into()))?,
+    ))
+}
+
+/// The picture, the first eye's distances when `depth_wanted` asks for them (the stipple
+/// style traces them apart; empty otherwise), and its line art when `svg_wanted` does.
 fn render_eyes(
     input: &Parts,
     settings: &RenderSettings,
     camera: &CameraSettings,
     depth_wanted: bool,
-) -> Result<(Picture, Vec<f64>), RenderError> {
+    svg_wanted: bool,
+) -> Result<(Picture, Vec<f64>, Option<String>), RenderError> {
     let (placement, scene) = prepare(input, settings, camera)?;
     let eyes = eyes(settings);
     let mut depth = Vec::new();
+    let mut svg = None;
     let (w, h) = (settings.width, settings.height);
     scene.check_memory(&Camera::new(camera, &placement, w, h, eyes[0])?, eyes.len())?;
     let mut rgb = vec![0u8; 3 * (w as usize * eyes.len()) * h as usize];
@@ -546,10 +582,14 @@ fn render_eyes(
         if e == 0 && depth_wanted {
             depth.clone_from(&view.front);
         }
-        for lines in scene.lines(&cam)? {
+        let runs = scene.runs(&cam, &view.gap)?;
+        for lines in scene.rasterize(&runs)? {
             for (c, &k) in view.rgb.iter_mut().zip(lines.coverage.values()) {
                 *c = c.lerp(lines.ink, f64::from(k));
             }
+        }
+        if e == 0 && svg_wanted {
+            svg = Some(svg::document(w, h, scene.background, &runs));
         }
         if settings.legend {
             legend(
@@ -576,6 +616,7 @@ fn render_eyes(
             rgb,
         },
         depth,
+        svg,
     ))
 }
 
@@ -614,7 +655,7 @@ pub fn line_coverage(
         settings.height,
         first_eye(settings),
     )?;
-    let mut inks = scene.lines(&cam)?.into_iter();
+    let mut inks = scene.lines(&cam, &[])?.into_iter();
     let Some(first) = inks.next() else {
         return Ok(vec![
             0.0;
@@ -991,12 +1032,19 @@ impl<'a> Scene<'a> {
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
         let mut rgb = vec![DVec3::ZERO; w * h];
         let mut front = vec![f64::INFINITY; w * h];
+        let mut gap = vec![false; w * h];
         // Row by row on the cores, each thread with its own hit buffer.
         rgb.par_chunks_mut(w)
             .zip(front.par_chunks_mut(w))
+            .zip(gap.par_chunks_mut(w))
             .enumerate()
-            .for_each_init(Vec::new, |hits, (y, (rgb, front))| {
-                for (x, (c, f)) in rgb.iter_mut().zip(front.iter_mut()).enumerate() {
+            .for_each_init(Vec::new, |hits, (y, ((rgb, front), gap))| {
+                for (x, ((c, f), g)) in rgb
+                    .iter_mut()
+                    .zip(front.iter_mut())
+                    .zip(gap.iter_mut())
+                    .enumerate()
+                {
                     let pixel = y * w + x;
                     let mut sum = DVec3::ZERO;
                     let mut count = 0;
@@ -1006,7 +1054,7 @@ impl<'a> Scene<'a> {
                         self.trace(origin, dir, hits);
                         let base = numbered;
                         numbered += hits.len();
-                        let (colour, first) =
+                        let (colour, first, first_hidden) =
                             self.shade(cam, origin, dir, hits, |k, hit, x, wd| {
                                 hidden(pixel, base + k, hit, x, wd)
                             });
@@ -1014,12 +1062,13 @@ impl<'a> Scene<'a> {
                         count += 1;
                         if centre {
                             *f = first;
+                            *g = first_hidden;
                         }
                     }
                     *c = sum / count as f64;
                 }
             });
-        View { rgb, front }
+        View { rgb, front, gap }
     }
 
     /// Every hit of a ray that is not clipped away (hither, ribbons), in order.
@@ -1027,6 +1076,9 @@ impl<'a> Scene<'a> {
         let s = self.settings;
         let t_min = s.hither.map_or(0.0, |h| h * self.radius);
         self.tracer.hits(origin, dir, t_min, hits);
+        if let Some(c) = &s.clip {
+            hits.retain(|hit| !c.removes(origin + dir * hit.t));
+        }
         if let Some(r) = s.ribbons {
             let k = match r.along {
                 RibbonAxis::U => 0,
@@ -1100,7 +1152,8 @@ impl<'a> Scene<'a> {
     }
 
     /// Composites the hits of one ray front to back, leaving out those `hidden(k, hit, x,
-    /// w)` says the halos hide: the colour, and the distance of the first visible hit.
+    /// w)` says the halos hide: the colour, the distance of the first visible hit, and
+    /// whether the first hit is hidden.
     fn shade(
         &self,
         cam: &Camera,
@@ -1108,13 +1161,14 @@ impl<'a> Scene<'a> {
         dir: DVec3,
         hits: &[Hit],
         hidden: impl Fn(usize, &Hit, DVec3, f64) -> bool,
-    ) -> (DVec3, f64) {
+    ) -> (DVec3, f64, bool) {
         let s = self.settings;
         let (w0, w1) = self.w_range;
         let span = if w1 > w0 { w1 - w0 } else { 1.0 };
         let mut colour = DVec3::ZERO;
         let mut alpha = 0.0;
         let mut first = f64::INFINITY;
+        let mut first_hidden = false;
         for (k, hit) in hits.iter().enumerate() {
             let surf = &self.input.surfaces[hit.surface as usize];
             let tri = surf.triangles[hit.triangle as usize];
@@ -1125,6 +1179,7 @@ impl<'a> Scene<'a> {
             let x = origin + dir * hit.t;
             let w = mix(&|v| surf.w[v]);
             if hidden(k, hit, x, w) {
+                first_hidden |= k == 0;
                 continue;
             }
             if first.is_infinite() {
@@ -1148,6 +1203,10 @@ impl<'a> Scene<'a> {
                 break;
             }
         }
-        (colour + self.background * (1.0 - alpha), first)
+        (
+            colour + self.background * (1.0 - alpha),
+            first,
+            first_hidden,
+        )
     }
 }

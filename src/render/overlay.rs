@@ -1,10 +1,11 @@
-//! The lines over a picture: the self-intersection curves and the silhouettes, drawn one
-//! pixel wide where they are visible and broadened to an exact width ([`super::lines`]).
+//! The lines over a picture: the self-intersection curves, the silhouettes and the edges a
+//! cutaway cuts ([`super::clip`]), drawn one pixel wide where they are visible and
+//! broadened to an exact width ([`super::lines`]).
 //!
-//! The curves are drawn in the ink of the sheet that passes over ([`OVER_INKS`]), each ink
-//! in a mask of its own broadened on its own, so that every line keeps its width; the inks
-//! are laid over the picture in a fixed order (silhouettes, then sheet 0 over, then sheet 1
-//! over).
+//! The curves are drawn in a dark shade of the colour of the sheet that passes over them
+//! ([`curve_ink`]: the w scale in [`OVER_BANDS`] bands), each band's ink in a mask of its own
+//! broadened on its own, so that every line keeps its width; the inks are laid over the
+//! picture in a fixed order (silhouettes and cut edges, then the bands from near to far).
 
 use super::camera::Camera;
 use super::lines::{Broadener, Coverage, Mask};
@@ -17,14 +18,32 @@ use glam::{DVec2, DVec3};
 /// RGB).
 pub const INK: DVec3 = DVec3::splat(0.02);
 
-/// The colours of the curves (linear RGB) where their sheet 0 passes over (is nearer in
-/// w), a dark red (sRGB 170, 20, 28), and where their sheet 1 does, a dark blue (sRGB 25,
-/// 61, 170): the sheets as the intersection stage labels them, consistently along each
-/// curve.
-pub const OVER_INKS: [DVec3; 2] = [
-    DVec3::new(0.402, 0.007, 0.0116),
-    DVec3::new(0.0097, 0.0467, 0.402),
-];
+/// The w scale is cut into this many bands for the curves' inks ([`curve_ink`]).
+pub const OVER_BANDS: usize = 12;
+
+/// How dark a curve is drawn against the colour of the sheet passing over it: the factor
+/// on that colour (linear RGB).
+pub const OVER_SHADE: f64 = 0.35;
+
+/// The band of the w scale `(w0, w1)` (the picture's colour scale) that `w` falls in.
+fn band((w0, w1): (f64, f64), w: f64) -> usize {
+    let span = if w1 > w0 { w1 - w0 } else { 1.0 };
+    let s = ((w - w0) / span).clamp(0.0, 1.0);
+    ((s * OVER_BANDS as f64) as usize).min(OVER_BANDS - 1)
+}
+
+/// The ink of a curve where the sheet passing over it (the one nearer in w) has depth `w`:
+/// the colour `map` gives the middle of that w's band of the scale `w_range`, darkened by
+/// [`OVER_SHADE`]. So a curve is drawn in a dark shade of the colour of the sheet that
+/// passes over it, which the reader sees beside it, and the sheet broken at it (its halo's
+/// gap) is the other.
+pub fn curve_ink(map: super::Colormap, w_range: (f64, f64), w: f64) -> DVec3 {
+    band_ink(map, band(w_range, w))
+}
+
+fn band_ink(map: super::Colormap, band: usize) -> DVec3 {
+    super::shade::colormap(map, (band as f64 + 0.5) / OVER_BANDS as f64) * OVER_SHADE
+}
 
 /// The lines of one ink: its colour and how much of each pixel it covers.
 pub(super) struct Lines {
@@ -100,29 +119,111 @@ where
         .collect()
 }
 
-/// Where a polyline is drawn: the silhouettes' and single ink's mask (0), or that of the
-/// curves over which sheet 0 (1) or sheet 1 (2) passes over.
-type InkClass = usize;
+/// Where a polyline is drawn: the silhouettes', cut edges' and single ink's mask (0), the
+/// broken edges' ([`BROKEN`]), or that of the curves whose sheet over lies in w band k - 2
+/// (k from 2 to [`OVER_BANDS`] + 1), laid over the picture in that order.
+pub(crate) type InkClass = usize;
+
+/// A visible stretch of a line in the picture: the mask it is drawn into, its ink, and its
+/// points in pixels (y down) with the line's width there.
+pub(crate) struct Run {
+    /// The mask ([`InkClass`]).
+    pub class: InkClass,
+    /// Linear RGB.
+    pub ink: DVec3,
+    /// Points in pixels, with the width at each.
+    pub points: Vec<(DVec2, f64)>,
+}
+
+/// The mask of the broken edges of the sheets passing under.
+const BROKEN: InkClass = 1;
+
+/// The mask of the curves whose sheet over lies in w band `band`.
+fn band_class(band: usize) -> InkClass {
+    2 + band
+}
+
+/// The width of the broken edges, as a share of the lines' width: thinner than the curves,
+/// which they meet.
+pub const BROKEN_WIDTH: f64 = 0.5;
 
 impl Scene<'_> {
     /// The scene's lines in the image of `cam`, one entry per ink that has any, in the
-    /// order they are laid over the picture.
-    pub(super) fn lines(&self, cam: &Camera) -> Result<Vec<Lines>, RenderError> {
+    /// order they are laid over the picture; `gap` marks the pixels whose first surface a
+    /// halo hides (empty where unknown), whose outline are the broken edges.
+    pub(super) fn lines(&self, cam: &Camera, gap: &[bool]) -> Result<Vec<Lines>, RenderError> {
+        self.rasterize(&self.runs(cam, gap)?)
+    }
+
+    /// The runs drawn one pixel wide into a mask per ink and broadened, one entry per ink
+    /// that has any, in the order they are laid over the picture.
+    pub(super) fn rasterize(&self, runs: &[Run]) -> Result<Vec<Lines>, RenderError> {
         let s = self.settings;
-        if !s.curves && !s.silhouettes {
-            return Ok(Vec::new());
+        let (w, h) = (s.width as usize, s.height as usize);
+        let mut masks: Vec<Option<(DVec3, Mask)>> =
+            (0..band_class(OVER_BANDS)).map(|_| None).collect();
+        for run in runs {
+            let (_, mask) = match &mut masks[run.class] {
+                Some(entry) => entry,
+                empty => empty.insert((run.ink, Mask::new(w, h).map_err(line_error)?)),
+            };
+            mask.draw_polyline(&run.points).map_err(line_error)?;
         }
+        let mut broadener = Broadener::new();
+        let mut out = Vec::new();
+        for (class, entry) in masks.into_iter().enumerate() {
+            let Some((ink, mask)) = entry.filter(|(_, m)| !m.is_empty()) else {
+                continue;
+            };
+            let coverage = match (s.line_width_far, class) {
+                (_, BROKEN) => broadener.broaden(&mask, s.line_width * BROKEN_WIDTH),
+                (Some(_), _) => broadener.broaden_varying(&mask),
+                (None, _) => broadener.broaden(&mask, s.line_width),
+            }
+            .map_err(line_error)?;
+            out.push(Lines { ink, coverage });
+        }
+        Ok(out)
+    }
+
+    /// The visible runs of the scene's lines in the image of `cam`: the curves, silhouettes
+    /// and cut edges where a ray from the eye reaches them, and the outline of `gap`.
+    pub(super) fn runs(&self, cam: &Camera, gap: &[bool]) -> Result<Vec<Run>, RenderError> {
+        let s = self.settings;
         let (w, h) = (s.width, s.height);
+        let mut out = Vec::new();
+        if s.broken_edges && gap.len() == w as usize * h as usize {
+            let width = s.line_width * BROKEN_WIDTH;
+            for line in super::contour::outline(gap, w as usize, h as usize) {
+                out.push(Run {
+                    class: BROKEN,
+                    ink: INK,
+                    points: line.into_iter().map(|p| (p, width)).collect(),
+                });
+            }
+        }
         let mut polylines: Vec<(InkClass, Vec<LinePoint>)> = Vec::new();
         if s.curves {
             for c in &self.input.curves.curves {
-                polylines.extend(curve_polylines(c, s.curve_colours));
+                polylines.extend(curve_polylines(c, s.curve_colours, self.w_range));
             }
         }
         if s.silhouettes {
             polylines.extend(
                 self.silhouette_edges(cam)
                     .into_iter()
+                    .map(|[a, b]| (0, vec![LinePoint::plain(a), LinePoint::plain(b)])),
+            );
+        }
+        if let Some(clip) = &s.clip {
+            let mut cuts = Vec::new();
+            for surf in &self.input.surfaces {
+                for t in surf.triangles {
+                    clip.cut_edges(t.map(|v| surf.positions[v as usize]), &mut cuts);
+                }
+            }
+            polylines.extend(
+                cuts.into_iter()
                     .map(|[a, b]| (0, vec![LinePoint::plain(a), LinePoint::plain(b)])),
             );
         }
@@ -140,26 +241,28 @@ impl Scene<'_> {
         };
         let mut hits = Vec::new();
         let see_through = s.opacity < 1.0 || s.opacity_far.is_some_and(|o| o < 1.0);
-        let mut masks: [Option<Mask>; 3] = [None, None, None];
         for (class, line) in &polylines {
-            let mask = match &mut masks[*class] {
-                Some(mask) => mask,
-                empty => empty.insert(Mask::new(w as usize, h as usize).map_err(line_error)?),
+            let ink = match *class {
+                0 => INK,
+                k => band_ink(s.colormap, k - 2),
             };
             let mut run: Vec<(DVec2, f64)> = Vec::new();
-            let mut flush = |run: &mut Vec<(DVec2, f64)>| -> Result<(), RenderError> {
+            let mut flush = |run: &mut Vec<(DVec2, f64)>| {
                 if run.len() >= 2 {
-                    mask.draw_polyline(run).map_err(line_error)?;
+                    out.push(Run {
+                        class: *class,
+                        ink,
+                        points: std::mem::take(run),
+                    });
                 }
                 run.clear();
-                Ok(())
             };
             for pair in line.windows(2) {
                 let (a, b) = (pair[0], pair[1]);
                 let (Some((pa, _)), Some((pb, _))) =
                     (cam.project(a.at, w, h), cam.project(b.at, w, h))
                 else {
-                    flush(&mut run)?;
+                    flush(&mut run);
                     continue;
                 };
                 let steps = ((pb[0] - pa[0]).hypot(pb[1] - pa[1]).ceil() as usize).clamp(1, 4096);
@@ -170,39 +273,23 @@ impl Scene<'_> {
                     let f = k as f64 / steps as f64;
                     let (p, seen) = (a.at + (b.at - a.at) * f, a.seen + (b.seen - a.seen) * f);
                     let Some((xy, _)) = cam.project(p, w, h) else {
-                        flush(&mut run)?;
+                        flush(&mut run);
                         continue;
                     };
                     let inside = xy[0] >= 0.0
                         && xy[1] >= 0.0
                         && xy[0] < f64::from(w)
-                        && xy[1] < f64::from(h);
+                        && xy[1] < f64::from(h)
+                        && !s.clip.is_some_and(|c| c.removes(p));
                     let visible = inside && (see_through || !self.occluded(cam, seen, &mut hits));
                     if visible {
                         run.push((DVec2::new(xy[0], xy[1]), width_at(p)));
                     } else {
-                        flush(&mut run)?;
+                        flush(&mut run);
                     }
                 }
             }
-            flush(&mut run)?;
-        }
-        let mut broadener = Broadener::new();
-        let mut out = Vec::new();
-        for (class, mask) in masks.into_iter().enumerate() {
-            let Some(mask) = mask.filter(|m| !m.is_empty()) else {
-                continue;
-            };
-            let coverage = match s.line_width_far {
-                Some(_) => broadener.broaden_varying(&mask),
-                None => broadener.broaden(&mask, s.line_width),
-            }
-            .map_err(line_error)?;
-            let ink = match class {
-                0 => INK,
-                k => OVER_INKS[k - 1],
-            };
-            out.push(Lines { ink, coverage });
+            flush(&mut run);
         }
         Ok(out)
     }
@@ -303,9 +390,12 @@ impl std::ops::Mul<f64> for LinePoint {
 }
 
 /// A curve's polylines with the mask each is drawn into: the whole curve in the single ink,
-/// or its pieces in the ink of the sheet over them (a curve with no sheet over anywhere in
-/// the single ink).
-fn curve_polylines(c: &Curve, colours: bool) -> Vec<(InkClass, Vec<LinePoint>)> {
+/// or its pieces in the ink of the w band of the sheet over them (the scale `w_range`).
+fn curve_polylines(
+    c: &Curve,
+    colours: bool,
+    w_range: (f64, f64),
+) -> Vec<(InkClass, Vec<LinePoint>)> {
     let point = |p: &crate::intersect::CurvePoint| LinePoint {
         at: p.position,
         seen: p.on_mesh,
@@ -314,11 +404,11 @@ fn curve_polylines(c: &Curve, colours: bool) -> Vec<(InkClass, Vec<LinePoint>)> 
         let points: Vec<(LinePoint, Option<usize>)> = c
             .points
             .iter()
-            .map(|p| (point(p), (p.w[0] != p.w[1]).then(|| p.near())))
+            .map(|p| (point(p), Some(band(w_range, p.w[0].min(p.w[1])))))
             .collect();
         over_pieces(&points, c.closed)
             .into_iter()
-            .map(|(near, piece)| (near.map_or(0, |n| 1 + n), piece))
+            .map(|(band, piece)| (band.map_or(0, band_class), piece))
             .collect()
     } else {
         let mut p: Vec<LinePoint> = c.points.iter().map(point).collect();

@@ -127,7 +127,12 @@ impl Scene<'_> {
                         && pixel[1] > -margin
                         && pixel[0] < f64::from(w) + margin
                         && pixel[1] < f64::from(h) + margin;
-                    if !inside || cam.ray_distance(x) < t_min || self.in_ribbon_gap(surf, set, k) {
+                    let clipped = s.clip.is_some_and(|c| c.removes(x));
+                    if !inside
+                        || clipped
+                        || cam.ray_distance(x) < t_min
+                        || self.in_ribbon_gap(surf, set, k)
+                    {
                         return None;
                     }
                     let dir = cam.ray_to(x).1;
@@ -288,7 +293,11 @@ impl Scene<'_> {
         } else {
             vec![f64::INFINITY; w * h]
         };
-        Ok(View { rgb, front })
+        Ok(View {
+            rgb,
+            front,
+            gap: Vec::new(),
+        })
     }
 
     /// Per pixel the distance of the first surface the halos leave visible along its centre

@@ -6,7 +6,8 @@
 //! they are drawn: the product of 1 - opacity (by w, as the picture composites it) over the
 //! surfaces the ray meets before the point and the halos leave visible, 0 when one of them
 //! is opaque. Pieces outside the picture count 0; pieces behind a perspective eye are left
-//! out of the length too. The point a ray aims at is the curve's point on the mesh
+//! out of the length too, and pieces a cutaway removes ([`super::clip`]) count 0. The point a
+//! ray aims at is the curve's point on the mesh
 //! ([`crate::CurvePoint::on_mesh`]), as for the drawn lines, so that the sheets through it
 //! never hide it.
 
@@ -33,6 +34,21 @@ pub struct CurveVisibility {
     /// the two sheets there (1 where they cross at right angles, 0 where they touch): how
     /// much of the picture's crossings read as crossings.
     pub transversal_visible_px: f64,
+    /// The gap the halos cut along the visible curves, in pixels: the half-width of the
+    /// halo of the sheet passing over (the mean of its face's corners, less where the
+    /// build shrank it) over the side of a pixel at the curve's depth; the value a tenth of
+    /// the visible length lies below (0 without a halo or a visible curve).
+    pub gap_px_p10: f64,
+    /// The same, the median.
+    pub gap_px_median: f64,
+    /// Curve ends at branch points (cross-caps of the projection).
+    pub branch_points: usize,
+    /// Those the picture shows (the transmittance to them above one half).
+    pub branch_points_visible: usize,
+    /// Points where three sheets cross.
+    pub triple_points: usize,
+    /// Those the picture shows.
+    pub triple_points_visible: usize,
 }
 
 /// The camera of a picture in the coordinates of the projected scene (the `.ply` files'
@@ -113,27 +129,40 @@ impl Scene<'_> {
     /// How much of the curves the picture through `cam` shows.
     pub(super) fn curve_visibility(&self, cam: &Camera) -> CurveVisibility {
         let (w, h) = (self.settings.width, self.settings.height);
-        // Each segment with the sine of the sheets' angle at its first point.
-        let mut segments: Vec<([(DVec3, DVec3); 2], f64)> = Vec::new();
+        // Each segment with the sine of the sheets' angle and the halo's half-width of the
+        // sheet passing over, at its first point.
+        let mut segments: Vec<([(DVec3, DVec3); 2], f64, f64)> = Vec::new();
         for c in &self.input.curves.curves {
-            let points: Vec<((DVec3, DVec3), f64)> = c
+            let points: Vec<((DVec3, DVec3), f64, f64)> = c
                 .points
                 .iter()
-                .map(|p| ((p.position, p.on_mesh), self.crossing_sine(p.faces)))
+                .map(|p| {
+                    let over = p.faces[p.near()];
+                    (
+                        (p.position, p.on_mesh),
+                        self.crossing_sine(p.faces),
+                        self.half_width(over),
+                    )
+                })
                 .collect();
-            segments.extend(points.windows(2).map(|s| ([s[0].0, s[1].0], s[0].1)));
+            segments.extend(
+                points
+                    .windows(2)
+                    .map(|s| ([s[0].0, s[1].0], s[0].1, s[0].2)),
+            );
             if c.closed && points.len() > 2 {
                 let last = points[points.len() - 1];
-                segments.push(([last.0, points[0].0], last.1));
+                segments.push(([last.0, points[0].0], last.1, last.2));
             }
         }
         // Per segment on the cores, summed in order: the same total on any number of threads.
-        let pieces: Vec<(f64, f64, f64)> = segments
+        let pieces: Vec<(f64, f64, f64, f64)> = segments
             .par_iter()
-            .map_init(Vec::new, |hits, &([(a, sa), (b, sb)], sine)| {
-                let (Some((pa, _)), Some((pb, _))) = (cam.project(a, w, h), cam.project(b, w, h))
+            .map_init(Vec::new, |hits, &([(a, sa), (b, sb)], sine, rho)| {
+                let (Some((pa, depth)), Some((pb, _))) =
+                    (cam.project(a, w, h), cam.project(b, w, h))
                 else {
-                    return (0.0, 0.0, 0.0);
+                    return (0.0, 0.0, 0.0, 0.0);
                 };
                 let length = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
                 let steps = (length.ceil() as usize).clamp(1, 4096);
@@ -149,19 +178,67 @@ impl Scene<'_> {
                         && xy[1] >= 0.0
                         && xy[0] < f64::from(w)
                         && xy[1] < f64::from(h);
-                    if inside {
+                    let clipped = self.settings.clip.is_some_and(|c| c.removes(p));
+                    if inside && !clipped {
                         seen += piece * self.transmittance(cam, s, hits);
                     }
                 }
-                (length, seen, seen * sine)
+                (length, seen, seen * sine, rho / pixel_size(cam, depth, h))
             })
             .collect();
         let (projected, visible, transversal) = pieces
             .iter()
-            .fold((0.0, 0.0, 0.0), |(p, v, t), &(a, b, c)| {
+            .fold((0.0, 0.0, 0.0), |(p, v, t), &(a, b, c, _)| {
                 (p + a, v + b, t + c)
             });
+        // The gap in pixels along the visible curves, weighted by the length seen.
+        let mut gaps: Vec<(f64, f64)> = pieces
+            .iter()
+            .filter(|p| p.1 > 0.0)
+            .map(|p| (p.3, p.1))
+            .collect();
+        gaps.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let quantile = |q: f64| {
+            let mut left = q * visible;
+            for &(gap, weight) in &gaps {
+                left -= weight;
+                if left <= 0.0 {
+                    return gap;
+                }
+            }
+            gaps.last().map_or(0.0, |g| g.0)
+        };
+        let (gap_p10, gap_median) = (quantile(0.1), quantile(0.5));
+        // The curves' ends at branch points, and the triple points, each seen or not.
+        let mut marks: Vec<DVec3> = Vec::new();
+        for c in &self.input.curves.curves {
+            for (end, p) in c.ends.iter().zip([c.points.first(), c.points.last()]) {
+                if let (crate::intersect::End::BranchPoint, Some(p)) = (end, p) {
+                    marks.push(p.on_mesh);
+                }
+            }
+        }
+        let branch_points = marks.len();
+        marks.extend(self.input.curves.triple_points.iter().map(|t| t.position));
+        let seen: Vec<bool> = marks
+            .par_iter()
+            .map_init(Vec::new, |hits, &p| {
+                let inside = cam.project(p, w, h).is_some_and(|(xy, _)| {
+                    xy[0] >= 0.0 && xy[1] >= 0.0 && xy[0] < f64::from(w) && xy[1] < f64::from(h)
+                });
+                inside
+                    && !self.settings.clip.is_some_and(|c| c.removes(p))
+                    && self.transmittance(cam, p, hits) > 0.5
+            })
+            .collect();
+        let count = |s: &[bool]| s.iter().filter(|&&v| v).count();
         CurveVisibility {
+            gap_px_p10: gap_p10,
+            gap_px_median: gap_median,
+            branch_points,
+            branch_points_visible: count(&seen[..branch_points]),
+            triple_points: marks.len() - branch_points,
+            triple_points_visible: count(&seen[branch_points..]),
             curves_projected_px: projected,
             curves_visible_px: visible,
             visible_curve_share: if projected > 0.0 {
@@ -171,6 +248,20 @@ impl Scene<'_> {
             },
             transversal_visible_px: transversal,
         }
+    }
+
+    /// The half-width of the halo of `face`'s surface at that face: the mean over its
+    /// corners (0 where the surface has no halo).
+    fn half_width(&self, face: crate::intersect::Face) -> f64 {
+        let Some(Some(halo)) = self.input.halos.get(face.surface as usize) else {
+            return 0.0;
+        };
+        let surf = &self.input.surfaces[face.surface as usize];
+        let tri = surf.triangles[face.triangle as usize];
+        tri.iter()
+            .map(|&v| halo.half_width(v as usize))
+            .sum::<f64>()
+            / 3.0
     }
 
     /// The sine of the angle between the planes of the two triangles `faces` (0 where one

@@ -308,12 +308,21 @@ struct LineOut {
     @builtin(position) clip: vec4<f32>,
     // The line's centre under this fragment: pixel position and view depth.
     @location(0) @interpolate(linear) centre: vec3<f32>,
+    // The line's colour (linear).
+    @location(1) @interpolate(flat) ink: vec3<f32>,
 }
+
+// The CPU renderer's curve inks (render::overlay::curve_ink): the w scale in OVER_BANDS
+// bands, each curve drawn in the colour of the middle of the band of the sheet passing
+// over it, darkened by OVER_SHADE.
+const OVER_BANDS: f32 = 12.0;
+const OVER_SHADE: f32 = 0.35;
 
 // Corner `vertex` (0..6, two triangles) of the segment from p to q drawn as a band
 // `viewport.z` pixels either side of it, capped as far beyond its ends.
 fn band(p: vec3<f32>, q: vec3<f32>, vertex: u32) -> LineOut {
     var out: LineOut;
+    out.ink = INK;
     let a = view.clip * vec4<f32>(p, 1.0);
     let b = view.clip * vec4<f32>(q, 1.0);
     if a.w <= 0.0 || b.w <= 0.0 {
@@ -351,7 +360,14 @@ fn band(p: vec3<f32>, q: vec3<f32>, vertex: u32) -> LineOut {
 @vertex
 fn curve_vs(@builtin(vertex_index) vertex: u32, @builtin(instance_index) segment: u32) -> LineOut {
     let ends = curve_segments[segment];
-    return band(curve_points[ends.x].xyz, curve_points[ends.y].xyz, vertex);
+    var out = band(curve_points[ends.x].xyz, curve_points[ends.y].xyz, vertex);
+    if (view.options.x & 2u) != 0u {
+        // The w of the sheet passing over, at the segment's first point.
+        let s = clamp((curve_points[ends.x].w - view.w_norm.x) * view.w_norm.y, 0.0, 1.0);
+        let b = min(floor(s * OVER_BANDS), OVER_BANDS - 1.0);
+        out.ink = colormap((b + 0.5) / OVER_BANDS) * OVER_SHADE;
+    }
+    return out;
 }
 
 // Whether triangle `k`, whose vertex `p` is, faces the eye.
@@ -414,7 +430,7 @@ fn line_fs(in: LineOut) -> OpaqueOut {
             discard;
         }
     }
-    return OpaqueOut(vec4<f32>(INK, 1.0), 0.0);
+    return OpaqueOut(vec4<f32>(in.ink, 1.0), 0.0);
 }
 
 // ---------------------------------------------------------------- halo depth
