@@ -20,8 +20,8 @@ struct Cli {
 enum Command {
     /// Build a scene: sample, view and export its surfaces.
     Build {
-        /// Scene file (JSON). Without it, the built-in default scene (a spun trefoil in an
-        /// oblique 4D view) is built.
+        /// Scene file (JSON). Without it, the built-in default scene (a spun trefoil in the
+        /// 4D view the view search found) is built.
         scene: Option<PathBuf>,
         /// Output folder [default: exports/<scene name>/].
         #[arg(long)]

@@ -16,7 +16,7 @@ use crate::view::View;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// The scene built when none is given: a spun trefoil in an oblique 4D view.
+/// The scene built when none is given: a spun trefoil in the 4D view the view search found.
 pub const DEFAULT_SCENE: &str = include_str!("../fixtures/scenes/default.json");
 
 /// A scene: what to build and what to write.

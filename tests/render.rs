@@ -1225,7 +1225,11 @@ fn every_catalogue_surface_has_a_fixture_whose_picture_shows_its_crossings() {
         assert_eq!(scene.surfaces[0].surface.type_name(), kind, "{name}");
         assert_eq!((scene.render.width, scene.render.height), (1024, 1024));
         let built = halo4d::run(&scene, true).unwrap();
-        assert!(built.failures().is_empty(), "{name}: {:?}", built.failures());
+        assert!(
+            built.failures().is_empty(),
+            "{name}: {:?}",
+            built.failures()
+        );
         let parts = built.parts(&scene.halo);
         let (_, seen) =
             halo4d::internals::curve_visibility(&parts, &scene.render, &scene.camera).unwrap();

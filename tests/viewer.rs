@@ -171,7 +171,8 @@ fn every_fixture_turned_in_4d_on_the_gpu_matches_the_exact_render_of_its_rotated
             vertices += found.vertices;
             // Where the sliced halo depth itself is off (steep w in a 4D perspective close
             // to the eye), the measure is the viewer on the build's own `.glb` of this view:
-            // the GPU's halos must do as well as the build's, to half a percent.
+            // the GPU's halos must do as well as the build's, to half a percent and a tenth
+            // of the share of the vertices where the build shrank rho.
             let mut allowed = 0.02;
             if found.rows.iter().any(|r| r.verdict_differs >= allowed) {
                 let turned = Scene {
@@ -199,7 +200,11 @@ fn every_fixture_turned_in_4d_on_the_gpu_matches_the_exact_render_of_its_rotated
                     scene.name,
                     built * 100.0
                 );
-                allowed = allowed.max(built + 0.005);
+                // The GPU's halos have the full rho where the build shrank it (its
+                // `shrunk` vertices, the only places they may differ from the build's):
+                // a tenth of the share of those vertices more.
+                let shrunk_share = found.shrunk as f64 / found.vertices.max(1) as f64;
+                allowed = allowed.max(built + 0.005 + 0.1 * shrunk_share);
             }
             for row in &found.rows {
                 eprintln!(

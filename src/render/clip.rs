@@ -178,18 +178,18 @@ impl Clip {
 mod tests {
     use super::*;
 
+    /// The wedge x > 0, y > 0.
+    fn quadrant() -> Clip {
+        let plane = |normal| ClipPlane {
+            normal,
+            offset: 0.0,
+        };
+        Clip::wedge(plane([1.0, 0.0, 0.0]), plane([0.0, 1.0, 0.0]))
+    }
+
     #[test]
     fn a_wedge_removes_what_is_beyond_both_planes() {
-        let wedge = Clip::wedge(
-            ClipPlane {
-                normal: [1.0, 0.0, 0.0],
-                offset: 0.0,
-            },
-            ClipPlane {
-                normal: [0.0, 1.0, 0.0],
-                offset: 0.0,
-            },
-        );
+        let wedge = quadrant();
         assert!(wedge.removes(DVec3::new(1.0, 1.0, 5.0)));
         assert!(!wedge.removes(DVec3::new(1.0, -1.0, 0.0)));
         assert!(!wedge.removes(DVec3::new(-1.0, 1.0, 0.0)));
@@ -201,16 +201,7 @@ mod tests {
     fn cut_edges_run_along_the_boundary_of_the_removed_region() {
         // The triangle in z = 0 spanning [-1, 1]^2 roughly, cut by the wedge x > 0, y > 0:
         // the cuts are the segments of x = 0 with y > 0 and of y = 0 with x > 0.
-        let wedge = Clip::wedge(
-            ClipPlane {
-                normal: [1.0, 0.0, 0.0],
-                offset: 0.0,
-            },
-            ClipPlane {
-                normal: [0.0, 1.0, 0.0],
-                offset: 0.0,
-            },
-        );
+        let wedge = quadrant();
         let t = [
             DVec3::new(-1.0, -1.0, 0.0),
             DVec3::new(3.0, -1.0, 0.0),

@@ -70,31 +70,81 @@ impl<'a> Tracer<'a> {
     /// triangles of one surface hits it once.
     pub fn hits(&self, origin: DVec3, dir: DVec3, t_min: f64, hits: &mut Vec<Hit>) {
         hits.clear();
-        let ray = Ray::new(
+        self.bvh
+            .ray_traverse_anyhit(self.ray(origin, dir), |_, slot| {
+                if let Some(hit) = self.hit(origin, dir, slot)
+                    && hit.t > t_min
+                {
+                    hits.push(hit);
+                }
+            });
+        self.order(hits);
+    }
+
+    /// The hits of the ray beyond `t_min` no farther than `slack` past the nearest one, in
+    /// order: the start of what [`Tracer::hits`] gives, by a closest-hit traversal, which
+    /// visits far fewer boxes where many sheets lie along the ray.
+    pub fn nearest_hits(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        t_min: f64,
+        slack: f64,
+        hits: &mut Vec<Hit>,
+    ) {
+        hits.clear();
+        let mut nearest = f64::INFINITY;
+        let mut found = obvhs::ray::RayHit::none();
+        self.bvh
+            .ray_traverse(self.ray(origin, dir), &mut found, |_, slot| {
+                match self.hit(origin, dir, slot) {
+                    Some(hit) if hit.t > t_min && hit.t <= nearest + slack => {
+                        nearest = nearest.min(hit.t);
+                        hits.push(hit);
+                        // Rounded up past the slack, so that the boxes of every hit within
+                        // it are still visited.
+                        ((nearest + slack) as f32).next_up()
+                    }
+                    _ => f32::INFINITY,
+                }
+            });
+        hits.retain(|h| h.t <= nearest + slack);
+        self.order(hits);
+    }
+
+    /// Hits closer than this along the ray are compared for duplicates.
+    pub fn same(&self) -> f64 {
+        self.same
+    }
+
+    /// The ray in the BVH's f32.
+    fn ray(&self, origin: DVec3, dir: DVec3) -> Ray {
+        Ray::new(
             Vec3A::new(origin.x as f32, origin.y as f32, origin.z as f32),
             Vec3A::new(dir.x as f32, dir.y as f32, dir.z as f32),
             0.0,
             f32::INFINITY,
-        );
-        self.bvh.ray_traverse_anyhit(ray, |_, slot| {
-            let g = self.bvh.primitive_indices[slot];
-            let (s, i) = self.tris[g as usize];
-            let surf = &self.surfaces[s as usize];
-            let tri = surf.triangles[i as usize];
-            let p = tri.map(|v| surf.positions[v as usize]);
-            if let Some((t, bary)) = intersect(origin, dir, p)
-                && t > t_min
-            {
-                hits.push(Hit {
-                    t,
-                    surface: s,
-                    triangle: i,
-                    bary,
-                });
-            }
-        });
+        )
+    }
+
+    /// Where the ray meets the triangle in BVH slot `slot`, if it does.
+    fn hit(&self, origin: DVec3, dir: DVec3, slot: usize) -> Option<Hit> {
+        let g = self.bvh.primitive_indices[slot];
+        let (s, i) = self.tris[g as usize];
+        let surf = &self.surfaces[s as usize];
+        let p = surf.triangles[i as usize].map(|v| surf.positions[v as usize]);
+        intersect(origin, dir, p).map(|(t, bary)| Hit {
+            t,
+            surface: s,
+            triangle: i,
+            bary,
+        })
+    }
+
+    /// Sorts hits by t and drops the second of two at one t on neighbouring triangles of
+    /// one surface (a ray through their shared edge or vertex).
+    fn order(&self, hits: &mut Vec<Hit>) {
         hits.sort_by(|a, b| a.t.total_cmp(&b.t));
-        // Drop the second of two hits at one t on neighbouring triangles of one surface.
         let mut kept = 0;
         for k in 0..hits.len() {
             let h = hits[k];

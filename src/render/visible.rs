@@ -125,40 +125,50 @@ pub fn curve_visibility(
     ))
 }
 
+/// A segment of a curve (each end's point and its point on the mesh), with the sine of
+/// the sheets' angle and the halo's half-width of the sheet passing over at its first end.
+#[derive(Clone, Copy)]
+struct Segment {
+    ends: [(DVec3, DVec3); 2],
+    sine: f64,
+    rho: f64,
+}
+
 impl Scene<'_> {
     /// How much of the curves the picture through `cam` shows.
     pub(super) fn curve_visibility(&self, cam: &Camera) -> CurveVisibility {
         let (w, h) = (self.settings.width, self.settings.height);
         // Each segment with the sine of the sheets' angle and the halo's half-width of the
         // sheet passing over, at its first point.
-        let mut segments: Vec<([(DVec3, DVec3); 2], f64, f64)> = Vec::new();
+        let mut segments: Vec<Segment> = Vec::new();
         for c in &self.input.curves.curves {
-            let points: Vec<((DVec3, DVec3), f64, f64)> = c
+            let points: Vec<Segment> = c
                 .points
                 .iter()
-                .map(|p| {
-                    let over = p.faces[p.near()];
-                    (
-                        (p.position, p.on_mesh),
-                        self.crossing_sine(p.faces),
-                        self.half_width(over),
-                    )
+                .map(|p| Segment {
+                    ends: [(p.position, p.on_mesh); 2],
+                    sine: self.crossing_sine(p.faces),
+                    rho: self.half_width(p.faces[p.near()]),
                 })
                 .collect();
-            segments.extend(
-                points
-                    .windows(2)
-                    .map(|s| ([s[0].0, s[1].0], s[0].1, s[0].2)),
-            );
+            let join = |a: &Segment, b: &Segment| Segment {
+                ends: [a.ends[0], b.ends[0]],
+                ..*a
+            };
+            segments.extend(points.windows(2).map(|s| join(&s[0], &s[1])));
             if c.closed && points.len() > 2 {
-                let last = points[points.len() - 1];
-                segments.push(([last.0, points[0].0], last.1, last.2));
+                segments.push(join(&points[points.len() - 1], &points[0]));
             }
         }
         // Per segment on the cores, summed in order: the same total on any number of threads.
         let pieces: Vec<(f64, f64, f64, f64)> = segments
             .par_iter()
-            .map_init(Vec::new, |hits, &([(a, sa), (b, sb)], sine, rho)| {
+            .map_init(Vec::new, |hits, segment| {
+                let Segment {
+                    ends: [(a, sa), (b, sb)],
+                    sine,
+                    rho,
+                } = *segment;
                 let (Some((pa, depth)), Some((pb, _))) =
                     (cam.project(a, w, h), cam.project(b, w, h))
                 else {
