@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The viewer's window on a virtual X display: it opens, shows its settings in the title,
 # answers the keys, a drag and the wheel, and quits on Q; on a scene file it turns in 4D (a
-# plane key, a Shift drag), settles its curves, resets and saves the view.
+# plane key, a Shift drag), settles its curves, searches a view, resets and saves the view.
 # Usage: .ci/window-check.sh SCENE.glb SCENE.json (a scene whose view turns only yw by 30)
 set -euo pipefail
 glb=$1
@@ -68,7 +68,7 @@ expect "azimuth 355"
 # The camera is fitted (the file's scene records no distance); the wheel zooms from there
 # (the title drops "fitted"), and R goes back to the fit.
 xdotool mousemove --window "$w" 240 180 click 4; expect_not " fitted | "
-xdotool key r; expect "azimuth 35 elevation 25 distance"; expect " fitted | "
+xdotool key r; expect "azimuth 35 elevation -42 distance"; expect " fitted | "
 xdotool key q
 wait "$viewer"
 echo "the viewer's window answered every key and quit"
@@ -91,6 +91,9 @@ case "$t" in
 esac
 echo "  $t"
 expect "settled"
+# The view search runs in the background and turns the view to what it found.
+xdotool key a; expect "searching the view"
+expect "view search:"
 xdotool key v; expect "4D xy 0 xz 0 xw 0 yz 0 yw 30 zw 0 orthographic"
 xdotool key f; expect "saved exports/views/"
 xdotool key q

@@ -66,6 +66,7 @@ pub fn run(source: Source, view: Option<View>, settings: ViewSettings) -> Result
         saved: None,
         saves: 0,
         build: None,
+        search: None,
         note: String::new(),
         stipples: None,
     };
@@ -116,6 +117,8 @@ struct App {
     saves: u32,
     /// A build running in the background: its outcome in words.
     build: Option<Receiver<String>>,
+    /// A view search running in the background (`A`): the view found, or why none.
+    search: Option<Receiver<Result<crate::viewsearch::Found, String>>>,
     /// The last message for the title (a save, a build's outcome, a refused view).
     note: String,
     /// The stipples being made in the background, until the renderer has them.
@@ -216,6 +219,26 @@ impl App {
         {
             self.note = outcome;
             self.build = None;
+        }
+        if let Some(rx) = &self.search
+            && let Ok(found) = rx.try_recv()
+        {
+            self.search = None;
+            match found {
+                Ok(found) => {
+                    if let Some(view) = &mut self.view {
+                        view.rotation = found.rotation;
+                    }
+                    self.settings.camera.azimuth = found.azimuth;
+                    self.settings.camera.elevation = found.elevation;
+                    self.note = format!(
+                        "view search: {:.2} of the curves in view (was {:.2})",
+                        found.visible_curve_share, found.start_share
+                    );
+                    state.window.request_redraw();
+                }
+                Err(e) => self.note = e,
+            }
         }
         // The stipples: made once, in the background; shaded until they are ready, and
         // back to shaded, the reason in the title, where the source has no 4D mesh.
@@ -443,6 +466,29 @@ impl App {
                     }
                     Err(e) => e.to_string(),
                 };
+                return true;
+            }
+            "a" => {
+                if self.search.is_some() {
+                    self.note = "a view search is running".into();
+                    return true;
+                }
+                // From the view and camera shown.
+                let mut scene = model.scene.clone();
+                scene.view = *view;
+                scene.camera.azimuth = self.settings.camera.azimuth;
+                scene.camera.elevation = self.settings.camera.elevation;
+                let window = self.state.as_ref().map(|s| Arc::clone(&s.window));
+                let (tx, rx) = channel();
+                self.note = "searching the view that shows the most of the curves".into();
+                std::thread::spawn(move || {
+                    let found = crate::viewsearch::search(&scene, true).map_err(|e| e.to_string());
+                    let _ = tx.send(found);
+                    if let Some(w) = window {
+                        w.request_redraw();
+                    }
+                });
+                self.search = Some(rx);
                 return true;
             }
             "b" => {
