@@ -237,12 +237,16 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
             })
         }
         Command::View { scene, out, quiet } => {
-            let text = match &scene {
-                Some(path) => std::fs::read_to_string(path)
-                    .map_err(|e| format!("{}: cannot read the scene: {e}", path.display()))?,
-                None => halo4d::DEFAULT_SCENE.to_string(),
+            // Read once: parsed here, and written back with the view found.
+            let (text, parsed) = match &scene {
+                Some(path) => {
+                    let text = std::fs::read_to_string(path)
+                        .map_err(|e| format!("{}: cannot read the scene: {e}", path.display()))?;
+                    let parsed = Scene::parse(&text, &path.display().to_string())?;
+                    (text, parsed)
+                }
+                None => (halo4d::DEFAULT_SCENE.to_string(), Scene::default_scene()),
             };
-            let parsed = load(scene)?;
             let found = halo4d::search_view(&parsed, quiet)?;
             eprintln!(
                 "view search: {} 4D views on {} triangles in {:.1} s; visible share of the curves {:.3} (the scene's own view: {:.3}), score {:.0} ({:.0})",

@@ -941,36 +941,29 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     let mut picture_report = None;
     if scene.outputs.png || scene.outputs.svg {
         let start = Instant::now();
-        let render_error = |source| Error::Render {
+        let rendered = render::render_for_build(
+            &built.parts(&scene.halo),
+            &scene.render,
+            &scene.camera,
+            scene.outputs.svg,
+        )
+        .map_err(|source| Error::Render {
             scene: scene.name.clone(),
             source,
-        };
-        let parts = built.parts(&scene.halo);
-        let (picture, svg) = if scene.outputs.svg {
-            let (picture, svg) = render::render_with_svg(&parts, &scene.render, &scene.camera)
-                .map_err(render_error)?;
-            (picture, Some(svg))
-        } else {
-            let picture =
-                render::render(&parts, &scene.render, &scene.camera).map_err(render_error)?;
-            (picture, None)
-        };
+        })?;
         timings.render = ms(start);
         if scene.outputs.png {
-            files.push(write(format!("{name}.png"), &picture.png())?);
+            files.push(write(format!("{name}.png"), &rendered.picture.png())?);
         }
-        if let Some(svg) = svg {
+        if let Some(svg) = &rendered.svg {
             files.push(write(format!("{name}.svg"), svg.as_bytes())?);
         }
-        let (camera, curves) =
-            render::visible::curve_visibility(&parts, &scene.render, &scene.camera)
-                .map_err(render_error)?;
         picture_report = Some(PictureReport {
-            camera,
+            camera: rendered.camera,
             clip: scene.render.clip,
             rho: built.rho,
             gap_px: built.rho / built.pixel_size,
-            curves,
+            curves: rendered.curves,
         });
     }
     if scene.outputs.report {

@@ -11,7 +11,7 @@
 //! length is visible; everything else of the scene kept. The surfaces are
 //! sampled once on a coarse uniform grid ([`SEARCH_TRIANGLES`] triangles in all; a mesh file
 //! as it is); each 4D view projects it and finds its exact curves ([`crate::intersect`]),
-//! then tries several camera orbits on them, which cost only the rays.
+//! then tries several camera orbits on them, indexed once, which cost only the rays.
 //!
 //! The search is deterministic (a Halton sequence over the eight angles, the scene's own
 //! view first, then a pattern search around the best with halving steps) and bounded:
@@ -311,15 +311,20 @@ fn evaluate_view(
         halos: vec![None; meshes.len()],
         curves: &curves,
     };
+    let settings_of = |&(azimuth, elevation): &(f64, f64)| CameraSettings {
+        azimuth,
+        elevation,
+        ..scene.camera
+    };
+    let orbits: Vec<CameraSettings> = cameras.iter().map(settings_of).collect();
+    let Ok(seen) = render::visible::curve_visibility_each(&parts, settings, &orbits) else {
+        return Vec::new();
+    };
     cameras
         .iter()
-        .filter_map(|&(azimuth, elevation)| {
-            let camera = CameraSettings {
-                azimuth,
-                elevation,
-                ..scene.camera
-            };
-            let (_, seen) = render::visible::curve_visibility(&parts, settings, &camera).ok()?;
+        .zip(seen)
+        .filter_map(|(&(azimuth, elevation), seen)| {
+            let seen = seen?;
             let marks = seen.branch_points_visible + seen.triple_points_visible;
             let score = (seen.transversal_visible_px * seen.visible_curve_share
                 + MARK_SHARE * f64::from(SEARCH_SIDE) * marks as f64)

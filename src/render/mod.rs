@@ -528,7 +528,7 @@ pub fn render(
     settings: &RenderSettings,
     camera: &CameraSettings,
 ) -> Result<Picture, RenderError> {
-    Ok(render_eyes(input, settings, camera, false, false)?.0)
+    Ok(render_eyes(input, settings, camera, Want::default())?.picture)
 }
 
 /// [`render`], and per pixel of the first eye the ray distance of the first surface the
@@ -539,37 +539,91 @@ pub fn render_with_depth(
     settings: &RenderSettings,
     camera: &CameraSettings,
 ) -> Result<(Picture, Vec<f64>), RenderError> {
-    let (picture, depth, _) = render_eyes(input, settings, camera, true, false)?;
-    Ok((picture, depth))
+    let eyes = render_eyes(
+        input,
+        settings,
+        camera,
+        Want {
+            depth: true,
+            ..Want::default()
+        },
+    )?;
+    Ok((eyes.picture, eyes.depth))
 }
 
-/// [`render`], and the first eye's lines as an SVG document: the same runs the picture's
-/// lines are drawn from ([`svg`]).
-pub fn render_with_svg(
+/// A picture and what a build reports of it.
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    /// The picture.
+    pub picture: Picture,
+    /// The first eye's lines as an SVG document (when asked for): the same runs the
+    /// picture's lines are drawn from ([`svg`]).
+    pub svg: Option<String>,
+    /// The first eye's camera.
+    pub camera: visible::PictureCamera,
+    /// How much of the curves the first eye's picture shows.
+    pub curves: visible::CurveVisibility,
+}
+
+/// [`render`], with its line art when `svg` asks for it, its camera and the share of the
+/// curves it shows, from one indexing of the scene.
+pub fn render_for_build(
     input: &Parts,
     settings: &RenderSettings,
     camera: &CameraSettings,
-) -> Result<(Picture, String), RenderError> {
-    let (picture, _, svg) = render_eyes(input, settings, camera, false, true)?;
-    Ok((
-        picture,
-        svg.ok_or_else(|| RenderError::Internal("the first eye made no line art".into()))?,
-    ))
+    svg: bool,
+) -> Result<Rendered, RenderError> {
+    let eyes = render_eyes(
+        input,
+        settings,
+        camera,
+        Want {
+            svg,
+            seen: true,
+            ..Want::default()
+        },
+    )?;
+    let (camera, curves) = eyes
+        .seen
+        .ok_or_else(|| RenderError::Internal("the first eye measured no curves".into()))?;
+    Ok(Rendered {
+        picture: eyes.picture,
+        svg: eyes.svg,
+        camera,
+        curves,
+    })
 }
 
-/// The picture, the first eye's distances when `depth_wanted` asks for them (the stipple
-/// style traces them apart; empty otherwise), and its line art when `svg_wanted` does.
+/// What a picture is made with besides its pixels, of the first eye.
+#[derive(Clone, Copy, Debug, Default)]
+struct Want {
+    /// The distances of the first visible surfaces (the stipple style traces them apart).
+    depth: bool,
+    /// The line art.
+    svg: bool,
+    /// The camera and the share of the curves in view.
+    seen: bool,
+}
+
+/// A picture and what [`Want`] asked for (empty or `None` otherwise).
+struct Eyes {
+    picture: Picture,
+    depth: Vec<f64>,
+    svg: Option<String>,
+    seen: Option<(visible::PictureCamera, visible::CurveVisibility)>,
+}
+
+/// The picture of every eye, and of the first eye what `want` asks for.
 fn render_eyes(
     input: &Parts,
     settings: &RenderSettings,
     camera: &CameraSettings,
-    depth_wanted: bool,
-    svg_wanted: bool,
-) -> Result<(Picture, Vec<f64>, Option<String>), RenderError> {
+    want: Want,
+) -> Result<Eyes, RenderError> {
     let (placement, scene) = prepare(input, settings, camera)?;
     let eyes = eyes(settings);
     let mut depth = Vec::new();
-    let mut svg = None;
+    let (mut svg, mut seen) = (None, None);
     let (w, h) = (settings.width, settings.height);
     scene.check_memory(&Camera::new(camera, &placement, w, h, eyes[0])?, eyes.len())?;
     let mut rgb = vec![0u8; 3 * (w as usize * eyes.len()) * h as usize];
@@ -577,9 +631,9 @@ fn render_eyes(
         let cam = Camera::new(camera, &placement, w, h, offset)?;
         let mut view = match settings.style {
             Style::Shaded => scene.view(&cam),
-            Style::Stipple => scene.view_stipples(&cam, depth_wanted && e == 0)?,
+            Style::Stipple => scene.view_stipples(&cam, want.depth && e == 0)?,
         };
-        if e == 0 && depth_wanted {
+        if e == 0 && want.depth {
             depth.clone_from(&view.front);
         }
         let runs = scene.runs(&cam, &view.gap)?;
@@ -588,8 +642,12 @@ fn render_eyes(
                 *c = c.lerp(lines.ink, f64::from(k));
             }
         }
-        if e == 0 && svg_wanted {
+        if e == 0 && want.svg {
             svg = Some(svg::document(w, h, scene.background, &runs));
+        }
+        if e == 0 && want.seen {
+            let camera = visible::PictureCamera::of(&cam, placement.target, w, h);
+            seen = Some((camera, scene.curve_visibility(&cam)));
         }
         if settings.legend {
             legend(
@@ -609,15 +667,16 @@ fn render_eyes(
             }
         }
     }
-    Ok((
-        Picture {
+    Ok(Eyes {
+        picture: Picture {
             width: w * eyes.len() as u32,
             height: h,
             rgb,
         },
         depth,
         svg,
-    ))
+        seen,
+    })
 }
 
 /// The stipples the first eye's picture in the stipple style draws (whatever
@@ -628,13 +687,7 @@ pub fn stipples_drawn(
     camera: &CameraSettings,
 ) -> Result<Vec<stipple::Drawn>, RenderError> {
     let (placement, scene) = prepare(input, settings, camera)?;
-    let cam = Camera::new(
-        camera,
-        &placement,
-        settings.width,
-        settings.height,
-        first_eye(settings),
-    )?;
+    let cam = first_camera(settings, camera, &placement)?;
     scene.stipples(&cam)
 }
 
@@ -648,13 +701,7 @@ pub fn line_coverage(
     camera: &CameraSettings,
 ) -> Result<Vec<f32>, RenderError> {
     let (placement, scene) = prepare(input, settings, camera)?;
-    let cam = Camera::new(
-        camera,
-        &placement,
-        settings.width,
-        settings.height,
-        first_eye(settings),
-    )?;
+    let cam = first_camera(settings, camera, &placement)?;
     let mut inks = scene.lines(&cam, &[])?.into_iter();
     let Some(first) = inks.next() else {
         return Ok(vec![
@@ -699,13 +746,7 @@ impl<'a> Prober<'a> {
         camera: &CameraSettings,
     ) -> Result<Self, RenderError> {
         let (placement, scene) = prepare(input, settings, camera)?;
-        let cam = Camera::new(
-            camera,
-            &placement,
-            settings.width,
-            settings.height,
-            first_eye(settings),
-        )?;
+        let cam = first_camera(settings, camera, &placement)?;
         Ok(Prober { scene, cam })
     }
 
@@ -732,6 +773,21 @@ impl<'a> Prober<'a> {
             })
         })
     }
+}
+
+/// The camera of the first (left) image of a picture placed by `placement`.
+fn first_camera(
+    settings: &RenderSettings,
+    camera: &CameraSettings,
+    placement: &camera::Placement,
+) -> Result<Camera, RenderError> {
+    Camera::new(
+        camera,
+        placement,
+        settings.width,
+        settings.height,
+        first_eye(settings),
+    )
 }
 
 /// The azimuth offset of the first (left) image.
@@ -805,13 +861,7 @@ pub fn picture_pixel_size<'a>(
     camera: &CameraSettings,
 ) -> Result<f64, RenderError> {
     let (placement, _) = place(surfaces, settings, camera)?;
-    let cam = Camera::new(
-        camera,
-        &placement,
-        settings.width,
-        settings.height,
-        first_eye(settings),
-    )?;
+    let cam = first_camera(settings, camera, &placement)?;
     let depth = (placement.target - cam.eye).dot(cam.forward);
     Ok(visible::pixel_size(&cam, depth, settings.height))
 }

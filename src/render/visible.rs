@@ -78,7 +78,8 @@ pub struct PictureCamera {
 }
 
 impl PictureCamera {
-    fn of(cam: &Camera, target: DVec3, width: u32, height: u32) -> Self {
+    /// The camera `cam` of a picture of `width` x `height` looking at `target`.
+    pub(super) fn of(cam: &Camera, target: DVec3, width: u32, height: u32) -> Self {
         let depth = (target - cam.eye).dot(cam.forward);
         let perspective = cam.projection == CameraProjection::Perspective;
         PictureCamera {
@@ -112,17 +113,34 @@ pub fn curve_visibility(
     camera: &CameraSettings,
 ) -> Result<(PictureCamera, CurveVisibility), RenderError> {
     let (placement, scene) = super::prepare(input, settings, camera)?;
-    let cam = Camera::new(
-        camera,
-        &placement,
-        settings.width,
-        settings.height,
-        super::first_eye(settings),
-    )?;
+    let cam = super::first_camera(settings, camera, &placement)?;
     Ok((
         PictureCamera::of(&cam, placement.target, settings.width, settings.height),
         scene.curve_visibility(&cam),
     ))
+}
+
+/// [`curve_visibility`] through each of `cameras`, the scene indexed once; `None` for a
+/// camera that cannot see it (an orthographic eye inside it).
+pub fn curve_visibility_each(
+    input: &Parts,
+    settings: &super::RenderSettings,
+    cameras: &[CameraSettings],
+) -> Result<Vec<Option<CurveVisibility>>, RenderError> {
+    let Some(first) = cameras.first() else {
+        return Ok(Vec::new());
+    };
+    let (_, scene) = super::prepare(input, settings, first)?;
+    let surfaces = input.surfaces.iter().map(|s| (s.positions, s.triangles));
+    cameras
+        .iter()
+        .map(|camera| {
+            let (placement, _) = super::place(surfaces.clone(), settings, camera)?;
+            Ok(super::first_camera(settings, camera, &placement)
+                .ok()
+                .map(|cam| scene.curve_visibility(&cam)))
+        })
+        .collect()
 }
 
 /// A segment of a curve (each end's point and its point on the mesh), with the sine of
