@@ -21,6 +21,7 @@ mod check;
 mod convention;
 mod error;
 mod export;
+pub mod gallery;
 mod halo;
 mod import;
 mod inspect;
@@ -70,8 +71,8 @@ pub use parts::{HaloIndex, HaloPart, Parts, SurfacePart};
 pub use render::clip::{Clip, ClipPlane};
 pub use render::compare::Comparison;
 pub use render::{
-    CameraProjection, CameraSettings, Colormap, Picture, RenderError, RenderMode, RenderSettings,
-    RibbonAxis, Ribbons, StippleSettings, Style, render,
+    CameraProjection, CameraSettings, Colormap, Lighting, Picture, RenderError, RenderMode,
+    RenderSettings, RibbonAxis, Ribbons, StippleSettings, Style, render,
 };
 pub use sample::{
     Audit, Mesh4, MeshData4, MeshFileError, MeshFileLocation, MeshFormat, MeshStats, MeshSurface,

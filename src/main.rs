@@ -142,6 +142,23 @@ enum Command {
     },
     /// List the surface catalogue with each surface's parameters and defaults.
     List,
+    /// Build every scene of a folder (paper 000's figures by default) into a gallery: each
+    /// figure's picture and report in a folder of its own, an index page (index.html) with
+    /// each picture's description, the share of its double curves in view and its
+    /// verdict, and a contact sheet of all the pictures (gallery.png).
+    ///
+    /// Exit status 0 when every figure is verified, 3 when one is not, 1 on an error.
+    Gallery {
+        /// The folder of scene files.
+        #[arg(default_value = "fixtures/figures")]
+        figures: PathBuf,
+        /// The gallery's folder.
+        #[arg(long, default_value = "exports/gallery")]
+        out: PathBuf,
+        /// No progress output.
+        #[arg(long, short)]
+        quiet: bool,
+    },
     /// Check the halos of a .glb or .vtk file with the independent checker, or a build's
     /// output folder: its halos and their verification against the intersection curves.
     ///
@@ -454,6 +471,44 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
             }
             println!("{}", out.display());
             Ok(if summary.failed.is_empty() {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(UNVERIFIED)
+            })
+        }
+        Command::Gallery {
+            figures,
+            out,
+            quiet,
+        } => {
+            let gallery = halo4d::gallery::make(&figures, &out, quiet, |k, n, file| {
+                if !quiet {
+                    eprintln!("figure {} of {n}: {}", k + 1, file.display());
+                }
+            })?;
+            for f in &gallery.figures {
+                let share = f
+                    .report
+                    .picture
+                    .as_ref()
+                    .map_or(f64::NAN, |p| p.curves.visible_curve_share);
+                eprintln!(
+                    "{:<36} {} visible curve share {share:.3}, {:.1} s",
+                    f.name,
+                    if f.report.verified {
+                        "verified    "
+                    } else {
+                        "NOT verified"
+                    },
+                    f.report.timings_ms.total / 1e3
+                );
+                for failure in &f.report.failures {
+                    eprintln!("UNVERIFIED {}: {failure}", f.name);
+                }
+            }
+            println!("{}", gallery.index.display());
+            println!("{}", gallery.sheet.display());
+            Ok(if gallery.verified() {
                 ExitCode::SUCCESS
             } else {
                 ExitCode::from(UNVERIFIED)

@@ -135,6 +135,20 @@ pub enum Style {
     Stipple,
 }
 
+/// How shaded surfaces are lit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Lighting {
+    /// Phong shading with the 3D normals of the projected surfaces ([`shade::phong`]).
+    #[default]
+    #[serde(rename = "3d")]
+    ThreeD,
+    /// Illumination in 4D ([`shade::phong4`]): the lights leaned into w, lighting the
+    /// surface by its plane of normals in 4D, so that the shade shows how the surface leans
+    /// in w (the fully 4D-lit rendering of paper 000's fig. 5c).
+    #[serde(rename = "4d")]
+    FourD,
+}
+
 /// The stipple style's settings (`render.stipple` in a scene file).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -193,6 +207,9 @@ pub struct RenderSettings {
     pub silhouette_opacity: bool,
     /// Colour of w-depth.
     pub colormap: Colormap,
+    /// `3d` (Phong with the projected surfaces' normals) or `4d` (lit in 4D by the plane
+    /// of normals: the shade shows how the surface leans in w).
+    pub lighting: Lighting,
     /// A colour bar of the w scale along the bottom of the image (near w at the left).
     pub legend: bool,
     /// Hither clipping: surfaces nearer the eye than this (in units of half the scene's
@@ -219,6 +236,10 @@ pub struct RenderSettings {
     /// Draw the broken edges of the sheets passing under: the outline, in the picture, of
     /// where a halo hides the first surface (the gaps' edges), thinner than the curves.
     pub broken_edges: bool,
+    /// The colour of the broken edges, RGB in [0, 1] (paper 000's fig. 8 outlines the
+    /// halos in green); the silhouettes' near-black ink when absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub broken_edge_colour: Option<[f64; 3]>,
     /// Line width in pixels.
     pub line_width: f64,
     /// Line width at the far side of the scene, for lines that thin with distance; the
@@ -248,6 +269,7 @@ impl Default for RenderSettings {
             opacity_far: None,
             silhouette_opacity: true,
             colormap: Colormap::Diverging,
+            lighting: Lighting::ThreeD,
             legend: false,
             hither: None,
             ribbons: None,
@@ -256,6 +278,7 @@ impl Default for RenderSettings {
             curve_colours: true,
             silhouettes: true,
             broken_edges: true,
+            broken_edge_colour: None,
             line_width: 2.5,
             line_width_far: None,
             stereo: false,
@@ -386,15 +409,19 @@ impl RenderSettings {
                 format!("must be 0 to 30 degrees, got {}", self.eye_separation),
             ));
         }
-        if self
-            .background
-            .iter()
-            .any(|c| !(c.is_finite() && (0.0..=1.0).contains(c)))
-        {
-            return Err(FieldError::new(
-                "background",
-                format!("must be three numbers in [0, 1], got {:?}", self.background),
-            ));
+        for (field, colour) in [
+            ("background", Some(self.background)),
+            ("broken_edge_colour", self.broken_edge_colour),
+        ] {
+            if let Some(c) = colour
+                && c.iter()
+                    .any(|c| !(c.is_finite() && (0.0..=1.0).contains(c)))
+            {
+                return Err(FieldError::new(
+                    field,
+                    format!("must be three numbers in [0, 1], got {c:?}"),
+                ));
+            }
         }
         Ok(())
     }
@@ -945,6 +972,9 @@ struct Scene<'a> {
     settings: &'a RenderSettings,
     tracer: Tracer<'a>,
     halos: Option<HaloIndex<'a>>,
+    /// Per surface and vertex, the tangent plane in 4D ([`shade::vertex_tangent_projectors`])
+    /// when the lighting is 4D; empty otherwise.
+    planes: Vec<Vec<glam::DMat4>>,
     w_range: (f64, f64),
     centre: DVec3,
     radius: f64,
@@ -973,6 +1003,14 @@ impl<'a> Scene<'a> {
             settings,
             tracer: Tracer::new(trace, (hi - lo).length()),
             halos: settings.halos.then(|| HaloIndex::new(&input.halos)),
+            planes: match settings.lighting {
+                Lighting::ThreeD => Vec::new(),
+                Lighting::FourD => input
+                    .surfaces
+                    .par_iter()
+                    .map(|s| shade::vertex_tangent_projectors(s.positions, s.w, s.triangles))
+                    .collect(),
+            },
             w_range,
             centre: (lo + hi) * 0.5,
             radius: (hi - lo).length() * 0.5,
@@ -1275,7 +1313,13 @@ impl<'a> Scene<'a> {
             );
             let depth = (w - w0) / span;
             let base = shade::colormap(s.colormap, depth);
-            let lit = shade::phong(base, n, dir, cam.right, cam.up);
+            let lit = match self.planes.get(hit.surface as usize) {
+                Some(planes) => {
+                    let plane = mix_planes(tri.map(|v| planes[v as usize]), b);
+                    shade::phong4(base, plane, dir, cam.right, cam.up)
+                }
+                None => shade::phong(base, n, dir, cam.right, cam.up),
+            };
             let mut a = self.opacity_at(hit);
             if s.silhouette_opacity {
                 a = shade::silhouette_opacity(a, n.dot(dir));
@@ -1292,6 +1336,11 @@ impl<'a> Scene<'a> {
             first_hidden,
         )
     }
+}
+
+/// The tangent projectors of a triangle's corners interpolated at barycentric `b`.
+fn mix_planes(p: [glam::DMat4; 3], b: [f64; 3]) -> glam::DMat4 {
+    p[0] * b[0] + p[1] * b[1] + p[2] * b[2]
 }
 
 #[cfg(test)]

@@ -197,7 +197,7 @@ impl Scene<'_> {
             for line in super::contour::outline(gap, w as usize, h as usize) {
                 out.push(Run {
                     class: BROKEN,
-                    ink: INK,
+                    ink: s.broken_edge_colour.map_or(INK, DVec3::from),
                     points: line.into_iter().map(|p| (p, width)).collect(),
                 });
             }

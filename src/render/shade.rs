@@ -1,7 +1,8 @@
-//! Colour by w-depth and Phong shading with two lights.
+//! Colour by w-depth, and Phong shading with two lights in 3D ([`phong`]) or in 4D
+//! ([`phong4`]).
 
 use super::Colormap;
-use glam::DVec3;
+use glam::{DMat4, DVec3, DVec4};
 
 /// The colour of w-depth `s` in [0, 1] (0 nearest in w, 1 farthest).
 ///
@@ -53,12 +54,8 @@ pub(crate) fn stops(map: Colormap) -> &'static [[f64; 3]] {
 pub fn phong(base: DVec3, n: DVec3, view: DVec3, right: DVec3, up: DVec3) -> DVec3 {
     let n = if n.dot(view) > 0.0 { -n } else { n };
     let to_eye = -view;
-    let lights = [
-        ((to_eye + up * 0.8 - right * 0.6).normalize(), 0.75),
-        ((to_eye + right * 0.9 - up * 0.2).normalize(), 0.35),
-    ];
     let mut c = base * 0.22;
-    for (l, strength) in lights {
+    for (l, strength) in lights(view, right, up) {
         let diffuse = n.dot(l).max(0.0);
         let h = (l + to_eye).normalize();
         let specular = if diffuse > 0.0 {
@@ -66,6 +63,90 @@ pub fn phong(base: DVec3, n: DVec3, view: DVec3, right: DVec3, up: DVec3) -> DVe
         } else {
             0.0
         };
+        c += base * (diffuse * strength) + DVec3::splat(0.35 * strength * specular);
+    }
+    c.clamp(DVec3::ZERO, DVec3::ONE)
+}
+
+/// The two lights of [`phong`], fixed to the camera (`view` from the eye, `right`, `up`):
+/// unit directions towards them and their strengths.
+fn lights(view: DVec3, right: DVec3, up: DVec3) -> [(DVec3, f64); 2] {
+    let to_eye = -view;
+    [
+        ((to_eye + up * 0.8 - right * 0.6).normalize(), 0.75),
+        ((to_eye + right * 0.9 - up * 0.2).normalize(), 0.35),
+    ]
+}
+
+/// How far [`phong4`]'s lights lean out of the picture's 3D space towards +w, in degrees.
+pub const LIGHT_W_TILT: f64 = 25.0;
+
+/// The tangent plane of a surface in 4D as its orthogonal projector `t1 t1ᵀ + t2 t2ᵀ` (for
+/// any orthonormal basis `t1`, `t2` of the plane spanned by `e1` and `e2`): it does not
+/// depend on the basis or its orientation, so the planes of the vertices of a
+/// non-orientable surface average without cancelling. `None` where `e1` and `e2` span no
+/// plane.
+pub fn tangent_projector(e1: DVec4, e2: DVec4) -> Option<DMat4> {
+    let t1 = e1.try_normalize()?;
+    let t2 = (e2 - t1 * t1.dot(e2)).try_normalize()?;
+    let outer = |t: DVec4| DMat4::from_cols(t * t.x, t * t.y, t * t.z, t * t.w);
+    Some(outer(t1) + outer(t2))
+}
+
+/// Per vertex, the area-weighted mean of the tangent projectors ([`tangent_projector`]) of
+/// its triangles, in the 4D frame of the picture: a vertex's 3D position with its w-depth
+/// as the fourth coordinate (for an orthographic 4D projection, the turned surface itself).
+/// The zero matrix at a vertex of no triangle with an area.
+pub fn vertex_tangent_projectors(
+    positions: &[DVec3],
+    w: &[f64],
+    triangles: &[[u32; 3]],
+) -> Vec<DMat4> {
+    let at = |v: u32| positions[v as usize].extend(w[v as usize]);
+    let mut sum = vec![DMat4::ZERO; positions.len()];
+    for t in triangles {
+        let [a, b, c] = t.map(at);
+        let (e1, e2) = (b - a, c - a);
+        // The area of the triangle in 4D (Lagrange's identity).
+        let area = (e1.length_squared() * e2.length_squared() - e1.dot(e2).powi(2))
+            .max(0.0)
+            .sqrt();
+        let Some(p) = tangent_projector(e1, e2).filter(|_| area.is_finite()) else {
+            continue;
+        };
+        for &v in t {
+            sum[v as usize] += p * area;
+        }
+    }
+    for p in &mut sum {
+        // The weights sum to the trace (each projector's is 2).
+        let trace = p.x_axis.x + p.y_axis.y + p.z_axis.z + p.w_axis.w;
+        *p = if trace > 0.0 && trace.is_finite() {
+            *p * (2.0 / trace)
+        } else {
+            DMat4::ZERO
+        };
+    }
+    sum
+}
+
+/// Phong shading in 4D (Hanson and Heng's illumination of surfaces in four dimensions): a
+/// surface of colour `base` whose tangent plane has the projector `plane` (a mean of
+/// [`tangent_projector`]s) lit by [`phong`]'s two lights leaned [`LIGHT_W_TILT`] towards +w.
+/// A surface in 4D has a plane of normals, so the diffuse term is the length of the light's
+/// component in that plane, `sqrt(1 - lᵀ P l)`, and the specular one that of the halfway
+/// vector's; both need no orientation. A surface lying in a hyperplane w = const has the
+/// normal plane spanned by its 3D normal and w: its diffuse term is `sqrt((n·l)² cos² θ +
+/// sin² θ)` for the tilt θ, and what varies the shade is how the tangent plane leans in w.
+pub fn phong4(base: DVec3, plane: DMat4, view: DVec3, right: DVec3, up: DVec3) -> DVec3 {
+    let (sin, cos) = LIGHT_W_TILT.to_radians().sin_cos();
+    let to_eye = (-view).extend(0.0);
+    let normal_length = |d: DVec4| (1.0 - d.dot(plane * d)).clamp(0.0, 1.0).sqrt();
+    let mut c = base * 0.22;
+    for (l, strength) in lights(view, right, up) {
+        let l = (l * cos).extend(sin);
+        let diffuse = normal_length(l);
+        let specular = normal_length((l + to_eye).normalize()).powi(40);
         c += base * (diffuse * strength) + DVec3::splat(0.35 * strength * specular);
     }
     c.clamp(DVec3::ZERO, DVec3::ONE)
@@ -136,6 +217,53 @@ mod tests {
         // Normals that cancel even when turned: the triangle's own.
         let flat = shading_normal(p, [DVec3::X, -DVec3::X, DVec3::X], [0.5, 0.5, 0.0]);
         assert_eq!(flat, DVec3::Z);
+    }
+
+    #[test]
+    fn four_d_shading_of_a_flat_surface_is_that_of_its_normal_plane() {
+        let (view, right, up) = (-DVec3::Z, DVec3::X, DVec3::Y);
+        let base = DVec3::new(0.5, 0.6, 0.7);
+        let lit = |plane| phong4(base, plane, view, right, up);
+        // The plane z = w = 0 in either orientation and basis: one projector, one shade.
+        let p = tangent_projector(DVec4::X, DVec4::Y).unwrap();
+        let q = tangent_projector(DVec4::new(1.0, 1.0, 0.0, 0.0), -DVec4::X).unwrap();
+        assert!((p - q).abs_diff_eq(DMat4::ZERO, 1e-15));
+        assert_eq!(lit(p), lit(q));
+        // Its normal plane is (z, w): each light's diffuse term is the length of its
+        // (z, w) part, the specular term that of the halfway vector's.
+        let (sin, cos) = LIGHT_W_TILT.to_radians().sin_cos();
+        let mut expect = base * 0.22;
+        for (l, strength) in lights(view, right, up) {
+            let l4 = (l * cos).extend(sin);
+            let h = (l4 + DVec4::Z).normalize();
+            let diffuse = (l4.z * l4.z + l4.w * l4.w).sqrt();
+            let specular = (h.z * h.z + h.w * h.w).sqrt().powi(40);
+            expect += base * (diffuse * strength) + DVec3::splat(0.35 * strength * specular);
+        }
+        let expect = expect.clamp(DVec3::ZERO, DVec3::ONE);
+        assert!((lit(p) - expect).length() < 1e-12, "{} {expect}", lit(p));
+        // Tilted into w, the same plane in 3D reads differently: the 4D cue.
+        let tilted = tangent_projector(DVec4::new(1.0, 0.0, 0.0, 1.0), DVec4::Y).unwrap();
+        assert!((lit(tilted) - lit(p)).length() > 0.02);
+        // Without a plane (no triangle with an area), the surface is lit all over.
+        assert!(lit(DMat4::ZERO).is_finite());
+        assert_eq!(tangent_projector(DVec4::X, DVec4::X * 2.0), None);
+    }
+
+    #[test]
+    fn vertex_projectors_average_their_triangles_planes() {
+        // Two triangles folded along the x axis: one in the xy plane, one in the xw plane.
+        let positions = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::ZERO];
+        let w = [0.0, 0.0, 0.0, 1.0];
+        let triangles = [[0, 1, 2], [1, 0, 3]];
+        let p = vertex_tangent_projectors(&positions, &w, &triangles);
+        let xy = tangent_projector(DVec4::X, DVec4::Y).unwrap();
+        let xw = tangent_projector(DVec4::X, DVec4::W).unwrap();
+        assert!(p[2].abs_diff_eq(xy, 1e-15) && p[3].abs_diff_eq(xw, 1e-15));
+        assert!(p[0].abs_diff_eq((xy + xw) * 0.5, 1e-15));
+        // A vertex of no triangle has none.
+        let p = vertex_tangent_projectors(&[DVec3::ZERO], &[0.0], &[]);
+        assert_eq!(p, vec![DMat4::ZERO]);
     }
 
     #[test]
