@@ -22,6 +22,15 @@ pub enum Error {
         /// The offending vertex.
         source: BehindEye,
     },
+    /// The scene leaves its view to the view search, which has not run.
+    #[error(
+        "scene `{}`: its view is \"auto\", which the view search finds before a build (halo4d::resolve_view; halo4d build, render, animate and gallery run it)",
+        shorten(.scene)
+    )]
+    UnresolvedView {
+        /// The scene.
+        scene: String,
+    },
     /// The scene's numbers are finite but put its geometry where the files' f32 or the exact
     /// predicates cannot follow (too large or too small), or so many triangles that the
     /// stages from the halos on would need more memory than the limit

@@ -53,6 +53,14 @@ pub enum GalleryError {
         /// Why.
         source: crate::error::Error,
     },
+    /// The view search of a figure whose view is `"auto"` found no view.
+    #[error("figure {}: {source}", file.display())]
+    Search {
+        /// The scene file.
+        file: PathBuf,
+        /// Why.
+        source: crate::viewsearch::SearchError,
+    },
     /// The index page or the contact sheet could not be made or written.
     #[error("{}: {message}", path.display())]
     Write {
@@ -149,6 +157,10 @@ pub fn make(
     let (count, mut built) = (scenes.len(), Vec::new());
     for (k, (file, mut scene)) in scenes.into_iter().enumerate() {
         progress(k, count, &file);
+        crate::viewsearch::resolve(&mut scene, quiet).map_err(|source| GalleryError::Search {
+            file: file.clone(),
+            source,
+        })?;
         scene.outputs.png = true;
         let report = pipeline::build(&scene, &out.join(&scene.name), quiet).map_err(|source| {
             GalleryError::Build {

@@ -51,7 +51,7 @@ pub use pipeline::{
     sample_scene, write,
 };
 pub use scene::{DEFAULT_SCENE, Outputs, Scene, SceneError, SceneSurface};
-pub use viewsearch::{Found, SearchError, search as search_view};
+pub use viewsearch::{Found, SearchError, resolve as resolve_view, search as search_view};
 
 // Animations: a path through 4D views, and its frames.
 pub use animate::{

@@ -198,11 +198,19 @@ enum Command {
     },
 }
 
-fn load(scene: Option<PathBuf>) -> Result<Scene, halo4d::SceneError> {
-    match scene {
-        Some(path) => Scene::load(&path),
-        None => Ok(Scene::default_scene()),
+/// The scene file (the default scene without one), its view found by the view search when
+/// it is `"auto"`.
+fn load(scene: Option<PathBuf>, quiet: bool) -> Result<Scene, Box<dyn std::error::Error>> {
+    let mut scene = match scene {
+        Some(path) => Scene::load(&path)?,
+        None => Scene::default_scene(),
+    };
+    if let Some(found) = halo4d::resolve_view(&mut scene, quiet)?
+        && !quiet
+    {
+        eprintln!("{}", found.summary());
     }
+    Ok(scene)
 }
 
 /// The exit status of a build whose own verification failed.
@@ -226,7 +234,7 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
             quiet,
             allow_unverified,
         } => {
-            let scene = load(scene)?;
+            let scene = load(scene, quiet)?;
             let out = out.unwrap_or_else(|| PathBuf::from("exports").join(&scene.name));
             let report = halo4d::build(&scene, &out, quiet)?;
             eprint!("{}", report.summary());
@@ -265,16 +273,7 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
                 None => (halo4d::DEFAULT_SCENE.to_string(), Scene::default_scene()),
             };
             let found = halo4d::search_view(&parsed, quiet)?;
-            eprintln!(
-                "view search: {} 4D views on {} triangles in {:.1} s; visible share of the curves {:.3} (the scene's own view: {:.3}), score {:.0} ({:.0})",
-                found.views,
-                found.triangles,
-                found.ms / 1e3,
-                found.visible_curve_share,
-                found.start_share,
-                found.score,
-                found.start_score
-            );
+            eprintln!("{}", found.summary());
             let mut json: serde_json::Value = serde_json::from_str(&text)?;
             let rotation = serde_json::to_value(found.rotation)?;
             let object = json
@@ -311,7 +310,7 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
             stereo,
             quiet,
         } => {
-            let mut scene = load(scene)?;
+            let mut scene = load(scene, quiet)?;
             let r = &mut scene.render;
             r.width = width.unwrap_or(r.width);
             r.height = height.unwrap_or(r.height);
@@ -341,7 +340,7 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
             slices,
             quiet,
         } => {
-            let scene = load(scene)?;
+            let scene = load(scene, quiet)?;
             let files = if render {
                 let mut progress = |r: &Comparison| {
                     if !quiet {
@@ -439,7 +438,7 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
                 println!("{}", a.path.display());
                 return Ok(ExitCode::SUCCESS);
             }
-            let mut scene = load(scene)?;
+            let mut scene = load(scene, quiet)?;
             let r = &mut scene.render;
             r.width = width.unwrap_or(r.width);
             r.height = height.unwrap_or(r.height);

@@ -695,6 +695,11 @@ fn in_view(
     stages: Stages,
     bar: &ProgressBar,
 ) -> Result<Built, Error> {
+    if scene.view.auto {
+        return Err(Error::UnresolvedView {
+            scene: scene.name.clone(),
+        });
+    }
     let mut timings = samples.timings;
     let mut products = Vec::with_capacity(scene.surfaces.len());
     let mut projections = Vec::with_capacity(scene.surfaces.len());

@@ -30,8 +30,8 @@ pub struct Scene {
     pub description: String,
     /// The surfaces.
     pub surfaces: Vec<SceneSurface>,
-    /// The 4D view.
-    #[serde(default)]
+    /// The 4D view, or `"auto"`: the view search's ([`View::auto`]).
+    #[serde(default, deserialize_with = "crate::view::view_or_auto")]
     pub view: View,
     /// Default sampling for surfaces that set none.
     #[serde(default)]

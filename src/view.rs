@@ -190,12 +190,43 @@ impl Projection {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct View {
+    /// Whether the rotation (and the camera's azimuth and elevation) are left to the view
+    /// search, which starts from `rotation` (`"view": "auto"` in a scene file is short for
+    /// `{"auto": true}`). A build finds them before anything uses the view
+    /// (`halo4d::resolve_view`) and records the view found.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub auto: bool,
     /// Rotation angles in degrees.
     pub rotation: Rotation4,
     /// Translation (x, y, z, w) applied after the rotation.
     pub translation: [f64; 4],
     /// Projection to 3D.
     pub projection: Projection,
+}
+
+/// Reads a [`View`], or the string `"auto"` for `{"auto": true}` (serde's
+/// `deserialize_with` for a scene's `view`).
+pub fn view_or_auto<'de, D: serde::Deserializer<'de>>(d: D) -> Result<View, D::Error> {
+    struct Visitor;
+    impl<'de> serde::de::Visitor<'de> for Visitor {
+        type Value = View;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a view (an object with rotation, translation, projection) or \"auto\"")
+        }
+        fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<View, E> {
+            match v {
+                "auto" => Ok(View {
+                    auto: true,
+                    ..View::default()
+                }),
+                other => Err(E::invalid_value(serde::de::Unexpected::Str(other), &self)),
+            }
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<View, A::Error> {
+            View::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+        }
+    }
+    d.deserialize_any(Visitor)
 }
 
 /// A point at or behind the 4D eye.

@@ -83,8 +83,38 @@ impl Found {
         out.view.rotation = self.rotation;
         out.camera.azimuth = self.azimuth;
         out.camera.elevation = self.elevation;
+        out.view.auto = false;
         out
     }
+
+    /// One line: what the search did and what it found.
+    pub fn summary(&self) -> String {
+        format!(
+            "view search: {} 4D views on {} triangles in {:.1} s; visible share of the curves {:.3} (the scene's own view: {:.3}), score {:.0} ({:.0}); rotation {}, camera azimuth {} and elevation {}",
+            self.views,
+            self.triangles,
+            self.ms / 1e3,
+            self.visible_curve_share,
+            self.start_share,
+            self.score,
+            self.start_score,
+            serde_json::to_string(&self.rotation).unwrap_or_default(),
+            self.azimuth,
+            self.elevation
+        )
+    }
+}
+
+/// Finds the view of a scene whose view is left to the search (`"view": "auto"`,
+/// [`View::auto`]) with [`search`] (a progress bar unless `quiet`) and puts it into the
+/// scene; `None`, and the scene as it was, when the scene gives its view.
+pub fn resolve(scene: &mut Scene, quiet: bool) -> Result<Option<Found>, SearchError> {
+    if !scene.view.auto {
+        return Ok(None);
+    }
+    let found = search(scene, quiet)?;
+    *scene = found.apply(scene);
+    Ok(Some(found))
 }
 
 /// Why a search could not run.

@@ -23,3 +23,4 @@ mod surfaces;
 mod view;
 #[cfg(feature = "viewer")]
 mod viewer;
+mod viewsearch;

@@ -19,6 +19,7 @@ fn one_vertex(s: &Surface, u: f64, v: f64) -> Mesh4 {
 fn random_view(rng: &mut Rng, projection: Projection) -> View {
     let mut a = || 360.0 * rng.unit() - 180.0;
     View {
+        auto: false,
         rotation: Rotation4 {
             xy: a(),
             xz: a(),

@@ -696,8 +696,14 @@ impl Source {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
         {
-            let scene = Scene::load(path).map_err(crate::error::Error::from)?;
-            return Ok((Source::Model(Model::new(scene)?.into()), vec![]));
+            let mut scene = Scene::load(path).map_err(crate::error::Error::from)?;
+            // A view left to the search ("view": "auto") opens on the view it finds.
+            let notes = crate::viewsearch::resolve(&mut scene, false)
+                .map_err(|e| ViewerError::View(e.to_string()))?
+                .map(|found| found.summary())
+                .into_iter()
+                .collect();
+            return Ok((Source::Model(Model::new(scene)?.into()), notes));
         }
         let (imported, asset) = Asset::read(path)?;
         let mut notes = Vec::new();
