@@ -128,6 +128,78 @@ fn every_fixture_matches_the_exact_cpu_render_at_256_slices() {
     );
 }
 
+#[test]
+fn a_cutaway_removes_on_the_gpu_what_the_cpu_renderer_removes() {
+    // The Klein bottle keeps its double curves inside: a wedge through its centre opens it.
+    let gpu = gpu();
+    let mut scene = Scene::load(&crate::common::fixture("scenes/klein-bottle.json")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let (_, asset) = exported(&scene, dir.path());
+    let c = asset.centre();
+    scene.render.clip = Some(halo4d::Clip::wedge(
+        halo4d::ClipPlane {
+            normal: [0.0, 0.0, 1.0],
+            offset: c.z,
+        },
+        halo4d::ClipPlane {
+            normal: [1.0, 0.0, 0.0],
+            offset: c.x,
+        },
+    ));
+    let built = halo4d::run(&scene, true).unwrap();
+    let exact = exact_distances(&scene, &built);
+    let whole = distances(
+        &viewer::screenshot(gpu, &asset, &settings(&scene, HaloMode::Grid, 256)).unwrap(),
+    );
+    let removed = verdict_differs(&exact, &whole, SAME);
+    for mode in [HaloMode::Grid, HaloMode::View] {
+        let cut = ViewSettings {
+            clip: scene.render.clip,
+            ..settings(&scene, mode, 256)
+        };
+        let frame = viewer::screenshot(gpu, &asset, &cut).unwrap();
+        let differs = verdict_differs(&exact, &distances(&frame), SAME);
+        eprintln!(
+            "klein-bottle cut ({}): {:.3}% differ from the CPU, {:.1}% without the cut",
+            mode.name(),
+            differs * 100.0,
+            removed * 100.0
+        );
+        assert!(
+            differs < 0.02,
+            "{}: {:.2}% differ",
+            mode.name(),
+            differs * 100.0
+        );
+    }
+    assert!(
+        removed > 0.1,
+        "the cut changes {:.1}% of the picture",
+        removed * 100.0
+    );
+    // The cut edges in the ink (no other line drawn): none without the cut.
+    let ink = |clip| {
+        let s = ViewSettings {
+            clip,
+            curves: false,
+            silhouettes: false,
+            ..settings(&scene, HaloMode::Grid, 256)
+        };
+        let frame = viewer::screenshot(gpu, &asset, &s).unwrap();
+        frame
+            .picture
+            .rgb
+            .chunks(3)
+            .filter(|c| c.iter().all(|&v| v < 45))
+            .count()
+    };
+    let (cut, uncut) = (ink(scene.render.clip), ink(None));
+    assert!(
+        cut > 200 && uncut == 0,
+        "ink pixels: {cut} cut, {uncut} uncut"
+    );
+}
+
 /// Seeded 4D rotations: each of the six planes turned by up to 35 degrees either way.
 fn seeded_rotations(seed: u64, count: usize) -> Vec<Rotation4> {
     let mut rng = Rng(seed);

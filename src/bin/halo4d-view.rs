@@ -233,6 +233,7 @@ fn run(args: &Args) -> Result<(), ViewerError> {
             Map::Gray => Colormap::Gray,
         },
         style: args.style.unwrap_or(render.style),
+        clip: render.clip,
         stipple: render.stipple,
     };
     settings.check()?;

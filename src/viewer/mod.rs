@@ -121,6 +121,9 @@ pub struct ViewSettings {
     /// Shaded surfaces, or stipples on the first surface the halos leave visible (the
     /// stipples must be given to the renderer: [`Renderer::set_stipples`]).
     pub style: Style,
+    /// The scene's cutaway (`render.clip`): what lies beyond every plane is not drawn
+    /// (surfaces, curves, silhouettes, stipples), as the CPU renderer removes it.
+    pub clip: Option<crate::render::clip::Clip>,
     /// The stipples' size and colour, drawn per frame, and their count and seed, with which
     /// the set is made ([`Source::stipples`]).
     pub stipple: StippleSettings,
@@ -142,6 +145,7 @@ impl Default for ViewSettings {
             colour_by_w: true,
             colormap: Colormap::Diverging,
             style: Style::Shaded,
+            clip: None,
             stipple: StippleSettings::default(),
         }
     }

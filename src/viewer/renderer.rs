@@ -55,6 +55,7 @@ struct ViewUniform {
     depth_proj: [f32; 4],
     stipple: [f32; 4],
     stops: [[f32; 4]; 8],
+    cuts: [[f32; 4]; 2],
 }
 
 /// What a frame cost, in milliseconds of wall time.
@@ -998,7 +999,12 @@ impl Renderer {
                 (step * f64::from(settings.slices)) as f32,
             ],
             grid_dims: [dims[0], dims[1], dims[2], dims[0].next_multiple_of(64)],
-            options: [flags, stops.len() as u32, 0, settings.samples.isqrt()],
+            options: [
+                flags,
+                stops.len() as u32,
+                settings.clip.map_or(0, |c| c.planes().count() as u32),
+                settings.samples.isqrt(),
+            ],
             band: [0; 4],
             depth_proj: {
                 let (near, far) = (camera.near, camera.far);
@@ -1018,6 +1024,19 @@ impl Renderer {
                 0.0,
             ],
             stops: stop_array,
+            cuts: {
+                // The planes for positions relative to the centre: n · (p + c) > d.
+                let centre = self.asset.centre();
+                let mut cuts = [[0.0f32; 4]; 2];
+                for (slot, plane) in cuts
+                    .iter_mut()
+                    .zip(settings.clip.iter().flat_map(|c| c.planes()))
+                {
+                    let n = DVec3::from(plane.normal);
+                    *slot = v4(n, plane.offset - n.dot(centre));
+                }
+                cuts
+            },
         }
     }
 

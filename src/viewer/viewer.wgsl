@@ -22,7 +22,7 @@ struct View {
     // x, y, z: voxels; w: texels per row of the grid buffer.
     grid_dims: vec4<u32>,
     // x: flags (1 halos, 2 colour by w, 4 lines test the surfaces' depth, 8 surfaces in the
-    // background's colour, for stipples); y: colour stops;
+    // background's colour, for stipples); y: colour stops; z: clip planes (0 to 2);
     // w: samples per pixel along each side.
     options: vec4<u32>,
     // Voxelization of one band of the grid: x: items; y: the band's first z layer.
@@ -35,6 +35,9 @@ struct View {
     // x: a stipple's diameter in pixels; y: 1 when stipples take the colour of their w.
     stipple: vec4<f32>,
     stops: array<vec4<f32>, 8>,
+    // render.clip: options.z planes (xyz: normal, w: offset, relative to the centre);
+    // a point beyond every one is removed.
+    cuts: array<vec4<f32>, 2>,
 }
 
 @group(0) @binding(0) var<uniform> view: View;
@@ -105,6 +108,39 @@ fn phong(base: vec3<f32>, normal: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
         c += base * (diffuse * lights[k].w) + vec3<f32>(0.35 * lights[k].w * specular);
     }
     return clamp(c, vec3<f32>(0.0), vec3<f32>(1.0));
+}
+
+// Whether render.clip removes p (render::clip::Clip::removes): beyond every plane.
+fn clipped(p: vec3<f32>) -> bool {
+    let n = view.options.z;
+    if n == 0u {
+        return false;
+    }
+    for (var k = 0u; k < n; k++) {
+        if dot(view.cuts[k].xyz, p) <= view.cuts[k].w {
+            return false;
+        }
+    }
+    return true;
+}
+
+// Whether p lies on a cut edge of render.clip: within half the lines' width (in pixels,
+// measured by the screen derivative of its distance) of a plane, on the kept side, where
+// the other plane removes (a wedge's edge) or there is none. The CPU renderer draws these
+// edges as lines; the explorer draws the kept surface's fringe along them in the ink.
+// Called in uniform control flow (the derivatives need it).
+fn on_cut_edge(p: vec3<f32>) -> bool {
+    let s = vec2<f32>(dot(view.cuts[0].xyz, p) - view.cuts[0].w, dot(view.cuts[1].xyz, p) - view.cuts[1].w);
+    let reach = fwidth(s) * view.viewport.z;
+    let n = view.options.z;
+    if n == 0u {
+        return false;
+    }
+    let near = s <= vec2<f32>(0.0) & s > -reach;
+    if n == 1u {
+        return near.x;
+    }
+    return (near.x && s.y > 0.0) || (near.y && s.x > 0.0);
 }
 
 // The direction of the eye ray through p.
@@ -216,18 +252,20 @@ struct OpaqueOut {
 
 @fragment
 fn surface_grid_fs(in: SurfaceOut) -> OpaqueOut {
-    if hidden_in_grid(in) {
+    let edge = on_cut_edge(in.pos);
+    if clipped(in.pos) || hidden_in_grid(in) {
         discard;
     }
-    return OpaqueOut(vec4<f32>(surface_colour(in), 1.0), ray_distance(in.pos));
+    return OpaqueOut(vec4<f32>(select(surface_colour(in), INK, edge), 1.0), ray_distance(in.pos));
 }
 
 @fragment
 fn surface_view_fs(in: SurfaceOut) -> OpaqueOut {
-    if slab_of(view_depth(in.pos)) != in.slab || hidden_in_slab(in) {
+    let edge = on_cut_edge(in.pos);
+    if clipped(in.pos) || slab_of(view_depth(in.pos)) != in.slab || hidden_in_slab(in) {
         discard;
     }
-    return OpaqueOut(vec4<f32>(surface_colour(in), 1.0), ray_distance(in.pos));
+    return OpaqueOut(vec4<f32>(select(surface_colour(in), INK, edge), 1.0), ray_distance(in.pos));
 }
 
 // Weighted blended order-independent transparency (McGuire and Bavoil 2013), with paper
@@ -237,33 +275,38 @@ struct BlendOut {
     @location(1) reveal: f32,
 }
 
-fn blended(in: SurfaceOut) -> BlendOut {
+fn blended(in: SurfaceOut, edge: bool) -> BlendOut {
     let dir = ray_dir(in.pos);
     var n = in.normal;
     if dot(n, n) < 1e-20 {
         n = view.forward.xyz;
     }
     let c = abs(dot(normalize(n), dir));
-    let alpha = 1.0 - pow(1.0 - view.background.a, 1.0 / max(c, 0.02));
+    var alpha = 1.0 - pow(1.0 - view.background.a, 1.0 / max(c, 0.02));
+    if edge {
+        alpha = 1.0;
+    }
     let d = clamp((view_depth(in.pos) - view.slabs.x) / view.slabs.w, 0.0, 1.0);
     let weight = alpha * clamp(3e3 * pow(1.0 - d, 3.0), 1e-2, 3e3);
-    return BlendOut(vec4<f32>(surface_colour(in) * weight, weight), alpha);
+    return BlendOut(vec4<f32>(select(surface_colour(in), INK, edge) * weight, weight), alpha);
 }
 
 @fragment
 fn surface_grid_blend_fs(in: SurfaceOut) -> BlendOut {
-    if hidden_in_grid(in) {
+    let edge = on_cut_edge(in.pos);
+    if clipped(in.pos) || hidden_in_grid(in) {
         discard;
     }
-    return blended(in);
+    return blended(in, edge);
 }
 
 @fragment
 fn surface_view_blend_fs(in: SurfaceOut) -> BlendOut {
-    if slab_of(view_depth(in.pos)) != in.slab || hidden_in_slab(in) {
+    let edge = on_cut_edge(in.pos);
+    if clipped(in.pos) || slab_of(view_depth(in.pos)) != in.slab || hidden_in_slab(in) {
         discard;
     }
-    return blended(in);
+    return blended(in, edge);
 }
 
 // ---------------------------------------------------------------- composite
@@ -310,6 +353,8 @@ struct LineOut {
     @location(0) @interpolate(linear) centre: vec3<f32>,
     // The line's colour (linear).
     @location(1) @interpolate(flat) ink: vec3<f32>,
+    // The point of the line under this fragment (for the clip).
+    @location(2) pos: vec3<f32>,
 }
 
 // The CPU renderer's curve inks (render::overlay::curve_ink): the w scale in OVER_BANDS
@@ -348,6 +393,7 @@ fn band(p: vec3<f32>, q: vec3<f32>, vertex: u32) -> LineOut {
     let end = select(sa, sb, c.x > 0.5) + along * (c.x * 2.0 - 1.0);
     let offset = (across * c.y + along * (c.x * 2.0 - 1.0)) / half_size;
     out.clip = vec4<f32>(clip.xy + offset * clip.w, 0.0, clip.w);
+    out.pos = select(p, q, c.x > 0.5);
     // Pixels from the top left, as the fragment position.
     out.centre = vec3<f32>(
         half_size.x + end.x,
@@ -412,6 +458,9 @@ fn depth_of(z: f32) -> f32 {
 // it does.
 @fragment
 fn line_fs(in: LineOut) -> OpaqueOut {
+    if clipped(in.pos) {
+        discard;
+    }
     if (view.options.x & 4u) != 0u {
         let size = vec2<i32>(view.viewport.xy);
         let at = vec2<i32>(floor(in.centre.xy));
@@ -669,6 +718,9 @@ fn stipple_vs(@builtin(vertex_index) i: u32) -> StippleOut {
     }
     let l = vec3<f32>(s.bary, 1.0 - s.bary.x - s.bary.y);
     let p = a.pos * l.x + b.pos * l.y + c.pos * l.z;
+    if clipped(p) {
+        return out;
+    }
     let dir = ray_dir(p);
     let face = face_normals[t].xyz;
     var n = a.normal * l.x + b.normal * l.y + c.normal * l.z;
