@@ -460,6 +460,57 @@ fn frame(p: &Projected, triangles: &[[u32; 3]], stars: &Stars) -> Frame {
 /// Halvings of rho at a vertex before it collapses to zero.
 pub const HALVINGS: u32 = 10;
 
+/// How fast rho may grow along the surface away from where it is lowered (a shrunk,
+/// collapsed or singular vertex): at most this much per unit of distance along the mesh's
+/// edges. Halved at single vertices and kept at their neighbours, rho would jump from vertex
+/// to vertex, and the gap the halo cuts into a sheet passing under would follow the mesh in
+/// a staircase; graded, the gap's edge runs smoothly and shrinks no faster than this.
+pub const RHO_SLOPE: f64 = 0.25;
+
+/// Lowers `rho` to its graded envelope, the largest field below it that grows by at most
+/// [`RHO_SLOPE`] times the length of every mesh edge (Dijkstra from every vertex at once,
+/// in one deterministic order). Gives the vertices it lowered.
+fn grade(rho: &mut [f64], positions: &[DVec3], triangles: &[[u32; 3]], stars: &Stars) -> Vec<u32> {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+    /// A vertex and its rho, ordered by rho, then by index.
+    #[derive(PartialEq)]
+    struct Entry(f64, u32);
+    impl Eq for Entry {}
+    impl PartialOrd for Entry {
+        fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+            Some(self.cmp(other))
+        }
+    }
+    impl Ord for Entry {
+        fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+            self.0.total_cmp(&other.0).then(self.1.cmp(&other.1))
+        }
+    }
+    let before = rho.to_vec();
+    let mut heap: BinaryHeap<Reverse<Entry>> = (0..rho.len())
+        .map(|v| Reverse(Entry(rho[v], v as u32)))
+        .collect();
+    while let Some(Reverse(Entry(r, v))) = heap.pop() {
+        if r > rho[v as usize] {
+            continue;
+        }
+        for &(t, _) in stars.of(v as usize) {
+            for u in triangles[t as usize] {
+                let reach =
+                    r + RHO_SLOPE * (positions[u as usize] - positions[v as usize]).length();
+                if reach < rho[u as usize] {
+                    rho[u as usize] = reach;
+                    heap.push(Reverse(Entry(reach, u)));
+                }
+            }
+        }
+    }
+    (0..rho.len() as u32)
+        .filter(|&v| rho[v as usize] < before[v as usize])
+        .collect()
+}
+
 /// Rounds to f32, the precision of the exported files, so that the checked halo is the
 /// exported one.
 fn f32_exact(p: DVec3) -> DVec3 {
@@ -605,24 +656,37 @@ pub fn build_halo(
         // the prism is as thin as it can be) ends it too, and the checker counts what is
         // left. No grading of rho between neighbours is needed: the surface triangle is a
         // face of both layers, so however rho varies the surface keeps t = 1/2.
+        // Then rho is graded around every lowered vertex ([`grade`]); where that inverts a
+        // tetrahedron (rho only falls, but unevenly), the halving starts again. Both only
+        // lower rho, so this ends too.
         loop {
-            bad.sort_unstable();
-            bad.dedup();
-            bad.retain(|&v| offsets.rho[v as usize] > 0.0);
-            if bad.is_empty() {
+            loop {
+                bad.sort_unstable();
+                bad.dedup();
+                bad.retain(|&v| offsets.rho[v as usize] > 0.0);
+                if bad.is_empty() {
+                    break;
+                }
+                for &v in &bad {
+                    let v = v as usize;
+                    offsets.rho[v] = if offsets.rho[v] > floor {
+                        0.5 * offsets.rho[v]
+                    } else {
+                        0.0
+                    };
+                    offsets.place(v);
+                }
+                let touched = std::mem::take(&mut bad);
+                reexamine(&touched, &offsets, &mut bad);
+            }
+            let lowered = grade(&mut offsets.rho, &projected.positions, triangles, &stars);
+            if lowered.is_empty() {
                 break;
             }
-            for &v in &bad {
-                let v = v as usize;
-                offsets.rho[v] = if offsets.rho[v] > floor {
-                    0.5 * offsets.rho[v]
-                } else {
-                    0.0
-                };
-                offsets.place(v);
+            for &v in &lowered {
+                offsets.place(v as usize);
             }
-            let touched = std::mem::take(&mut bad);
-            reexamine(&touched, &offsets, &mut bad);
+            reexamine(&lowered, &offsets, &mut bad);
         }
     }
     lap(&mut stage_ms.shrink);
@@ -680,4 +744,50 @@ pub fn build_halo(
         stage_ms,
     };
     (halo, report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grading_lowers_rho_to_its_envelope_and_nothing_else() {
+        // A strip of 2 x 6 vertices a unit apart along x: one vertex at 0 (a collapsed
+        // vertex) lowers its neighbours by RHO_SLOPE per unit of distance, up to the
+        // given rho.
+        let positions: Vec<DVec3> = (0..12)
+            .map(|i| DVec3::new((i % 6) as f64, (i / 6) as f64, 0.0))
+            .collect();
+        let triangles: Vec<[u32; 3]> = (0..5)
+            .flat_map(|i| [[i, i + 1, i + 7], [i, i + 7, i + 6]])
+            .collect();
+        let stars = Stars::new(12, &triangles);
+        let mut rho = vec![1.0; 12];
+        rho[0] = 0.0;
+        let lowered = grade(&mut rho, &positions, &triangles, &stars);
+        for (v, &r) in rho.iter().enumerate() {
+            // The graph distance from vertex 0 along the strip's edges.
+            let (x, y) = ((v % 6) as f64, (v / 6) as f64);
+            let distance = if y == 0.0 {
+                x
+            } else {
+                (x - 1.0).max(0.0) + std::f64::consts::SQRT_2.min(1.0 + x)
+            };
+            let expect = (RHO_SLOPE * distance).min(1.0);
+            assert!(
+                (r - expect).abs() < 1e-12,
+                "vertex {v}: {r} against {expect}"
+            );
+        }
+        assert_eq!(
+            lowered,
+            (1..12u32)
+                .filter(|&v| rho[v as usize] < 1.0)
+                .collect::<Vec<_>>()
+        );
+        // Graded once, it is its own envelope.
+        let again = rho.clone();
+        assert!(grade(&mut rho, &positions, &triangles, &stars).is_empty());
+        assert_eq!(rho, again);
+    }
 }

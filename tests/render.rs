@@ -1003,18 +1003,27 @@ fn the_colour_bar_is_labelled_with_w_where_the_picture_has_room() {
     }
 }
 
-/// The picture of `scene` at 256 x 256 without its lines, as linear luminance per pixel
-/// (`None` on the background), with every surface sampled at `tolerance`.
-fn luminance_at_tolerance(scene: &Scene, tolerance: f64) -> Vec<Option<f64>> {
+/// The picture of `scene` at `side` x `side` without its lines, as linear luminance per
+/// pixel (`None` on the background), with every surface sampled at `tolerance`, and with
+/// its halos or without them.
+fn luminance_at_tolerance(
+    scene: &Scene,
+    tolerance: f64,
+    side: u32,
+    halos: bool,
+) -> Vec<Option<f64>> {
     let mut scene = scene.clone();
     (
         scene.render.width,
         scene.render.height,
         scene.render.samples,
-    ) = (256, 256, 4);
-    (scene.render.curves, scene.render.silhouettes) = (false, false);
-    // The shading alone: the halos' gaps follow the mesh near tangential contacts.
-    scene.render.halos = false;
+    ) = (side, side, 4);
+    (
+        scene.render.curves,
+        scene.render.silhouettes,
+        scene.render.broken_edges,
+    ) = (false, false, false);
+    scene.render.halos = halos;
     scene.sampling = halo4d::Sampling::adaptive(tolerance);
     for s in &mut scene.surfaces {
         s.sampling = None;
@@ -1035,31 +1044,45 @@ fn luminance_at_tolerance(scene: &Scene, tolerance: f64) -> Vec<Option<f64>> {
         .collect()
 }
 
-/// An artifact of the mesh (a shading seam, a crack, a wedge cut by a halo's staircase)
-/// moves or vanishes when the surface is sampled four times finer (sixteen times the
-/// triangles); the shading of the surface itself does not. Counts the pixels covered in
-/// both pictures whose luminance differs by more than 0.06 with none of their 3 x 3
-/// neighbourhood on the background (a silhouette moving by a fraction of a pixel is not an
-/// artifact).
-fn artifact_pixels(scene: &Scene, tolerance: f64) -> (usize, usize) {
-    let coarse = luminance_at_tolerance(scene, tolerance);
-    let fine = luminance_at_tolerance(scene, tolerance / 16.0);
-    let n = 256usize;
-    let interior = |x: usize, y: usize| {
-        (y.saturating_sub(1)..=(y + 1).min(n - 1)).all(|j| {
-            (x.saturating_sub(1)..=(x + 1).min(n - 1))
-                .all(|i| coarse[j * n + i].is_some() && fine[j * n + i].is_some())
-        })
+/// An artifact of the mesh (a shading seam, a crack, a gap's edge in a staircase) moves or
+/// vanishes when the surface is sampled four times finer (sixteen times the triangles); the
+/// shading of the surface itself does not. Counts the pixels covered in both `side` x
+/// `side` pictures (with the halos or without) with none of their 3 x 3 neighbourhood on
+/// the background (a silhouette moving by a fraction of a pixel is not an artifact) whose
+/// luminance differs by more than 0.06 from the other picture's at the same pixel or, with
+/// `shift`, from every pixel of its 3 x 3 neighbourhood there, either way (an edge inside
+/// the picture that moves by a pixel is not an artifact either).
+fn artifact_pixels(
+    scene: &Scene,
+    tolerance: f64,
+    side: u32,
+    halos: bool,
+    shift: bool,
+) -> (usize, usize) {
+    let coarse = luminance_at_tolerance(scene, tolerance, side, halos);
+    let fine = luminance_at_tolerance(scene, tolerance / 16.0, side, halos);
+    let n = side as usize;
+    let around = |x: usize, y: usize| {
+        (y.saturating_sub(1)..=(y + 1).min(n - 1))
+            .flat_map(move |j| (x.saturating_sub(1)..=(x + 1).min(n - 1)).map(move |i| j * n + i))
+    };
+    let matched = |other: &[Option<f64>], x: usize, y: usize, v: f64| {
+        let close = |k: usize| other[k].is_some_and(|o| (o - v).abs() <= 0.06);
+        if shift {
+            around(x, y).any(close)
+        } else {
+            close(y * n + x)
+        }
     };
     let (mut covered, mut differ) = (0, 0);
     for y in 0..n {
         for x in 0..n {
-            if !interior(x, y) {
+            if !around(x, y).all(|k| coarse[k].is_some() && fine[k].is_some()) {
                 continue;
             }
             covered += 1;
             let (a, b) = (coarse[y * n + x].unwrap(), fine[y * n + x].unwrap());
-            if (a - b).abs() > 0.06 {
+            if !matched(&fine, x, y, a) || !matched(&coarse, x, y, b) {
                 differ += 1;
             }
         }
@@ -1083,13 +1106,29 @@ fn pictures_of_non_orientable_surfaces_have_no_shading_seam() {
             *scene.view.rotation.angle_mut(plane).unwrap() = angle;
         }
         scene.camera = halo4d::CameraSettings::default();
-        let (differ, covered) = artifact_pixels(&scene, 1e-3);
+        let (differ, covered) = artifact_pixels(&scene, 1e-3, 256, false, false);
         assert!(covered > 5000, "{name}: {covered} pixels covered");
         assert!(
             differ * 1000 <= covered,
             "{name}: {differ} of {covered} covered pixels change when the surface is sampled finer"
         );
     }
+}
+
+#[test]
+fn the_default_picture_has_no_artifact_of_the_mesh_where_the_halos_cut_the_sheets() {
+    // Rho halved at single vertices where the offsets fold jumped between neighbours, and
+    // the gaps' edges followed the mesh in a staircase: 1.28% of the covered pixels at 512
+    // changed when the surface was sampled finer (2,106 of 164,170). Graded (halo::RHO_SLOPE),
+    // 0.61%: what is left is the gaps' edges, piecewise linear on the coarse mesh, moving by
+    // a pixel or two.
+    let scene = Scene::default_scene();
+    let (differ, covered) = artifact_pixels(&scene, 1e-3, 512, true, true);
+    assert!(covered > 100_000, "{covered} pixels covered");
+    assert!(
+        differ * 100 <= covered,
+        "{differ} of {covered} covered pixels change when the surface is sampled finer"
+    );
 }
 
 /// The distance along the ray (`o`, unit `d`) to the triangle `p`, when it crosses it
