@@ -21,6 +21,10 @@ pub struct HaloIndex<'a> {
     /// Per global tetrahedron, the surface vertices it is built over (an inserted vertex
     /// stands for those of the tetrahedra around it), sorted, padded with `u32::MAX`.
     over: Vec<[u32; 6]>,
+    /// Per global tetrahedron, a lower bound of its halo depth anywhere in it ([`floor`]):
+    /// a point at a depth below it is hidden by nothing there, so its corners need no
+    /// exact test.
+    floor: Vec<f64>,
     bvh: obvhs::bvh2::Bvh2,
 }
 
@@ -38,11 +42,12 @@ impl<'a> HaloIndex<'a> {
         let mut boxes = Vec::new();
         let mut tets = Vec::new();
         let mut over = Vec::new();
+        let mut floors = Vec::new();
         for (s, halo) in halos.iter().enumerate() {
             let Some(h) = halo else { continue };
             let n = h.surface_vertices as u32;
             let inserted = inserted_sets(h);
-            let kept: Vec<(u32, Aabb, [u32; 6])> = (0..h.tets.len() as u32)
+            let kept: Vec<(u32, Aabb, [u32; 6], f64)> = (0..h.tets.len() as u32)
                 .into_par_iter()
                 .filter(|&i| keep(s, i))
                 .map(|i| {
@@ -62,21 +67,29 @@ impl<'a> HaloIndex<'a> {
                     for (slot, v) in padded.iter_mut().zip(vs) {
                         *slot = v;
                     }
-                    (i, aabb, padded)
+                    (i, aabb, padded, floor(h, i))
                 })
                 .collect();
-            for (i, aabb, vs) in kept {
+            for (i, aabb, vs, f) in kept {
                 boxes.push(aabb);
                 tets.push((s as u32, i));
                 over.push(vs);
+                floors.push(f);
             }
         }
         HaloIndex {
             halos,
             tets,
             over,
+            floor: floors,
             bvh: broad::build(&boxes, 4),
         }
+    }
+
+    /// Whether tetrahedron `g` may hide a point at depth `w`: its halo depth can be below
+    /// `w` somewhere ([`floor`]).
+    fn may_hide(&self, g: u32, w: f64) -> bool {
+        self.floor[g as usize] < w
     }
 
     /// Whether the point `x` of a triangle (with vertices `own`) of surface `surface`, at
@@ -85,7 +98,9 @@ impl<'a> HaloIndex<'a> {
     pub fn hidden(&self, x: DVec3, w: f64, surface: u32, own: [u32; 3]) -> bool {
         let mut hidden = false;
         self.visit(x, |g| {
-            if !self.within(g, surface, &own) && self.depth_at(g, x).is_some_and(|depth| depth < w)
+            if self.may_hide(g, w)
+                && !self.within(g, surface, &own)
+                && self.depth_at(g, x).is_some_and(|depth| depth < w)
             {
                 hidden = true;
             }
@@ -156,7 +171,10 @@ impl<'a> HaloIndex<'a> {
     pub(crate) fn hiders(&self, x: DVec3, w: f64, own: (u32, &[u32])) -> Vec<Hider> {
         let mut out = Vec::new();
         self.visit(x, |g| {
-            if !self.within(g, own.0, own.1) && self.depth_at(g, x).is_some_and(|depth| depth < w) {
+            if self.may_hide(g, w)
+                && !self.within(g, own.0, own.1)
+                && self.depth_at(g, x).is_some_and(|depth| depth < w)
+            {
                 out.push(Hider(g));
             }
             true
@@ -221,6 +239,21 @@ pub(crate) fn inserted_sets(h: &HaloPart) -> Vec<Vec<u32>> {
         set.dedup();
     }
     sets
+}
+
+/// A lower bound of the halo depth [`HaloIndex::depth_at`] computes anywhere in tetrahedron
+/// `i` of `h`: the smallest d_orig of its corners (an interpolation of them) plus the most
+/// eq. 3's term can take from it where delta_d is negative, lowered by a few units in the
+/// last place for the rounding of the interpolation, so that no point it could hide is
+/// skipped.
+pub(crate) fn floor(h: &HaloPart, i: u32) -> f64 {
+    let lowest = h.tets[i as usize]
+        .iter()
+        .map(|&v| h.d_orig[v as usize])
+        .fold(f64::INFINITY, f64::min);
+    let term = (1.0 - h.delta_t).max(0.0) * h.delta_d.min(0.0);
+    let bound = lowest + term;
+    bound - 8.0 * f64::EPSILON * (lowest.abs() + term.abs())
 }
 
 /// The f32 box around tetrahedron `i` of `h` (rounded outward).
