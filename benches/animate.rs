@@ -13,9 +13,10 @@ fn frame(c: &mut Criterion) {
         "/fixtures/animations/spun-trefoil-xw.json"
     );
     let scene = halo4d::Scene::load(std::path::Path::new(path)).expect("the fixture loads");
-    let samples = halo4d::sample_scene(&scene);
+    let samples = halo4d::Sampled::of(&scene);
     let frame = scene.frame(90).expect("the animation has a frame 90");
-    let built = halo4d::run_sampled(&frame, samples.clone()).expect("the frame builds");
+    let stages = halo4d::Stages::verified_picture(&frame);
+    let built = samples.build(&frame, stages).expect("the frame builds");
     assert!(built.failures().is_empty(), "{:?}", built.failures());
     let picture = || {
         built
@@ -26,12 +27,12 @@ fn frame(c: &mut Criterion) {
     let mut group = c.benchmark_group("animate/default_scene_512");
     group.sample_size(10);
     group.bench_function("build", |b| {
-        b.iter(|| halo4d::run_sampled(black_box(&frame), samples.clone()).expect("builds"))
+        b.iter(|| samples.build(black_box(&frame), stages).expect("builds"))
     });
     group.bench_function("picture", |b| b.iter(picture));
     group.bench_function("frame", |b| {
         b.iter(|| {
-            let built = halo4d::run_sampled(black_box(&frame), samples.clone()).expect("builds");
+            let built = samples.build(black_box(&frame), stages).expect("builds");
             built
                 .render(&frame.halo, &frame.render, &frame.camera)
                 .expect("renders")

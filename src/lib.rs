@@ -46,9 +46,8 @@ mod viewsearch;
 // The scene, the build and what it gives.
 pub use error::Error;
 pub use pipeline::{
-    Bounds, Built, MemoryReport, Report, Samples, SamplingReport, Stages, SurfaceProduct,
-    SurfaceReport, Timings, build, glb_bytes, render_to, run, run_for_picture, run_sampled,
-    sample_scene, write,
+    Bounds, Built, MemoryReport, Report, Sampled, SamplingReport, Stages, SurfaceProduct,
+    SurfaceReport, Timings, build, glb_bytes, render_to, run, run_for_picture, shown_curves, write,
 };
 pub use scene::{DEFAULT_SCENE, Outputs, Scene, SceneError, SceneSurface};
 pub use viewsearch::{Found, SearchError, resolve as resolve_view, search as search_view};

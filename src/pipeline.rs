@@ -6,7 +6,7 @@
 use crate::error::Error;
 use crate::export::{self, SurfaceData};
 use crate::halo::{Halo, HaloParams, HaloReport, build_halo};
-use crate::intersect::{self, Curves, CurvesReport};
+use crate::intersect::{self, Curves, CurvesReport, Sheet};
 use crate::limits::{MAX_COORDINATE, MIN_EXTENT};
 use crate::parts::{HaloPart, Parts, SurfacePart};
 use crate::render::{self, CameraSettings, Picture, RenderError, RenderSettings, Style};
@@ -95,6 +95,17 @@ impl Stages {
     /// The stages `scene`'s outputs need.
     pub fn of(scene: &Scene) -> Stages {
         Stages::with_picture(scene, scene.outputs.png || scene.outputs.svg)
+    }
+
+    /// Every stage of a verified build with its picture, whatever files the scene writes:
+    /// an animation's frame.
+    pub fn verified_picture(scene: &Scene) -> Stages {
+        Stages {
+            halos: true,
+            curves: true,
+            verify: true,
+            ..Stages::with_picture(scene, true)
+        }
     }
 
     /// The stages `scene`'s outputs need, with a picture's when `picture` whatever the scene
@@ -591,10 +602,11 @@ fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error
 }
 
 /// A scene's surfaces sampled (or read from their files) and audited: what a build makes
-/// before the view, which an animation makes once for all its frames ([`sample_scene`],
-/// [`run_sampled`]).
+/// before the view, which does not depend on the view. Sample once ([`Sampled::of`]), then
+/// build any number of views ([`Sampled::build`]): what an animation does for its frames,
+/// and what the explorer turns ([`Sampled::curves`] gives it the curves a build shows).
 #[derive(Clone, Debug)]
-pub struct Samples {
+pub struct Sampled {
     surfaces: Vec<Sample>,
     /// The sampling and audit times (the other stages 0).
     timings: Timings,
@@ -608,7 +620,50 @@ struct Sample {
     report: SamplingReport,
 }
 
-impl Samples {
+impl Sampled {
+    /// Samples (or reads) and audits every surface of the scene, printing the warnings a
+    /// build prints.
+    pub fn of(scene: &Scene) -> Sampled {
+        sample_with(scene, &ProgressBar::hidden())
+    }
+
+    /// The build of `scene` from these samples (of a scene with the same surfaces and
+    /// sampling) in its view: the stages `stages` asks for ([`Stages::of`] for what its
+    /// outputs need); the sampling times are these samples'.
+    pub fn build(&self, scene: &Scene, stages: Stages) -> Result<Built, Error> {
+        self.clone().into_built(scene, stages)
+    }
+
+    /// [`Sampled::build`], the samples moved into the build.
+    pub fn into_built(self, scene: &Scene, stages: Stages) -> Result<Built, Error> {
+        in_view(scene, self, stages, &ProgressBar::hidden())
+    }
+
+    /// The curves a build of `scene` (of the same surfaces and sampling) shows in its view:
+    /// the exact curves of the projected meshes, moved onto the analytic surfaces as
+    /// `scene.curves` says ([`Built::shown_curves`]), without the halos or a picture.
+    pub fn curves(&self, scene: &Scene) -> Result<Curves, Error> {
+        shown_curves(scene, &self.meshes().map(|(_, m)| m).collect::<Vec<_>>())
+    }
+
+    /// Each surface's name and 4D mesh, in the scene's order.
+    pub fn meshes(&self) -> impl Iterator<Item = (&str, &Mesh4)> {
+        self.surfaces.iter().map(|s| (s.name.as_str(), &s.mesh))
+    }
+
+    /// Each surface's sampling report (method, tolerance met, audited error, times).
+    pub fn reports(&self) -> impl Iterator<Item = &SamplingReport> {
+        self.surfaces.iter().map(|s| &s.report)
+    }
+
+    /// Each surface's name and 4D mesh, moved out.
+    pub fn into_meshes(self) -> Vec<(String, Mesh4)> {
+        self.surfaces
+            .into_iter()
+            .map(|s| (s.name, s.mesh))
+            .collect()
+    }
+
     /// Triangles of all surfaces.
     pub fn triangles(&self) -> usize {
         self.surfaces.iter().map(|s| s.mesh.triangles.len()).sum()
@@ -620,27 +675,72 @@ impl Samples {
     }
 }
 
-/// Samples (or reads) and audits every surface of the scene, printing the warnings a build
-/// prints.
-pub fn sample_scene(scene: &Scene) -> Samples {
-    sample_with(scene, &ProgressBar::hidden())
+/// The curves a build of `scene` shows from its surfaces' 4D meshes (one per surface, in
+/// the scene's order): each mesh projected as the build projects it, the exact curves of
+/// the sheets, and those refined onto the analytic surfaces when `scene.curves.refine`.
+pub fn shown_curves(scene: &Scene, meshes: &[&Mesh4]) -> Result<Curves, Error> {
+    if scene.view.auto {
+        return Err(Error::UnresolvedView {
+            scene: scene.name.clone(),
+        });
+    }
+    let projected = meshes
+        .iter()
+        .enumerate()
+        .map(|(i, mesh)| {
+            scene.view.project(mesh).map_err(|source| Error::View {
+                scene: scene.name.clone(),
+                surface: scene.surface_name(i),
+                source,
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let sheets: Vec<Sheet> = projected
+        .iter()
+        .zip(meshes)
+        .map(|(p, mesh)| Sheet {
+            positions: &p.positions,
+            w: &p.w,
+            triangles: &mesh.triangles,
+        })
+        .collect();
+    let curves = intersect::curves(&sheets);
+    if !scene.curves.refine {
+        return Ok(curves);
+    }
+    let (lo, hi) = projected.iter().filter_map(|p| p.bounds()).fold(
+        (DVec3::INFINITY, DVec3::NEG_INFINITY),
+        |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
+    );
+    let sources = scene.surfaces.iter().map(|s| &s.surface);
+    Ok(refine_curves(
+        scene,
+        &curves,
+        &sheets,
+        sources.zip(meshes.iter().copied()),
+        (hi - lo).length(),
+    ))
 }
 
-/// The build of `scene` from its `samples` ([`sample_scene`] of a scene with the same
-/// surfaces and sampling): the view, the stages a picture needs, and the halos verified
-/// against the curves whatever files the scene writes; the sampling times are those of
-/// `samples`.
-pub fn run_sampled(scene: &Scene, samples: Samples) -> Result<Built, Error> {
-    let stages = Stages {
-        halos: true,
-        curves: true,
-        verify: true,
-        ..Stages::with_picture(scene, true)
-    };
-    in_view(scene, samples, stages, &ProgressBar::hidden())
+/// `curves` (found on `sheets`) moved onto the analytic surfaces of `surfaces` (each
+/// surface's source and 4D mesh, in the sheets' order) in the scene's view.
+fn refine_curves<'a>(
+    scene: &Scene,
+    curves: &Curves,
+    sheets: &[Sheet],
+    surfaces: impl Iterator<Item = (&'a Source, &'a Mesh4)>,
+    diagonal: f64,
+) -> Curves {
+    let analytic: Vec<intersect::Analytic> = surfaces
+        .map(|(source, mesh)| intersect::Analytic {
+            surface: source.parametric(),
+            mesh,
+        })
+        .collect();
+    intersect::refine(curves, sheets, &analytic, &scene.view, diagonal)
 }
 
-fn sample_with(scene: &Scene, bar: &ProgressBar) -> Samples {
+fn sample_with(scene: &Scene, bar: &ProgressBar) -> Sampled {
     let mut timings = Timings::default();
     let mut surfaces = Vec::with_capacity(scene.surfaces.len());
     for (i, entry) in scene.surfaces.iter().enumerate() {
@@ -685,13 +785,13 @@ fn sample_with(scene: &Scene, bar: &ProgressBar) -> Samples {
             report,
         });
     }
-    Samples { surfaces, timings }
+    Sampled { surfaces, timings }
 }
 
 /// The stages from the view on, from the scene's samples.
 fn in_view(
     scene: &Scene,
-    samples: Samples,
+    samples: Sampled,
     stages: Stages,
     bar: &ProgressBar,
 ) -> Result<Built, Error> {
@@ -822,15 +922,9 @@ fn in_view(
         bar.set_message("refining the curves");
         let start = Instant::now();
         let none = Curves::default();
-        let analytic: Vec<intersect::Analytic> = products
-            .iter()
-            .map(|p| intersect::Analytic {
-                surface: p.surface.parametric(),
-                mesh: &p.mesh,
-            })
-            .collect();
         let sheets = parts(&products, &scene.halo, &none).sheets();
-        let refined = intersect::refine(&curves, &sheets, &analytic, &scene.view, diagonal);
+        let surfaces = products.iter().map(|p| (&p.surface, &p.mesh));
+        let refined = refine_curves(scene, &curves, &sheets, surfaces, diagonal);
         timings.refine = ms(start);
         refined
     });

@@ -200,6 +200,40 @@ fn a_cutaway_removes_on_the_gpu_what_the_cpu_renderer_removes() {
     );
 }
 
+#[test]
+fn the_explorer_draws_the_curves_a_build_shows() {
+    // The explorer samples through the library and asks it for the curves of each view: the
+    // same refined curves as the build (they were the mesh's, up to 1e-2 away).
+    for name in ["default", "klein-bottle", "fermat-quadratic"] {
+        let scene = Scene::load(&crate::common::fixture(&format!("scenes/{name}.json"))).unwrap();
+        assert!(scene.curves.refine, "{name} refines its curves");
+        let built = halo4d::run(&scene, true).unwrap();
+        let model = Model::new(scene.clone()).unwrap();
+        let turned = |rotation: Rotation4| halo4d::View {
+            rotation,
+            ..scene.view
+        };
+        let shown = model.curves(&scene.view).unwrap();
+        assert!(!shown.curves.is_empty(), "{name}");
+        assert_eq!(shown.curves, built.shown_curves().curves, "{name}");
+        assert_ne!(
+            shown.curves, built.curves.curves,
+            "{name}: the refined curves are not the mesh's"
+        );
+        // Another view: what a build in that view shows.
+        let mut rotation = scene.view.rotation;
+        rotation.xw += 7.0;
+        let mut other = scene.clone();
+        other.view = turned(rotation);
+        let built = halo4d::run(&other, true).unwrap();
+        assert_eq!(
+            model.curves(&other.view).unwrap().curves,
+            built.shown_curves().curves,
+            "{name} turned"
+        );
+    }
+}
+
 /// Seeded 4D rotations: each of the six planes turned by up to 35 degrees either way.
 fn seeded_rotations(seed: u64, count: usize) -> Vec<Rotation4> {
     let mut rng = Rng(seed);

@@ -32,7 +32,7 @@ pub use assemble::{Assembled, Status, assemble, status};
 use crate::error::Error;
 use crate::export;
 use crate::limits::FieldError;
-use crate::pipeline::{self, Samples, Timings};
+use crate::pipeline::{self, Sampled, Stages, Timings};
 use crate::render::CameraSettings;
 use crate::scene::Scene;
 use crate::view::View;
@@ -334,7 +334,7 @@ pub fn animate(request: &Request) -> Result<Summary, AnimateError> {
             summary.skipped
         ));
         let sampled = Instant::now();
-        let samples = pipeline::sample_scene(scene);
+        let samples = Sampled::of(scene);
         summary.sample_ms = ms(sampled);
         progress.note(&format!(
             "sampled {} triangles in {:.1} s",
@@ -432,7 +432,7 @@ fn read_done(dir: &Path, k: u32) -> Option<(FrameRecord, Vec<u8>)> {
 fn make_frame(
     scene: &Scene,
     k: u32,
-    samples: &Samples,
+    samples: &Sampled,
     dir: &Path,
     glb: bool,
 ) -> Result<FrameRecord, AnimateError> {
@@ -454,16 +454,18 @@ fn make_frame(
         timings_ms: Timings::default(),
         files: Vec::new(),
     };
-    let made = pipeline::run_sampled(&frame, samples.clone()).and_then(|built| {
-        let rendered = Instant::now();
-        let picture = built
-            .render(&frame.halo, &frame.render, &frame.camera)
-            .map_err(|source| Error::Render {
-                scene: frame.name.clone(),
-                source,
-            })?;
-        Ok((built, picture, ms(rendered)))
-    });
+    let made = samples
+        .build(&frame, Stages::verified_picture(&frame))
+        .and_then(|built| {
+            let rendered = Instant::now();
+            let picture = built
+                .render(&frame.halo, &frame.render, &frame.camera)
+                .map_err(|source| Error::Render {
+                    scene: frame.name.clone(),
+                    source,
+                })?;
+            Ok((built, picture, ms(rendered)))
+        });
     let (built, picture, render_ms) = match made {
         Ok(made) => made,
         Err(e) => {

@@ -27,7 +27,7 @@
 //! picture, 1.64%).
 
 use super::{HaloVertex, SurfaceVertex, ViewerError};
-use crate::intersect::{Curves, Sheet};
+use crate::intersect::Curves;
 use crate::limits::{MAX_COORDINATE, MIN_EXTENT};
 use crate::sample::Mesh4;
 use crate::scene::Scene;
@@ -35,7 +35,6 @@ use crate::tets::{self, Corners, Split};
 use crate::view::View;
 use bytemuck::Zeroable;
 use glam::{DVec3, DVec4};
-use rayon::prelude::*;
 
 /// A scene sampled in 4D, ready to be turned.
 #[derive(Clone, Debug)]
@@ -66,13 +65,7 @@ impl Model {
     /// than the viewer loads.
     pub fn new(scene: Scene) -> Result<Model, ViewerError> {
         scene.validate()?;
-        let surfaces: Vec<(String, Mesh4)> = (0..scene.surfaces.len())
-            .into_par_iter()
-            .map(|i| {
-                let sampled = scene.surfaces[i].surface.sample(scene.surface_sampling(i));
-                (scene.surface_name(i), sampled.mesh)
-            })
-            .collect();
+        let surfaces = crate::pipeline::Sampled::of(&scene).into_meshes();
         Model::with_meshes(scene, surfaces)
     }
 
@@ -251,27 +244,16 @@ impl Model {
         })
     }
 
-    /// The exact intersection curves of the surfaces in `view` (the library's own
-    /// [`crate::intersect::curves`], on the positions the build would project), as the
-    /// renderer draws them: points relative to `centre` with the nearer sheet's w, and
-    /// segments.
+    /// The curves a build of the scene shows in `view` ([`crate::pipeline::shown_curves`]:
+    /// the exact curves of the positions the build projects, refined onto the analytic
+    /// surfaces as the scene's `curves` say), as the renderer draws them.
     pub fn curves(&self, view: &View) -> Result<Curves, ViewerError> {
-        let projected = self
-            .surfaces
-            .iter()
-            .map(|(_, mesh)| view.project(mesh))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| ViewerError::View(e.to_string()))?;
-        let sheets: Vec<Sheet> = projected
-            .iter()
-            .zip(&self.surfaces)
-            .map(|(p, (_, mesh))| Sheet {
-                positions: &p.positions,
-                w: &p.w,
-                triangles: &mesh.triangles,
-            })
-            .collect();
-        Ok(crate::intersect::curves(&sheets))
+        let scene = Scene {
+            view: *view,
+            ..self.scene.clone()
+        };
+        let meshes: Vec<&Mesh4> = self.surfaces.iter().map(|(_, m)| m).collect();
+        Ok(crate::pipeline::shown_curves(&scene, &meshes)?)
     }
 
     /// The GPU's static inputs: per vertex its 4D position and tangents, its surface, index
