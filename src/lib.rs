@@ -13,6 +13,38 @@
 //! with [`check_file`] and [`check_dir`]. [`limits`] holds every limit a user can meet;
 //! [`sweep`] measures speed against error. The README's ARCHITECTURE section draws the
 //! module graph.
+//!
+//! From a scene to a verified build and its files:
+//!
+//! ```
+//! // A flat torus turned 30 degrees in yw: its projection crosses itself along two arcs.
+//! let scene = halo4d::Scene::parse(
+//!     r#"{
+//!         "name": "torus",
+//!         "surfaces": [{ "surface": { "type": "flat_torus" } }],
+//!         "sampling": { "method": "uniform", "u": 32, "v": 32 },
+//!         "view": { "rotation": { "yw": 30 } },
+//!         "render": { "width": 160, "height": 160 },
+//!         "outputs": { "glb": true, "ply": false, "vtk": false, "png": true }
+//!     }"#,
+//!     "torus.json",
+//! )?;
+//! // Sample once; build it in its view (the halos verified against the exact curves).
+//! let sampled = halo4d::Sampled::of(&scene);
+//! let built = sampled.build(&scene, halo4d::Stages::of(&scene))?;
+//! assert!(built.failures().is_empty(), "{:?}", built.failures());
+//! assert_eq!(built.shown_curves().curves.len(), 2);
+//! // The files: the .glb, the picture and report.json.
+//! let out = std::env::temp_dir().join(format!("halo4d-doc-{}", std::process::id()));
+//! let report = halo4d::write(&scene, &built, &out)?;
+//! assert!(report.verified);
+//! assert!(out.join("torus.glb").is_file() && out.join("torus.png").is_file());
+//! // The independent checker on the file: every halo conforms.
+//! let checked = halo4d::check_file(&out.join("torus.glb"))?;
+//! assert!(checked.failures().is_empty());
+//! # std::fs::remove_dir_all(&out)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 #![warn(missing_docs)]
 
 mod animate;
