@@ -57,10 +57,10 @@ pub const SLICES: RangeInclusive<u32> = 1..=4096;
 
 /// Stipples per surface (`render.stipple.count`): the set ranks four candidates per
 /// stipple, about 70 bytes each.
-pub const STIPPLES: RangeInclusive<usize> = 1..=4_194_304;
+pub const STIPPLES: Bound<usize> = Bound::closed(1, 4_194_304, "stipples per surface");
 
 /// A stipple's diameter in pixels (`render.stipple.size`).
-pub const STIPPLE_SIZE: RangeInclusive<f64> = 0.5..=16.0;
+pub const STIPPLE_SIZE: Bound<f64> = Bound::closed(0.5, 16.0, "pixels (a stipple's diameter)");
 
 /// Slices of the halo depth in the viewer, whose slice textures live on the GPU.
 pub const VIEWER_SLICES: RangeInclusive<u32> = 2..=1024;
@@ -182,6 +182,141 @@ pub fn shorten(text: &str) -> String {
     cut(&out, ECHO_TOTAL)
 }
 
+/// A number as a limit's message and the README's table write it: whole numbers without a
+/// decimal point, very small or large ones in exponent form.
+pub trait Number: Copy + PartialOrd + fmt::Display {
+    /// The number as text.
+    fn text(self) -> String {
+        self.to_string()
+    }
+}
+
+impl Number for u32 {}
+impl Number for u64 {}
+impl Number for usize {}
+impl Number for f64 {
+    fn text(self) -> String {
+        let a = self.abs();
+        if a != 0.0 && !(1e-3..1e6).contains(&a) {
+            format!("{self:e}")
+        } else {
+            format!("{self}")
+        }
+    }
+}
+
+/// The range of a setting: from `lo` to `hi`, each end included or not, in `unit`. Its
+/// [`Bound::check`] words the error from the range itself, so that the message says what
+/// the check does (an excluded end reads "greater than", "less than").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bound<T> {
+    /// The low end.
+    pub lo: T,
+    /// Whether `lo` is allowed.
+    pub lo_included: bool,
+    /// The high end.
+    pub hi: T,
+    /// Whether `hi` is allowed.
+    pub hi_included: bool,
+    /// What the numbers count ("degrees"; empty for none).
+    pub unit: &'static str,
+}
+
+impl<T: Number> Bound<T> {
+    /// `lo` to `hi`, both allowed.
+    pub const fn closed(lo: T, hi: T, unit: &'static str) -> Self {
+        Bound {
+            lo,
+            lo_included: true,
+            hi,
+            hi_included: true,
+            unit,
+        }
+    }
+
+    /// Between `lo` and `hi`, neither allowed.
+    pub const fn open(lo: T, hi: T, unit: &'static str) -> Self {
+        Bound {
+            lo,
+            lo_included: false,
+            hi,
+            hi_included: false,
+            unit,
+        }
+    }
+
+    /// Above `lo` (not allowed) up to `hi` (allowed).
+    pub const fn above(lo: T, hi: T, unit: &'static str) -> Self {
+        Bound {
+            lo,
+            lo_included: false,
+            hi,
+            hi_included: true,
+            unit,
+        }
+    }
+
+    /// Whether `v` is in the range (never a NaN).
+    pub fn contains(&self, v: T) -> bool {
+        let low = if self.lo_included {
+            v >= self.lo
+        } else {
+            v > self.lo
+        };
+        let high = if self.hi_included {
+            v <= self.hi
+        } else {
+            v < self.hi
+        };
+        low && high
+    }
+
+    /// The range in words: `1 to 8192 pixels`, `greater than 1 and less than 170 degrees`.
+    pub fn words(&self) -> String {
+        let (lo, hi) = (self.lo.text(), self.hi.text());
+        let range = match (self.lo_included, self.hi_included) {
+            (true, true) => format!("{lo} to {hi}"),
+            (false, false) => format!("greater than {lo} and less than {hi}"),
+            (false, true) => format!("greater than {lo} and at most {hi}"),
+            (true, false) => format!("at least {lo} and less than {hi}"),
+        };
+        if self.unit.is_empty() {
+            range
+        } else {
+            format!("{range} {}", self.unit)
+        }
+    }
+
+    /// `v` checked: outside, the error of `field` says the range and `v`.
+    pub fn check(&self, field: &str, v: T) -> Result<(), FieldError> {
+        if self.contains(v) {
+            return Ok(());
+        }
+        Err(FieldError::new(
+            field,
+            format!("must be {}, got {}", self.words(), v.text()),
+        ))
+    }
+}
+
+/// `render.eye_separation`: the angle between the eyes of a stereo pair.
+pub const EYE_SEPARATION: Bound<f64> = Bound::closed(0.0, 30.0, "degrees");
+
+/// `camera.elevation`: above or below the xy plane, short of the poles.
+pub const ELEVATION: Bound<f64> = Bound::closed(-89.0, 89.0, "degrees");
+
+/// `camera.fov`: the vertical field of view of a perspective camera.
+pub const FOV: Bound<f64> = Bound::open(1.0, 170.0, "degrees");
+
+/// `camera.distance`: the eye's distance from the scene's centre.
+pub const CAMERA_DISTANCE: Bound<f64> = Bound::above(0.0, 1e4, "half-diagonals of the scene");
+
+/// `render.ribbons.count`: bands per unit of the parameter.
+pub const RIBBON_COUNT: Bound<f64> = Bound::above(0.0, 1e4, "bands per unit");
+
+/// `render.ribbons.gap`: the share of each band cut away.
+pub const RIBBON_GAP: Bound<f64> = Bound::open(0.0, 1.0, "");
+
 /// A setting outside its limits, or inconsistent with another: the field's path (like
 /// `surfaces[0].sampling.u`) and what is wrong, with what is allowed.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -258,6 +393,16 @@ pub fn table() -> String {
             range(&PICTURE_SIDE),
             "pixels",
         ),
+        ("`camera.elevation`", ELEVATION.words(), ""),
+        ("`camera.fov`", FOV.words(), ""),
+        (
+            "`camera.distance` (absent: fitted)",
+            CAMERA_DISTANCE.words(),
+            "",
+        ),
+        ("`render.eye_separation`", EYE_SEPARATION.words(), ""),
+        ("`render.ribbons.count`", RIBBON_COUNT.words(), ""),
+        ("`render.ribbons.gap`", RIBBON_GAP.words(), "of each band"),
         (
             "`halo.gap_px`",
             format!("more than 0, up to {MAX_GAP_PX}"),
@@ -284,16 +429,8 @@ pub fn table() -> String {
             "slices",
         ),
         ("the viewer's slices", range(&VIEWER_SLICES), "slices"),
-        (
-            "`render.stipple.count`",
-            range(&STIPPLES),
-            "stipples per surface",
-        ),
-        (
-            "`render.stipple.size`",
-            range(&STIPPLE_SIZE),
-            "pixels (diameter)",
-        ),
+        ("`render.stipple.count`", STIPPLES.words(), ""),
+        ("`render.stipple.size`", STIPPLE_SIZE.words(), ""),
         (
             "surface triangles the viewer loads",
             format!("up to {VIEWER_TRIANGLES}"),
@@ -379,6 +516,38 @@ mod tests {
             .within("sampling")
             .within("surfaces[0]");
         assert_eq!(e.to_string(), "surfaces[0].sampling.u: must be even");
+    }
+
+    #[test]
+    fn a_bound_words_its_error_as_it_checks() {
+        assert_eq!(
+            FOV.check("fov", 1.0).unwrap_err().to_string(),
+            "fov: must be greater than 1 and less than 170 degrees, got 1"
+        );
+        assert!(FOV.check("fov", 1.5).is_ok() && FOV.check("fov", f64::NAN).is_err());
+        assert_eq!(
+            ELEVATION.check("elevation", 90.0).unwrap_err().message,
+            "must be -89 to 89 degrees, got 90"
+        );
+        assert!(ELEVATION.contains(-89.0) && ELEVATION.contains(89.0));
+        assert_eq!(
+            CAMERA_DISTANCE.check("distance", 0.0).unwrap_err().message,
+            "must be greater than 0 and at most 10000 half-diagonals of the scene, got 0"
+        );
+        assert_eq!(
+            Bound::closed(1e-9, 0.5, "").words(),
+            "1e-9 to 0.5",
+            "small numbers in exponent form"
+        );
+        let ends = Bound {
+            lo_included: true,
+            ..RIBBON_GAP
+        };
+        assert_eq!(ends.words(), "at least 0 and less than 1");
+        assert_eq!(
+            Bound::closed(1u32, 8192, "pixels").words(),
+            "1 to 8192 pixels"
+        );
     }
 
     #[test]

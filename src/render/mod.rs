@@ -25,7 +25,10 @@ pub(crate) mod text;
 pub mod trace;
 pub mod visible;
 
-use crate::limits::{FieldError, PICTURE_SIDE, SAMPLES, SLICES};
+use crate::limits::{
+    CAMERA_DISTANCE, ELEVATION, EYE_SEPARATION, FOV, FieldError, PICTURE_SIDE, RIBBON_COUNT,
+    RIBBON_GAP, SAMPLES, SLICES,
+};
 use crate::parts::{HaloIndex, Parts};
 use camera::Camera;
 use glam::DVec3;
@@ -164,6 +167,15 @@ pub struct StippleSettings {
     /// Stipples in the colour of their w-depth (paper 003's coloured stipples with tone
     /// shading) instead of black.
     pub colour: bool,
+}
+
+impl StippleSettings {
+    /// Checks the size and the count ([`crate::limits::STIPPLE_SIZE`],
+    /// [`crate::limits::STIPPLES`]): the renderer's and the explorer's one check.
+    pub fn check(&self) -> Result<(), FieldError> {
+        crate::limits::STIPPLE_SIZE.check("size", self.size)?;
+        crate::limits::STIPPLES.check("count", self.count)
+    }
 }
 
 impl Default for StippleSettings {
@@ -323,29 +335,7 @@ impl RenderSettings {
                 ),
             ));
         }
-        let st = &self.stipple;
-        if !crate::limits::STIPPLE_SIZE.contains(&st.size) {
-            return Err(FieldError::new(
-                "stipple.size",
-                format!(
-                    "must be {:?} to {:?} pixels (a stipple's diameter), got {}",
-                    crate::limits::STIPPLE_SIZE.start(),
-                    crate::limits::STIPPLE_SIZE.end(),
-                    st.size
-                ),
-            ));
-        }
-        if !crate::limits::STIPPLES.contains(&st.count) {
-            return Err(FieldError::new(
-                "stipple.count",
-                format!(
-                    "must be {} to {} stipples per surface, got {}",
-                    crate::limits::STIPPLES.start(),
-                    crate::limits::STIPPLES.end(),
-                    st.count
-                ),
-            ));
-        }
+        self.stipple.check().map_err(|e| e.within("stipple"))?;
         let unit = |v: f64| v.is_finite() && v > 0.0 && v <= 1.0;
         if !unit(self.opacity) {
             return Err(FieldError::new(
@@ -370,18 +360,8 @@ impl RenderSettings {
             ));
         }
         if let Some(r) = self.ribbons {
-            if !(r.count.is_finite() && r.count > 0.0 && r.count <= 1e4) {
-                return Err(FieldError::new(
-                    "ribbons.count",
-                    format!("must be in (0, 10000], got {}", r.count),
-                ));
-            }
-            if !(r.gap.is_finite() && r.gap > 0.0 && r.gap < 1.0) {
-                return Err(FieldError::new(
-                    "ribbons.gap",
-                    format!("must be in (0, 1), got {}", r.gap),
-                ));
-            }
+            RIBBON_COUNT.check("ribbons.count", r.count)?;
+            RIBBON_GAP.check("ribbons.gap", r.gap)?;
         }
         if let Some(c) = &self.clip {
             c.check().map_err(|e| e.within("clip"))?;
@@ -403,12 +383,7 @@ impl RenderSettings {
                 ));
             }
         }
-        if !(self.eye_separation.is_finite() && (0.0..=30.0).contains(&self.eye_separation)) {
-            return Err(FieldError::new(
-                "eye_separation",
-                format!("must be 0 to 30 degrees, got {}", self.eye_separation),
-            ));
-        }
+        EYE_SEPARATION.check("eye_separation", self.eye_separation)?;
         for (field, colour) in [
             ("background", Some(self.background)),
             ("broken_edge_colour", self.broken_edge_colour),
@@ -436,29 +411,19 @@ impl CameraSettings {
                 format!("must be finite, got {}", self.azimuth),
             ));
         }
-        if !(self.elevation.is_finite() && (-89.0..=89.0).contains(&self.elevation)) {
-            return Err(FieldError::new(
-                "elevation",
-                format!("must be -89 to 89 degrees, got {}", self.elevation),
-            ));
+        ELEVATION.check("elevation", self.elevation)?;
+        if let Some(d) = self.distance {
+            CAMERA_DISTANCE.check("distance", d).map_err(|e| {
+                FieldError::new(
+                    e.field,
+                    format!(
+                        "{}; or absent, for a camera fitted to the surfaces",
+                        e.message
+                    ),
+                )
+            })?;
         }
-        if let Some(d) = self.distance
-            && !(d.is_finite() && d > 0.0 && d <= 1e4)
-        {
-            return Err(FieldError::new(
-                "distance",
-                format!(
-                    "must be in (0, 10000] (units of half the scene's diagonal), or absent for a camera fitted to the surfaces, got {d}"
-                ),
-            ));
-        }
-        if !(self.fov.is_finite() && self.fov > 1.0 && self.fov < 170.0) {
-            return Err(FieldError::new(
-                "fov",
-                format!("must be 1 to 170 degrees, got {}", self.fov),
-            ));
-        }
-        Ok(())
+        FOV.check("fov", self.fov)
     }
 }
 

@@ -186,18 +186,9 @@ impl ViewSettings {
                 format!("{} is not 1, 4, 9 or 16 (a square grid)", self.samples),
             );
         }
-        let size = crate::limits::STIPPLE_SIZE;
-        if !size.contains(&self.stipple.size) {
-            return bad(
-                "stipple.size",
-                format!(
-                    "must be {:?} to {:?} pixels (a stipple's diameter), got {}",
-                    size.start(),
-                    size.end(),
-                    self.stipple.size
-                ),
-            );
-        }
+        self.stipple
+            .check()
+            .map_err(|e| ViewerError::Setting(e.within("stipple")))?;
         self.camera
             .check()
             .map_err(|e| ViewerError::Setting(e.within("camera")))
@@ -783,16 +774,9 @@ impl Source {
     /// the reason, for a `.glb` without its 4D mesh. Takes as long as a build's stipples: a
     /// window makes them in the background.
     pub fn stipples(&self, count: usize, seed: u64) -> Result<StippleSet, ViewerError> {
-        if !crate::limits::STIPPLES.contains(&count) {
-            return Err(ViewerError::Setting(FieldError::new(
-                "stipple.count",
-                format!(
-                    "must be {} to {} stipples per surface, got {count}",
-                    crate::limits::STIPPLES.start(),
-                    crate::limits::STIPPLES.end()
-                ),
-            )));
-        }
+        crate::limits::STIPPLES
+            .check("stipple.count", count)
+            .map_err(ViewerError::Setting)?;
         match self {
             Source::Model(m) => {
                 let meshes: Vec<_> = m
