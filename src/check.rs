@@ -13,6 +13,9 @@
 //!
 //! The checker reads the surface off the boundary: a boundary face whose three vertices are
 //! offsets of three different surface vertices is an offset face over that surface triangle.
+//! Where the surface's own triangles are given ([`TetMesh::surface_triangles`], as both of
+//! halo4d's files carry them), each must be there too: read off the boundary alone, a halo
+//! with whole prisms cut away is a valid shell of what is left.
 //! What it checks, each as its own count:
 //! - every tetrahedron positively oriented under exact `robust::orient3d` (`inverted`, `flat`),
 //!   with four distinct vertices (`degenerate`) and no repeat (`duplicate_tets`); decided on
@@ -47,6 +50,11 @@ pub struct TetMesh {
     pub surface_vertices: usize,
     /// Four vertex indices each.
     pub tets: Vec<[u32; 4]>,
+    /// The surface's triangles (surface vertex indices, below `surface_vertices`), where the
+    /// file gives them: every one must have its two offset faces and be a face between the
+    /// two layers, so that a missing prism is seen. Empty where unknown: the surface is
+    /// then read off the boundary, which cannot see a prism that is missing whole.
+    pub surface_triangles: Vec<[u32; 3]>,
 }
 
 /// What the checker found.
@@ -479,15 +487,22 @@ pub fn boundary_faces(tets: &[[u32; 4]], vertices: usize) -> Vec<([u32; 3], u32)
 
 /// Checks a tetrahedral halo (see the module documentation).
 pub fn check(mesh: &TetMesh) -> CheckStats {
-    check_parts(&mesh.positions, mesh.surface_vertices, &mesh.tets)
+    check_parts(
+        &mesh.positions,
+        mesh.surface_vertices,
+        &mesh.tets,
+        &mesh.surface_triangles,
+    )
 }
 
-/// [`check`] on borrowed parts: vertex positions, the number n of surface vertices and the
-/// tetrahedra (what [`TetMesh`] holds), so that a halo is checked without a copy of it.
+/// [`check`] on borrowed parts: vertex positions, the number n of surface vertices, the
+/// tetrahedra and the surface's triangles (empty where unknown; what [`TetMesh`] holds), so
+/// that a halo is checked without a copy of it.
 pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
     positions: &[P],
     surface_vertices: usize,
     tets: &[[u32; 4]],
+    surface_triangles: &[[u32; 3]],
 ) -> CheckStats {
     let n = surface_vertices;
     let nv = positions.len();
@@ -608,6 +623,21 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
         others.extend(k);
     }
     let offset_faces = bucket_sort(offset_faces, n, |f| f.0[0]);
+    // The surface's own triangles, where given: one whose offset faces are not on the
+    // boundary at all (its prism missing, or its faces buried) is counted missing, and its
+    // surface face too unless two tetrahedra share it. A triangle whose three corners are
+    // collapsed has a flat prism and no offset face.
+    if !surface_triangles.is_empty() {
+        let over: std::collections::HashSet<[u32; 3]> = offset_faces.iter().map(|f| f.0).collect();
+        for &t in surface_triangles {
+            let k = key(t);
+            let flat = t.iter().all(|&v| (v as usize) < n && collapsed[v as usize]);
+            if !flat && !over.contains(&k) && t.iter().all(|&v| (v as usize) < n) {
+                s.missing_offset_faces += 1;
+                s.missing_surface_faces += usize::from(count(k.map(mid)) != 2);
+            }
+        }
+    }
     // Surface edges, each with the side pairing of the offset face's edge over it: `true`
     // when that edge joins two offsets on the same side (its quad's perimeter runs
     // straight, so the diagonals cross sides), `None` at a collapsed end.

@@ -173,6 +173,9 @@ pub struct Halo {
     pub rho: Vec<f64>,
     /// The surface triangle whose prism each inserted vertex (from 3n on) is in.
     pub inserted_in: Vec<u32>,
+    /// The surface's triangles the halo is built over (surface vertex indices): each a face
+    /// between the two layers, with an offset face on either side.
+    pub surface_triangles: Vec<[u32; 3]>,
 }
 
 impl Halo {
@@ -182,6 +185,7 @@ impl Halo {
             positions: self.positions.iter().map(|p| p.to_array()).collect(),
             surface_vertices: self.surface_vertices,
             tets: self.tets.clone(),
+            surface_triangles: self.surface_triangles.clone(),
         }
     }
 }
@@ -719,9 +723,10 @@ pub fn build_halo(
         tets: tets.tets,
         rho: offsets.rho,
         inserted_in: tets.inserted_in,
+        surface_triangles: triangles.to_vec(),
     };
     lap(&mut stage_ms.split);
-    let checked = check_parts(&halo.positions, n, &halo.tets);
+    let checked = check_parts(&halo.positions, n, &halo.tets, triangles);
     lap(&mut stage_ms.check);
     let report = HaloReport {
         split: params.split.name(),

@@ -299,6 +299,10 @@ impl<T: Number> Bound<T> {
     }
 }
 
+/// A Fermat surface's `y_range` (the half-width a of its strips in the imaginary
+/// direction).
+pub const FERMAT_Y_RANGE: Bound<f64> = Bound::closed(1e-6, 4.0, "");
+
 /// `render.eye_separation`: the angle between the eyes of a stereo pair.
 pub const EYE_SEPARATION: Bound<f64> = Bound::closed(0.0, 30.0, "degrees");
 
@@ -393,6 +397,7 @@ pub fn table() -> String {
             range(&PICTURE_SIDE),
             "pixels",
         ),
+        ("a Fermat surface's `y_range`", FERMAT_Y_RANGE.words(), ""),
         ("`camera.elevation`", ELEVATION.words(), ""),
         ("`camera.fov`", FOV.words(), ""),
         (

@@ -247,8 +247,24 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
             for f in &report.failures {
                 eprintln!("UNVERIFIED {f}");
             }
+            // Say where the verdict is marked only in files that were written.
+            let marks: Vec<&str> = [
+                (scene.outputs.report, "report.json"),
+                (scene.outputs.glb, "the .glb's asset extras"),
+            ]
+            .into_iter()
+            .filter_map(|(written, what)| written.then_some(what))
+            .collect();
             eprintln!(
-                "the build is not verified: its files are written and marked `verified: false` (report.json, the .glb's asset extras){}",
+                "the build is not verified: {}{}",
+                if marks.is_empty() {
+                    "the files asked for are written; none records the verdict (outputs.report and outputs.glb are off)".to_string()
+                } else {
+                    format!(
+                        "its files are written and marked `verified: false` ({})",
+                        marks.join(", ")
+                    )
+                },
                 if allow_unverified {
                     ""
                 } else {

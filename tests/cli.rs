@@ -452,6 +452,20 @@ fn an_unverified_build_writes_its_files_marked_and_exits_3_unless_allowed() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(String::from_utf8_lossy(&out.stderr).contains("UNVERIFIED"));
+    // With no file that records the verdict, the message names none.
+    let quiet = scene.replace(
+        r#""outputs": { "png": false }"#,
+        r#""outputs": { "png": false, "glb": false, "vtk": false, "ply": false, "report": false, "verify": true }"#,
+    );
+    std::fs::write(dir.path().join("none.json"), quiet).unwrap();
+    let out = halo4d(&["build", "-q", "none.json", "--out", "n"], dir.path());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(
+        err.contains("none records the verdict (outputs.report and outputs.glb are off)")
+            && !err.contains("report.json,"),
+        "{err}"
+    );
 
     // A verified build says so.
     let out = halo4d(&["build", "-q", "--out", "d"], dir.path());

@@ -1460,7 +1460,7 @@ fn ascii_vtk(h: &ImportedHalo, version5: bool) -> String {
     let field = |s: &mut String| {
         let _ = write!(
             s,
-            "FIELD FieldData 5\nsurface_vertices 1 1 int\n{}\nlayers 1 1 int\n2\n",
+            "FIELD FieldData 6\nsurface_vertices 1 1 int\n{}\nlayers 1 1 int\n2\n",
             m.surface_vertices
         );
         for (name, value) in [
@@ -1469,6 +1469,11 @@ fn ascii_vtk(h: &ImportedHalo, version5: bool) -> String {
             ("delta_t", h.params.delta_t),
         ] {
             let _ = write!(s, "{name} 1 1 double\n{}\n", value.unwrap());
+        }
+        let triangles = &m.surface_triangles;
+        let _ = writeln!(s, "surface_triangles 3 {} int", triangles.len());
+        for t in triangles {
+            let _ = writeln!(s, "{} {} {}", t[0], t[1], t[2]);
         }
     };
     if !version5 {

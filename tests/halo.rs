@@ -259,6 +259,7 @@ fn a_single_prism_splits_every_way_into_its_volume() {
             positions: positions.to_vec(),
             surface_vertices: 3,
             tets: prism([0, 1, 2], 3, f, [9, 10]),
+            surface_triangles: vec![[0, 1, 2]],
         };
         let s = check(&mesh);
         assert_valid(&s, &format!("{f:?}"));
@@ -271,6 +272,7 @@ fn a_single_prism_splits_every_way_into_its_volume() {
         positions: positions.to_vec(),
         surface_vertices: 3,
         tets: tets::prism_tets([0, 1, 2, 3, 4, 5], [true, true, false], 0).collect(),
+        surface_triangles: vec![[0, 1, 2]],
     };
     let s = check(&mesh);
     assert_eq!(s.missing_surface_faces, 1, "{s:?}");

@@ -55,11 +55,16 @@ fn ascii_vtk(h: &ImportedHalo, with_layout: bool) -> String {
         h.name
     );
     if with_layout {
+        let triangles = &m.surface_triangles;
         s += &format!(
-            "FIELD FieldData 3\nsurface_vertices 1 1 int\n{}\nlayers 1 1 int\n2\nrho 1 1 double\n{}\n",
+            "FIELD FieldData 4\nsurface_vertices 1 1 int\n{}\nlayers 1 1 int\n2\nrho 1 1 double\n{}\nsurface_triangles 3 {} int\n",
             m.surface_vertices,
-            h.params.rho.unwrap()
+            h.params.rho.unwrap(),
+            triangles.len()
         );
+        for t in triangles {
+            s += &format!("{} {} {}\n", t[0], t[1], t[2]);
+        }
     }
     s += &format!("POINTS {} double\n", m.positions.len());
     for p in &m.positions {
@@ -462,6 +467,65 @@ fn check_passes_a_valid_halo_and_catches_faults_planted_in_its_files() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert_eq!(out.status.code(), Some(1), "{text}");
     assert!(text.contains("FAILED patches-halo: 1 inverted"), "{text}");
+}
+
+#[test]
+fn check_file_sees_every_prism_missing_from_a_halo() {
+    // Tetrahedra cut away whole prisms at a time leave a valid shell of what is left: read
+    // off the boundary, the surface shrinks with it and the halo passed. The file's own
+    // surface triangles show what is missing.
+    let dir = tempfile::tempdir().unwrap();
+    let (glb, vtk, _) = patches(dir.path());
+    let halo = read_vtk(&std::fs::read(&vtk).unwrap()).unwrap();
+    let triangles = halo.mesh.surface_triangles.len();
+    assert!(triangles > 0, "the .vtk lists its surface's triangles");
+    let json = |bytes: &[u8]| -> Value {
+        let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+        serde_json::from_slice(&bytes[20..20 + len]).unwrap()
+    };
+    let bytes = std::fs::read(&glb).unwrap();
+    let tets_accessor = halo_mesh(&mut json(&bytes))["extras"]["halo"]["tetrahedra"]
+        .as_u64()
+        .unwrap() as usize;
+    let total = halo.mesh.tets.len();
+    // Each prism is six tetrahedra, in the surface's triangle order: the first half of the
+    // tetrahedra is the first half of the prisms.
+    for (name, kept) in [("none", 0), ("half", total / 2)] {
+        let cut = with_json(&bytes, |j| {
+            j["accessors"][tets_accessor]["count"] = (4 * kept).into();
+        });
+        std::fs::write(dir.path().join(format!("{name}.glb")), &cut).unwrap();
+        let mut h = halo.clone();
+        h.mesh.tets.truncate(kept);
+        std::fs::write(dir.path().join(format!("{name}.vtk")), ascii_vtk(&h, true)).unwrap();
+        for file in [format!("{name}.glb"), format!("{name}.vtk")] {
+            let out = halo4d(&["check", &file], dir.path());
+            let text = String::from_utf8_lossy(&out.stdout);
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            if kept == 0 && out.status.code() == Some(2) {
+                // No tetrahedron at all: refused as no halo, which is no pass either.
+                assert!(stderr.contains(&file), "{file}: {stderr}");
+                continue;
+            }
+            assert_eq!(out.status.code(), Some(1), "{file}: {text}{stderr}");
+            let verdict = text.lines().last().unwrap();
+            let missing = triangles - kept / 6;
+            assert!(
+                verdict.contains(&format!("{missing} missing_offset_faces"))
+                    && verdict.contains("missing_surface_faces"),
+                "{file}: {verdict}"
+            );
+        }
+    }
+    // The whole halo still passes, from either file.
+    for file in [&glb, &vtk] {
+        let out = halo4d(&["check", file.to_str().unwrap()], dir.path());
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+    }
 }
 
 #[test]

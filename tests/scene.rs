@@ -43,6 +43,21 @@ fn every_catalogue_surface_has_a_fixture_scene() {
 /// Each broken scene with words its error must contain (the field and what is allowed).
 const BROKEN: &[(&str, &[&str])] = &[
     (
+        "fermat-y-range-tiny.json",
+        &[
+            "surfaces[0].surface.y_range",
+            "must be 1e-6 to 4",
+            "got 5e-324",
+        ],
+    ),
+    (
+        "camera-fov-at-its-bound.json",
+        &[
+            "camera.fov",
+            "must be greater than 1 and less than 170 degrees, got 1",
+        ],
+    ),
+    (
         "unknown-surface.json",
         &[
             "surfaces[0].surface",

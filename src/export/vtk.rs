@@ -3,8 +3,9 @@
 //! One `UNSTRUCTURED_GRID` per halo: every halo vertex in the layout of [`crate::check`]
 //! (negative offsets, positive offsets, the surface, inserted vertices) as `double` POINTS,
 //! every tetrahedron as a cell of 4 ids and type 10 (`VTK_TETRA`) in VTK's orientation
-//! ([`file_order`]), the dataset's field data `surface_vertices` and `layers`
-//! ([`LAYERS`]) (int), `rho` (absolute), `delta_d` and `delta_t` (double), and the point
+//! ([`file_order`]), the dataset's field data `surface_vertices`, `surface_triangles` (the
+//! surface's triangles, three surface vertex indices each) and `layers` ([`LAYERS`]) (int),
+//! `rho` (absolute), `delta_d` and `delta_t` (double), and the point
 //! scalars `t` and `d_orig` (double). Binary legacy VTK is big-endian; each binary block ends
 //! with a newline, as VTK's own writer does and meshio requires.
 //!
@@ -49,8 +50,14 @@ pub fn write_vtk(out: &mut dyn Write, surface: &SurfaceData, scene_name: &str) -
     for _ in 0..tets {
         out.write_all(&10i32.to_be_bytes())?;
     }
-    write!(out, "\nFIELD FieldData 5\nsurface_vertices 1 1 int\n")?;
+    write!(out, "\nFIELD FieldData 6\nsurface_vertices 1 1 int\n")?;
     out.write_all(&(halo.surface_vertices as i32).to_be_bytes())?;
+    // The surface's triangles, so that a checker sees a prism missing whole.
+    let triangles = &halo.surface_triangles;
+    write!(out, "\nsurface_triangles 3 {} int\n", triangles.len())?;
+    for &v in triangles.iter().flatten() {
+        out.write_all(&(v as i32).to_be_bytes())?;
+    }
     write!(out, "\nlayers 1 1 int\n")?;
     out.write_all(&(LAYERS as i32).to_be_bytes())?;
     let params = surface.halo_params;

@@ -781,6 +781,59 @@ impl<'a> Doc<'a> {
         Ok(indices)
     }
 
+    /// The vertex count and triangles of mesh `m`, the surface a halo's `surface_mesh` (in
+    /// `what`) names.
+    fn triangles_of(&self, m: u64, what: &str) -> Result<(usize, Vec<[u32; 3]>)> {
+        let i = usize::try_from(m)
+            .ok()
+            .filter(|&i| i < self.root.meshes.len());
+        let i = i.ok_or_else(|| {
+            glb_err(format!(
+                "{what}.surface_mesh = {m}, but the file has {} meshes",
+                self.root.meshes.len()
+            ))
+        })?;
+        let mesh = &self.root.meshes[i];
+        if extras(&mesh.extras).get("surface").is_none() {
+            return Err(glb_err(format!(
+                "{what}.surface_mesh = {m} is not one of the file's surface meshes"
+            )));
+        }
+        let surface = format!("meshes[{i}] (`{}`)", mesh_name(mesh, i));
+        let primitive = mesh
+            .primitives
+            .first()
+            .filter(|p| p.mode == Checked::Valid(Mode::Triangles))
+            .ok_or_else(|| {
+                glb_err(format!(
+                    "{surface}, the surface of {what}, has no primitive of TRIANGLES"
+                ))
+            })?;
+        let indices = primitive.indices.ok_or_else(|| {
+            glb_err(format!(
+                "{surface}.primitives[0], the surface of {what}, has no `indices`"
+            ))
+        })?;
+        let indices = self.unsigned(indices.value() as u64)?;
+        if indices.len() % 3 != 0 {
+            return Err(glb_err(format!(
+                "meshes[{i}], the surface of {what}: {} triangle indices, not a multiple of 3",
+                indices.len()
+            )));
+        }
+        let position = attribute(primitive, Semantic::Positions).ok_or_else(|| {
+            glb_err(format!(
+                "{surface}, the surface of {what}, has no POSITION attribute"
+            ))
+        })?;
+        let vertices = self.accessor(position)?.count.0 as usize;
+        let triangles = indices
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
+        Ok((vertices, triangles))
+    }
+
     /// The halo of mesh `i`, whose extras' `halo` is `halo`.
     fn halo(
         &self,
@@ -828,6 +881,16 @@ impl<'a> Doc<'a> {
             "surface_vertices",
         )?;
         let number = |key: &str| halo.get(key).and_then(Value::as_f64);
+        // The surface's triangles, from the mesh `surface_mesh` names, so that the checker
+        // sees a prism missing whole; none where the halo names no surface.
+        let (surface_mesh_vertices, surface_triangles) =
+            match halo.get("surface_mesh").and_then(Value::as_u64) {
+                Some(m) => {
+                    let (vertices, triangles) = self.triangles_of(m, &extras)?;
+                    (Some(vertices), triangles)
+                }
+                None => (None, Vec::new()),
+            };
         Ok(ImportedHalo {
             name,
             mesh: TetMesh {
@@ -837,6 +900,7 @@ impl<'a> Doc<'a> {
                     .chunks_exact(4)
                     .map(|c| file_order([c[0], c[1], c[2], c[3]]))
                     .collect(),
+                surface_triangles,
             },
             t,
             d_orig,
@@ -849,6 +913,7 @@ impl<'a> Doc<'a> {
                     .get("surface_mesh")
                     .and_then(Value::as_u64)
                     .and_then(|m| usize::try_from(m).ok()),
+                surface_mesh_vertices,
                 layers: number("layers"),
             },
         })

@@ -150,6 +150,8 @@ pub struct FileParams {
     pub split: Option<String>,
     /// Index of the surface's own mesh (`.glb` only).
     pub surface_mesh: Option<usize>,
+    /// The vertices of that surface mesh, which must be the halo's surface vertices.
+    pub surface_mesh_vertices: Option<usize>,
     /// Layers of prisms the halo's layout has (`LAYERS`, 2: the offsets, then the surface itself).
     pub layers: Option<f64>,
 }
@@ -267,6 +269,19 @@ impl ImportedHalo {
                 "surface_vertices = {n} needs the 3n = {} offset and surface vertices, but the halo has {nv} vertices",
                 n.saturating_mul(3)
             )));
+        }
+        if let Some(m) = self.params.surface_mesh_vertices.filter(|&m| m != n) {
+            return Err(bad(format!(
+                "surface_vertices = {n}, but its surface (meshes[{}]) has {m} vertices",
+                self.params.surface_mesh.unwrap_or_default()
+            )));
+        }
+        for (k, t) in self.mesh.surface_triangles.iter().enumerate() {
+            if let Some(&v) = t.iter().find(|&&v| v as usize >= n) {
+                return Err(bad(format!(
+                    "surface triangle {k} names vertex {v}, but the surface has {n} vertices (surface_vertices)"
+                )));
+            }
         }
         for (k, tet) in self.mesh.tets.iter().enumerate() {
             if let Some(&i) = tet.iter().find(|&&i| i as usize >= nv) {

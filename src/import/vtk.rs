@@ -104,12 +104,38 @@ pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
             )));
         }
     }
+    // The surface's triangles, where the file lists them (halo4d writes them since the
+    // checker needs them to see a missing prism; an older file has none).
+    let surface_triangles = match grid.field.get("surface_triangles") {
+        None => Vec::new(),
+        Some(v) => {
+            if v.len() % 3 != 0 {
+                return Err(err(format!(
+                    "the FIELD array surface_triangles has {} values, not three per triangle",
+                    v.len()
+                )));
+            }
+            if let Some(x) = v
+                .iter()
+                .find(|x| !(**x >= 0.0 && x.fract() == 0.0 && **x < n))
+            {
+                return Err(err(format!(
+                    "the FIELD array surface_triangles names {x}, not a surface vertex (0 to {})",
+                    n - 1.0
+                )));
+            }
+            v.chunks_exact(3)
+                .map(|c| [c[0] as u32, c[1] as u32, c[2] as u32])
+                .collect()
+        }
+    };
     ImportedHalo {
         name,
         mesh: TetMesh {
             positions: grid.points,
             surface_vertices: n as usize,
             tets: grid.tets,
+            surface_triangles,
         },
         t: grid.t,
         d_orig: grid.d_orig,
@@ -119,6 +145,7 @@ pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
             delta_t: field("delta_t"),
             split: None,
             surface_mesh: None,
+            surface_mesh_vertices: None,
             layers: field("layers"),
         },
     }
@@ -508,8 +535,8 @@ impl Reader<'_> {
                 .checked_mul(tuples)
                 .ok_or_else(|| err(format!("{what}: size too large")))?;
             let values = self.numbers(total, Type::parse(ty)?, &what)?;
-            // Only single-component arrays matter to a halo.
-            if components == 1 {
+            // Only single-component arrays matter to a halo, and the surface's triangles.
+            if components == 1 || (components == 3 && name == "surface_triangles") {
                 out.push((name.clone(), values));
             }
             k += 1;

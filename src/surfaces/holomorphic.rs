@@ -207,17 +207,17 @@ impl Parametric for Fermat {
                 format!("must be between 2 and 6, got {}", self.n),
             ));
         }
-        positive("y_range", self.y_range)?;
-        if self.y_range > 4.0 {
-            return Err(FieldError::new(
-                "y_range",
-                format!(
-                    "must be at most 4 (coordinates grow like e^(2a/n)), got {}",
-                    self.y_range
-                ),
-            ));
-        }
-        Ok(())
+        crate::limits::FERMAT_Y_RANGE
+            .check("y_range", self.y_range)
+            .map_err(|e| {
+                FieldError::new(
+                    e.field,
+                    format!(
+                        "{} (coordinates grow like e^(2a/n); a narrower strip is a sliver with nothing to show)",
+                        e.message
+                    ),
+                )
+            })
     }
 }
 

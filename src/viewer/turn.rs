@@ -165,6 +165,7 @@ impl Model {
                         .filter(|k| range.contains(&k[0]))
                         .map(|k| k.map(|v| v - range.start))
                         .collect(),
+                    surface_triangles: mesh.triangles.clone(),
                 };
                 base += 3 * n;
                 out
