@@ -46,7 +46,7 @@ pub struct HaloParams {
     pub rho: Option<f64>,
     /// Half-width of the halo in pixels of the scene's picture, at the depth of the point
     /// the camera looks at: about the width of the gap the halo cuts into the sheet
-    /// passing under on each side of a crossing ([`DEFAULT_GAP_PX`] when neither this nor
+    /// passing under on each side of a crossing (`halo::DEFAULT_GAP_PX` when neither this nor
     /// `rho` is given). One of `rho` and `gap_px`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gap_px: Option<f64>,
@@ -100,7 +100,7 @@ pub const DEFAULT_GAP_PX: f64 = 8.0;
 impl HaloParams {
     /// The halo's half-width in scene units, for a projected scene of bounding `diagonal`
     /// whose picture has pixels of side `pixel_size` (scene units) at the depth the camera
-    /// looks at; no larger than [`MAX_RHO`] of the diagonal.
+    /// looks at; no larger than `halo::MAX_RHO` of the diagonal.
     pub fn half_width(&self, diagonal: f64, pixel_size: f64) -> f64 {
         match self.rho {
             Some(rho) => rho * diagonal,

@@ -7,7 +7,7 @@
 //! and projected by a [`View`] ([`Projected`]), thickened into a [`Halo`] of tetrahedra
 //! ([`build_halo`], checked by the independent [`check`]); the intersection [`curves`] of
 //! all surfaces are the ground truth the halos are verified against ([`verify`]), and
-//! [`refine`] moves them onto the analytic surfaces for the files and the picture;
+//! [`refine()`] moves them onto the analytic surfaces for the files and the picture;
 //! [`Parts`] hands what a scene produced to the verification and the renderer ([`render`]).
 //! The files are read back with [`read_halos`] and [`read_scene_glb`], and checked again
 //! with [`check_file`] and [`check_dir`]. [`limits`] holds every limit a user can meet;

@@ -731,9 +731,14 @@ fn refine_curves<'a>(
     surfaces: impl Iterator<Item = (&'a Source, &'a Mesh4)>,
     diagonal: f64,
 ) -> Curves {
+    // A mesh without its triangles' parameters (a 4D mesh read back from a .glb, which
+    // keeps the vertices' only) keeps its curve points, as a mesh file's do.
     let analytic: Vec<intersect::Analytic> = surfaces
         .map(|(source, mesh)| intersect::Analytic {
-            surface: source.parametric(),
+            surface: source.parametric().filter(|_| {
+                mesh.triangle_uv.len() == mesh.triangles.len()
+                    && mesh.triangle_patch.len() == mesh.triangles.len()
+            }),
             mesh,
         })
         .collect();

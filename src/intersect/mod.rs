@@ -181,7 +181,7 @@ pub struct CurvesReport {
     pub exact_ms: f64,
     /// Placing, chaining and counting.
     pub chain_ms: f64,
-    /// What moving the points onto the analytic surfaces did ([`refine`]), when it ran.
+    /// What moving the points onto the analytic surfaces did ([`refine()`](fn@refine)), when it ran.
     #[serde(flatten)]
     pub refinement: Option<Refinement>,
 }

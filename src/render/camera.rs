@@ -163,7 +163,7 @@ impl Placement {
     /// the settings' direction, moved across it so that the surfaces are centred in the
     /// picture, and the eye stands as near as it can (perspective), or the picture is as
     /// small as it can be (orthographic), with every point inside the picture and
-    /// [`FIT_MARGIN`] of the picture free on each side, for every eye.
+    /// `FIT_MARGIN` of the picture free on each side, for every eye.
     ///
     /// A point at offsets a, b, c along right, up and forward from where the eye looks, the
     /// eye D away, lies in the picture when |a| <= kx (D + c) and |b| <= ky (D + c), with kx =

@@ -141,11 +141,11 @@ pub enum Style {
 /// How shaded surfaces are lit.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Lighting {
-    /// Phong shading with the 3D normals of the projected surfaces ([`shade::phong`]).
+    /// Phong shading with the 3D normals of the projected surfaces (`render::shade::phong`).
     #[default]
     #[serde(rename = "3d")]
     ThreeD,
-    /// Illumination in 4D ([`shade::phong4`]): the lights leaned into w, lighting the
+    /// Illumination in 4D (`render::shade::phong4`): the lights leaned into w, lighting the
     /// surface by its plane of normals in 4D, so that the shade shows how the surface leans
     /// in w (the fully 4D-lit rendering of paper 000's fig. 5c).
     #[serde(rename = "4d")]
@@ -233,7 +233,7 @@ pub struct RenderSettings {
     pub ribbons: Option<Ribbons>,
     /// A cutaway: one plane `{"normal": [x, y, z], "offset": d}` or a list of two (a
     /// wedge), removing the points of the projected scene where `normal · p > d` holds for
-    /// every plane ([`clip`]); the cut edges are drawn as lines.
+    /// every plane (see [`crate::Clip`]); the cut edges are drawn as lines.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub clip: Option<clip::Clip>,
     /// Draw the self-intersection curves.

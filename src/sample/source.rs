@@ -56,7 +56,7 @@ impl MeshSurface {
         Ok(())
     }
 
-    /// What the mesh's combinatorics say of the surface ([`mesh_topology`] of its
+    /// What the mesh's combinatorics say of the surface (`mesh_topology` of its
     /// statistics).
     pub fn topology(&self) -> Topology {
         mesh_topology(&self.mesh.validate())
