@@ -38,7 +38,7 @@ fn halos(c: &mut Criterion) {
         );
     }
     let (halo, _) = build_halo(&projected, &mesh.triangles, rho, &scene.halo);
-    let tet_mesh = halo.tet_mesh();
+    let tet_mesh = halo.tet_mesh(&mesh.triangles);
     group.bench_function("check", |b| b.iter(|| check(black_box(&tet_mesh))));
     group.finish();
 }

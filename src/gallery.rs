@@ -76,18 +76,19 @@ pub enum GalleryError {
 pub struct Figure {
     /// The scene file.
     pub file: PathBuf,
-    /// The scene's name: its folder in the gallery, and its picture `<name>/<name>.png`.
-    pub name: String,
-    /// The scene's description.
-    pub description: String,
-    /// The build's report.
+    /// The build's report (with the scene it built, in the view it was built in).
     pub report: Report,
 }
 
 impl Figure {
+    /// The scene's name: its folder in the gallery.
+    pub fn name(&self) -> &str {
+        &self.report.scene.name
+    }
+
     /// The picture, relative to the gallery's folder.
     pub fn picture(&self) -> String {
-        format!("{0}/{0}.png", self.name)
+        format!("{0}/{0}.png", self.name())
     }
 }
 
@@ -168,12 +169,7 @@ pub fn make(
                 source,
             }
         })?;
-        built.push(Figure {
-            file,
-            name: scene.name,
-            description: scene.description,
-            report,
-        });
+        built.push(Figure { file, report });
     }
     let write = |name: &str, bytes: &[u8]| {
         let path = out.join(name);
@@ -270,9 +266,9 @@ fn index_page(figures: &[Figure]) -> String {
         };
         html.push_str(&format!(
             "<figure id=\"{name}\">\n<img src=\"{src}\" alt=\"{name}\">\n<figcaption><b>{name}</b>: {description}<br><small>{share}; {verdict}; built in {ms:.1} s from <code>{file}</code></small></figcaption>\n</figure>\n",
-            name = escape(&f.name),
+            name = escape(f.name()),
             src = escape(&f.picture()),
-            description = escape(&f.description),
+            description = escape(&f.report.scene.description),
             ms = r.timings_ms.total / 1e3,
             file = escape(&f.file.display().to_string()),
         ));

@@ -173,19 +173,16 @@ pub struct Halo {
     pub rho: Vec<f64>,
     /// The surface triangle whose prism each inserted vertex (from 3n on) is in.
     pub inserted_in: Vec<u32>,
-    /// The surface's triangles the halo is built over (surface vertex indices): each a face
-    /// between the two layers, with an offset face on either side.
-    pub surface_triangles: Vec<[u32; 3]>,
 }
 
 impl Halo {
-    /// The halo in the checker's terms.
-    pub fn tet_mesh(&self) -> TetMesh {
+    /// The halo in the checker's terms, over the surface `triangles` it was built over.
+    pub fn tet_mesh(&self, triangles: &[[u32; 3]]) -> TetMesh {
         TetMesh {
             positions: self.positions.iter().map(|p| p.to_array()).collect(),
             surface_vertices: self.surface_vertices,
             tets: self.tets.clone(),
-            surface_triangles: self.surface_triangles.clone(),
+            surface_triangles: triangles.to_vec(),
         }
     }
 }
@@ -723,7 +720,6 @@ pub fn build_halo(
         tets: tets.tets,
         rho: offsets.rho,
         inserted_in: tets.inserted_in,
-        surface_triangles: triangles.to_vec(),
     };
     lap(&mut stage_ms.split);
     let checked = check_parts(&halo.positions, n, &halo.tets, triangles);

@@ -509,7 +509,7 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
                     .map_or(f64::NAN, |p| p.curves.visible_curve_share);
                 eprintln!(
                     "{:<36} {} visible curve share {share:.3}, {:.1} s",
-                    f.name,
+                    f.name(),
                     if f.report.verified {
                         "verified    "
                     } else {
@@ -518,7 +518,7 @@ fn run(command: Command) -> Result<ExitCode, Box<dyn std::error::Error>> {
                     f.report.timings_ms.total / 1e3
                 );
                 for failure in &f.report.failures {
-                    eprintln!("UNVERIFIED {}: {failure}", f.name);
+                    eprintln!("UNVERIFIED {}: {failure}", f.name());
                 }
             }
             println!("{}", gallery.index.display());

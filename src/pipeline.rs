@@ -604,7 +604,7 @@ fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error
 /// A scene's surfaces sampled (or read from their files) and audited: what a build makes
 /// before the view, which does not depend on the view. Sample once ([`Sampled::of`]), then
 /// build any number of views ([`Sampled::build`]): what an animation does for its frames,
-/// and what the explorer turns ([`Sampled::curves`] gives it the curves a build shows).
+/// and what the explorer turns ([`shown_curves`] gives it the curves a build shows).
 #[derive(Clone, Debug)]
 pub struct Sampled {
     surfaces: Vec<Sample>,
@@ -639,21 +639,9 @@ impl Sampled {
         in_view(scene, self, stages, &ProgressBar::hidden())
     }
 
-    /// The curves a build of `scene` (of the same surfaces and sampling) shows in its view:
-    /// the exact curves of the projected meshes, moved onto the analytic surfaces as
-    /// `scene.curves` says ([`Built::shown_curves`]), without the halos or a picture.
-    pub fn curves(&self, scene: &Scene) -> Result<Curves, Error> {
-        shown_curves(scene, &self.meshes().map(|(_, m)| m).collect::<Vec<_>>())
-    }
-
     /// Each surface's name and 4D mesh, in the scene's order.
     pub fn meshes(&self) -> impl Iterator<Item = (&str, &Mesh4)> {
         self.surfaces.iter().map(|s| (s.name.as_str(), &s.mesh))
-    }
-
-    /// Each surface's sampling report (method, tolerance met, audited error, times).
-    pub fn reports(&self) -> impl Iterator<Item = &SamplingReport> {
-        self.surfaces.iter().map(|s| &s.report)
     }
 
     /// Each surface's name and 4D mesh, moved out.

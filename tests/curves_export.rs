@@ -431,7 +431,7 @@ fn a_scene_reads_back_from_its_glb_with_every_surface_and_its_halo() {
 
         let h = s.halo.as_ref().expect("a halo per surface");
         assert_eq!(h.name, format!("{}-halo", p.name));
-        assert_eq!(h.mesh, p.halo.tet_mesh(), "{}", p.name);
+        assert_eq!(h.mesh, p.halo.tet_mesh(&p.mesh.triangles), "{}", p.name);
         assert_eq!(h.mesh.surface_vertices, s.positions.len());
         assert_eq!(h.params.delta_d, Some(scene.halo.delta_d));
         assert_eq!(h.params.delta_t, Some(scene.halo.delta_t));

@@ -70,7 +70,9 @@ fn halo_of(projected: &Projected, triangles: &[[u32; 3]], split: Split) -> TetMe
         split,
         ..HaloParams::default()
     };
-    build_halo(projected, triangles, 0.05, &params).0.tet_mesh()
+    build_halo(projected, triangles, 0.05, &params)
+        .0
+        .tet_mesh(triangles)
 }
 
 fn assert_valid(stats: &CheckStats, what: &str) {
@@ -94,7 +96,7 @@ fn with_each_split(
                 ..HaloParams::default()
             };
             let (halo, report) = build_halo(projected, triangles, 0.05, &params);
-            let stats = check(&halo.tet_mesh());
+            let stats = check(&halo.tet_mesh(triangles));
             assert_valid(&stats, &what);
             assert_eq!(report.split_stats.mismatches_final, 0, "{what}");
             assert_eq!(report.inverted, 0, "{what}");
@@ -475,7 +477,7 @@ fn the_checker_catches_faults_at_twisted_and_collapsed_prisms() {
     let mut rng = Rng(77);
     let (projected, triangles) = random_moebius(&mut rng, 16, 2);
     let (halo, report) = build_halo(&projected, &triangles, 0.05, &HaloParams::default());
-    assert!(check(&halo.tet_mesh()).passes() && report.collapsed_vertices == 0);
+    assert!(check(&halo.tet_mesh(&triangles)).passes() && report.collapsed_vertices == 0);
     let n = halo.surface_vertices as u32;
     // Twisted prisms: their offset faces on the boundary mix the two sides.
     let mut uses = std::collections::HashMap::new();
@@ -499,7 +501,7 @@ fn the_checker_catches_faults_at_twisted_and_collapsed_prisms() {
     };
     let mut caught = 0;
     for (t, &tri) in triangles.iter().enumerate().filter(|&(t, _)| twisted(t)) {
-        let mut bad = halo.tet_mesh();
+        let mut bad = halo.tet_mesh(&triangles);
         let plain = Corners::plain(tri)
             .layers(n)
             .into_iter()
@@ -516,7 +518,7 @@ fn the_checker_catches_faults_at_twisted_and_collapsed_prisms() {
     let products = run_fixture("flat-torus", |_| {});
     let halo = &products[0].halo;
     let v = halo.rho.iter().position(|&r| r == 0.0).unwrap();
-    let mut bad = halo.tet_mesh();
+    let mut bad = halo.tet_mesh(&products[0].mesh.triangles);
     bad.positions[halo.surface_vertices + v][2] += 1e-3;
     let s = check(&bad);
     assert_eq!(s.collapsed_vertices, 3, "{s:?}");

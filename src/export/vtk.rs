@@ -53,7 +53,7 @@ pub fn write_vtk(out: &mut dyn Write, surface: &SurfaceData, scene_name: &str) -
     write!(out, "\nFIELD FieldData 6\nsurface_vertices 1 1 int\n")?;
     out.write_all(&(halo.surface_vertices as i32).to_be_bytes())?;
     // The surface's triangles, so that a checker sees a prism missing whole.
-    let triangles = &halo.surface_triangles;
+    let triangles = &surface.mesh.triangles;
     write!(out, "\nsurface_triangles 3 {} int\n", triangles.len())?;
     for &v in triangles.iter().flatten() {
         out.write_all(&(v as i32).to_be_bytes())?;
