@@ -42,7 +42,9 @@ fn random_mask(side: usize, count: usize, widths: [f64; 2]) -> Mask {
 
 fn pictures(c: &mut Criterion) {
     let scene = halo4d::Scene::default_scene();
-    let built = halo4d::run(&scene, true).expect("the default scene builds");
+    let built = halo4d::Sampled::of(&scene)
+        .into_built(&scene, halo4d::Stages::of(&scene))
+        .expect("the default scene builds");
     let mut group = c.benchmark_group("render/default_scene_1024");
     group.sample_size(10);
     for (name, mode) in [
@@ -68,7 +70,9 @@ fn pictures(c: &mut Criterion) {
 fn stipples(c: &mut Criterion) {
     let mut scene = halo4d::Scene::default_scene();
     scene.render.style = halo4d::Style::Stipple;
-    let built = halo4d::run(&scene, true).expect("the default scene builds");
+    let built = halo4d::Sampled::of(&scene)
+        .into_built(&scene, halo4d::Stages::of(&scene))
+        .expect("the default scene builds");
     let mut group = c.benchmark_group("render/default_scene_1024");
     group.sample_size(10);
     group.bench_function("stipple", |b| {

@@ -90,7 +90,7 @@ pub fn check_dir(dir: &Path) -> Result<Checked, InspectError> {
 }
 
 /// Recomputes the intersection curves of a scene read from its `.glb` and verifies its
-/// halos against them, as a build does ([`crate::pipeline::run`]).
+/// halos against them, as a build does ([`crate::pipeline::Sampled::build`]).
 pub fn verify_scene(scene: &ImportedScene) -> (Curves, Verification) {
     let curves = intersect::curves(&scene.parts(&Curves::default()).sheets());
     let verification = verify::verify(&scene.parts(&curves));

@@ -1,7 +1,8 @@
 //! halo4d turns surfaces that live in four dimensions into verified 3D geometry.
 //!
 //! A [`Scene`] says what to build; [`build`] runs the stages its outputs need and writes the
-//! files ([`run`] and [`write()`] do the two halves, [`render_to`] makes its picture). The
+//! files ([`Sampled::of`] then [`Sampled::build`], and [`write()`], do the two halves; a
+//! sample serves any number of views; [`render_to`] makes its picture). The
 //! stages, in the order of the pipeline: a [`Surface`] of the catalogue (4D, exact
 //! derivatives) is sampled to a tolerance ([`sample`], a welded, audited [`Mesh4`]), turned
 //! and projected by a [`View`] ([`Projected`]), thickened into a [`Halo`] of tetrahedra
@@ -78,8 +79,8 @@ mod viewsearch;
 // The scene, the build and what it gives.
 pub use error::Error;
 pub use pipeline::{
-    Bounds, Built, MemoryReport, Report, Sampled, SamplingReport, Stages, SurfaceProduct,
-    SurfaceReport, Timings, build, glb_bytes, render_to, run, run_for_picture, shown_curves, write,
+    Bounds, Built, MemoryReport, PictureReport, Report, Sampled, SamplingReport, Stages,
+    SurfaceProduct, SurfaceReport, Timings, build, glb_bytes, render_to, shown_curves, write,
 };
 pub use scene::{DEFAULT_SCENE, Outputs, Scene, SceneError, SceneSurface};
 pub use viewsearch::{Found, SearchError, resolve as resolve_view, search as search_view};
@@ -106,9 +107,8 @@ pub use render::{
     RenderSettings, RibbonAxis, Ribbons, StippleSettings, Style, render,
 };
 pub use sample::{
-    Audit, Mesh4, MeshData4, MeshFileError, MeshFileLocation, MeshFormat, MeshStats, MeshSurface,
-    Sampling, Source, audit, mesh_from_data, mesh_tangents, parse_mesh4, read_mesh4, sample,
-    sample_adaptive, sample_uniform, write_4off,
+    Audit, Mesh4, MeshData4, MeshStats, MeshSurface, Sampling, Source, audit, mesh_from_data,
+    mesh_tangents, sample, sample_adaptive, sample_uniform,
 };
 pub use stipple::{Stipples, poisson_radius};
 pub use surfaces::{
@@ -120,10 +120,13 @@ pub use verify::{Ambiguous, Verification, verify};
 pub use view::{BehindEye, Mapped, Projected, Projection, Rotation4, View, ViewMap};
 
 // The files: written, read back and checked.
-pub use export::{StagedError, SurfaceData, to_curves_ply, to_obj, to_ply, write_vtk};
+pub use export::{
+    StagedError, SurfaceData, to_4off, to_curves_ply, to_obj, to_ply, write_atomic, write_vtk,
+};
 pub use import::{
     FileParams, ImportError, ImportedCurves, ImportedHalo, ImportedScene, ImportedSurface,
-    read as read_halos, read_glb, read_scene_glb, read_vtk,
+    MeshFileError, MeshFileLocation, MeshFormat, parse_mesh4, read as read_halos, read_glb,
+    read_mesh4, read_scene_glb, read_vtk,
 };
 pub use inspect::{Checked, InspectError, check_dir, check_file, verify_scene};
 

@@ -83,6 +83,11 @@ pub struct Outputs {
     pub ply: bool,
     /// `<name>.obj`: the surfaces as Wavefront OBJ.
     pub obj: bool,
+    /// `<name>.4off` (one surface) or `<name>-<surface>.4off` (several): each surface's 4D
+    /// mesh before the view, as Geomview `4OFF` text that reads back bit for bit (a scene's
+    /// `mesh` surface, or another 4D viewer).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub off4: bool,
     /// `<name>-halo.vtk` (one surface) or `<name>-<surface>-halo.vtk` (several): each halo's
     /// tetrahedra as legacy VTK, for ParaView and meshio.
     pub vtk: bool,
@@ -147,6 +152,7 @@ impl Default for Outputs {
             glb: true,
             ply: true,
             obj: false,
+            off4: false,
             vtk: true,
             report: true,
             png: true,
@@ -240,7 +246,10 @@ impl Scene {
         };
         for (i, s) in scene.surfaces.iter_mut().enumerate() {
             if let Source::Mesh(m) = &mut s.surface {
-                m.load(folder)
+                let file = folder.join(&m.path);
+                crate::import::read_mesh4(&file)
+                    .map_err(|e| FieldError::new("path", e.to_string()))
+                    .and_then(|data| m.set(data, &file))
                     .map_err(|e| invalid(e.within(&format!("surfaces[{i}].surface"))))?;
             }
         }

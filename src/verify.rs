@@ -622,7 +622,12 @@ mod tests {
         );
         let mut scene = Scene::load(std::path::Path::new(path)).unwrap();
         scene.sampling = Sampling::Uniform { u: 48, v: 48 };
-        (crate::run(&scene, true).unwrap(), scene)
+        (
+            crate::Sampled::of(&scene)
+                .into_built(&scene, crate::Stages::of(&scene))
+                .unwrap(),
+            scene,
+        )
     }
 
     #[test]

@@ -1,15 +1,16 @@
-//! The module graph: every `crate::` edge in `src/` points down the layers of the README's
-//! ARCHITECTURE table, and that table lists exactly the library's modules.
+//! The module graph: every `crate::` edge in `src/` points down the layers of the ARCHITECTURE
+//! table in docs/ARCHITECTURE.md, and that table lists exactly the library's modules.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// The README's ARCHITECTURE table: module -> layer, from its rows `| layer | `module` | ...`.
-fn layers(readme: &str) -> BTreeMap<String, u32> {
-    let section = readme
+/// The ARCHITECTURE table of docs/ARCHITECTURE.md: module -> layer, from its rows
+/// `| layer | `module` | ...`.
+fn layers(architecture: &str) -> BTreeMap<String, u32> {
+    let section = architecture
         .split("\n## ARCHITECTURE")
         .nth(1)
-        .expect("the README has an ARCHITECTURE section");
+        .expect("docs/ARCHITECTURE.md has an ARCHITECTURE section");
     let mut out = BTreeMap::new();
     for line in section.lines().filter(|l| l.starts_with("| ")) {
         let cells: Vec<&str> = line.split('|').map(str::trim).collect();
@@ -161,16 +162,16 @@ fn root() -> &'static Path {
 }
 
 #[test]
-fn every_edge_between_modules_points_down_the_readme_layers() {
-    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
-    let layers = layers(&readme);
+fn every_edge_between_modules_points_down_the_layers() {
+    let architecture = std::fs::read_to_string(root().join("docs/ARCHITECTURE.md")).unwrap();
+    let layers = layers(&architecture);
     let sources = library_sources(&root().join("src"));
     let modules: std::collections::BTreeSet<String> =
         sources.iter().map(|(m, _)| m.clone()).collect();
     let listed: std::collections::BTreeSet<String> = layers.keys().cloned().collect();
     assert_eq!(
         modules, listed,
-        "the README's ARCHITECTURE table lists exactly the modules of src/"
+        "the ARCHITECTURE table of docs/ARCHITECTURE.md lists exactly the modules of src/"
     );
     let up = upward_edges(&layers, &sources);
     assert!(
@@ -187,8 +188,8 @@ fn every_edge_between_modules_points_down_the_readme_layers() {
 
 #[test]
 fn a_planted_upward_use_is_caught() {
-    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
-    let layers = layers(&readme);
+    let architecture = std::fs::read_to_string(root().join("docs/ARCHITECTURE.md")).unwrap();
+    let layers = layers(&architecture);
     let mut sources = library_sources(&root().join("src"));
     let sample = sources.iter_mut().find(|(m, _)| m == "sample").unwrap();
     let clean = sample.1.clone();

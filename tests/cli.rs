@@ -679,3 +679,45 @@ fn a_picture_gets_its_halos_whatever_files_the_scene_writes() {
 fn folder_names(dir: &std::path::Path) -> Vec<String> {
     folder(dir).into_iter().map(|(name, _)| name).collect()
 }
+
+#[test]
+fn render_writes_beside_the_build_s_picture_and_refuses_an_out_that_is_not_a_png_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let small = r#"{"render": {"width": 64, "height": 64, "samples": 1, "style": "stipple"}}"#;
+    let file = patches_scene(dir.path(), "small", small);
+    // The build's picture stays; the render goes beside it, and says what it drew.
+    let build = halo4d(&["build", "-q", &file], dir.path());
+    assert!(build.status.success());
+    let built = dir.path().join("exports/patches/patches.png");
+    let before = std::fs::read(&built).unwrap();
+    let out = halo4d(
+        &["render", &file, "--quiet", "--style", "shaded"],
+        dir.path(),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("64 x 64 shaded picture, exact halos"), "{err}");
+    assert!(
+        dir.path()
+            .join("exports/patches/patches-render.png")
+            .is_file()
+    );
+    assert_eq!(
+        std::fs::read(&built).unwrap(),
+        before,
+        "the build's picture"
+    );
+    // A .jpg or a folder is refused before anything is built or written.
+    for (out_flag, words) in [
+        ("x.jpg", ["--out", "ending in .png"]),
+        ("exports", ["--out", "is a folder"]),
+    ] {
+        let out = halo4d(&["render", &file, "--quiet", "--out", out_flag], dir.path());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        for w in words {
+            assert!(err.contains(w), "`{w}` not in {err}");
+        }
+    }
+    assert!(!dir.path().join("x.jpg").exists());
+}

@@ -147,3 +147,8 @@ pub fn formula_surfaces() -> Vec<halo4d::Surface> {
         })),
     ]
 }
+
+/// The build of `scene` in its view: sampled once, then the stages its outputs need.
+pub fn built(scene: &halo4d::Scene) -> Result<halo4d::Built, halo4d::Error> {
+    halo4d::Sampled::of(scene).into_built(scene, halo4d::Stages::of(scene))
+}

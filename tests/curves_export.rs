@@ -17,7 +17,7 @@ use std::path::Path;
 
 /// Builds a scene into `dir`.
 fn build(scene: &Scene, dir: &Path) -> Built {
-    let built = halo4d::run(scene, true).unwrap();
+    let built = crate::common::built(scene).unwrap();
     halo4d::write(scene, &built, dir).unwrap();
     built
 }
@@ -346,7 +346,7 @@ fn check_on_the_written_glb_finds_exactly_what_the_build_found() {
     // from the .glb have the same counts.
     for path in fixture_scenes().into_iter().chain(hard_scenes()) {
         let scene = Scene::load(&path).unwrap();
-        let built = halo4d::run(&scene, true).unwrap();
+        let built = crate::common::built(&scene).unwrap();
         let what = path.display();
         assert_eq!(built.failures(), Vec::<String>::new(), "{what}");
         let data: Vec<_> = built.surfaces.iter().map(|p| p.data(&scene.halo)).collect();
@@ -379,7 +379,7 @@ fn check_on_the_written_glb_finds_exactly_what_the_build_found() {
 #[test]
 fn without_curves_the_glb_has_no_curves_mesh_and_the_ply_is_empty_but_valid() {
     let scene = Scene::load(&fixture("scenes/patches.json")).unwrap();
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     let data: Vec<_> = built.surfaces.iter().map(|p| p.data(&scene.halo)).collect();
     let none = Curves::default();
     let glb = halo4d::internals::to_glb(&data, &none, 0.01, &Value::Null).unwrap();

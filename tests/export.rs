@@ -25,7 +25,7 @@ fn every_fixture_builds_and_reads_back() {
             scene.render.samples,
         ) = (128, 128, 1);
         let out = dir.path().join(&scene.name);
-        let built = halo4d::run(&scene, true).unwrap();
+        let built = crate::common::built(&scene).unwrap();
         let products = &built.surfaces;
         let report = halo4d::write(&scene, &built, &out)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));

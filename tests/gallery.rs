@@ -114,7 +114,7 @@ fn a_gallery_of_no_scene_or_of_two_scenes_of_one_name_is_refused() {
 /// The picture of `scene` at `side` x `side` pixels per eye.
 fn picture(mut scene: Scene, side: u32) -> image::RgbImage {
     (scene.render.width, scene.render.height) = (side, side);
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     let p = built
         .render(&scene.halo, &scene.render, &scene.camera)
         .unwrap();

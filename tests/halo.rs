@@ -385,7 +385,7 @@ fn every_split_conforms_with_holes_and_bowtie_boundary_vertices() {
 fn run_fixture(name: &str, edit: impl FnOnce(&mut Scene)) -> Vec<halo4d::SurfaceProduct> {
     let mut scene = Scene::load(&fixture(&format!("scenes/{name}.json"))).unwrap();
     edit(&mut scene);
-    halo4d::run(&scene, true).unwrap().surfaces
+    crate::common::built(&scene).unwrap().surfaces
 }
 
 #[test]

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 
 /// Builds a scene into `dir`, returning its products.
 fn build(scene: &Scene, dir: &Path) -> Vec<SurfaceProduct> {
-    let built = halo4d::run(scene, true).unwrap();
+    let built = crate::common::built(scene).unwrap();
     halo4d::write(scene, &built, dir).unwrap();
     built.surfaces
 }

@@ -386,7 +386,7 @@ fn every_fixture_halo_is_verified_by_its_curves() {
     let (mut correct, mut ambiguous) = (0, 0);
     for path in fixture_scenes() {
         let scene = Scene::load(&path).unwrap();
-        let built = halo4d::run(&scene, true).unwrap();
+        let built = crate::common::built(&scene).unwrap();
         let v = &built.verification;
         let what = format!("{}: {v:?}", path.display());
         assert!(built.curves.report.count > 0, "{what}");
@@ -423,7 +423,7 @@ fn where_a_view_folds_fermat_patches_together_the_curves_end_at_the_vertex() {
     // end at that vertex. Ends there are branch points, not unresolved branches; the halo
     // collapses around it, and the samples there are ambiguous, not wrong.
     let scene = Scene::load(&fixture("hard/two-surfaces.json")).unwrap();
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     let report = &built.curves.report;
     assert_eq!(report.unresolved, 0, "{report:?}");
     let at_fold = |p: &halo4d::CurvePoint| {
@@ -454,7 +454,7 @@ fn where_a_view_folds_fermat_patches_together_the_curves_end_at_the_vertex() {
 /// The flat torus fixture's build, for planting faults in its halo.
 fn flat_torus_build() -> halo4d::Built {
     let scene = Scene::load(&fixture("scenes/flat-torus.json")).unwrap();
-    halo4d::run(&scene, true).unwrap()
+    crate::common::built(&scene).unwrap()
 }
 
 fn verify(built: &halo4d::Built, scene: &Scene) -> halo4d::Verification {
@@ -609,7 +609,7 @@ fn the_verdict_does_not_depend_on_the_resolution() {
             }
             scene.halo.rho = Some(0.01);
             scene.halo.gap_px = None;
-            let built = halo4d::run(&scene, true).unwrap();
+            let built = crate::common::built(&scene).unwrap();
             let v = &built.verification;
             let triangles: usize = built.surfaces.iter().map(|p| p.mesh.triangles.len()).sum();
             let what = format!("{name} at {triangles} triangles: {v:?}");
@@ -639,7 +639,7 @@ fn planted_faults_are_caught_at_a_million_triangles() {
     // tetrahedra): sound, then each fault planted in its halo and caught.
     let mut scene = Scene::load(&fixture("scenes/flat-torus.json")).unwrap();
     scene.sampling = Sampling::Uniform { u: 708, v: 708 };
-    let mut built = halo4d::run(&scene, true).unwrap();
+    let mut built = crate::common::built(&scene).unwrap();
     assert_eq!(built.surfaces[0].mesh.triangles.len(), 1_002_528);
     let v = verify(&built, &scene);
     assert_eq!(

@@ -14,6 +14,7 @@ mod halo_export;
 mod intersect;
 mod lines;
 mod own;
+mod readme;
 mod refine;
 mod render;
 mod sample;

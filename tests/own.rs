@@ -1,7 +1,7 @@
 //! Surfaces users bring: formulas and 4D meshes from files, built like the catalogue's.
 
 use crate::common::{Rng, fixture};
-use halo4d::{MeshData4, Scene, Source, write_4off};
+use halo4d::{Scene, Source};
 
 /// A fixture scene with its pictures off (the builds compare meshes, curves and halos).
 fn fixture_scene(name: &str) -> Scene {
@@ -49,8 +49,8 @@ fn catalogue_surfaces_as_formulas_give_the_same_points_derivatives_and_builds() 
         }
 
         let (ba, bb) = (
-            halo4d::run(&a, true).unwrap(),
-            halo4d::run(&b, true).unwrap(),
+            crate::common::built(&a).unwrap(),
+            crate::common::built(&b).unwrap(),
         );
         let (ma, mb) = (&ba.surfaces[0].mesh, &bb.surfaces[0].mesh);
         assert_eq!(ma.triangles, mb.triangles, "{name}: the same mesh");
@@ -114,19 +114,19 @@ fn scene_json(surface: &str, sampling: &str) -> String {
 #[test]
 fn a_4off_of_a_catalogue_mesh_builds_the_same_curves_and_verifies() {
     let dir = tempfile::tempdir().unwrap();
-    for (surface, file) in [
-        (r#"{"type": "flat_torus"}"#, "torus.4off"),
-        (r#"{"type": "klein_bottle"}"#, "klein.4off"),
+    for (surface, folder) in [
+        (r#"{"type": "flat_torus"}"#, "torus"),
+        (r#"{"type": "klein_bottle"}"#, "klein"),
     ] {
+        // The build writes its 4D mesh (`outputs.off4`), and nothing else.
         let grid = r#""sampling": {"method": "uniform", "u": 48, "v": 48},"#;
-        let scene = Scene::parse(&scene_json(surface, grid), "catalogue.json").unwrap();
-        let catalogue = halo4d::run(&scene, true).unwrap();
+        let mut scene = Scene::parse(&scene_json(surface, grid), "catalogue.json").unwrap();
+        scene.outputs.off4 = true;
+        let catalogue = crate::common::built(&scene).unwrap();
         let mesh = &catalogue.surfaces[0].mesh;
-        let data = MeshData4 {
-            positions: mesh.positions.clone(),
-            triangles: mesh.triangles.clone(),
-        };
-        std::fs::write(dir.path().join(file), write_4off(&data)).unwrap();
+        let written = halo4d::write(&scene, &catalogue, &dir.path().join(folder)).unwrap();
+        let file = format!("{folder}/{}.4off", scene.name);
+        assert_eq!(written.files, [format!("{}.4off", scene.name)]);
         let path = dir.path().join("scene.json");
         let text = scene_json(&format!(r#"{{"type": "mesh", "path": "{file}"}}"#), "");
         std::fs::write(&path, text).unwrap();
@@ -139,7 +139,7 @@ fn a_4off_of_a_catalogue_mesh_builds_the_same_curves_and_verifies() {
             m.mesh.triangles, mesh.triangles,
             "{file}: triangles read back"
         );
-        let built = halo4d::run(&scene, true).unwrap();
+        let built = crate::common::built(&scene).unwrap();
 
         // The curves depend on the projected mesh only: the same, point for point.
         let (a, b) = (&catalogue.curves, &built.curves);

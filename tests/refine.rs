@@ -147,7 +147,7 @@ fn refined_flat_torus_curves_of_adaptive_meshes_end_at_the_true_cross_caps() {
 fn every_fixture_refines_to_rounding_and_keeps_its_curves() {
     for path in fixture_scenes() {
         let scene = Scene::load(&path).unwrap();
-        let built = halo4d::run(&scene, true).unwrap();
+        let built = crate::common::built(&scene).unwrap();
         let what = path.display().to_string();
         let (Some(refined), mesh) = (&built.refined, &built.curves) else {
             panic!("{what}: no refined curves");
@@ -183,7 +183,7 @@ fn every_fixture_refines_to_rounding_and_keeps_its_curves() {
 fn without_refinement_the_files_show_the_mesh_curves() {
     let mut scene = Scene::load(&fixture("scenes/flat-torus.json")).unwrap();
     scene.curves.refine = false;
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     assert!(built.refined.is_none());
     assert!(std::ptr::eq(built.shown_curves(), &built.curves));
     assert!(built.curves.report.refinement.is_none());

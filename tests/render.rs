@@ -22,7 +22,7 @@ fn every_fixture_renders_a_picture_of_its_surfaces() {
     for path in fixture_scenes() {
         let mut scene = Scene::load(&path).unwrap();
         small(&mut scene);
-        let built = halo4d::run(&scene, true).unwrap();
+        let built = crate::common::built(&scene).unwrap();
         let picture = built
             .render(&scene.halo, &scene.render, &scene.camera)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -45,7 +45,7 @@ fn every_fixture_renders_a_picture_of_its_surfaces() {
 fn renders_are_deterministic_and_stereo_is_two_views() {
     let mut scene = Scene::load(&fixture("scenes/klein-bottle.json")).unwrap();
     small(&mut scene);
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     let a = built
         .render(&scene.halo, &scene.render, &scene.camera)
         .unwrap();
@@ -87,7 +87,7 @@ impl Torus {
         // A halo a hundredth of the diagonal wide: 8 px of this small picture would be
         // a fifth of the torus's tube, within which other sheets pass.
         scene.halo.rho = Some(0.01);
-        let built = halo4d::run(&scene, true).unwrap();
+        let built = crate::common::built(&scene).unwrap();
         Torus { scene, built }
     }
 
@@ -398,7 +398,7 @@ fn the_drawn_curves_lie_on_the_computed_curves_at_the_width_asked_for() {
     ) = (400, 400, 1);
     scene.render.silhouettes = false;
     scene.render.line_width = 4.0;
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     let parts = built.parts(&scene.halo);
     let input = parts;
     let coverage = halo4d::internals::line_coverage(&input, &scene.render, &scene.camera).unwrap();
@@ -547,7 +547,7 @@ fn sweep_render_writes_the_slice_modes_speed_against_error() {
 fn in_the_patches_of_paper_000_fig_1_the_nearer_patch_is_drawn_at_each_crossing() {
     let mut scene = Scene::load(&fixture("scenes/patches.json")).unwrap();
     small(&mut scene);
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     let parts = built.parts(&scene.halo);
     let input = parts;
     let without = RenderSettings {
@@ -637,7 +637,7 @@ fn the_default_camera_fits_the_surfaces_in_the_picture() {
         scene.render.samples,
     ) = (300, 240, 1);
     assert_eq!(scene.camera.distance, None, "the default camera is fitted");
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     let parts = built.parts(&scene.halo);
     let picture = halo4d::render(&parts, &scene.render, &scene.camera).unwrap();
     let (w, h) = (picture.width as usize, picture.height as usize);
@@ -932,7 +932,7 @@ fn where_the_sheet_over_changes_along_a_curve_it_is_drawn_in_the_colour_of_each(
         scene.render.height,
         scene.render.samples,
     ) = (400, 400, 1);
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     let counts = inks_along_the_curves(&scene, &built, true);
     let both = counts
         .iter()
@@ -1028,7 +1028,7 @@ fn luminance_at_tolerance(
     for s in &mut scene.surfaces {
         s.sampling = None;
     }
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     let picture = built
         .render(&scene.halo, &scene.render, &scene.camera)
         .unwrap();
@@ -1155,7 +1155,7 @@ fn the_visible_share_of_the_curves_is_that_of_a_brute_force_ray_cast() {
     scene.sampling = halo4d::Sampling::Uniform { u: 24, v: 24 };
     (scene.render.width, scene.render.height) = (160, 120);
     (scene.camera.azimuth, scene.camera.elevation) = (20.0, 10.0);
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     let parts = built.parts(&scene.halo);
     let (camera, seen) =
         halo4d::internals::curve_visibility(&parts, &scene.render, &scene.camera).unwrap();
@@ -1263,7 +1263,7 @@ fn every_catalogue_surface_has_a_fixture_whose_picture_shows_its_crossings() {
         let scene = Scene::load(&fixture(&format!("scenes/{name}.json"))).unwrap();
         assert_eq!(scene.surfaces[0].surface.type_name(), kind, "{name}");
         assert_eq!((scene.render.width, scene.render.height), (1024, 1024));
-        let built = halo4d::run(&scene, true).unwrap();
+        let built = crate::common::built(&scene).unwrap();
         assert!(
             built.failures().is_empty(),
             "{name}: {:?}",

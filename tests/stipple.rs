@@ -157,7 +157,7 @@ fn default_scene() -> (Scene, halo4d::Built) {
     let mut scene = Scene::default_scene();
     scene.render.style = Style::Stipple;
     (scene.render.width, scene.render.height) = (400, 400);
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     (scene, built)
 }
 
@@ -201,7 +201,7 @@ fn the_far_sheet_has_no_stipples_in_the_gap_and_has_them_beyond() {
     scene.render.style = Style::Stipple;
     (scene.render.width, scene.render.height) = (800, 800);
     scene.halo.rho = Some(0.03);
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     let parts = built.parts(&scene.halo);
     let without = RenderSettings {
         halos: false,
@@ -301,7 +301,7 @@ fn every_fixture_draws_in_stipples_in_both_modes() {
         scene.render.style = Style::Stipple;
         (scene.render.width, scene.render.height) = (200, 200);
         scene.render.stipple.count = 50_000;
-        let built = halo4d::run(&scene, true).unwrap();
+        let built = crate::common::built(&scene).unwrap();
         for mode in [halo4d::RenderMode::Exact, halo4d::RenderMode::Slices] {
             let settings = RenderSettings {
                 mode,
@@ -326,7 +326,7 @@ fn every_fixture_draws_in_stipples_in_both_modes() {
 fn a_surface_without_stipples_is_a_clear_error() {
     let mut scene = Scene::load(&fixture("scenes/klein-bottle.json")).unwrap();
     (scene.render.width, scene.render.height) = (64, 64);
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     let stipple = RenderSettings {
         style: Style::Stipple,
         ..scene.render
@@ -348,7 +348,7 @@ fn the_stipples_files_hold_the_pictures_stipples() {
     let dir = tempfile::tempdir().unwrap();
     let report = halo4d::build(&scene, dir.path(), true).unwrap();
     assert_eq!(report.surfaces[0].stipples, Some(200_000));
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     let drawn = stipples_drawn(&built.parts(&scene.halo), &scene.render, &scene.camera).unwrap();
     assert!(drawn.len() > 1000, "{} stipples drawn", drawn.len());
     let name = &scene.name;
@@ -436,7 +436,7 @@ fn coloured_stipples_take_the_w_colours() {
     scene.camera = halo4d::CameraSettings::default();
     (scene.render.width, scene.render.height) = (400, 400);
     scene.render.style = Style::Stipple;
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     scene.render.stipple.colour = true;
     (scene.render.curves, scene.render.silhouettes) = (false, false);
     let picture = built

@@ -125,7 +125,7 @@ fn points_at_or_behind_the_eye_are_errors_not_nans() {
     let text = r#"{ "name": "near", "surfaces": [ { "name": "ring", "surface": { "type": "flat_torus" } } ],
         "view": { "translation": [0, 0, 0, -1.5], "projection": { "type": "perspective", "eye_distance": 2 } } }"#;
     let scene = halo4d::Scene::parse(text, "near.json").unwrap();
-    let err = halo4d::run(&scene, true).unwrap_err().to_string();
+    let err = crate::common::built(&scene).unwrap_err().to_string();
     assert!(
         err.contains("`ring`") && err.contains("`near`") && err.contains("eye_distance"),
         "{err}"

@@ -27,7 +27,7 @@ const SIDE: u32 = 320;
 
 /// Builds `scene` into `dir` and loads its `.glb` as the viewer does.
 fn exported(scene: &Scene, dir: &Path) -> (halo4d::Built, Asset) {
-    let built = halo4d::run(scene, true).unwrap();
+    let built = crate::common::built(scene).unwrap();
     halo4d::write(scene, &built, dir).unwrap();
     let glb = dir.join(format!("{}.glb", scene.name));
     let asset = Asset::load(&glb).unwrap_or_else(|e| panic!("{e}"));
@@ -146,7 +146,7 @@ fn a_cutaway_removes_on_the_gpu_what_the_cpu_renderer_removes() {
             offset: c.x,
         },
     ));
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     let exact = exact_distances(&scene, &built);
     let whole = distances(
         &viewer::screenshot(gpu, &asset, &settings(&scene, HaloMode::Grid, 256)).unwrap(),
@@ -207,7 +207,7 @@ fn the_explorer_draws_the_curves_a_build_shows() {
     for name in ["default", "klein-bottle", "fermat-quadratic"] {
         let scene = Scene::load(&crate::common::fixture(&format!("scenes/{name}.json"))).unwrap();
         assert!(scene.curves.refine, "{name} refines its curves");
-        let built = halo4d::run(&scene, true).unwrap();
+        let built = crate::common::built(&scene).unwrap();
         let model = Model::new(scene.clone()).unwrap();
         let turned = |rotation: Rotation4| halo4d::View {
             rotation,
@@ -225,7 +225,7 @@ fn the_explorer_draws_the_curves_a_build_shows() {
         rotation.xw += 7.0;
         let mut other = scene.clone();
         other.view = turned(rotation);
-        let built = halo4d::run(&other, true).unwrap();
+        let built = crate::common::built(&other).unwrap();
         assert_eq!(
             model.curves(&other.view).unwrap().curves,
             built.shown_curves().curves,
@@ -1074,7 +1074,7 @@ fn stipple_tile_difference(scene: &Scene, view: Option<&halo4d::View>) -> (f64, 
     if let Some(v) = view {
         scene.view = *v;
     }
-    let built = halo4d::run(&scene, true).unwrap();
+    let built = crate::common::built(&scene).unwrap();
     let cpu = built
         .render(
             &scene.halo,

@@ -87,7 +87,9 @@ fn a_scene_whose_view_is_auto_builds_in_the_view_the_search_finds() {
     let text = flat_torus_with_view(serde_json::json!("auto"));
     let mut scene = Scene::parse(&text, "auto.json").unwrap();
     // Nothing builds a view not yet found.
-    let err = halo4d::run(&scene, true).expect_err("refused").to_string();
+    let err = crate::common::built(&scene)
+        .expect_err("refused")
+        .to_string();
     assert!(
         err.contains("its view is \"auto\"") && err.contains("resolve_view"),
         "{err}"

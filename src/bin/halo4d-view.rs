@@ -255,11 +255,9 @@ fn run(args: &Args) -> Result<(), ViewerError> {
     if let Some(out) = &args.screenshot {
         let gpu = Gpu::headless()?;
         let frame = viewer::screenshot_of(&gpu, &source, view.as_ref(), &settings)?;
-        halo4d::internals::write_atomic(out, &frame.picture.png()).map_err(|e| {
-            ViewerError::Write {
-                path: out.display().to_string(),
-                message: e.to_string(),
-            }
+        halo4d::write_atomic(out, &frame.picture.png()).map_err(|e| ViewerError::Write {
+            path: out.display().to_string(),
+            message: e.to_string(),
         })?;
         println!(
             "{}: {}x{}, {}, {} {} slices, {:.1} ms{} on {}",

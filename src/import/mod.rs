@@ -16,9 +16,11 @@
 //! tetrahedra's, the polylines') is never read as ours.
 
 mod glb;
+mod mesh;
 mod vtk;
 
 pub use glb::{read_glb, read_scene_glb};
+pub use mesh::{MeshFileError, MeshFileLocation, MeshFormat, parse_mesh4, read_mesh4};
 pub use vtk::read_vtk;
 
 use crate::check::{LAYERS, TetMesh};

@@ -1326,7 +1326,9 @@ mod tests {
         ] {
             let mut scene = scene;
             (scene.render.width, scene.render.height) = (200, 200);
-            let built = crate::pipeline::run(&scene, true).unwrap();
+            let built = crate::Sampled::of(&scene)
+                .into_built(&scene, crate::Stages::of(&scene))
+                .unwrap();
             let parts = built.parts(&scene.halo);
             let (placement, prepared) = prepare(&parts, &scene.render, &scene.camera).unwrap();
             assert!(prepared.opaque_and_uncut());

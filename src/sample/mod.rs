@@ -16,16 +16,12 @@
 
 mod adaptive;
 mod audit;
-mod file;
 mod source;
 mod uniform;
 
 pub use adaptive::{metric_aspect, sample_adaptive};
 pub use audit::{AUDIT_POINTS, Audit, audit};
-pub use file::{
-    MeshData4, MeshFileError, MeshFileLocation, MeshFormat, parse_mesh4, read_mesh4, write_4off,
-};
-pub use source::{MeshSurface, Source, mesh_from_data, mesh_tangents, mesh_topology};
+pub use source::{MeshData4, MeshSurface, Source, mesh_from_data, mesh_tangents, mesh_topology};
 pub use uniform::sample_uniform;
 
 use crate::limits::{FieldError, GRID_CELLS, RELATIVE_TOLERANCE, TRIANGLES};

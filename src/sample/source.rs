@@ -7,7 +7,6 @@
 //! triangles' orthogonal projectors, a 4 x 4 symmetric matrix), turned to agree with the
 //! triangles' winding. Its vertices all get patch 0 and parameters (0, 0).
 
-use super::file::{MeshData4, read_mesh4};
 use super::{Mesh4, MeshStats, Sampled, Sampling};
 use crate::limits::FieldError;
 use crate::surfaces::{Surface, Topology};
@@ -15,6 +14,16 @@ use glam::DVec4;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::sync::Arc;
+
+/// A triangle mesh in R^4 as a file holds it ([`crate::import::read_mesh4`] reads one).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MeshData4 {
+    /// The vertices' points of R^4.
+    pub positions: Vec<DVec4>,
+    /// Triangles as indices into `positions`, in the order and orientation of the file's
+    /// faces.
+    pub triangles: Vec<[u32; 3]>,
+}
 
 /// A surface of a scene: parametric, or a 4D mesh from a file.
 #[derive(Clone, Debug, PartialEq)]
@@ -38,11 +47,9 @@ pub struct MeshSurface {
 }
 
 impl MeshSurface {
-    /// Reads the file, `path` taken relative to `folder` (the scene file's), and makes the
-    /// mesh's tangents.
-    pub fn load(&mut self, folder: &Path) -> Result<(), FieldError> {
-        let file = folder.join(&self.path);
-        let data = read_mesh4(&file).map_err(|e| FieldError::new("path", e.to_string()))?;
+    /// Takes the mesh read from its file `file`: welds its coincident vertices and makes
+    /// its tangents.
+    pub fn set(&mut self, data: MeshData4, file: &Path) -> Result<(), FieldError> {
         let data = weld(data).map_err(|m| {
             FieldError::new(
                 "path",

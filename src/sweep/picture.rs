@@ -2,6 +2,7 @@
 
 use super::{SweepError, plot, write_files};
 use crate::limits::{FieldError, SLICES};
+use crate::pipeline::{Sampled, Stages};
 use crate::render::compare::{self, Comparison};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
@@ -14,7 +15,6 @@ pub fn picture_sweep(
     scene: &Scene,
     slices: &[u32],
     out_dir: &Path,
-    quiet: bool,
     progress: &mut dyn FnMut(&Comparison),
 ) -> Result<(Vec<Comparison>, Vec<PathBuf>), SweepError> {
     if let Some(bad) = slices.iter().find(|n| !SLICES.contains(*n)) {
@@ -28,7 +28,7 @@ pub fn picture_sweep(
         )
         .into());
     }
-    let built = crate::pipeline::run_for_picture(scene, quiet)?;
+    let built = Sampled::of(scene).into_built(scene, Stages::picture(scene))?;
     let rows = compare::compare(
         &built.parts(&scene.halo),
         &scene.render,

@@ -1122,7 +1122,8 @@ pub fn compare_turned(
         view: *view,
         ..model.scene.clone()
     };
-    let built = crate::pipeline::run_for_picture(&scene, true)?;
+    let built = crate::pipeline::Sampled::of(&scene)
+        .into_built(&scene, crate::pipeline::Stages::picture(&scene))?;
     let parts = built.parts(&scene.halo);
     let (exact, _) = exact_distances(&parts, settings)?;
     let cpu_ms = start.elapsed().as_secs_f64() * 1e3;

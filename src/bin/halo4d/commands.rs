@@ -1,0 +1,420 @@
+//! What each command of `halo4d` does: one function per command, each giving the exit
+//! status.
+
+use crate::cli::{AnimateArgs, BuildArgs, CheckArgs, GalleryArgs, RenderArgs, SweepArgs, ViewArgs};
+use clap::ValueEnum;
+use halo4d::limits::{FieldError, shorten};
+use halo4d::{Comparison, Scene, Shard, sweep};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// What a command gives: its exit status, or an error printed as `error: ...` (exit 1).
+pub type Outcome = Result<ExitCode, Box<dyn std::error::Error>>;
+
+/// The exit status of a build whose own verification failed.
+const UNVERIFIED: u8 = 3;
+
+/// The scene file (the default scene without one), its view found by the view search when
+/// it is `"auto"`.
+fn load(scene: Option<PathBuf>, quiet: bool) -> Result<Scene, Box<dyn std::error::Error>> {
+    let mut scene = match scene {
+        Some(path) => Scene::load(&path)?,
+        None => Scene::default_scene(),
+    };
+    if let Some(found) = halo4d::resolve_view(&mut scene, quiet)?
+        && !quiet
+    {
+        eprintln!("{}", found.summary());
+    }
+    Ok(scene)
+}
+
+/// `halo4d build`.
+pub fn build(args: BuildArgs) -> Outcome {
+    let BuildArgs {
+        scene,
+        out,
+        quiet,
+        allow_unverified,
+    } = args;
+    let scene = load(scene, quiet)?;
+    let out = out.unwrap_or_else(|| PathBuf::from("exports").join(&scene.name));
+    let report = halo4d::build(&scene, &out, quiet)?;
+    eprint!("{}", report.summary());
+    for f in &report.files {
+        println!("{}", out.join(f).display());
+    }
+    if report.verified {
+        return Ok(ExitCode::SUCCESS);
+    }
+    for f in &report.failures {
+        eprintln!("UNVERIFIED {f}");
+    }
+    // Say where the verdict is marked only in files that were written.
+    let marks: Vec<&str> = [
+        (scene.outputs.report, "report.json"),
+        (scene.outputs.glb, "the .glb's asset extras"),
+    ]
+    .into_iter()
+    .filter_map(|(written, what)| written.then_some(what))
+    .collect();
+    eprintln!(
+        "the build is not verified: {}{}",
+        if marks.is_empty() {
+            "the files asked for are written; none records the verdict (outputs.report and outputs.glb are off)".to_string()
+        } else {
+            format!(
+                "its files are written and marked `verified: false` ({})",
+                marks.join(", ")
+            )
+        },
+        if allow_unverified {
+            ""
+        } else {
+            "; exit status 3 (--allow-unverified exits 0)"
+        }
+    );
+    Ok(if allow_unverified {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(UNVERIFIED)
+    })
+}
+
+/// `halo4d view`.
+pub fn view(args: ViewArgs) -> Outcome {
+    let ViewArgs { scene, out, quiet } = args;
+    // Read once: parsed here, and written back with the view found.
+    let (text, parsed) = match &scene {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| format!("{}: cannot read the scene: {e}", path.display()))?;
+            let parsed = Scene::parse(&text, &path.display().to_string())?;
+            (text, parsed)
+        }
+        None => (halo4d::DEFAULT_SCENE.to_string(), Scene::default_scene()),
+    };
+    let found = halo4d::search_view(&parsed, quiet)?;
+    eprintln!("{}", found.summary());
+    let mut json: serde_json::Value = serde_json::from_str(&text)?;
+    let rotation = serde_json::to_value(found.rotation)?;
+    let object = json
+        .as_object_mut()
+        .ok_or("the scene is not a JSON object")?;
+    let view = object
+        .entry("view")
+        .or_insert_with(|| serde_json::json!({}));
+    view["rotation"] = rotation;
+    let camera = object
+        .entry("camera")
+        .or_insert_with(|| serde_json::json!({}));
+    camera["azimuth"] = serde_json::json!(found.azimuth);
+    camera["elevation"] = serde_json::json!(found.elevation);
+    let text = serde_json::to_string_pretty(&json)? + "\n";
+    match out {
+        Some(out) => {
+            halo4d::write_atomic(&out, text.as_bytes())
+                .map_err(|e| format!("{}: cannot write the scene: {e}", out.display()))?;
+            println!("{}", out.display());
+        }
+        None => print!("{text}"),
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `halo4d render`.
+pub fn render(args: RenderArgs) -> Outcome {
+    let RenderArgs {
+        scene,
+        out,
+        width,
+        height,
+        mode,
+        slices,
+        style,
+        stereo,
+        quiet,
+    } = args;
+    // The flag first: a bad path stops the command before the build.
+    if let Some(out) = &out {
+        png_path(out)?;
+    }
+    let mut scene = load(scene, quiet)?;
+    let r = &mut scene.render;
+    r.width = width.unwrap_or(r.width);
+    r.height = height.unwrap_or(r.height);
+    r.slices = slices.unwrap_or(r.slices);
+    r.stereo |= stereo;
+    r.mode = mode.unwrap_or(r.mode);
+    r.style = style.unwrap_or(r.style);
+    // Beside the build's picture, not over it: its report.json describes that one.
+    let out = out.unwrap_or_else(|| {
+        Path::new("exports")
+            .join(&scene.name)
+            .join(format!("{}-render.png", scene.name))
+    });
+    let (picture, ms) = halo4d::render_to(&scene, &out, quiet)?;
+    eprintln!(
+        "{} x {} {} picture, {} halos, in {ms:.0} ms",
+        picture.width,
+        picture.height,
+        value_name(scene.render.style),
+        value_name(scene.render.mode)
+    );
+    println!("{}", out.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `--out` of `halo4d render`: a `.png` file's path, not a folder.
+fn png_path(out: &Path) -> Result<(), FieldError> {
+    let shown = shorten(&out.display().to_string());
+    if out.is_dir() {
+        return Err(FieldError::new(
+            "--out",
+            format!("`{shown}` is a folder; name the picture's file, e.g. {shown}/picture.png"),
+        ));
+    }
+    let png = out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !png {
+        return Err(FieldError::new(
+            "--out",
+            format!("`{shown}`: the picture is written as PNG; name a file ending in .png"),
+        ));
+    }
+    Ok(())
+}
+
+/// `halo4d sweep`.
+pub fn sweep(args: SweepArgs) -> Outcome {
+    let SweepArgs {
+        scene,
+        out,
+        tolerances,
+        max_triangles,
+        render,
+        slices,
+        quiet,
+    } = args;
+    let scene = load(scene, quiet)?;
+    let files = if render {
+        let mut progress = |r: &Comparison| {
+            if !quiet {
+                eprintln!(
+                    "{:>5} {:>9.0} ms  verdict differs on {:.3}% of covered pixels, p99 difference {:.3}",
+                    if r.slices == 0 {
+                        "exact".to_string()
+                    } else {
+                        r.slices.to_string()
+                    },
+                    r.ms,
+                    100.0 * r.verdict_differs,
+                    r.p99_diff
+                );
+            }
+        };
+        sweep::picture_sweep(&scene, &slices, &out, &mut progress)
+            .map_err(flag_names)?
+            .1
+    } else {
+        let surfaces = (0..scene.surfaces.len())
+            .map(|i| match &scene.surfaces[i].surface {
+                halo4d::Source::Parametric(s) => Ok((scene.surface_name(i), s.clone())),
+                halo4d::Source::Mesh(m) => Err(format!(
+                    "surface `{}` is a mesh file ({}): the sweep samples parametric surfaces at several tolerances; sweep the pictures (`--slices`) instead",
+                    scene.surface_name(i),
+                    shorten(&m.path)
+                )),
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let settings = sweep::Settings {
+            tolerances,
+            max_triangles,
+            view: scene.view,
+        };
+        let mut progress = |msg: &str| {
+            if !quiet {
+                eprintln!("{msg}");
+            }
+        };
+        let (rows, files) =
+            sweep::run(&surfaces, &settings, &out, &mut progress).map_err(flag_names)?;
+        print!("{}", sweep::table(&rows));
+        files
+    };
+    for f in files {
+        println!("{}", f.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `halo4d animate`, with `--status` and `--assemble`.
+pub fn animate(args: AnimateArgs) -> Outcome {
+    if let Some(dir) = &args.status {
+        return Ok(match halo4d::status(dir) {
+            Ok(s) => {
+                print!("{}", s.text());
+                if s.complete() {
+                    ExitCode::SUCCESS
+                } else {
+                    ExitCode::FAILURE
+                }
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::from(2)
+            }
+        });
+    }
+    if let Some(dir) = &args.assemble {
+        let a = halo4d::assemble(dir)?;
+        eprintln!(
+            "{} frames assembled into an animated PNG of {:.1} MB",
+            a.frames,
+            a.bytes as f64 / 1e6
+        );
+        eprintln!(
+            "an MP4 with ffmpeg{}:\n  {}",
+            if a.ffmpeg_found {
+                ""
+            } else {
+                " (not found on this machine; install it, e.g. apt-get install ffmpeg)"
+            },
+            a.ffmpeg
+        );
+        println!("{}", a.path.display());
+        return Ok(ExitCode::SUCCESS);
+    }
+    let quiet = args.quiet;
+    let mut scene = load(args.scene, quiet)?;
+    let r = &mut scene.render;
+    r.width = args.width.unwrap_or(r.width);
+    r.height = args.height.unwrap_or(r.height);
+    scene
+        .render
+        .check()
+        .map_err(|e| flag_field(e.field.as_str(), e.message))?;
+    let out = (args.out).unwrap_or_else(|| Path::new("exports").join(&scene.name).join("frames"));
+    let summary = halo4d::animate(&halo4d::Request {
+        scene: &scene,
+        out: &out,
+        frames: args.frames,
+        shard: args.shard.unwrap_or(Shard::ALL),
+        glb: args.glb,
+        quiet,
+    })?;
+    if !quiet {
+        eprintln!(
+            "{} frames in this run: {} made, {} done before; {} not verified; {:.1} s",
+            summary.selected,
+            summary.made,
+            summary.skipped,
+            summary.failed.len(),
+            summary.ms / 1e3
+        );
+    }
+    for (k, why) in &summary.failed {
+        eprintln!("UNVERIFIED frame {k}: {why}");
+    }
+    println!("{}", out.display());
+    Ok(if summary.failed.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(UNVERIFIED)
+    })
+}
+
+/// `halo4d gallery`.
+pub fn gallery(args: GalleryArgs) -> Outcome {
+    let GalleryArgs {
+        figures,
+        out,
+        quiet,
+    } = args;
+    let gallery = halo4d::gallery::make(&figures, &out, quiet, |k, n, file| {
+        if !quiet {
+            eprintln!("figure {} of {n}: {}", k + 1, file.display());
+        }
+    })?;
+    for f in &gallery.figures {
+        let share = f
+            .report
+            .picture
+            .as_ref()
+            .map_or(f64::NAN, |p| p.curves.visible_curve_share);
+        eprintln!(
+            "{:<36} {} visible curve share {share:.3}, {:.1} s",
+            f.name(),
+            if f.report.verified {
+                "verified    "
+            } else {
+                "NOT verified"
+            },
+            f.report.timings_ms.total / 1e3
+        );
+        for failure in &f.report.failures {
+            eprintln!("UNVERIFIED {}: {failure}", f.name());
+        }
+    }
+    println!("{}", gallery.index.display());
+    println!("{}", gallery.sheet.display());
+    Ok(if gallery.verified() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(UNVERIFIED)
+    })
+}
+
+/// `halo4d list`.
+pub fn list() -> Outcome {
+    print!("{}", halo4d::Source::listing());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `halo4d check`.
+pub fn check(args: CheckArgs) -> Outcome {
+    let file = args.file;
+    let checked = if file.is_dir() {
+        halo4d::check_dir(&file)
+    } else {
+        halo4d::check_file(&file)
+    };
+    match checked {
+        Ok(c) => {
+            print!("{}", c.text());
+            Ok(if c.failures().is_empty() {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::FAILURE
+            })
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            Ok(ExitCode::from(2))
+        }
+    }
+}
+
+/// The name a flag gives a value (`stipple`, `exact`).
+fn value_name(value: impl ValueEnum) -> String {
+    value
+        .to_possible_value()
+        .map_or_else(String::new, |v| v.get_name().to_string())
+}
+
+/// A render setting's error named by its flag (`width` is `--width`).
+fn flag_field(field: &str, message: String) -> FieldError {
+    FieldError::new(format!("--{}", field.replace('_', "-")), message)
+}
+
+/// A sweep's setting error named by its flag (`max_triangles` is `--max-triangles`).
+fn flag_names(e: sweep::SweepError) -> sweep::SweepError {
+    match e {
+        sweep::SweepError::Setting(f) => sweep::SweepError::Setting(FieldError {
+            field: format!("--{}", f.field.replace('_', "-")),
+            ..f
+        }),
+        other => other,
+    }
+}

@@ -1,0 +1,401 @@
+//! What a build computes before writing ([`Built`]): the stages from the view on, run on a
+//! scene's samples.
+
+use super::report::{MemoryReport, SamplingReport, Timings};
+use super::sampled::{Sample, Sampled, refine_curves};
+use super::{Stages, ms};
+use crate::error::Error;
+use crate::export::SurfaceData;
+use crate::halo::{Halo, HaloParams, HaloReport, build_halo};
+use crate::intersect::{self, Curves};
+use crate::limits::{MAX_COORDINATE, MIN_EXTENT};
+use crate::parts::{HaloPart, Parts, SurfacePart};
+use crate::render::{self, CameraSettings, Picture, RenderError, RenderSettings};
+use crate::sample::{Mesh4, MeshStats, Source};
+use crate::scene::{Scene, SceneSurface};
+use crate::stipple::Stipples;
+use crate::verify::{self, Verification};
+use crate::view::Projected;
+use glam::DVec3;
+use indicatif::ProgressBar;
+use std::time::Instant;
+
+/// One surface after sampling and projection.
+#[derive(Clone, Debug)]
+pub struct SurfaceProduct {
+    /// Name in the outputs.
+    pub name: String,
+    /// The surface.
+    pub surface: Source,
+    /// Its 4D mesh.
+    pub mesh: Mesh4,
+    /// The mesh's statistics.
+    pub stats: MeshStats,
+    /// How it was sampled and how far it is from the surface.
+    pub sampling: SamplingReport,
+    /// Its 3D projection.
+    pub projected: Projected,
+    /// Its halo and what the checker said of it.
+    pub halo: Halo,
+    /// The halo's report.
+    pub halo_report: HaloReport,
+    /// Its stipples, made from the 4D mesh when the stipple style or a stipple file asks.
+    pub stipples: Option<Stipples>,
+}
+
+/// Everything a build computes before writing.
+#[derive(Clone, Debug)]
+pub struct Built {
+    /// Per surface.
+    pub surfaces: Vec<SurfaceProduct>,
+    /// The intersection curves of all surfaces together, exact for the meshes: what the
+    /// halos are verified against.
+    pub curves: Curves,
+    /// The same curves moved onto the analytic surfaces (`curves.refine`), when made.
+    pub refined: Option<Curves>,
+    /// The halos checked against the curves.
+    pub verification: Verification,
+    /// Milliseconds per stage so far.
+    pub timings: Timings,
+    /// The diagonal of the projected scene's bounding box, of which `halo.rho` and
+    /// `outputs.curve_radius` are shares, at least [`MIN_EXTENT`].
+    pub diagonal: f64,
+    /// The side of a pixel of the scene's picture at the depth its camera looks at, in
+    /// scene units, of which `halo.gap_px` is a multiple.
+    pub pixel_size: f64,
+    /// The halos' half-width asked for, in scene units (less where a halo was shrunk).
+    pub rho: f64,
+    /// The memory the stages from the halos on were estimated to need, and the limit.
+    pub memory: MemoryReport,
+    /// Which stages after the projection ran.
+    pub stages: Stages,
+}
+
+impl Built {
+    /// The build's verdict: what keeps it from being verified, empty when it is. Of the
+    /// stages that ran: every surface has a halo that passes the checker
+    /// ([`crate::check::CheckStats::passes`]), every curve is resolved, and the halos'
+    /// verification found no wrong curve sample and no spurious hidden surface sample.
+    pub fn failures(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for p in self.surfaces.iter().filter(|_| self.stages.halos) {
+            if p.halo.tets.is_empty() {
+                out.push(format!("{}: no halo (no tetrahedron)", p.name));
+            } else {
+                out.extend(p.halo_report.check.verdict(&format!("{}-halo", p.name)));
+            }
+        }
+        out.extend(self.curves.report.failures());
+        out.extend(self.verification.failures());
+        out
+    }
+
+    /// The curves the files and the picture show: the refined ones when made, else the
+    /// mesh's.
+    pub fn shown_curves(&self) -> &Curves {
+        self.refined.as_ref().unwrap_or(&self.curves)
+    }
+
+    /// What the build produced, as the renderer and the viewer read it, with the curves
+    /// the files show; `halo` are the scene's halo parameters.
+    pub fn parts<'a>(&'a self, halo: &HaloParams) -> Parts<'a> {
+        parts(&self.surfaces, halo, self.shown_curves())
+    }
+
+    /// [`Built::parts`] with the mesh's curves, which the halos are verified against.
+    pub fn verified_parts<'a>(&'a self, halo: &HaloParams) -> Parts<'a> {
+        parts(&self.surfaces, halo, &self.curves)
+    }
+
+    /// The picture of the given settings (the scene's `render` and `camera`, usually).
+    pub fn render(
+        &self,
+        halo: &HaloParams,
+        settings: &RenderSettings,
+        camera: &CameraSettings,
+    ) -> Result<Picture, RenderError> {
+        render::render(&self.parts(halo), settings, camera)
+    }
+}
+
+/// The one place a build's products become the hand-off.
+fn parts<'a>(surfaces: &'a [SurfaceProduct], halo: &HaloParams, curves: &'a Curves) -> Parts<'a> {
+    Parts {
+        surfaces: surfaces
+            .iter()
+            .map(|p| SurfacePart {
+                positions: &p.projected.positions,
+                w: &p.projected.w,
+                normals: &p.projected.normals,
+                // A mesh file's vertices have no parameters.
+                uv: p.surface.parametric().map(|_| p.mesh.uv.as_slice()),
+                triangles: &p.mesh.triangles,
+                stipples: p.stipples.as_ref(),
+            })
+            .collect(),
+        halos: surfaces
+            .iter()
+            .map(|p| {
+                (!p.halo.tets.is_empty()).then_some(HaloPart {
+                    positions: &p.halo.positions,
+                    t: &p.halo.t,
+                    d_orig: &p.halo.d_orig,
+                    tets: &p.halo.tets,
+                    surface_vertices: p.halo.surface_vertices,
+                    delta_d: halo.delta_d,
+                    delta_t: halo.delta_t,
+                })
+            })
+            .collect(),
+        curves,
+    }
+}
+
+impl SurfaceProduct {
+    /// The view the writers take; `halo_params` are the scene's.
+    pub fn data<'a>(&'a self, halo_params: &'a HaloParams) -> SurfaceData<'a> {
+        SurfaceData {
+            name: &self.name,
+            surface_type: self.surface.type_name(),
+            patches: self.surface.patch_count(),
+            mesh: &self.mesh,
+            projected: &self.projected,
+            halo: &self.halo,
+            halo_params,
+            rho: self.halo_report.rho,
+        }
+    }
+}
+
+/// One surface sampled and projected: what the stages from the halos on take.
+struct InView<'a> {
+    entry: &'a SceneSurface,
+    sample: Sample,
+    projected: Projected,
+}
+
+/// The stages from the view on, from the scene's samples.
+pub(super) fn in_view(
+    scene: &Scene,
+    samples: Sampled,
+    stages: Stages,
+    bar: &ProgressBar,
+) -> Result<Built, Error> {
+    if scene.view.auto {
+        return Err(Error::UnresolvedView {
+            scene: scene.name.clone(),
+        });
+    }
+    let mut timings = samples.timings;
+    let projections = project(scene, samples.surfaces, &mut timings, bar)?;
+    let scale = Scale::of(scene, &projections, stages)?;
+    let Scale {
+        diagonal,
+        pixel,
+        rho,
+        memory,
+    } = scale;
+    let mut products = Vec::with_capacity(projections.len());
+    for InView {
+        entry,
+        sample:
+            Sample {
+                name,
+                mesh,
+                stats,
+                report,
+            },
+        projected,
+    } in projections
+    {
+        let (halo, halo_report) = if stages.halos {
+            bar.set_message(format!("halo of {name}"));
+            let start = Instant::now();
+            let built = build_halo(&projected, &mesh.triangles, rho, &scene.halo);
+            timings.halo += ms(start);
+            built
+        } else {
+            Default::default()
+        };
+        bar.inc(1);
+        let stipples = stages.stipples.then(|| {
+            bar.set_message(format!("stipples of {name}"));
+            let start = Instant::now();
+            let st = &scene.render.stipple;
+            let set = Stipples::generate(&mesh.positions, &mesh.triangles, st.count, st.seed);
+            timings.stipples += ms(start);
+            set
+        });
+        products.push(SurfaceProduct {
+            name,
+            surface: entry.surface.clone(),
+            mesh,
+            stats,
+            sampling: report,
+            projected,
+            halo,
+            halo_report,
+            stipples,
+        });
+    }
+    let mut curves = Curves::default();
+    if stages.curves {
+        bar.set_message("intersection curves");
+        let start = Instant::now();
+        // The curves are made from the sheets alone.
+        let none = Curves::default();
+        curves = intersect::curves(&parts(&products, &scene.halo, &none).sheets());
+        timings.curves = ms(start);
+    }
+    bar.inc(1);
+    let refined = (stages.curves && scene.curves.refine).then(|| {
+        bar.set_message("refining the curves");
+        let start = Instant::now();
+        let none = Curves::default();
+        let sheets = parts(&products, &scene.halo, &none).sheets();
+        let surfaces = products.iter().map(|p| (&p.surface, &p.mesh));
+        let refined = refine_curves(scene, &curves, &sheets, surfaces, diagonal);
+        timings.refine = ms(start);
+        refined
+    });
+    let mut verification = Verification::default();
+    if stages.verify {
+        bar.set_message("verifying halos");
+        let start = Instant::now();
+        verification = verify::verify(&parts(&products, &scene.halo, &curves));
+        timings.verify = ms(start);
+    }
+    Ok(Built {
+        surfaces: products,
+        diagonal,
+        pixel_size: pixel,
+        rho,
+        memory,
+        curves,
+        refined,
+        verification,
+        timings,
+        stages,
+    })
+}
+
+/// Each sample in the scene's view, its coordinates checked against the files' range.
+fn project<'a>(
+    scene: &'a Scene,
+    samples: Vec<Sample>,
+    timings: &mut Timings,
+    bar: &ProgressBar,
+) -> Result<Vec<InView<'a>>, Error> {
+    let mut projections = Vec::with_capacity(samples.len());
+    for (entry, sample) in scene.surfaces.iter().zip(samples) {
+        let name = &sample.name;
+        bar.set_message(format!("projecting {name}"));
+        let start = Instant::now();
+        let projected = scene
+            .view
+            .project(&sample.mesh)
+            .map_err(|source| Error::View {
+                scene: scene.name.clone(),
+                surface: name.clone(),
+                source,
+            })?;
+        timings.view += ms(start);
+        bar.inc(1);
+        if let Some(largest) = projected.out_of_range() {
+            return Err(Error::Scale {
+                scene: scene.name.clone(),
+                message: format!(
+                    "surface `{name}` reaches a coordinate of {largest:.3e} in the view, beyond {MAX_COORDINATE:e}, where the files' f32 and the exact predicates stay exact; make it smaller (its size parameters, or view.translation)"
+                ),
+            });
+        }
+        projections.push(InView {
+            entry,
+            sample,
+            projected,
+        });
+    }
+    Ok(projections)
+}
+
+/// The scene's size in the view and what follows from it: the diagonal the halos' rho is a
+/// share of, a pixel's size, rho, and the memory the stages from the halos on need.
+struct Scale {
+    diagonal: f64,
+    pixel: f64,
+    rho: f64,
+    memory: MemoryReport,
+}
+
+impl Scale {
+    /// The scale of `projections`, refused when too small to keep its digits or too large
+    /// for the memory limit.
+    fn of(scene: &Scene, projections: &[InView], stages: Stages) -> Result<Scale, Error> {
+        // Halos: rho is a share of the whole projected scene's diagonal.
+        let (lo, hi) = projections
+            .iter()
+            .filter_map(|p| p.projected.bounds())
+            .fold(
+                (DVec3::INFINITY, DVec3::NEG_INFINITY),
+                |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
+            );
+        let diagonal = (hi - lo).length();
+        if diagonal.is_nan() || diagonal < MIN_EXTENT {
+            return Err(Error::Scale {
+                scene: scene.name.clone(),
+                message: format!(
+                    "the projected surfaces are {diagonal:.3e} across, less than {MIN_EXTENT:e}, below which the files' f32 and the exact predicates lose their digits; make them larger (their size parameters)"
+                ),
+            });
+        }
+        let pixel = render::picture_pixel_size(
+            projections.iter().map(|p| {
+                (
+                    p.projected.positions.as_slice(),
+                    p.sample.mesh.triangles.as_slice(),
+                )
+            }),
+            &scene.render,
+            &scene.camera,
+        )
+        .map_err(|source| Error::Render {
+            scene: scene.name.clone(),
+            source,
+        })?;
+        let rho = scene.halo.half_width(diagonal, pixel);
+        let triangles: usize = projections
+            .iter()
+            .map(|p| p.sample.mesh.triangles.len())
+            .sum();
+        let needed = if stages.halos || stages.curves {
+            triangles as f64 * crate::memory::BUILD_BYTES_PER_TRIANGLE
+        } else {
+            0.0
+        };
+        let (limit, source_of_limit) = crate::memory::limit().map_err(|message| Error::Scale {
+            scene: scene.name.clone(),
+            message,
+        })?;
+        if needed > limit {
+            return Err(Error::Scale {
+                scene: scene.name.clone(),
+                message: format!(
+                    "the halos, curves and verification of {triangles} triangles would need about {:.2} GB ({} bytes per triangle), more than the limit of {:.2} GB ({source_of_limit}); sample fewer triangles (sampling.tolerance, sampling.max_triangles or a coarser grid)",
+                    needed / crate::memory::GB,
+                    crate::memory::BUILD_BYTES_PER_TRIANGLE,
+                    limit / crate::memory::GB
+                ),
+            });
+        }
+        Ok(Scale {
+            diagonal,
+            pixel,
+            rho,
+            memory: MemoryReport {
+                estimate_gb: needed / crate::memory::GB,
+                limit_gb: limit / crate::memory::GB,
+                peak_gb: None,
+            },
+        })
+    }
+}

@@ -1,0 +1,351 @@
+//! What a build reports (`report.json`): counts, bounds, mesh statistics, timings, memory,
+//! the picture and the verdict.
+
+use super::Stages;
+use super::built::SurfaceProduct;
+use crate::halo::HaloReport;
+use crate::intersect::CurvesReport;
+use crate::render;
+use crate::sample::{self, Audit, MeshStats, Sampling, Source};
+use crate::scene::Scene;
+use crate::stipple::Stipples;
+use crate::surfaces::Topology;
+use crate::verify::Verification;
+use serde::Serialize;
+
+/// `report.json`'s `memory`: what the stages from the halos on were estimated to need (1100
+/// bytes per triangle) against the limit (`HALO4D_MAX_MEMORY` gigabytes, or three quarters
+/// of the machine's memory), in GB. The picture is estimated on its own when it is made.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct MemoryReport {
+    /// Estimated peak of the stages from the halos on.
+    pub estimate_gb: f64,
+    /// The limit a build refuses to go beyond.
+    pub limit_gb: f64,
+    /// The process's peak resident memory when the files were made (null where the system
+    /// does not say).
+    pub peak_gb: Option<f64>,
+}
+
+/// How a surface was sampled, and the audit of the mesh (`report.json`'s `sampling`).
+#[derive(Clone, Debug, Serialize)]
+pub struct SamplingReport {
+    /// `adaptive`, `uniform`, or `file` for a mesh read from a file (not sampled, not
+    /// audited: the mesh is the surface, its errors are 0).
+    pub method: &'static str,
+    /// The absolute tolerance the adaptive sampler aimed at.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
+    /// The same, relative to `diagonal`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub relative_tolerance: Option<f64>,
+    /// The adaptive sampler's triangle budget.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_triangles: Option<usize>,
+    /// Diagonal of the surface's 4D bounding box, the length relative values refer to.
+    pub diagonal: f64,
+    /// Triangles.
+    pub triangles: usize,
+    /// Vertices.
+    pub vertices: usize,
+    /// Audited largest distance, triangle to surface, in R^4.
+    pub max_error: f64,
+    /// Audited root mean square distance.
+    pub rms_error: f64,
+    /// `max_error / diagonal`.
+    pub max_error_relative: f64,
+    /// `rms_error / diagonal`.
+    pub rms_error_relative: f64,
+    /// Whether the sampler met its tolerance everywhere (false when its triangle budget
+    /// stopped it).
+    pub complete: bool,
+    /// When the budget stopped adaptive sampling: the audited max error of a uniform grid
+    /// of about as many triangles ([`sample::uniform_error`]), to compare `max_error` with.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub uniform_max_error: Option<f64>,
+    /// Milliseconds spent sampling.
+    pub ms: f64,
+    /// Milliseconds spent auditing (with the uniform grid of `uniform_max_error`).
+    pub audit_ms: f64,
+}
+
+impl SamplingReport {
+    pub(super) fn new(
+        method: &'static str,
+        sampling: &Sampling,
+        sampled: &sample::Sampled,
+        audit: &Audit,
+        uniform_max_error: Option<f64>,
+        ms: f64,
+        audit_ms: f64,
+    ) -> Self {
+        let (max_rel, rms_rel) = audit.relative(sampled.diagonal);
+        SamplingReport {
+            method,
+            max_triangles: match *sampling {
+                Sampling::Adaptive { max_triangles, .. } if method == "adaptive" => {
+                    Some(max_triangles)
+                }
+                _ => None,
+            },
+            tolerance: sampled.tolerance,
+            relative_tolerance: sampled.tolerance.map(|t| t / sampled.diagonal),
+            diagonal: sampled.diagonal,
+            triangles: sampled.mesh.triangles.len(),
+            vertices: sampled.mesh.vertex_count(),
+            max_error: audit.max_error,
+            rms_error: audit.rms_error,
+            max_error_relative: max_rel,
+            rms_error_relative: rms_rel,
+            complete: sampled.complete,
+            uniform_max_error,
+            ms,
+            audit_ms,
+        }
+    }
+
+    /// The warning a build prints when the sampler stopped short of its tolerance.
+    pub fn warning(&self, surface: &str) -> Option<String> {
+        if self.complete {
+            return None;
+        }
+        Some(format!(
+            "surface `{surface}`: the triangle budget (max_triangles = {}) stopped refinement at {} triangles before every triangle met the tolerance {:.3e}; the audited max error is {:.3e} ({:.3e} of the diagonal; a uniform grid of as many triangles: {:.3e}). Raise max_triangles or the tolerance.",
+            self.max_triangles.unwrap_or(0),
+            self.triangles,
+            self.tolerance.unwrap_or(f64::NAN),
+            self.max_error,
+            self.max_error_relative,
+            self.uniform_max_error.unwrap_or(f64::NAN),
+        ))
+    }
+}
+
+/// The warning a build prints for a mesh file that is not a manifold (the sampler's meshes
+/// always are): what the halos and curves meet there is what the file gives.
+pub(super) fn mesh_file_warning(
+    surface: &str,
+    source: &Source,
+    stats: &MeshStats,
+) -> Option<String> {
+    if !matches!(source, Source::Mesh(_)) || stats.is_manifold() {
+        return None;
+    }
+    Some(format!(
+        "surface `{surface}`: the mesh file is not a manifold: {} edges in more than two triangles, {} triangles of zero area; halos and curves follow the triangles as they are, and verification may call samples there ambiguous",
+        stats.non_manifold_edges, stats.degenerate_triangles
+    ))
+}
+
+/// Milliseconds spent in each stage.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
+pub struct Timings {
+    /// Sampling, all surfaces.
+    pub sample: f64,
+    /// Auditing the samples, all surfaces.
+    pub audit: f64,
+    /// View (rotation, projection, normals), all surfaces.
+    pub view: f64,
+    /// Halos: thickening, tetrahedra, checking, all surfaces.
+    pub halo: f64,
+    /// Intersection curves, all surfaces together.
+    pub curves: f64,
+    /// Moving the curves onto the analytic surfaces.
+    pub refine: f64,
+    /// Verifying the halos against the curves.
+    pub verify: f64,
+    /// Ranking the stipples, all surfaces.
+    pub stipples: f64,
+    /// Rendering the picture.
+    pub render: f64,
+    /// Writing the outputs.
+    pub export: f64,
+    /// Sum of the stages.
+    pub total: f64,
+}
+
+/// Bounding box.
+#[derive(Clone, Debug, Serialize)]
+pub struct Bounds {
+    /// Lower corner.
+    pub min: Vec<f64>,
+    /// Upper corner.
+    pub max: Vec<f64>,
+}
+
+/// What the report says of one surface.
+#[derive(Clone, Debug, Serialize)]
+pub struct SurfaceReport {
+    /// Mesh name.
+    pub name: String,
+    /// Catalogue type.
+    #[serde(rename = "type")]
+    pub type_name: String,
+    /// Parameter patches.
+    pub patches: usize,
+    /// Sampling and its audit.
+    pub sampling: SamplingReport,
+    /// Vertices.
+    pub vertices: usize,
+    /// Triangles.
+    pub triangles: usize,
+    /// Expected topology.
+    pub topology: Topology,
+    /// Measured combinatorics.
+    pub mesh: MeshStats,
+    /// Bounding box in R^4 before the view.
+    pub bounds_4d: Option<Bounds>,
+    /// Bounding box of the projection.
+    pub bounds_3d: Option<Bounds>,
+    /// Range of w-depth after the view.
+    pub w_range: Option<[f64; 2]>,
+    /// The halo (null when no output needs one).
+    pub halo: Option<HaloReport>,
+    /// Stipples ranked on the 4D mesh (absent when none were made).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stipples: Option<usize>,
+}
+
+/// `report.json`'s `picture`: how to reproduce the picture's projection, the halos' width in
+/// it, and the share of the curves it shows ([`render::visible`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct PictureReport {
+    /// The camera, in the projected scene's coordinates.
+    #[serde(flatten)]
+    pub camera: render::visible::PictureCamera,
+    /// The cutaway (`render.clip`), when set: the points where `normal · p > offset` holds
+    /// for every plane are removed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub clip: Option<render::clip::Clip>,
+    /// The halos' half-width asked for, in scene units.
+    pub rho: f64,
+    /// The same in pixels at the depth the camera looks at.
+    pub gap_px: f64,
+    /// The curves' projected length and the share of it in view.
+    #[serde(flatten)]
+    pub curves: render::visible::CurveVisibility,
+}
+
+/// `report.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Version of halo4d that wrote it.
+    pub halo4d: &'static str,
+    /// Scene name.
+    pub scene_name: String,
+    /// Per surface.
+    pub surfaces: Vec<SurfaceReport>,
+    /// Which stages after the projection ran (those the outputs need).
+    pub stages: Stages,
+    /// The intersection curves of all surfaces together (null when not computed).
+    pub curves: Option<CurvesReport>,
+    /// The halos checked against the curves (null when not verified).
+    pub halo_verification: Option<Verification>,
+    /// Milliseconds per stage.
+    pub timings_ms: Timings,
+    /// Memory estimated before the halos, against the limit.
+    pub memory: MemoryReport,
+    /// Warnings, also printed on stderr.
+    pub warnings: Vec<String>,
+    /// The picture: its camera, halo width and how much of the curves it shows (absent when
+    /// no picture was drawn).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub picture: Option<PictureReport>,
+    /// Whether the build is verified: [`Built::failures`] found nothing in the stages that
+    /// ran.
+    pub verified: bool,
+    /// What [`Built::failures`] found.
+    pub failures: Vec<String>,
+    /// Files written, relative to the output folder.
+    pub files: Vec<String>,
+    /// The scene as parsed, with every default filled in.
+    pub scene: Scene,
+}
+
+impl Report {
+    /// What `halo4d build` prints on stderr: per surface its mesh, the curves, the halo
+    /// verification, the timings and the memory, one line each.
+    pub fn summary(&self) -> String {
+        let mut out = String::new();
+        for s in &self.surfaces {
+            out += &format!(
+                "{:<24} {:>9} vertices {:>9} triangles  Euler characteristic {}\n",
+                s.name, s.vertices, s.triangles, s.mesh.euler_characteristic
+            );
+        }
+        match &self.curves {
+            Some(c) => out += &format!("{}\n", c.summary()),
+            None => out += "curves: not computed (no output uses them)\n",
+        }
+        match &self.halo_verification {
+            Some(v) => {
+                out += &format!(
+                    "halo verification: {} curve samples: {} correct, {} wrong, {} ambiguous, {} third sheet; {} surface samples, {} far tetrahedra, {} spurious\n",
+                    v.curve_samples,
+                    v.correct,
+                    v.wrong,
+                    v.ambiguous,
+                    v.third_sheet,
+                    v.surface_samples,
+                    v.far_tetrahedra,
+                    v.spurious_hidden_samples
+                )
+            }
+            None => {
+                out += "halo verification: not run (no halo file written; `outputs.verify: true` asks for it)\n"
+            }
+        }
+        let t = self.timings_ms;
+        out += &format!(
+            "sample {:.1} ms, audit {:.1} ms, view {:.1} ms, halo {:.1} ms, curves {:.1} ms, refine {:.1} ms, verify {:.1} ms, export {:.1} ms, render {:.1} ms, total {:.1} ms\n",
+            t.sample,
+            t.audit,
+            t.view,
+            t.halo,
+            t.curves,
+            t.refine,
+            t.verify,
+            t.export,
+            t.render,
+            t.total
+        );
+        out += &format!(
+            "memory: about {:.2} GB estimated from the halos on, limit {:.2} GB{}\n",
+            self.memory.estimate_gb,
+            self.memory.limit_gb,
+            self.memory
+                .peak_gb
+                .map(|gb| format!(", peak {gb:.2} GB"))
+                .unwrap_or_default()
+        );
+        out
+    }
+}
+
+pub(super) fn surface_report(p: &SurfaceProduct, halo: bool) -> SurfaceReport {
+    SurfaceReport {
+        name: p.name.clone(),
+        type_name: p.surface.type_name().to_string(),
+        patches: p.surface.patch_count(),
+        sampling: p.sampling.clone(),
+        vertices: p.mesh.vertex_count(),
+        triangles: p.mesh.triangles.len(),
+        // A mesh file's from the statistics already measured, not by validating it again.
+        topology: match &p.surface {
+            Source::Parametric(s) => s.topology(),
+            Source::Mesh(_) => sample::mesh_topology(&p.stats),
+        },
+        mesh: p.stats,
+        bounds_4d: p.mesh.bounds().map(|(lo, hi)| Bounds {
+            min: lo.to_array().to_vec(),
+            max: hi.to_array().to_vec(),
+        }),
+        bounds_3d: p.projected.bounds().map(|(lo, hi)| Bounds {
+            min: lo.to_array().to_vec(),
+            max: hi.to_array().to_vec(),
+        }),
+        w_range: p.projected.w_range(),
+        halo: halo.then(|| p.halo_report.clone()),
+        stipples: p.stipples.as_ref().map(Stipples::len),
+    }
+}

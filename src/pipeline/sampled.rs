@@ -1,0 +1,192 @@
+//! A scene's surfaces sampled once ([`Sampled`]), and the curves a build shows of 4D meshes
+//! ([`shown_curves`]).
+
+use super::report::{SamplingReport, Timings, mesh_file_warning};
+use super::{Built, Stages, built::in_view, ms};
+use crate::error::Error;
+use crate::intersect::{self, Curves, Sheet};
+use crate::sample::{self, Audit, Mesh4, MeshStats, Source, audit};
+use crate::scene::Scene;
+use glam::DVec3;
+use indicatif::ProgressBar;
+use std::time::Instant;
+
+/// A scene's surfaces sampled (or read from their files) and audited: what a build makes
+/// before the view, which does not depend on the view. Sample once ([`Sampled::of`]), then
+/// build any number of views ([`Sampled::build`]): what an animation does for its frames,
+/// and what the explorer turns ([`shown_curves`] gives it the curves a build shows).
+#[derive(Clone, Debug)]
+pub struct Sampled {
+    pub(super) surfaces: Vec<Sample>,
+    /// The sampling and audit times (the other stages 0).
+    pub(super) timings: Timings,
+}
+
+#[derive(Clone, Debug)]
+pub(super) struct Sample {
+    pub(super) name: String,
+    pub(super) mesh: Mesh4,
+    pub(super) stats: MeshStats,
+    pub(super) report: SamplingReport,
+}
+
+impl Sampled {
+    /// Samples (or reads) and audits every surface of the scene, printing the warnings a
+    /// build prints.
+    pub fn of(scene: &Scene) -> Sampled {
+        sample_with(scene, &ProgressBar::hidden())
+    }
+
+    /// The build of `scene` from these samples (of a scene with the same surfaces and
+    /// sampling) in its view: the stages `stages` asks for ([`Stages::of`] for what its
+    /// outputs need); the sampling times are these samples'.
+    pub fn build(&self, scene: &Scene, stages: Stages) -> Result<Built, Error> {
+        self.clone().into_built(scene, stages)
+    }
+
+    /// [`Sampled::build`], the samples moved into the build.
+    pub fn into_built(self, scene: &Scene, stages: Stages) -> Result<Built, Error> {
+        in_view(scene, self, stages, &ProgressBar::hidden())
+    }
+
+    /// Each surface's name and 4D mesh, in the scene's order.
+    pub fn meshes(&self) -> impl Iterator<Item = (&str, &Mesh4)> {
+        self.surfaces.iter().map(|s| (s.name.as_str(), &s.mesh))
+    }
+
+    /// Each surface's name and 4D mesh, moved out.
+    pub fn into_meshes(self) -> Vec<(String, Mesh4)> {
+        self.surfaces
+            .into_iter()
+            .map(|s| (s.name, s.mesh))
+            .collect()
+    }
+
+    /// Triangles of all surfaces.
+    pub fn triangles(&self) -> usize {
+        self.surfaces.iter().map(|s| s.mesh.triangles.len()).sum()
+    }
+
+    /// Milliseconds spent sampling and auditing.
+    pub fn ms(&self) -> f64 {
+        self.timings.sample + self.timings.audit
+    }
+}
+
+/// The curves a build of `scene` shows from its surfaces' 4D meshes (one per surface, in
+/// the scene's order): each mesh projected as the build projects it, the exact curves of
+/// the sheets, and those refined onto the analytic surfaces when `scene.curves.refine`.
+pub fn shown_curves(scene: &Scene, meshes: &[&Mesh4]) -> Result<Curves, Error> {
+    if scene.view.auto {
+        return Err(Error::UnresolvedView {
+            scene: scene.name.clone(),
+        });
+    }
+    let projected = meshes
+        .iter()
+        .enumerate()
+        .map(|(i, mesh)| {
+            scene.view.project(mesh).map_err(|source| Error::View {
+                scene: scene.name.clone(),
+                surface: scene.surface_name(i),
+                source,
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let sheets: Vec<Sheet> = projected
+        .iter()
+        .zip(meshes)
+        .map(|(p, mesh)| Sheet {
+            positions: &p.positions,
+            w: &p.w,
+            triangles: &mesh.triangles,
+        })
+        .collect();
+    let curves = intersect::curves(&sheets);
+    if !scene.curves.refine {
+        return Ok(curves);
+    }
+    let (lo, hi) = projected.iter().filter_map(|p| p.bounds()).fold(
+        (DVec3::INFINITY, DVec3::NEG_INFINITY),
+        |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
+    );
+    let sources = scene.surfaces.iter().map(|s| &s.surface);
+    Ok(refine_curves(
+        scene,
+        &curves,
+        &sheets,
+        sources.zip(meshes.iter().copied()),
+        (hi - lo).length(),
+    ))
+}
+
+/// `curves` (found on `sheets`) moved onto the analytic surfaces of `surfaces` (each
+/// surface's source and 4D mesh, in the sheets' order) in the scene's view.
+pub(super) fn refine_curves<'a>(
+    scene: &Scene,
+    curves: &Curves,
+    sheets: &[Sheet],
+    surfaces: impl Iterator<Item = (&'a Source, &'a Mesh4)>,
+    diagonal: f64,
+) -> Curves {
+    // A mesh without its triangles' parameters (a 4D mesh read back from a .glb, which
+    // keeps the vertices' only) keeps its curve points, as a mesh file's do.
+    let analytic: Vec<intersect::Analytic> = surfaces
+        .map(|(source, mesh)| intersect::Analytic {
+            surface: source.parametric().filter(|_| {
+                mesh.triangle_uv.len() == mesh.triangles.len()
+                    && mesh.triangle_patch.len() == mesh.triangles.len()
+            }),
+            mesh,
+        })
+        .collect();
+    intersect::refine(curves, sheets, &analytic, &scene.view, diagonal)
+}
+
+pub(super) fn sample_with(scene: &Scene, bar: &ProgressBar) -> Sampled {
+    let mut timings = Timings::default();
+    let mut surfaces = Vec::with_capacity(scene.surfaces.len());
+    for (i, entry) in scene.surfaces.iter().enumerate() {
+        let name = scene.surface_name(i);
+        bar.set_message(format!("sampling {name}"));
+        let sampling = scene.surface_sampling(i);
+        let start = Instant::now();
+        let sampled = entry.surface.sample(sampling);
+        let sample_ms = ms(start);
+        timings.sample += sample_ms;
+        let start = Instant::now();
+        // Stopped by its budget: the uniform grid of as many triangles to compare with,
+        // audited too (and timed with the audit). A mesh file is the surface: nothing to
+        // audit.
+        let (audited, uniform, method) = match &entry.surface {
+            Source::Parametric(surface) => (
+                audit(surface, &sampled.mesh),
+                (!sampled.complete)
+                    .then(|| sample::uniform_error(surface, sampled.mesh.triangles.len())),
+                sampling.method(),
+            ),
+            Source::Mesh(_) => (Audit::default(), None, "file"),
+        };
+        let audit_ms = ms(start);
+        timings.audit += audit_ms;
+        let report = SamplingReport::new(
+            method, sampling, &sampled, &audited, uniform, sample_ms, audit_ms,
+        );
+        if let Some(w) = report.warning(&name) {
+            bar.suspend(|| eprintln!("warning: {w}"));
+        }
+        let mesh = sampled.mesh;
+        let stats = mesh.validate();
+        if let Some(w) = mesh_file_warning(&name, &entry.surface, &stats) {
+            bar.suspend(|| eprintln!("warning: {w}"));
+        }
+        bar.inc(1);
+        surfaces.push(Sample {
+            name,
+            mesh,
+            stats,
+            report,
+        });
+    }
+    Sampled { surfaces, timings }
+}

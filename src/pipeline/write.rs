@@ -1,0 +1,254 @@
+//! A build's files: written under temporary names side by side, moved into place together,
+//! with `report.json`.
+
+use super::report::{MemoryReport, PictureReport, Report, mesh_file_warning, surface_report};
+use super::{Built, ms};
+use crate::error::Error;
+use crate::export::{self, SurfaceData};
+use crate::render;
+use crate::scene::Scene;
+use rayon::prelude::*;
+use std::path::Path;
+use std::time::Instant;
+
+/// Writes the outputs the scene asks for from the products of [`run`] into `out_dir`, and
+/// returns the report (also written as `report.json` when asked for). The export time is
+/// added to the timings of [`run`], and the total is the sum of the stages.
+pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Error> {
+    let products = &built.surfaces;
+    let mut timings = built.timings;
+    let export_start = Instant::now();
+    // Every file under a temporary name until all were made: a failure leaves the folder
+    // as it was.
+    let staged = export::Staged::new(out_dir).map_err(staged_error)?;
+    let data: Vec<SurfaceData> = products.iter().map(|p| p.data(&scene.halo)).collect();
+    let write = |file: String, bytes: &[u8]| -> Result<String, Error> {
+        staged.write(file, bytes).map_err(staged_error)
+    };
+    let name = &scene.name;
+    let failures = built.failures();
+    let stipples = file_stipples(scene, built)?;
+    // The files are made on the cores side by side, each written as it is made (a halo's
+    // `.vtk` streamed, the `.glb`'s chunks written as they are, with no copy of the whole
+    // file in memory); the report lists them in this order.
+    type Job<'a> = Box<dyn FnOnce() -> Result<Vec<String>, Error> + Send + 'a>;
+    let mut jobs: Vec<Job> = Vec::new();
+    if scene.outputs.glb {
+        jobs.push(Box::new(|| {
+            let (text, bin) = glb_chunks(scene, built, &data, &stipples, &failures)?;
+            let file = staged
+                .stream(format!("{name}.glb"), |w| {
+                    export::write_glb_container(w, &text, &bin)
+                })
+                .map_err(staged_error)?;
+            Ok(vec![file])
+        }));
+    }
+    if scene.outputs.ply {
+        jobs.push(Box::new(|| {
+            Ok(vec![
+                write(format!("{name}.ply"), &export::to_ply(&data, name))?,
+                write(
+                    format!("{name}-curves.ply"),
+                    &export::to_curves_ply(built.shown_curves(), name),
+                )?,
+            ])
+        }));
+    }
+    if scene.outputs.stipples {
+        jobs.push(Box::new(|| {
+            Ok(vec![write(
+                format!("{name}-stipples.ply"),
+                &export::to_stipples_ply(&stipples, name),
+            )?])
+        }));
+    }
+    if scene.outputs.obj {
+        jobs.push(Box::new(|| {
+            Ok(vec![write(
+                format!("{name}.obj"),
+                export::to_obj(&data, name).as_bytes(),
+            )?])
+        }));
+    }
+    if scene.outputs.off4 {
+        for p in products {
+            let file = per_surface(name, &p.name, data.len(), ".4off");
+            jobs.push(Box::new(move || {
+                let text = export::to_4off(&p.mesh.positions, &p.mesh.triangles, &p.name);
+                Ok(vec![write(file, text.as_bytes())?])
+            }));
+        }
+    }
+    if scene.outputs.vtk {
+        for d in &data {
+            let file = per_surface(name, d.name, data.len(), "-halo.vtk");
+            let staged = &staged;
+            jobs.push(Box::new(move || {
+                let file = staged
+                    .stream(file, |w| export::write_vtk(w, d, name))
+                    .map_err(staged_error)?;
+                Ok(vec![file])
+            }));
+        }
+    }
+    let written: Result<Vec<Vec<String>>, Error> = jobs.into_par_iter().map(|job| job()).collect();
+    let mut files: Vec<String> = written?.into_iter().flatten().collect();
+    timings.export = ms(export_start);
+    let mut picture_report = None;
+    if scene.outputs.png || scene.outputs.svg {
+        let start = Instant::now();
+        let rendered = render::render_for_build(
+            &built.parts(&scene.halo),
+            &scene.render,
+            &scene.camera,
+            scene.outputs.svg,
+        )
+        .map_err(|source| Error::Render {
+            scene: scene.name.clone(),
+            source,
+        })?;
+        timings.render = ms(start);
+        if scene.outputs.png {
+            files.push(write(format!("{name}.png"), &rendered.picture.png())?);
+        }
+        if let Some(svg) = &rendered.svg {
+            files.push(write(format!("{name}.svg"), svg.as_bytes())?);
+        }
+        picture_report = Some(PictureReport {
+            camera: rendered.camera,
+            clip: scene.render.clip,
+            rho: built.rho,
+            gap_px: built.rho / built.pixel_size,
+            curves: rendered.curves,
+        });
+    }
+    if scene.outputs.report {
+        files.push("report.json".into());
+    }
+    timings.total = timings.sample
+        + timings.audit
+        + timings.view
+        + timings.halo
+        + timings.curves
+        + timings.refine
+        + timings.verify
+        + timings.stipples
+        + timings.render
+        + timings.export;
+    let report = Report {
+        halo4d: env!("CARGO_PKG_VERSION"),
+        scene_name: scene.name.clone(),
+        surfaces: products
+            .iter()
+            .map(|p| surface_report(p, built.stages.halos))
+            .collect(),
+        stages: built.stages,
+        curves: built
+            .stages
+            .curves
+            .then(|| built.shown_curves().report.clone()),
+        halo_verification: built.stages.verify.then(|| built.verification.clone()),
+        timings_ms: timings,
+        memory: MemoryReport {
+            peak_gb: crate::memory::peak_resident().map(|b| b / crate::memory::GB),
+            ..built.memory
+        },
+        warnings: products
+            .iter()
+            .flat_map(|p| {
+                let file = mesh_file_warning(&p.name, &p.surface, &p.stats);
+                p.sampling.warning(&p.name).into_iter().chain(file)
+            })
+            .collect(),
+        picture: picture_report,
+        verified: failures.is_empty(),
+        failures,
+        files,
+        scene: scene.clone(),
+    };
+    if scene.outputs.report {
+        let text = serde_json::to_vec_pretty(&report).map_err(|e| Error::Internal {
+            stage: "export",
+            message: e.to_string(),
+        })?;
+        write("report.json".into(), &text)?;
+    }
+    staged.commit().map_err(staged_error)?;
+    Ok(report)
+}
+
+/// The file of one of a scene's `surfaces` surfaces: `<scene><ending>` when it has one,
+/// `<scene>-<surface><ending>` when several.
+fn per_surface(scene: &str, surface: &str, surfaces: usize, ending: &str) -> String {
+    if surfaces == 1 {
+        format!("{scene}{ending}")
+    } else {
+        format!("{scene}-{surface}{ending}")
+    }
+}
+
+/// The stipples of the picture, for the files that carry them (`outputs.stipples`; none
+/// otherwise).
+fn file_stipples(scene: &Scene, built: &Built) -> Result<Vec<render::stipple::Drawn>, Error> {
+    if !scene.outputs.stipples {
+        return Ok(Vec::new());
+    }
+    render::stipples_drawn(&built.parts(&scene.halo), &scene.render, &scene.camera).map_err(
+        |source| Error::Render {
+            scene: scene.name.clone(),
+            source,
+        },
+    )
+}
+
+/// The JSON and binary chunks of the scene's `.glb`: the surfaces, halos, shown curves and
+/// `stipples`, with the scene and the build's verdict (`failures`) in the asset's extras.
+fn glb_chunks(
+    scene: &Scene,
+    built: &Built,
+    data: &[SurfaceData],
+    stipples: &[render::stipple::Drawn],
+    failures: &[String],
+) -> Result<(Vec<u8>, Vec<u8>), Error> {
+    let internal = |message: String| Error::Internal {
+        stage: "export",
+        message,
+    };
+    let scene_json = serde_json::to_value(scene).map_err(|e| internal(e.to_string()))?;
+    let asset = serde_json::json!({
+        "scene": scene_json,
+        "verified": failures.is_empty(),
+        "failures": failures,
+    });
+    export::glb_chunks(
+        data,
+        built.shown_curves(),
+        scene.outputs.curve_radius * built.diagonal,
+        stipples,
+        &asset,
+    )
+    .map_err(internal)
+}
+
+/// The bytes of the `.glb` a build of `scene` writes (with its stipples when
+/// `outputs.stipples`), for a file written on its own.
+pub fn glb_bytes(scene: &Scene, built: &Built) -> Result<Vec<u8>, Error> {
+    let stipples = file_stipples(scene, built)?;
+    let data: Vec<SurfaceData> = built.surfaces.iter().map(|p| p.data(&scene.halo)).collect();
+    let (text, bin) = glb_chunks(scene, built, &data, &stipples, &built.failures())?;
+    let mut out = Vec::new();
+    export::write_glb_container(&mut out, &text, &bin).map_err(|e| Error::Internal {
+        stage: "export",
+        message: e.to_string(),
+    })?;
+    Ok(out)
+}
+
+/// A [`export::StagedError`] as the pipeline's error.
+fn staged_error(e: export::StagedError) -> Error {
+    match e {
+        export::StagedError::Io { path, source } => Error::Write { path, source },
+        busy => Error::Busy(busy),
+    }
+}
