@@ -9,8 +9,11 @@
 //! triangles; before the timed runs, prints its time against the curve stage's.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use halo4d::{Analytic, Curves, Mesh4, Projected, Scene, sample_uniform};
-use halo4d::{Sheet, curves, refine};
+use halo4d::{
+    Scene, intersect::Analytic, intersect::Curves, sample::Mesh4, sample::sample_uniform,
+    view::Projected,
+};
+use halo4d::{intersect::Sheet, intersect::curves, intersect::refine};
 use std::hint::black_box;
 use std::path::Path;
 

@@ -4,7 +4,7 @@
 //! (`fixtures/scenes/<name>.json` and `formula-<name>.json`).
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use halo4d::{Sampling, Scene, Surface, sample, sample_uniform};
+use halo4d::{Scene, sample::Sampling, sample::sample, sample::sample_uniform, surfaces::Surface};
 use std::hint::black_box;
 use std::path::PathBuf;
 

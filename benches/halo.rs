@@ -4,10 +4,10 @@
 //! second.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use halo4d::build_halo;
-use halo4d::check;
+use halo4d::check::check;
+use halo4d::halo::build_halo;
 use halo4d::internals::tets::Split;
-use halo4d::{Scene, sample_uniform};
+use halo4d::{Scene, sample::sample_uniform};
 use std::hint::black_box;
 use std::path::Path;
 
@@ -27,7 +27,7 @@ fn halos(c: &mut Criterion) {
     group.sample_size(10);
     group.throughput(Throughput::Elements(prisms));
     for split in [Split::GlobalOrder, Split::Paper, Split::Quality] {
-        let params = halo4d::HaloParams {
+        let params = halo4d::halo::HaloParams {
             split,
             ..scene.halo
         };

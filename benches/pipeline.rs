@@ -3,11 +3,11 @@
 //! the quartic Fermat.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use halo4d::internals::to_glb;
-use halo4d::{Fermat, SpunTrefoil};
-use halo4d::{HaloParams, build_halo};
-use halo4d::{Surface, View, sample_uniform};
-use halo4d::{SurfaceData, to_ply, write_vtk};
+use halo4d::export::to_glb;
+use halo4d::{export::SurfaceData, export::to_ply, export::write_vtk};
+use halo4d::{halo::HaloParams, halo::build_halo};
+use halo4d::{sample::sample_uniform, surfaces::Surface, view::View};
+use halo4d::{surfaces::Fermat, surfaces::SpunTrefoil};
 use std::hint::black_box;
 
 fn surfaces() -> [(&'static str, Surface); 2] {
@@ -47,7 +47,7 @@ fn stages(c: &mut Criterion) {
             halo_params: &params,
             rho,
         }];
-        let curves = halo4d::curves(&[halo4d::Sheet {
+        let curves = halo4d::intersect::curves(&[halo4d::intersect::Sheet {
             positions: &projected.positions,
             w: &projected.w,
             triangles: &mesh.triangles,

@@ -48,10 +48,10 @@ fn pictures(c: &mut Criterion) {
     let mut group = c.benchmark_group("render/default_scene_1024");
     group.sample_size(10);
     for (name, mode) in [
-        ("exact", halo4d::RenderMode::Exact),
-        ("slices_256", halo4d::RenderMode::Slices),
+        ("exact", halo4d::render::RenderMode::Exact),
+        ("slices_256", halo4d::render::RenderMode::Slices),
     ] {
-        let settings = halo4d::RenderSettings {
+        let settings = halo4d::render::RenderSettings {
             mode,
             slices: 256,
             ..scene.render
@@ -69,7 +69,7 @@ fn pictures(c: &mut Criterion) {
 
 fn stipples(c: &mut Criterion) {
     let mut scene = halo4d::Scene::default_scene();
-    scene.render.style = halo4d::Style::Stipple;
+    scene.render.style = halo4d::render::Style::Stipple;
     let built = halo4d::Sampled::of(&scene)
         .into_built(&scene, halo4d::Stages::of(&scene))
         .expect("the default scene builds");
@@ -88,7 +88,14 @@ fn stipples(c: &mut Criterion) {
     let mut group = c.benchmark_group("stipples/default_scene");
     group.sample_size(10);
     group.bench_function(format!("rank_{count}"), |b| {
-        b.iter(|| halo4d::Stipples::generate(black_box(&mesh.positions), &mesh.triangles, count, 1))
+        b.iter(|| {
+            halo4d::stipple::Stipples::generate(
+                black_box(&mesh.positions),
+                &mesh.triangles,
+                count,
+                1,
+            )
+        })
     });
     group.finish();
 }

@@ -13,11 +13,14 @@
 //! 1e-5 have millions of triangles).
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use halo4d::Surface;
-use halo4d::internals::bounding_diagonal;
+use halo4d::sample::bounding_diagonal;
+use halo4d::surfaces::Surface;
 use halo4d::sweep;
-use halo4d::{Fermat, FlatTorus, KleinBottle, SpunTrefoil, TwistSpunTrefoil};
-use halo4d::{audit, sample_adaptive};
+use halo4d::{sample::audit, sample::sample_adaptive};
+use halo4d::{
+    surfaces::Fermat, surfaces::FlatTorus, surfaces::KleinBottle, surfaces::SpunTrefoil,
+    surfaces::TwistSpunTrefoil,
+};
 use std::hint::black_box;
 use std::path::PathBuf;
 

@@ -1,5 +1,5 @@
 //! The independent checker of halo tetrahedra. It shares no code with the builder
-//! ([`crate::tets`]): it reads only vertex positions, the vertex layout and the tetrahedra,
+//! (`tets`): it reads only vertex positions, the vertex layout and the tetrahedra,
 //! and decides with exact predicates.
 //!
 //! Layout (the same in memory, in `.glb` and in `.vtk`): for a surface of n vertices, vertex

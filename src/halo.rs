@@ -4,7 +4,7 @@
 //! triangles. Gives: a [`Halo`]: the two offset surfaces v ± rho n̂ (t = 0 on the negative
 //! side, 1 on the positive) and the surface itself between them (t = 1/2), each vertex
 //! keeping t and d_orig (its w-depth), and the tetrahedra of the prisms between the offsets,
-//! in two layers that meet at the surface triangle ([`crate::tets`]). Inside the halo the
+//! in two layers that meet at the surface triangle (`tets`). Inside the halo the
 //! depth grows as d_new = d_orig + max(0, |2t - 1| - delta_t) delta_d, evaluated after
 //! interpolating t and d_orig, so the halo carries those two and not d_new.
 //!
@@ -15,7 +15,7 @@
 //! triangles around the vertex ([`widest_direction`]), which depends on the mesh and the
 //! view, not on the parametrization. Never NaN. Each vertex orients the triangles around it
 //! by walking across their shared edges; where a non-orientable surface turns over, a prism's
-//! corners disagree and the prism is twisted (see [`crate::tets`]).
+//! corners disagree and the prism is twisted (see `tets`).
 //!
 //! Where no direction faces every triangle around a vertex (a cross-cap: the normals turn
 //! through a full circle around it), no rho keeps its prisms valid: the vertex is singular

@@ -1,19 +1,23 @@
 //! halo4d turns surfaces that live in four dimensions into verified 3D geometry.
 //!
-//! A [`Scene`] says what to build; [`build`] runs the stages its outputs need and writes the
-//! files ([`Sampled::of`] then [`Sampled::build`], and [`write()`], do the two halves; a
-//! sample serves any number of views; [`render_to`] makes its picture). The
-//! stages, in the order of the pipeline: a [`Surface`] of the catalogue (4D, exact
-//! derivatives) is sampled to a tolerance ([`sample`], a welded, audited [`Mesh4`]), turned
-//! and projected by a [`View`] ([`Projected`]), thickened into a [`Halo`] of tetrahedra
-//! ([`build_halo`], checked by the independent [`check`]); the intersection [`curves`] of
-//! all surfaces are the ground truth the halos are verified against ([`verify`]), and
-//! [`refine()`] moves them onto the analytic surfaces for the files and the picture;
-//! [`Parts`] hands what a scene produced to the verification and the renderer ([`render`]).
-//! The files are read back with [`read_halos`] and [`read_scene_glb`], and checked again
-//! with [`check_file`] and [`check_dir`]. [`limits`] holds every limit a user can meet;
-//! [`sweep`] measures speed against error. The README's ARCHITECTURE section draws the
-//! module graph.
+//! A [`Scene`] says what to build. [`Sampled::of`] samples and audits its surfaces once;
+//! [`Sampled::build`] builds them in the scene's view (any number of views from one
+//! sampling) into a [`Built`], whose verdict is [`Built::failures`]; [`write()`] makes the
+//! files the scene asks for and gives the [`report::Report`]. [`build`] does all three, with
+//! a progress bar, and [`render_to`] makes the scene's picture. The files are checked again
+//! by [`check_file`] and [`check_dir`].
+//!
+//! The stages, each a module, in the order of the pipeline: a surface of the catalogue or
+//! a formula ([`surfaces`]: 4D, exact derivatives) is sampled to a tolerance ([`sample`]: a
+//! welded, audited 4D mesh), turned and projected ([`view`]), thickened into halos of
+//! tetrahedra ([`halo`], checked by the independent [`check`]); the exact intersection
+//! curves of all surfaces ([`intersect`]) are the ground truth the halos are verified
+//! against ([`verify`]), and are moved onto the analytic surfaces for the files and the
+//! picture; [`Parts`] hands what a build or a file produced to the verification and the
+//! renderer ([`render`], [`stipple`]). [`export`] writes the files and [`import`] reads
+//! them back; [`animate`] makes the frames of a path through 4D views, [`gallery`] a folder
+//! of figures and [`sweep`] speed against error. [`limits`] holds every limit a user can
+//! meet. `docs/ARCHITECTURE.md` draws the module graph.
 //!
 //! From a scene to a verified build and its files:
 //!
@@ -48,101 +52,60 @@
 //! ```
 #![warn(missing_docs)]
 
-mod animate;
+pub mod animate;
 mod animation;
-mod check;
+pub mod check;
 mod convention;
 mod error;
-mod export;
+pub mod export;
 pub mod gallery;
-mod halo;
-mod import;
+pub mod halo;
+pub mod import;
 mod inspect;
-mod intersect;
+pub mod intersect;
 pub mod limits;
 mod memory;
 mod parts;
 mod pipeline;
-mod render;
-mod sample;
+pub mod render;
+pub mod sample;
 mod scene;
-mod stipple;
-mod surfaces;
+pub mod stipple;
+pub mod surfaces;
 pub mod sweep;
 mod tets;
-mod verify;
-mod view;
+pub mod verify;
+pub mod view;
 #[cfg(feature = "viewer")]
 pub mod viewer;
 mod viewsearch;
 
-// The scene, the build and what it gives.
+// The scene, the build and what it gives; the stages and the files are in the modules
+// above, in the order of the pipeline.
 pub use error::Error;
+pub use pipeline::report;
 pub use pipeline::{
-    Bounds, Built, MemoryReport, PictureReport, Report, Sampled, SamplingReport, Stages,
-    SurfaceProduct, SurfaceReport, Timings, build, glb_bytes, render_to, shown_curves, write,
+    Built, Sampled, Stages, SurfaceProduct, build, glb_bytes, render_to, shown_curves, write,
 };
 pub use scene::{DEFAULT_SCENE, Outputs, Scene, SceneError, SceneSurface};
 pub use viewsearch::{Found, SearchError, resolve as resolve_view, search as search_view};
 
-// Animations: a path through 4D views, and its frames.
-pub use animate::{
-    AnimateError, Assembled, FrameRange, FrameRecord, Request, Shard, Status, Summary, animate,
-    assemble, status,
-};
-pub use animation::{Animation, CameraKey, Keyframe, RotationKey, ViewKey};
-
-// The stages, in the order of the pipeline.
-pub use check::{CheckStats, TetMesh, check};
-pub use halo::{Fold, Halo, HaloParams, HaloReport, build_halo};
-pub use intersect::{
-    Analytic, Curve, CurvePoint, CurveSettings, Curves, CurvesReport, End, Face, Refinement, Sheet,
-    TriplePoint, curves, refine,
-};
+// What a build or a scene's file produced, as the verification and the renderer read it.
 pub use parts::{HaloIndex, HaloPart, Parts, SurfacePart};
-pub use render::clip::{Clip, ClipPlane};
-pub use render::compare::Comparison;
-pub use render::{
-    CameraProjection, CameraSettings, Colormap, Lighting, Picture, RenderError, RenderMode,
-    RenderSettings, RibbonAxis, Ribbons, StippleSettings, Style, render,
-};
-pub use sample::{
-    Audit, Mesh4, MeshData4, MeshStats, MeshSurface, Sampling, Source, audit, mesh_from_data,
-    mesh_tangents, sample, sample_adaptive, sample_uniform,
-};
-pub use stipple::{Stipples, poisson_radius};
-pub use surfaces::{
-    Bound, Domain, Eval4, Fermat, FlatTorus, Formula, FormulaEdge, FormulaSeam, FormulaSides,
-    FormulaSource, Glue, Jet, KleinBottle, Patches, ProductPolynomial, ProjectivePlane, Side,
-    SideRule, SpunTrefoil, Surface, Topology, TwistSpunTrefoil,
-};
-pub use verify::{Ambiguous, Verification, verify};
-pub use view::{BehindEye, Mapped, Projected, Projection, Rotation4, View, ViewMap};
 
-// The files: written, read back and checked.
-pub use export::{
-    StagedError, SurfaceData, to_4off, to_curves_ply, to_obj, to_ply, write_atomic, write_vtk,
-};
-pub use import::{
-    FileParams, ImportError, ImportedCurves, ImportedHalo, ImportedScene, ImportedSurface,
-    MeshFileError, MeshFileLocation, MeshFormat, parse_mesh4, read as read_halos, read_glb,
-    read_mesh4, read_scene_glb, read_vtk,
-};
+// The files: each written whole or not at all, and checked again.
+pub use export::write_atomic;
 pub use inspect::{Checked, InspectError, check_dir, check_file, verify_scene};
 
 /// What the tests and benches reach into beneath the API: stage internals with their own
 /// contracts, kept public so that they can be tested on their own, not for use.
 pub mod internals {
     pub use crate::convention::file_order;
-    pub use crate::export::{LOCK, glb_container, to_glb, write_atomic};
-    pub use crate::intersect::{BroadPhase, Node, curves_with};
     pub use crate::render::camera::{Camera, Placement};
     pub use crate::render::compare::verdict_differs;
     pub use crate::render::overlay::{INK, OVER_BANDS, OVER_SHADE, curve_ink};
-    pub use crate::render::stipple::{Drawn, density, luminance, tone};
-    pub use crate::render::visible::{CurveVisibility, PictureCamera, curve_visibility};
-    pub use crate::render::{Prober, Seen, line_coverage, render_with_depth, stipples_drawn};
-    pub use crate::sample::{bounding_diagonal, uniform_error};
+    pub use crate::render::stipple::{Drawn, tone};
+    pub use crate::render::visible::curve_visibility;
 
     /// One-pixel lines broadened to an exact width.
     pub mod lines {

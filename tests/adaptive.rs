@@ -2,10 +2,12 @@
 //! meshes keep the uniform sampler's guarantees, the audit is exact on a known case, and the
 //! budget stops refinement cleanly.
 
-use halo4d::internals::bounding_diagonal;
-use halo4d::{Fermat, FlatTorus, SpunTrefoil, TwistSpunTrefoil};
-use halo4d::{Mesh4, Surface};
-use halo4d::{Sampling, audit, sample, sample_adaptive};
+use halo4d::sample::bounding_diagonal;
+use halo4d::{sample::Mesh4, surfaces::Surface};
+use halo4d::{sample::Sampling, sample::audit, sample::sample, sample::sample_adaptive};
+use halo4d::{
+    surfaces::Fermat, surfaces::FlatTorus, surfaces::SpunTrefoil, surfaces::TwistSpunTrefoil,
+};
 
 /// Relative tolerances every catalogue surface is checked at.
 const TOLERANCES: [f64; 3] = [2e-2, 5e-3, 1e-3];
@@ -37,7 +39,7 @@ fn every_surface_meets_every_tolerance_as_audited_with_its_topology() {
     for s in surfaces() {
         let diagonal = bounding_diagonal(&s);
         let topo = s.topology();
-        let uniform = halo4d::sample_uniform(&s, 8, 8).validate();
+        let uniform = halo4d::sample::sample_uniform(&s, 8, 8).validate();
         for rel in TOLERANCES {
             let tol = rel * diagonal;
             let out = sample_adaptive(&s, tol, 2_000_000);
@@ -99,7 +101,7 @@ fn the_audit_is_exact_on_the_flat_torus_sagitta() {
     // its sagitta r (1 - cos(Δ/2)).
     for (r1, r2, nu, nv) in [(1.0, 1.0, 8, 8), (1.5, 0.5, 12, 6), (2.0, 1.0, 64, 40)] {
         let s = Surface::FlatTorus(FlatTorus { r1, r2 });
-        let mesh = halo4d::sample_uniform(&s, nu, nv);
+        let mesh = halo4d::sample::sample_uniform(&s, nu, nv);
         let a = audit(&s, &mesh);
         let tau = std::f64::consts::TAU;
         let sag = |r: f64, n: usize| r * (1.0 - (tau / n as f64 / 2.0).cos());
@@ -215,7 +217,7 @@ fn a_budget_refines_the_worst_triangles_first() {
     let out = sample_adaptive(&s, tol, 20_000);
     assert!(!out.complete);
     let error = audit(&s, &out.mesh).max_error;
-    let uniform = halo4d::internals::uniform_error(&s, out.mesh.triangles.len());
+    let uniform = halo4d::sample::uniform_error(&s, out.mesh.triangles.len());
     assert!(
         error <= 8.0 * uniform,
         "adaptive {error:e}, uniform {uniform:e} at {} triangles",

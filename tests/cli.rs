@@ -47,7 +47,7 @@ fn list_shows_every_surface_with_defaults_and_help_works_everywhere() {
     let dir = tempfile::tempdir().unwrap();
     let out = halo4d(&["list"], dir.path());
     let text = String::from_utf8_lossy(&out.stdout);
-    for s in halo4d::Surface::catalogue() {
+    for s in halo4d::surfaces::Surface::catalogue() {
         assert!(text.contains(s.type_name()), "{text}");
     }
     assert!(
@@ -345,7 +345,7 @@ fn a_killed_build_leaves_the_previous_build_and_its_lock_is_taken_over() {
         .stderr(std::process::Stdio::null())
         .spawn()
         .unwrap();
-    let lock = o.join(halo4d::internals::LOCK);
+    let lock = o.join(halo4d::export::LOCK);
     while !lock.exists() {
         assert!(child.try_wait().unwrap().is_none(), "it finished unkilled");
         std::thread::sleep(std::time::Duration::from_millis(2));
@@ -364,7 +364,7 @@ fn a_killed_build_leaves_the_previous_build_and_its_lock_is_taken_over() {
     assert_eq!(visible(&after), visible(&before), "the folder changed");
     assert!(after.iter().all(|(f, _)| !f.starts_with('.')
         || f.ends_with(".partial")
-        || f.starts_with(halo4d::internals::LOCK)));
+        || f.starts_with(halo4d::export::LOCK)));
     // Its lock names a process that is gone: the next build takes it over.
     let out = halo4d(&["build", "-q", "other.json", "--out", "o"], dir.path());
     assert!(
@@ -385,7 +385,7 @@ fn a_second_build_into_a_folder_in_use_fails_at_once_naming_the_other() {
     std::fs::create_dir(&o).unwrap();
     // This test's own process holds the lock, as a running build would.
     let me = std::process::id().to_string();
-    std::fs::write(o.join(halo4d::internals::LOCK), &me).unwrap();
+    std::fs::write(o.join(halo4d::export::LOCK), &me).unwrap();
     let scene = patches_scene(dir.path(), "p", "{}");
     let out = halo4d(&["build", "-q", &scene, "--out", "o"], dir.path());
     let err = String::from_utf8_lossy(&out.stderr);

@@ -118,13 +118,13 @@ pub fn assert_unreadable(out: &Output, what: &str, words: &[&str]) {
 /// Formula surfaces with every kind of side rule, each with a geometry those rules fit:
 /// the example torus, a Klein bottle flipped across v, a projective plane with its pole
 /// and half turn on the v sides, and a round sphere with two poles.
-pub fn formula_surfaces() -> Vec<halo4d::Surface> {
+pub fn formula_surfaces() -> Vec<halo4d::surfaces::Surface> {
     let tau = std::f64::consts::TAU;
-    let read = |json: serde_json::Value| -> halo4d::Surface {
+    let read = |json: serde_json::Value| -> halo4d::surfaces::Surface {
         serde_json::from_value(json).unwrap_or_else(|e| panic!("{e}"))
     };
     vec![
-        halo4d::Surface::Formula(halo4d::Formula::example()),
+        halo4d::surfaces::Surface::Formula(halo4d::surfaces::Formula::example()),
         read(serde_json::json!({
             "type": "formula",
             "x": "(1 + 0.5*cos(u))*cos(v)", "y": "(1 + 0.5*cos(u))*sin(v)",

@@ -8,9 +8,9 @@ use crate::common::{
     Rng, assert_unreadable, fixture, fixture_scenes, halo4d, hard_scenes, with_json,
 };
 use glam::DVec3;
-use halo4d::Curves;
+use halo4d::intersect::Curves;
 use halo4d::{Built, Scene};
-use halo4d::{ImportError, ImportedScene, read_scene_glb};
+use halo4d::{import::ImportError, import::ImportedScene, import::read_scene_glb};
 use ply_rs::ply::Property;
 use serde_json::Value;
 use std::path::Path;
@@ -350,9 +350,9 @@ fn check_on_the_written_glb_finds_exactly_what_the_build_found() {
         let what = path.display();
         assert_eq!(built.failures(), Vec::<String>::new(), "{what}");
         let data: Vec<_> = built.surfaces.iter().map(|p| p.data(&scene.halo)).collect();
-        let glb = halo4d::internals::to_glb(&data, &built.curves, 0.01, &Value::Null).unwrap();
+        let glb = halo4d::export::to_glb(&data, &built.curves, 0.01, &Value::Null).unwrap();
         let (curves, v) = halo4d::verify_scene(&read_scene_glb(&glb).unwrap());
-        let counts = |r: &halo4d::CurvesReport| {
+        let counts = |r: &halo4d::intersect::CurvesReport| {
             [
                 r.count,
                 r.closed,
@@ -368,7 +368,7 @@ fn check_on_the_written_glb_finds_exactly_what_the_build_found() {
             counts(&built.curves.report),
             "{what}"
         );
-        let untimed = |v: &halo4d::Verification| halo4d::Verification {
+        let untimed = |v: &halo4d::verify::Verification| halo4d::verify::Verification {
             ms: 0.0,
             ..v.clone()
         };
@@ -382,13 +382,13 @@ fn without_curves_the_glb_has_no_curves_mesh_and_the_ply_is_empty_but_valid() {
     let built = crate::common::built(&scene).unwrap();
     let data: Vec<_> = built.surfaces.iter().map(|p| p.data(&scene.halo)).collect();
     let none = Curves::default();
-    let glb = halo4d::internals::to_glb(&data, &none, 0.01, &Value::Null).unwrap();
+    let glb = halo4d::export::to_glb(&data, &none, 0.01, &Value::Null).unwrap();
     let gltf = gltf::Gltf::from_slice(&glb).unwrap();
     assert_eq!(gltf.meshes().count(), 2);
     assert!(gltf.meshes().all(|m| m.name() != Some("curves")));
     assert!(gltf.nodes().all(|n| n.name() != Some("curves")));
 
-    let bytes = halo4d::to_curves_ply(&none, "empty");
+    let bytes = halo4d::export::to_curves_ply(&none, "empty");
     let parser = ply_rs::parser::Parser::<ply_rs::ply::DefaultElement>::new();
     let ply = parser.read_ply(&mut bytes.as_slice()).unwrap();
     for element in ["vertex", "edge"] {

@@ -242,7 +242,7 @@ fn assert_only_finite_numbers(path: &std::path::Path) {
             }
         }
         "vtk" => {
-            let halo = halo4d::read_vtk(&bytes).unwrap();
+            let halo = halo4d::import::read_vtk(&bytes).unwrap();
             for p in &halo.mesh.positions {
                 p.iter().for_each(|&x| finite(x, "POINTS"));
             }

@@ -35,7 +35,10 @@
 
 use crate::common::{fixture, fixture_scenes, pack_glb};
 use halo4d::Scene;
-use halo4d::{ImportedHalo, ImportedScene, read_glb, read_scene_glb, read_vtk};
+use halo4d::{
+    import::ImportedHalo, import::ImportedScene, import::read_glb, import::read_scene_glb,
+    import::read_vtk,
+};
 use proptest::collection::vec;
 use proptest::prelude::*;
 use proptest::sample::select;
@@ -866,7 +869,7 @@ fn scene_seeds() -> &'static SceneSeeds {
             .collect();
         let full = serde_json::to_value(Scene::default_scene()).unwrap();
         trees.push(Node::from_value(&full));
-        for surface in halo4d::Surface::catalogue() {
+        for surface in halo4d::surfaces::Surface::catalogue() {
             let mut scene = full.clone();
             scene["surfaces"] = serde_json::json!([{ "surface": surface }]);
             trees.push(Node::from_value(&scene));
@@ -978,7 +981,7 @@ fn built() -> &'static Built {
         let mut scene = Scene::load(&fixture("scenes/patches.json")).unwrap();
         assert_eq!(
             scene.sampling,
-            halo4d::Sampling::Uniform { u: 8, v: 8 },
+            halo4d::sample::Sampling::Uniform { u: 8, v: 8 },
             "a small build"
         );
         scene.outputs.ply = false;
@@ -1411,7 +1414,7 @@ fn check_glb(bytes: &[u8], tally: &Tally) -> Result<(), String> {
 fn check_changed(h: &ImportedHalo, seed: &ImportedHalo, tally: &Tally) {
     if h.mesh != seed.mesh {
         tally.add("checked a changed halo");
-        let _ = halo4d::check(&h.mesh);
+        let _ = halo4d::check::check(&h.mesh);
     }
 }
 

@@ -143,10 +143,10 @@ fn figure_8_outlines_the_halos_in_its_own_colour() {
 #[test]
 fn four_d_lighting_shades_the_sheets_by_how_they_lean_in_w() {
     let scene = Scene::load(&fixture("figures/fig5c-spun-trefoil-4d-lit.json")).unwrap();
-    assert_eq!(scene.render.lighting, halo4d::Lighting::FourD);
+    assert_eq!(scene.render.lighting, halo4d::render::Lighting::FourD);
     let four = picture(scene.clone(), 192);
     let mut three = scene;
-    three.render.lighting = halo4d::Lighting::ThreeD;
+    three.render.lighting = halo4d::render::Lighting::ThreeD;
     let three = picture(three, 192);
     // The same surfaces in the same places, shaded otherwise.
     let drawn = |img: &image::RgbImage| img.pixels().map(|p| p.0 != [255; 3]).collect::<Vec<_>>();

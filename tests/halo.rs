@@ -3,12 +3,12 @@
 
 use crate::common::{Rng, fixture, fixture_scenes};
 use glam::DVec3;
-use halo4d::Projected;
-use halo4d::Sampling;
 use halo4d::Scene;
 use halo4d::internals::tets::{self, Corners, Split, prism};
-use halo4d::{CheckStats, TetMesh, check};
-use halo4d::{Fold, Halo, HaloParams, HaloReport, build_halo};
+use halo4d::sample::Sampling;
+use halo4d::view::Projected;
+use halo4d::{check::CheckStats, check::TetMesh, check::check};
+use halo4d::{halo::Fold, halo::Halo, halo::HaloParams, halo::HaloReport, halo::build_halo};
 
 /// A bumpy height field over a jittered grid, its cells cut along random diagonals, its
 /// triangles' corners rotated at random (so each triangle's own order, the paper's starting

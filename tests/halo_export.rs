@@ -6,10 +6,10 @@ use crate::common::{Rng, assert_unreadable, fixture, fixture_scenes, halo4d, wit
 use glam::{DVec3, Vec3};
 use halo4d::Scene;
 use halo4d::SurfaceProduct;
-use halo4d::check;
+use halo4d::check::check;
+use halo4d::import::read as read_halos;
 use halo4d::internals::file_order;
-use halo4d::read_halos;
-use halo4d::{ImportError, ImportedHalo, read_glb, read_vtk};
+use halo4d::{import::ImportError, import::ImportedHalo, import::read_glb, import::read_vtk};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 

@@ -3,9 +3,11 @@
 
 use crate::common::{Rng, fixture, fixture_scenes};
 use glam::DVec3;
-use halo4d::internals::{BroadPhase, Node, curves_with};
-use halo4d::{Curves, End, Sheet, curves};
-use halo4d::{Sampling, Scene, sample_uniform};
+use halo4d::intersect::BroadPhase;
+use halo4d::intersect::Node;
+use halo4d::intersect::curves_with;
+use halo4d::{Scene, sample::Sampling, sample::sample_uniform};
+use halo4d::{intersect::Curves, intersect::End, intersect::Sheet, intersect::curves};
 
 /// A mesh in the intersection stage's terms.
 struct Soup {
@@ -426,7 +428,7 @@ fn where_a_view_folds_fermat_patches_together_the_curves_end_at_the_vertex() {
     let built = crate::common::built(&scene).unwrap();
     let report = &built.curves.report;
     assert_eq!(report.unresolved, 0, "{report:?}");
-    let at_fold = |p: &halo4d::CurvePoint| {
+    let at_fold = |p: &halo4d::intersect::CurvePoint| {
         matches!(p.node, Node::Vertex(_))
             && (p.position - DVec3::new(-1.0, 0.0, 0.0)).length() < 1e-9
     };
@@ -457,8 +459,8 @@ fn flat_torus_build() -> halo4d::Built {
     crate::common::built(&scene).unwrap()
 }
 
-fn verify(built: &halo4d::Built, scene: &Scene) -> halo4d::Verification {
-    halo4d::verify(&built.verified_parts(&scene.halo))
+fn verify(built: &halo4d::Built, scene: &Scene) -> halo4d::verify::Verification {
+    halo4d::verify::verify(&built.verified_parts(&scene.halo))
 }
 
 #[test]
@@ -538,7 +540,7 @@ fn empty_and_single_triangle_inputs_give_no_curves() {
             halos: vec![None; sheets.len()],
             curves: &c,
         };
-        let v = halo4d::verify(&parts);
+        let v = halo4d::verify::verify(&parts);
         assert_eq!(
             (v.wrong, v.spurious_hidden_samples, v.far_tetrahedra),
             (0, 0, 0)
@@ -601,7 +603,7 @@ fn the_verdict_does_not_depend_on_the_resolution() {
             scene.sampling = sampling;
             // The views and halo width these bounds were measured in (the fixtures' views
             // have since been chosen for their pictures).
-            scene.view.rotation = halo4d::Rotation4::default();
+            scene.view.rotation = halo4d::view::Rotation4::default();
             *scene.view.rotation.angle_mut("yw").unwrap() =
                 if name == "flat-torus" { 30.0 } else { 35.0 };
             if name != "flat-torus" {

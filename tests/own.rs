@@ -1,7 +1,7 @@
 //! Surfaces users bring: formulas and 4D meshes from files, built like the catalogue's.
 
 use crate::common::{Rng, fixture};
-use halo4d::{Scene, Source};
+use halo4d::{Scene, sample::Source};
 
 /// A fixture scene with its pictures off (the builds compare meshes, curves and halos).
 fn fixture_scene(name: &str) -> Scene {
@@ -219,11 +219,11 @@ fn tangents_from_a_mesh_approach_the_surface_s_and_keep_its_orientation() {
     // growing size: the largest angle about halves with the cells (first order: a grid's
     // cells split along one diagonal make one-rings that are not symmetric), and u ∧ v
     // points the way the parametrization's does wherever the mesh's winding agrees.
-    let surface = halo4d::Surface::KleinBottle(Default::default());
+    let surface = halo4d::surfaces::Surface::KleinBottle(Default::default());
     let mut worst = Vec::new();
     for n in [16, 32, 64] {
-        let mesh = halo4d::sample_uniform(&surface, n, n);
-        let (tu, tv) = halo4d::mesh_tangents(&mesh.positions, &mesh.triangles);
+        let mesh = halo4d::sample::sample_uniform(&surface, n, n);
+        let (tu, tv) = halo4d::sample::mesh_tangents(&mesh.positions, &mesh.triangles);
         let mut largest = 0.0f64;
         for i in 0..mesh.positions.len() {
             let e1 = mesh.tangent_u[i].normalize();

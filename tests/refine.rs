@@ -4,8 +4,11 @@
 
 use crate::common::{fixture, fixture_scenes};
 use glam::DVec3;
-use halo4d::sample_uniform;
-use halo4d::{Analytic, Curves, End, Mesh4, Projected, Scene, Sheet, curves, refine};
+use halo4d::sample::sample_uniform;
+use halo4d::{
+    Scene, intersect::Analytic, intersect::Curves, intersect::End, intersect::Sheet,
+    intersect::curves, intersect::refine, sample::Mesh4, view::Projected,
+};
 
 /// The mesh curves and the refined ones of one surface in its scene's view.
 fn refined(scene: &Scene, mesh: &Mesh4) -> (Curves, Curves) {
@@ -132,7 +135,7 @@ fn refined_flat_torus_curves_of_adaptive_meshes_end_at_the_true_cross_caps() {
     for tolerance in [1e-2, 1e-3, 1e-4] {
         let sampled = scene.surfaces[0]
             .surface
-            .sample(&halo4d::Sampling::adaptive(tolerance));
+            .sample(&halo4d::sample::Sampling::adaptive(tolerance));
         let (mesh_curves, refined) = refined(&scene, &sampled.mesh);
         check_torus(
             30.0,

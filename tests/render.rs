@@ -3,10 +3,11 @@
 
 use crate::common::{fixture, fixture_scenes, halo4d, halo4d_with};
 use glam::DVec3;
-use halo4d::RenderSettings;
 use halo4d::Scene;
 use halo4d::internals::Camera;
-use halo4d::internals::{Prober, Seen};
+use halo4d::render::Prober;
+use halo4d::render::RenderSettings;
+use halo4d::render::Seen;
 
 /// Small, fast settings for tests.
 fn small(scene: &mut Scene) {
@@ -59,7 +60,7 @@ fn renders_are_deterministic_and_stereo_is_two_views() {
     };
     let pair = built.render(&scene.halo, &stereo, &scene.camera).unwrap();
     assert_eq!((pair.width, pair.height), (400, 200));
-    let half = |p: &halo4d::Picture, right: bool| -> Vec<u8> {
+    let half = |p: &halo4d::render::Picture, right: bool| -> Vec<u8> {
         (0..200)
             .flat_map(|y| {
                 let start = 3 * (y * 400 + if right { 200 } else { 0 });
@@ -401,7 +402,7 @@ fn the_drawn_curves_lie_on_the_computed_curves_at_the_width_asked_for() {
     let built = crate::common::built(&scene).unwrap();
     let parts = built.parts(&scene.halo);
     let input = parts;
-    let coverage = halo4d::internals::line_coverage(&input, &scene.render, &scene.camera).unwrap();
+    let coverage = halo4d::render::line_coverage(&input, &scene.render, &scene.camera).unwrap();
     let cam = *Prober::new(&input, &scene.render, &scene.camera)
         .unwrap()
         .camera();
@@ -639,7 +640,7 @@ fn the_default_camera_fits_the_surfaces_in_the_picture() {
     assert_eq!(scene.camera.distance, None, "the default camera is fitted");
     let built = crate::common::built(&scene).unwrap();
     let parts = built.parts(&scene.halo);
-    let picture = halo4d::render(&parts, &scene.render, &scene.camera).unwrap();
+    let picture = halo4d::render::render(&parts, &scene.render, &scene.camera).unwrap();
     let (w, h) = (picture.width as usize, picture.height as usize);
     // The surfaces' extent, from the picture: the columns and rows that are not background.
     let covered = |x: usize, y: usize| picture.rgb[3 * (y * w + x)..][..3] != [255, 255, 255];
@@ -702,10 +703,10 @@ fn a_camera_at_a_given_distance_stands_where_it_always_has() {
         );
     let (centre, radius) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
     for projection in [
-        halo4d::CameraProjection::Perspective,
-        halo4d::CameraProjection::Orthographic,
+        halo4d::render::CameraProjection::Perspective,
+        halo4d::render::CameraProjection::Orthographic,
     ] {
-        let camera = halo4d::CameraSettings {
+        let camera = halo4d::render::CameraSettings {
             distance: Some(3.2),
             projection,
             ..torus.scene.camera
@@ -720,16 +721,17 @@ fn a_camera_at_a_given_distance_stands_where_it_always_has() {
         assert_eq!(cam.eye, centre + towards_eye * 3.2 * radius);
         assert_eq!(cam.forward, -towards_eye);
         let half_height = match projection {
-            halo4d::CameraProjection::Perspective => (camera.fov.to_radians() * 0.5).tan(),
-            halo4d::CameraProjection::Orthographic => radius * 1.05,
+            halo4d::render::CameraProjection::Perspective => (camera.fov.to_radians() * 0.5).tan(),
+            halo4d::render::CameraProjection::Orthographic => radius * 1.05,
         };
         assert_eq!(cam.half_height, half_height);
         // A scene file that gives the distance reads as that camera, and one that gives none
         // as the fitted one.
-        let given: halo4d::CameraSettings = serde_json::from_str(r#"{ "distance": 3.2 }"#).unwrap();
+        let given: halo4d::render::CameraSettings =
+            serde_json::from_str(r#"{ "distance": 3.2 }"#).unwrap();
         assert_eq!(given.distance, Some(3.2));
-        let fitted: halo4d::CameraSettings = serde_json::from_str("{}").unwrap();
-        assert_eq!(fitted, halo4d::CameraSettings::default());
+        let fitted: halo4d::render::CameraSettings = serde_json::from_str("{}").unwrap();
+        assert_eq!(fitted, halo4d::render::CameraSettings::default());
         assert_eq!(
             serde_json::to_string(&fitted).unwrap().find("distance"),
             None
@@ -774,8 +776,8 @@ fn inks_along_the_curves(
         curves: false,
         ..with
     };
-    let drawn = halo4d::render(&parts, &with, &scene.camera).unwrap();
-    let bare = halo4d::render(&parts, &without, &scene.camera).unwrap();
+    let drawn = halo4d::render::render(&parts, &with, &scene.camera).unwrap();
+    let bare = halo4d::render::render(&parts, &without, &scene.camera).unwrap();
     let prober = Prober::new(&parts, &with, &scene.camera).unwrap();
     let cam = prober.camera();
     let (w, h) = (with.width, with.height);
@@ -798,7 +800,7 @@ fn inks_along_the_curves(
             srgb8(halo4d::internals::INK)
         }
     };
-    let near = |p: &halo4d::CurvePoint| (p.w[0] != p.w[1]).then(|| p.near());
+    let near = |p: &halo4d::intersect::CurvePoint| (p.w[0] != p.w[1]).then(|| p.near());
     let close = |a: &[u8], b: [u8; 3]| (0..3).all(|k| a[k].abs_diff(b[k]) <= 8);
     // Every projected curve segment: (curve, its length along the curve in the picture up
     // to the segment, ends).
@@ -963,8 +965,8 @@ fn the_colour_bar_is_labelled_with_w_where_the_picture_has_room() {
             legend: true,
             ..bare
         };
-        let without = halo4d::render(&parts, &bare, &torus.scene.camera).unwrap();
-        let with = halo4d::render(&parts, &legend, &torus.scene.camera).unwrap();
+        let without = halo4d::render::render(&parts, &bare, &torus.scene.camera).unwrap();
+        let with = halo4d::render::render(&parts, &legend, &torus.scene.camera).unwrap();
         let side = side as usize;
         let (margin, bar) = ((side / 40).max(2), (side / 40).max(4));
         let bar_top = side - margin - bar;
@@ -1024,7 +1026,7 @@ fn luminance_at_tolerance(
         scene.render.broken_edges,
     ) = (false, false, false);
     scene.render.halos = halos;
-    scene.sampling = halo4d::Sampling::adaptive(tolerance);
+    scene.sampling = halo4d::sample::Sampling::adaptive(tolerance);
     for s in &mut scene.surfaces {
         s.sampling = None;
     }
@@ -1101,11 +1103,11 @@ fn pictures_of_non_orientable_surfaces_have_no_shading_seam() {
         ("projective-plane", [("xw", 30.0), ("zw", 15.0)]),
     ] {
         let mut scene = Scene::load(&fixture(&format!("scenes/{name}.json"))).unwrap();
-        scene.view.rotation = halo4d::Rotation4::default();
+        scene.view.rotation = halo4d::view::Rotation4::default();
         for (plane, angle) in planes {
             *scene.view.rotation.angle_mut(plane).unwrap() = angle;
         }
-        scene.camera = halo4d::CameraSettings::default();
+        scene.camera = halo4d::render::CameraSettings::default();
         let (differ, covered) = artifact_pixels(&scene, 1e-3, 256, false, false);
         assert!(covered > 5000, "{name}: {covered} pixels covered");
         assert!(
@@ -1152,7 +1154,7 @@ fn the_visible_share_of_the_curves_is_that_of_a_brute_force_ray_cast() {
     // The flat torus turned in yw on a coarse grid, seen from where a sheet hides part of
     // each arc: every piece of curve cast against every triangle.
     let mut scene = Scene::load(&fixture("scenes/flat-torus.json")).unwrap();
-    scene.sampling = halo4d::Sampling::Uniform { u: 24, v: 24 };
+    scene.sampling = halo4d::sample::Sampling::Uniform { u: 24, v: 24 };
     (scene.render.width, scene.render.height) = (160, 120);
     (scene.camera.azimuth, scene.camera.elevation) = (20.0, 10.0);
     let built = crate::common::built(&scene).unwrap();
@@ -1257,7 +1259,7 @@ fn every_catalogue_surface_has_a_fixture_whose_picture_shows_its_crossings() {
         ("product-polynomial", "product_polynomial"),
         ("patches", "patches"),
     ];
-    let listed = halo4d::Source::listing();
+    let listed = halo4d::sample::Source::listing();
     for (name, kind) in types {
         assert!(listed.contains(kind), "{kind} is not in the catalogue");
         let scene = Scene::load(&fixture(&format!("scenes/{name}.json"))).unwrap();

@@ -1,8 +1,10 @@
 //! The uniform sampler: closed surfaces give closed manifold meshes of the right Euler
 //! characteristic, welded by rule; open ones have exactly the expected boundary.
 
-use halo4d::{Fermat, Patches, ProductPolynomial, TwistSpunTrefoil};
-use halo4d::{Surface, sample_uniform};
+use halo4d::{sample::sample_uniform, surfaces::Surface};
+use halo4d::{
+    surfaces::Fermat, surfaces::Patches, surfaces::ProductPolynomial, surfaces::TwistSpunTrefoil,
+};
 
 const GRIDS: [(usize, usize); 4] = [(4, 4), (4, 6), (16, 8), (30, 64)];
 

@@ -31,7 +31,7 @@ fn every_catalogue_surface_has_a_fixture_scene() {
                 .map(|s| s.surface.type_name())
         })
         .collect();
-    for s in halo4d::Surface::catalogue() {
+    for s in halo4d::surfaces::Surface::catalogue() {
         assert!(
             used.contains(&s.type_name()),
             "no fixture scene uses {}",

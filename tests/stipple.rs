@@ -4,8 +4,12 @@
 
 use crate::common::{fixture, fixture_scenes};
 use glam::{DVec3, DVec4};
-use halo4d::internals::{Camera, Drawn, Placement, stipples_drawn, tone};
-use halo4d::{CameraSettings, Curves, Parts, RenderSettings, Scene, Stipples, Style, SurfacePart};
+use halo4d::internals::{Camera, Drawn, Placement, tone};
+use halo4d::render::stipples_drawn;
+use halo4d::{
+    Parts, Scene, SurfacePart, intersect::Curves, render::CameraSettings, render::RenderSettings,
+    render::Style, stipple::Stipples,
+};
 use std::collections::BTreeSet;
 
 /// A unit sphere of `lat` x `lon` quads (poles welded), with its outward normals.
@@ -71,7 +75,7 @@ fn sphere_bands(
         distance: Some(3.2),
         ..CameraSettings::default()
     };
-    let picture = halo4d::render(&parts, &settings, &camera).unwrap();
+    let picture = halo4d::render::render(&parts, &settings, &camera).unwrap();
     let bounds = (DVec3::splat(-1.0), DVec3::splat(1.0));
     let placement = Placement::new(&camera, bounds, std::iter::empty(), side, side, &[0.0]);
     let cam = Camera::new(&camera, &placement, side, side, 0.0).unwrap();
@@ -302,7 +306,10 @@ fn every_fixture_draws_in_stipples_in_both_modes() {
         (scene.render.width, scene.render.height) = (200, 200);
         scene.render.stipple.count = 50_000;
         let built = crate::common::built(&scene).unwrap();
-        for mode in [halo4d::RenderMode::Exact, halo4d::RenderMode::Slices] {
+        for mode in [
+            halo4d::render::RenderMode::Exact,
+            halo4d::render::RenderMode::Slices,
+        ] {
             let settings = RenderSettings {
                 mode,
                 curves: false,
@@ -430,10 +437,10 @@ fn the_stipples_files_hold_the_pictures_stipples() {
 fn coloured_stipples_take_the_w_colours() {
     // The spun trefoil turned so that both ends of the w scale face the camera.
     let mut scene = Scene::default_scene();
-    scene.view.rotation = halo4d::Rotation4::default();
+    scene.view.rotation = halo4d::view::Rotation4::default();
     *scene.view.rotation.angle_mut("xw").unwrap() = 20.0;
     *scene.view.rotation.angle_mut("yw").unwrap() = 35.0;
-    scene.camera = halo4d::CameraSettings::default();
+    scene.camera = halo4d::render::CameraSettings::default();
     (scene.render.width, scene.render.height) = (400, 400);
     scene.render.style = Style::Stipple;
     let built = crate::common::built(&scene).unwrap();

@@ -3,8 +3,11 @@
 
 use crate::common::Rng;
 use glam::DVec4;
-use halo4d::Surface;
-use halo4d::{Fermat, Side, SideRule, SpunTrefoil, TwistSpunTrefoil};
+use halo4d::surfaces::Surface;
+use halo4d::{
+    surfaces::Fermat, surfaces::Side, surfaces::SideRule, surfaces::SpunTrefoil,
+    surfaces::TwistSpunTrefoil,
+};
 use std::f64::consts::FRAC_PI_2;
 
 fn surfaces_under_test() -> Vec<Surface> {
@@ -147,7 +150,7 @@ fn the_point_alone_is_the_point_of_the_full_evaluation() {
 
 #[test]
 fn parameters_past_a_glued_side_continue_on_the_side_it_is_glued_to() {
-    use halo4d::{KleinBottle, Patches, ProjectivePlane};
+    use halo4d::{surfaces::KleinBottle, surfaces::Patches, surfaces::ProjectivePlane};
     let close = |s: &Surface, a: (usize, f64, f64), b: (usize, f64, f64)| {
         let (p, q) = (s.point(a.0, a.1, a.2), s.point(b.0, b.1, b.2));
         assert!(p.distance(q) < 1e-12, "{p} against {q}");

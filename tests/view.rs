@@ -2,7 +2,7 @@
 
 use crate::common::Rng;
 use glam::{DVec3, DVec4};
-use halo4d::{Mesh4, Projection, Rotation4, Surface, View};
+use halo4d::{sample::Mesh4, surfaces::Surface, view::Projection, view::Rotation4, view::View};
 
 fn one_vertex(s: &Surface, u: f64, v: f64) -> Mesh4 {
     let e = s.eval(0, u, v);
@@ -136,7 +136,7 @@ fn points_at_or_behind_the_eye_are_errors_not_nans() {
 fn normals_are_unit_and_fall_back_where_tangents_degenerate() {
     // The spun trefoil has poles where ∂/∂θ = 0: the normal there must still be unit.
     let s = Surface::SpunTrefoil(Default::default());
-    let mesh = halo4d::sample_uniform(&s, 40, 16);
+    let mesh = halo4d::sample::sample_uniform(&s, 40, 16);
     let out = View::default().project(&mesh).unwrap();
     for n in &out.normals {
         assert!((n.length() - 1.0).abs() < 1e-12, "{n}");
@@ -159,7 +159,8 @@ fn the_view_maps_points_and_jets_with_the_exact_derivatives_of_the_projection() 
     let (u, v, h) = (0.7, 1.9, 1e-5);
     let jets = map.jets(&surface.eval(0, u, v)).unwrap();
     let mapped = map.map(&surface.eval(0, u, v)).unwrap();
-    let at = |f: fn(&halo4d::Jet) -> f64| DVec3::new(f(&jets[0]), f(&jets[1]), f(&jets[2]));
+    let at =
+        |f: fn(&halo4d::surfaces::Jet) -> f64| DVec3::new(f(&jets[0]), f(&jets[1]), f(&jets[2]));
     assert!(at(|j| j.v).distance(mapped.position) < 1e-15);
     assert!(at(|j| j.du).distance(mapped.tangents[0]) < 1e-14);
     assert!(at(|j| j.dv).distance(mapped.tangents[1]) < 1e-14);

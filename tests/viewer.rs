@@ -2,12 +2,12 @@
 //! CPU renderer's exact mode, both slicing modes, and files it must refuse.
 
 use crate::common::{Rng, fixture_scenes};
-use halo4d::Rotation4;
 use halo4d::Scene;
-use halo4d::internals::render_with_depth;
 use halo4d::internals::verdict_differs;
+use halo4d::render::render_with_depth;
+use halo4d::view::Rotation4;
 use halo4d::viewer::{self, Asset, Gpu, HaloMode, Model, ViewSettings};
-use halo4d::{RenderMode, RenderSettings};
+use halo4d::{render::RenderMode, render::RenderSettings};
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -136,12 +136,12 @@ fn a_cutaway_removes_on_the_gpu_what_the_cpu_renderer_removes() {
     let dir = tempfile::tempdir().unwrap();
     let (_, asset) = exported(&scene, dir.path());
     let c = asset.centre();
-    scene.render.clip = Some(halo4d::Clip::wedge(
-        halo4d::ClipPlane {
+    scene.render.clip = Some(halo4d::render::Clip::wedge(
+        halo4d::render::ClipPlane {
             normal: [0.0, 0.0, 1.0],
             offset: c.z,
         },
-        halo4d::ClipPlane {
+        halo4d::render::ClipPlane {
             normal: [1.0, 0.0, 0.0],
             offset: c.x,
         },
@@ -209,7 +209,7 @@ fn the_explorer_draws_the_curves_a_build_shows() {
         assert!(scene.curves.refine, "{name} refines its curves");
         let built = crate::common::built(&scene).unwrap();
         let model = Model::new(scene.clone()).unwrap();
-        let turned = |rotation: Rotation4| halo4d::View {
+        let turned = |rotation: Rotation4| halo4d::view::View {
             rotation,
             ..scene.view
         };
@@ -287,7 +287,7 @@ fn every_fixture_turned_in_4d_on_the_gpu_matches_the_exact_render_of_its_rotated
                 };
                 let dir = tempfile::tempdir().unwrap();
                 let (_, asset) = exported(&turned, dir.path());
-                let imported = halo4d::read_scene_glb(
+                let imported = halo4d::import::read_scene_glb(
                     &std::fs::read(dir.path().join(format!("{}.glb", turned.name))).unwrap(),
                 )
                 .unwrap();
@@ -370,7 +370,7 @@ fn the_halos_rebuilt_on_the_gpu_conform_in_every_view() {
                 scene.name
             );
             for (i, mesh) in meshes.iter().enumerate() {
-                let stats = halo4d::check(mesh);
+                let stats = halo4d::check::check(mesh);
                 let name = format!("{} surface {i} turned by {rotation:?}", scene.name);
                 assert_eq!(
                     stats.degenerate + stats.duplicate_tets,
@@ -605,7 +605,7 @@ fn edited(bytes: &[u8], edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
 
 /// A `.glb` of `json` and `bin`.
 fn glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
-    halo4d::internals::glb_container(serde_json::to_vec(json).unwrap(), bin.to_vec())
+    halo4d::export::glb_container(serde_json::to_vec(json).unwrap(), bin.to_vec())
 }
 
 /// Loading `bytes` fails with a message containing every one of `words`.
@@ -916,7 +916,7 @@ fn a_glb_turns_in_4d_as_its_scene_does_and_one_without_the_4d_mesh_in_3d() {
     let (scene, dir, built, _) = default_export();
     let path = dir.path().join(format!("{}.glb", scene.name));
     // The file's 4D mesh is the sampled one, in f32.
-    let imported = halo4d::read_scene_glb(&std::fs::read(&path).unwrap()).unwrap();
+    let imported = halo4d::import::read_scene_glb(&std::fs::read(&path).unwrap()).unwrap();
     for (s, product) in imported.surfaces.iter().zip(&built.surfaces) {
         let mesh = s.mesh_4d.as_ref().unwrap_or_else(|e| panic!("{e}"));
         for (file, sampled) in [
@@ -994,7 +994,7 @@ fn supersampling_draws_what_the_cpu_renderer_draws_with_as_many_samples() {
         )
         .unwrap()
     };
-    let mean_diff = |p: &halo4d::Picture| {
+    let mean_diff = |p: &halo4d::render::Picture| {
         p.rgb
             .iter()
             .zip(&reference.rgb)
@@ -1034,7 +1034,7 @@ const TILE: usize = 32;
 
 /// Per `TILE` x `TILE` tile (row-major), the mean ink of a stipple picture: per pixel, how
 /// far its linear grey is from the white background towards the ink (0.02), in [0, 1].
-fn tile_ink(p: &halo4d::Picture) -> Vec<f64> {
+fn tile_ink(p: &halo4d::render::Picture) -> Vec<f64> {
     let (w, h) = (p.width as usize, p.height as usize);
     let linear = |c: u8| {
         let c = f64::from(c) / 255.0;
@@ -1061,9 +1061,9 @@ fn tile_ink(p: &halo4d::Picture) -> Vec<f64> {
 /// The largest difference of tile ink between the GPU's stipple picture of `scene` in the
 /// 4D `view` (its own when `None`, turned on the GPU) and the CPU renderer's (exact mode,
 /// built in that view), without lines, and the mean ink of the CPU's picture.
-fn stipple_tile_difference(scene: &Scene, view: Option<&halo4d::View>) -> (f64, f64) {
+fn stipple_tile_difference(scene: &Scene, view: Option<&halo4d::view::View>) -> (f64, f64) {
     let mut scene = scene.clone();
-    scene.render.style = halo4d::Style::Stipple;
+    scene.render.style = halo4d::render::Style::Stipple;
     scene.render.curves = false;
     scene.render.silhouettes = false;
     scene.render.stipple.count = scene.render.stipple.count.min(100_000);
@@ -1092,7 +1092,7 @@ fn stipple_tile_difference(scene: &Scene, view: Option<&halo4d::View>) -> (f64, 
         &source,
         view,
         &ViewSettings {
-            style: halo4d::Style::Stipple,
+            style: halo4d::render::Style::Stipple,
             stipple: scene.render.stipple,
             curves: false,
             silhouettes: false,
@@ -1164,7 +1164,7 @@ fn the_stipple_style_is_refused_for_a_glb_without_its_4d_mesh() {
         &source,
         None,
         &ViewSettings {
-            style: halo4d::Style::Stipple,
+            style: halo4d::render::Style::Stipple,
             ..settings(&scene, HaloMode::Grid, 64)
         },
     )

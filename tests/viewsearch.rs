@@ -57,7 +57,7 @@ fn the_view_search_is_deterministic_no_worse_than_the_scenes_view_and_keeps_the_
 fn a_view_is_an_object_or_auto() {
     let auto = Scene::parse(&flat_torus_with_view(serde_json::json!("auto")), "s.json").unwrap();
     assert!(auto.view.auto);
-    assert_eq!(auto.view.rotation, halo4d::Rotation4::default());
+    assert_eq!(auto.view.rotation, halo4d::view::Rotation4::default());
     let from = Scene::parse(
         &flat_torus_with_view(serde_json::json!({ "auto": true, "rotation": { "yw": 30 } })),
         "s.json",

@@ -27,6 +27,7 @@
 
 mod assemble;
 
+pub use crate::animation::{Animation, CameraKey, Keyframe, RotationKey, ViewKey};
 pub use assemble::{Assembled, Status, assemble, status};
 
 use crate::error::Error;

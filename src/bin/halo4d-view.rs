@@ -4,7 +4,9 @@
 use clap::{Parser, ValueEnum};
 use halo4d::limits::FieldError;
 use halo4d::viewer::{self, Gpu, HaloMode, SLICE_COUNTS, Source, ViewSettings, ViewerError};
-use halo4d::{CameraProjection, CameraSettings, Colormap, Style, View};
+use halo4d::{
+    render::CameraProjection, render::CameraSettings, render::Colormap, render::Style, view::View,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -128,7 +130,10 @@ fn parse_rotate(s: &str) -> Result<(String, f64), String> {
         .split_once('=')
         .ok_or_else(|| format!("`{s}` is not PLANE=DEGREES, e.g. xw=20"))?;
     let plane = plane.trim().to_ascii_lowercase();
-    if halo4d::Rotation4::default().angle_mut(&plane).is_none() {
+    if halo4d::view::Rotation4::default()
+        .angle_mut(&plane)
+        .is_none()
+    {
         return Err(format!(
             "`{plane}` is not a plane of R^4: use xy, xz, xw, yz, yw or zw"
         ));

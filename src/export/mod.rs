@@ -7,7 +7,7 @@
 //! depth gap dw as vertex `quality`, for MeshLab), `.obj` (Wavefront, positions and normals
 //! only), `.vtk` (legacy VTK unstructured grids of the halos' tetrahedra, for ParaView and
 //! meshio) and `report.json`. Guarantees: each file in its format's conventions
-//! ([`crate::convention`]); every file is written to a temporary name and renamed into place,
+//! (`convention`); every file is written to a temporary name and renamed into place,
 //! so a failure never leaves a half-written file, and a build's files move into place
 //! together ([`Staged`]). [`crate::import`] reads the halos and
 //! surfaces back.

@@ -12,7 +12,7 @@
 //! counts that disagree, non-finite coordinates) is an [`ImportError`] that names the
 //! problem, never a panic; a count claimed in a file is checked against the bytes actually
 //! there before anything is allocated for it; everything comes back in halo4d's frame and
-//! orientation ([`crate::convention`]); an accessor that another program re-used (the
+//! orientation (`convention`); an accessor that another program re-used (the
 //! tetrahedra's, the polylines') is never read as ours.
 
 mod glb;

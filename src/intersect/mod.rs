@@ -6,10 +6,10 @@
 //! carrying the w-depth of both sheets there.
 //!
 //! - Broad phase: an obvhs BVH over the triangles' boxes, traversed against itself
-//!   ([`broad`]).
-//! - Narrow phase: exact `robust::orient3d` under Simulation of Simplicity ([`sos`]), so
+//!   (`broad`).
+//! - Narrow phase: exact `robust::orient3d` under Simulation of Simplicity (`sos`), so
 //!   coplanar overlaps, vertices exactly on triangles and edges through edges are decided
-//!   consistently rather than skipped ([`exact`]). Triangles sharing an edge never cross;
+//!   consistently rather than skipped (`exact`). Triangles sharing an edge never cross;
 //!   triangles sharing a vertex cross only along a segment that ends at that vertex, which
 //!   is how a curve ends at a cross-cap (a branch point of the projection).
 //! - Chaining by shared events, without a distance tolerance (`chain.rs`): closed curves
@@ -19,11 +19,11 @@
 //! perturbation decided is counted (`perturbed`, `coplanar` in [`CurvesReport`]), as is
 //! anything that could not be resolved.
 
-pub mod broad;
+pub(crate) mod broad;
 mod chain;
-pub mod exact;
-pub mod refine;
-pub mod sos;
+pub(crate) mod exact;
+pub(crate) mod refine;
+pub(crate) mod sos;
 
 pub use exact::Node;
 use exact::{Pair, Segment, Soup};

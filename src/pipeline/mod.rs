@@ -7,14 +7,12 @@
 //! timings.
 
 mod built;
-mod report;
+pub mod report;
 mod sampled;
 mod write;
 
 pub use built::{Built, SurfaceProduct};
-pub use report::{
-    Bounds, MemoryReport, PictureReport, Report, SamplingReport, SurfaceReport, Timings,
-};
+pub use report::{Report, Timings};
 pub use sampled::{Sampled, shown_curves};
 pub use write::{glb_bytes, write};
 

@@ -207,7 +207,7 @@ pub struct SurfaceReport {
 }
 
 /// `report.json`'s `picture`: how to reproduce the picture's projection, the halos' width in
-/// it, and the share of the curves it shows ([`render::visible`]).
+/// it, and the share of the curves it shows (`render::visible`).
 #[derive(Clone, Debug, Serialize)]
 pub struct PictureReport {
     /// The camera, in the projected scene's coordinates.
@@ -251,10 +251,10 @@ pub struct Report {
     /// no picture was drawn).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub picture: Option<PictureReport>,
-    /// Whether the build is verified: [`Built::failures`] found nothing in the stages that
+    /// Whether the build is verified: [`crate::Built::failures`] found nothing in the stages that
     /// ran.
     pub verified: bool,
-    /// What [`Built::failures`] found.
+    /// What [`crate::Built::failures`] found.
     pub failures: Vec<String>,
     /// Files written, relative to the output folder.
     pub files: Vec<String>,

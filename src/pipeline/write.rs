@@ -11,9 +11,9 @@ use rayon::prelude::*;
 use std::path::Path;
 use std::time::Instant;
 
-/// Writes the outputs the scene asks for from the products of [`run`] into `out_dir`, and
-/// returns the report (also written as `report.json` when asked for). The export time is
-/// added to the timings of [`run`], and the total is the sum of the stages.
+/// Writes the outputs the scene asks for from its build ([`crate::Sampled::build`]) into
+/// `out_dir`, and returns the report (also written as `report.json` when asked for). The
+/// export time is added to the build's timings, and the total is the sum of the stages.
 pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Error> {
     let products = &built.surfaces;
     let mut timings = built.timings;

@@ -3,32 +3,35 @@
 //! Takes: the projected surfaces (positions, w, normals, parameters), their halos and the
 //! intersection curves, a [`CameraSettings`] and [`RenderSettings`]. Gives: an RGB image.
 //! Eye rays are cast through an obvhs BVH over all triangles and every hit along a ray is
-//! kept ([`trace`]), so transparency composites in exact depth order. A hit is hidden where
+//! kept (`trace`), so transparency composites in exact depth order. A hit is hidden where
 //! it lies in a halo of another sheet whose halo depth (paper 000 eq. 3) is below its own
 //! w: decided per hit by a query over the tetrahedra (`exact`, the reference), or by the
 //! paper's multi-slice method (`slices`). Shading is Phong with two lights over a colour by
 //! w-depth, with paper 001's depth cues (opacity by w, silhouette opacity, hither clipping,
 //! ribbons), and the self-intersection curves and silhouettes are drawn as lines of exact
-//! width broadened through the FFT (paper 002, [`lines`]). Renders are deterministic.
+//! width broadened through the FFT (paper 002, `lines`). Renders are deterministic.
 
-pub mod camera;
-pub mod clip;
-pub mod compare;
+pub(crate) mod camera;
+pub(crate) mod clip;
+pub(crate) mod compare;
 mod contour;
-pub mod lines;
+pub(crate) mod lines;
 pub(crate) mod overlay;
-pub mod shade;
-pub mod slices;
-pub mod stipple;
+pub(crate) mod shade;
+pub(crate) mod slices;
+pub(crate) mod stipple;
 mod svg;
 pub(crate) mod text;
-pub mod trace;
-pub mod visible;
+pub(crate) mod trace;
+pub(crate) mod visible;
 
 use crate::limits::{
     CAMERA_DISTANCE, ELEVATION, EYE_SEPARATION, FOV, FieldError, PICTURE_SIDE, RIBBON_COUNT,
     RIBBON_GAP, SAMPLES, SLICES,
 };
+pub use clip::{Clip, ClipPlane};
+pub use compare::Comparison;
+
 use crate::parts::{HaloIndex, Parts};
 use camera::Camera;
 use glam::DVec3;
@@ -233,7 +236,7 @@ pub struct RenderSettings {
     pub ribbons: Option<Ribbons>,
     /// A cutaway: one plane `{"normal": [x, y, z], "offset": d}` or a list of two (a
     /// wedge), removing the points of the projected scene where `normal · p > d` holds for
-    /// every plane (see [`crate::Clip`]); the cut edges are drawn as lines.
+    /// every plane (see [`Clip`]); the cut edges are drawn as lines.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub clip: Option<clip::Clip>,
     /// Draw the self-intersection curves.
@@ -549,7 +552,7 @@ pub struct Rendered {
     /// The picture.
     pub picture: Picture,
     /// The first eye's lines as an SVG document (when asked for): the same runs the
-    /// picture's lines are drawn from ([`svg`]).
+    /// picture's lines are drawn from (`svg`).
     pub svg: Option<String>,
     /// The first eye's camera.
     pub camera: visible::PictureCamera,

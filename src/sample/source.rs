@@ -41,7 +41,7 @@ pub enum Source {
 pub struct MeshSurface {
     /// The file as the scene names it, relative to the scene file's folder.
     pub path: String,
-    /// The mesh with its tangents, once [`MeshSurface::load`] has read it.
+    /// The mesh with its tangents, once [`MeshSurface::set`] has it (the scene reads the file).
     #[serde(skip)]
     pub mesh: Arc<Mesh4>,
 }

@@ -11,7 +11,7 @@
 //!
 //! Every row's mesh (adaptive and uniform alike) also gets its intersection curves in the
 //! scene's view ([`Settings::view`]): the surface alone, as a one-sheet scene, projected,
-//! its self-intersections found by the exact curve stage ([`crate::curves`]) and moved onto
+//! its self-intersections found by the exact curve stage ([`crate::intersect::curves`]) and moved onto
 //! the analytic surface by Newton's method, as a build refines them. The refinement's
 //! largest shift is the mesh curve's error, measured for free; its largest residual is the
 //! refined curve's. Both are relative to the projected mesh's 3D bounding diagonal. A

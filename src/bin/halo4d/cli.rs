@@ -3,7 +3,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use halo4d::limits;
-use halo4d::{FrameRange, RenderMode, Shard, Style};
+use halo4d::{animate::FrameRange, animate::Shard, render::RenderMode, render::Style};
 use std::path::PathBuf;
 
 /// Surfaces in 4D turned into verified 3D geometry: glTF for Blender, PLY for MeshLab.

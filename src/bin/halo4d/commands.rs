@@ -4,7 +4,7 @@
 use crate::cli::{AnimateArgs, BuildArgs, CheckArgs, GalleryArgs, RenderArgs, SweepArgs, ViewArgs};
 use clap::ValueEnum;
 use halo4d::limits::{FieldError, shorten};
-use halo4d::{Comparison, Scene, Shard, sweep};
+use halo4d::{Scene, animate::Shard, render::Comparison, sweep};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -220,8 +220,8 @@ pub fn sweep(args: SweepArgs) -> Outcome {
     } else {
         let surfaces = (0..scene.surfaces.len())
             .map(|i| match &scene.surfaces[i].surface {
-                halo4d::Source::Parametric(s) => Ok((scene.surface_name(i), s.clone())),
-                halo4d::Source::Mesh(m) => Err(format!(
+                halo4d::sample::Source::Parametric(s) => Ok((scene.surface_name(i), s.clone())),
+                halo4d::sample::Source::Mesh(m) => Err(format!(
                     "surface `{}` is a mesh file ({}): the sweep samples parametric surfaces at several tolerances; sweep the pictures (`--slices`) instead",
                     scene.surface_name(i),
                     shorten(&m.path)
@@ -252,7 +252,7 @@ pub fn sweep(args: SweepArgs) -> Outcome {
 /// `halo4d animate`, with `--status` and `--assemble`.
 pub fn animate(args: AnimateArgs) -> Outcome {
     if let Some(dir) = &args.status {
-        return Ok(match halo4d::status(dir) {
+        return Ok(match halo4d::animate::status(dir) {
             Ok(s) => {
                 print!("{}", s.text());
                 if s.complete() {
@@ -268,7 +268,7 @@ pub fn animate(args: AnimateArgs) -> Outcome {
         });
     }
     if let Some(dir) = &args.assemble {
-        let a = halo4d::assemble(dir)?;
+        let a = halo4d::animate::assemble(dir)?;
         eprintln!(
             "{} frames assembled into an animated PNG of {:.1} MB",
             a.frames,
@@ -296,7 +296,7 @@ pub fn animate(args: AnimateArgs) -> Outcome {
         .check()
         .map_err(|e| flag_field(e.field.as_str(), e.message))?;
     let out = (args.out).unwrap_or_else(|| Path::new("exports").join(&scene.name).join("frames"));
-    let summary = halo4d::animate(&halo4d::Request {
+    let summary = halo4d::animate::animate(&halo4d::animate::Request {
         scene: &scene,
         out: &out,
         frames: args.frames,
@@ -368,7 +368,7 @@ pub fn gallery(args: GalleryArgs) -> Outcome {
 
 /// `halo4d list`.
 pub fn list() -> Outcome {
-    print!("{}", halo4d::Source::listing());
+    print!("{}", halo4d::sample::Source::listing());
     Ok(ExitCode::SUCCESS)
 }
 
