@@ -227,7 +227,7 @@ fn rank(
 /// points in a row of memory, not scattered over the candidates).
 struct Grid {
     cell: f64,
-    cells: HashMap<u64, Vec<DVec4>, BuildHasherDefault<CellHasher>>,
+    cells: HashMap<[i64; 4], Vec<DVec4>, BuildHasherDefault<CellHasher>>,
 }
 
 impl Grid {
@@ -238,17 +238,16 @@ impl Grid {
         }
     }
 
-    /// The cell of `p`, shifted by `corner`'s bits along the axes; its four integer
-    /// coordinates packed into 16 bits each (cells that wrap around share a key, which
-    /// costs distance tests, never a wrong answer).
-    fn key(&self, p: DVec4, corner: u32) -> u64 {
-        let mut key = 0u64;
-        for axis in 0..4 {
-            let k = (p[axis] / self.cell).floor().clamp(-1e9, 1e9) as i64
-                + i64::from((corner >> axis) & 1);
-            key = (key << 16) | (k as u64 & 0xFFFF);
-        }
-        key
+    /// The cell of `p`, shifted by `corner`'s bits along the axes: its four integer
+    /// coordinates, whole (packed into fewer bits, cells far apart would share a key, and a
+    /// mesh reaching 1e29 along w would pile its stipples into one).
+    fn key(&self, p: DVec4, corner: u32) -> [i64; 4] {
+        std::array::from_fn(|axis| {
+            // Beyond 2^62 cells (a coordinate of 1e30 over a cell of 1e-12) the cells merge,
+            // which costs distance tests, never a wrong answer.
+            const FAR: f64 = (1u64 << 62) as f64;
+            (p[axis] / self.cell).floor().clamp(-FAR, FAR) as i64 + i64::from((corner >> axis) & 1)
+        })
     }
 
     fn insert(&mut self, p: DVec4) {

@@ -54,19 +54,18 @@ fn list_shows_every_surface_with_defaults_and_help_works_everywhere() {
         text.contains("\"twists\":2") && text.contains("\"n\":4"),
         "{text}"
     );
-    // The formula's example is a surface a scene takes as it is; the mesh's names its type.
+    // The formula's and the mesh's examples are whole scenes (which load: `scene.rs`).
     let example = |ty: &str| {
         let line = text
             .lines()
             .skip_while(|l| !l.starts_with(ty))
-            .find_map(|l| l.trim().strip_prefix("example: "))
+            .find_map(|l| l.trim().strip_prefix("a scene: "))
             .unwrap_or_else(|| panic!("no example for {ty}: {text}"));
         serde_json::from_str::<serde_json::Value>(line).unwrap()
     };
     let formula = example("formula");
-    let scene = serde_json::json!({"name": "e", "surfaces": [{"surface": formula}]});
-    halo4d::Scene::parse(&scene.to_string(), "e.json").unwrap();
-    assert_eq!(example("mesh")["type"], "mesh");
+    halo4d::Scene::parse(&formula.to_string(), "e.json").unwrap();
+    assert_eq!(example("mesh")["surfaces"][0]["surface"]["type"], "mesh");
     for args in [&["--help"][..], &["build", "--help"], &["list", "--help"]] {
         let out = halo4d(args, dir.path());
         assert!(out.status.success() && !out.stdout.is_empty(), "{args:?}");

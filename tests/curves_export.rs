@@ -283,6 +283,13 @@ fn float(p: &Property) -> f32 {
     }
 }
 
+fn double(p: &Property) -> f64 {
+    match p {
+        Property::Double(x) => *x,
+        other => panic!("expected a double, got {other:?}"),
+    }
+}
+
 fn int(p: &Property) -> i32 {
     match p {
         Property::Int(x) => *x,
@@ -321,11 +328,11 @@ fn the_curves_ply_holds_the_same_points_and_edges() {
             for p in &curve.points {
                 let v = &vertices[k];
                 let near = p.near();
-                let xyz = [&v["x"], &v["y"], &v["z"]].map(float);
-                assert_eq!(xyz, p.position.as_vec3().to_array(), "{name}: vertex {k}");
+                let xyz = [&v["x"], &v["y"], &v["z"]].map(double);
+                assert_eq!(xyz, p.position.to_array(), "{name}: vertex {k}");
                 assert_eq!(float(&v["quality"]), p.dw() as f32, "{name}: vertex {k}");
-                assert_eq!(float(&v["w_near"]), p.w[near] as f32);
-                assert_eq!(float(&v["w_far"]), p.w[1 - near] as f32);
+                assert_eq!(double(&v["w_near"]), p.w[near]);
+                assert_eq!(double(&v["w_far"]), p.w[1 - near]);
                 assert_eq!(float(&v["curve"]), c as f32);
                 k += 1;
             }

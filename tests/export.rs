@@ -322,3 +322,34 @@ fn an_unwritable_output_folder_is_a_clear_error_and_writes_nothing() {
     let leftovers: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
     assert_eq!(leftovers.len(), 1);
 }
+
+#[test]
+fn check_dir_finds_the_build_s_verification_and_the_mesh_s_curve_points() {
+    // The Klein bottle's refinement trims a point beyond a cross-cap: `check DIR`, which
+    // recomputes the mesh's curves from the file, counts it.
+    let scene = halo4d::Scene::load(&crate::common::fixture("scenes/klein-bottle.json")).unwrap();
+    let built = crate::common::built(&scene).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let report = halo4d::write(&scene, &built, dir.path()).unwrap();
+    let checked = halo4d::check_dir(dir.path()).unwrap();
+    assert!(checked.failures().is_empty());
+    let (curves, verification) = checked.verification.expect("a folder is verified");
+    let built_curves = report.curves.expect("the build found curves");
+    let trimmed = built_curves.refinement.as_ref().map_or(0, |r| r.trimmed);
+    assert!(trimmed > 0, "the fixture trims a point: {built_curves:?}");
+    assert_eq!(curves.points, built_curves.points + trimmed);
+    assert_eq!(curves.count, built_curves.count);
+    assert_eq!(
+        curves.points, built.curves.report.points,
+        "the mesh's curves"
+    );
+    let v = report.halo_verification.expect("verified");
+    assert_eq!(
+        (
+            verification.curve_samples,
+            verification.correct,
+            verification.wrong
+        ),
+        (v.curve_samples, v.correct, v.wrong)
+    );
+}

@@ -875,8 +875,10 @@ fn scene_seeds() -> &'static SceneSeeds {
             trees.push(Node::from_value(&scene));
         }
         // Every seed is a valid scene: the mutations start from inputs that parse.
+        // (Named as in fixtures/scenes/, where a mesh file's relative path is.)
+        let file = fixture("scenes/seed.json").display().to_string();
         for t in &trees {
-            Scene::parse(&t.text(), "seed.json").unwrap_or_else(|e| panic!("{e}"));
+            Scene::parse(&t.text(), &file).unwrap_or_else(|e| panic!("{e}"));
         }
         let vocabulary = Vocabulary::of(&trees.iter().collect::<Vec<_>>());
         SceneSeeds { trees, vocabulary }

@@ -284,3 +284,48 @@ fn a_mesh_file_that_is_not_a_manifold_builds_with_a_warning() {
     );
     assert_eq!(report["surfaces"][0]["sampling"]["method"], "file");
 }
+
+#[test]
+fn a_formula_whose_open_sides_meet_builds_with_a_warning_naming_the_rule_that_glues_them() {
+    let grid = r#""sampling": {"method": "uniform", "u": 24, "v": 24},"#;
+    let torus = |sides: &str| {
+        format!(
+            r#"{{"type": "formula", "x": "cos(u)", "y": "sin(u)", "z": "cos(v)", "w": "sin(v)",
+                "u": [0, "2*pi"], "v": [0, "2*pi"]{sides}}}"#
+        )
+    };
+    // The flat torus with open sides: u and v both meet point for point.
+    let (open, glued, half) = (
+        torus(""),
+        torus(r#", "sides": {"u": "periodic", "v": "periodic"}"#),
+        torus(r#", "sides": {"u": "periodic"}"#),
+    );
+    let warnings = |surface: &str| {
+        let scene = Scene::parse(&scene_json(surface, grid), "own.json").unwrap();
+        let built = crate::common::built(&scene).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        halo4d::write(&scene, &built, dir.path()).unwrap().warnings
+    };
+    let w = warnings(&open);
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(
+        w[0].contains("u = 0") && w[0].contains(r#""sides": {"u": "periodic"}"#),
+        "{w:?}"
+    );
+    assert!(w[1].contains(r#""sides": {"v": "periodic"}"#), "{w:?}");
+    assert!(warnings(&glued).is_empty());
+    let w = warnings(&half);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(w[0].contains(r#"{"v": "periodic"}"#), "{w:?}");
+    // A Klein bottle's u sides meet with v reversed: `flip`.
+    let klein = r#"{"type": "formula",
+        "x": "(1 + 0.5*cos(v))*cos(u)", "y": "(1 + 0.5*cos(v))*sin(u)",
+        "z": "0.5*sin(v)*cos(u/2)", "w": "0.5*sin(v)*sin(u/2)",
+        "u": [0, "2*pi"], "v": [0, "2*pi"], "sides": {"v": "periodic"}}"#;
+    let w = warnings(klein);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].contains(r#"{"u": "flip"}"#) && w[0].contains("reversed"),
+        "{w:?}"
+    );
+}

@@ -43,6 +43,15 @@ fn every_catalogue_surface_has_a_fixture_scene() {
 /// Each broken scene with words its error must contain (the field and what is allowed).
 const BROKEN: &[(&str, &[&str])] = &[
     (
+        "spun-trefoil-scale-huge.json",
+        &[
+            "surfaces[0].surface.scale",
+            "reaches a coordinate of",
+            "beyond 1e30",
+            "make it smaller",
+        ],
+    ),
+    (
         "fermat-y-range-tiny.json",
         &[
             "surfaces[0].surface.y_range",
@@ -569,4 +578,21 @@ fn the_readme_lists_the_limits_of_the_code() {
         readme.contains(&table),
         "the README's table of limits is not the code's; it should read:\n{table}"
     );
+}
+
+#[test]
+fn the_scenes_halo4d_list_prints_are_whole_scenes_that_load() {
+    // Pasted into a file in halo4d's folder, each builds as it is.
+    let listing = halo4d::sample::Source::listing();
+    let scenes: Vec<&str> = listing
+        .lines()
+        .filter_map(|l| l.split_once("a scene: ").map(|(_, json)| json))
+        .collect();
+    assert_eq!(scenes.len(), 2, "{listing}");
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("listed.json");
+    for json in scenes {
+        let scene = Scene::parse(json, &file.display().to_string())
+            .unwrap_or_else(|e| panic!("{json}: {e}"));
+        assert!(scene.name.starts_with("my-"));
+    }
 }

@@ -52,10 +52,13 @@ fn exact_distances(scene: &Scene, built: &halo4d::Built) -> Vec<f64> {
 
 fn settings(scene: &Scene, mode: HaloMode, slices: u32) -> ViewSettings {
     ViewSettings {
-        width: SIDE,
-        height: SIDE,
+        render: RenderSettings {
+            width: SIDE,
+            height: SIDE,
+            slices,
+            ..ViewSettings::default().render
+        },
         camera: scene.camera,
-        slices,
         mode,
         ..ViewSettings::default()
     }
@@ -82,7 +85,10 @@ fn every_fixture_matches_the_exact_cpu_render_at_256_slices() {
         // What the halos hide at all: the verdict without them. A viewer whose halos hid
         // nothing would be this far off.
         let off = ViewSettings {
-            halos: false,
+            render: RenderSettings {
+                halos: false,
+                ..settings(&scene, HaloMode::Grid, 256).render
+            },
             ..settings(&scene, HaloMode::Grid, 256)
         };
         let hidden = verdict_differs(
@@ -154,7 +160,10 @@ fn a_cutaway_removes_on_the_gpu_what_the_cpu_renderer_removes() {
     let removed = verdict_differs(&exact, &whole, SAME);
     for mode in [HaloMode::Grid, HaloMode::View] {
         let cut = ViewSettings {
-            clip: scene.render.clip,
+            render: RenderSettings {
+                clip: scene.render.clip,
+                ..settings(&scene, mode, 256).render
+            },
             ..settings(&scene, mode, 256)
         };
         let frame = viewer::screenshot(gpu, &asset, &cut).unwrap();
@@ -180,9 +189,12 @@ fn a_cutaway_removes_on_the_gpu_what_the_cpu_renderer_removes() {
     // The cut edges in the ink (no other line drawn): none without the cut.
     let ink = |clip| {
         let s = ViewSettings {
-            clip,
-            curves: false,
-            silhouettes: false,
+            render: RenderSettings {
+                clip,
+                curves: false,
+                silhouettes: false,
+                ..settings(&scene, HaloMode::Grid, 256).render
+            },
             ..settings(&scene, HaloMode::Grid, 256)
         };
         let frame = viewer::screenshot(gpu, &asset, &s).unwrap();
@@ -418,7 +430,7 @@ fn the_grid_is_built_once_per_slice_count_and_every_camera_reuses_it() {
     let turned = renderer.read_frame(gpu, &s).unwrap();
     assert_eq!(turned.times.grid_ms, None, "a new camera reuses the grid");
     assert_ne!(first.picture, turned.picture, "the camera turned");
-    s.slices = 256;
+    s.render.slices = 256;
     assert!(
         renderer
             .read_frame(gpu, &s)
@@ -433,7 +445,7 @@ fn the_grid_is_built_once_per_slice_count_and_every_camera_reuses_it() {
     // 512 slices: a grid larger than one storage binding on lavapipe (128 MiB), built in
     // bands of layers, still agrees with the exact render.
     s.mode = HaloMode::Grid;
-    s.slices = 512;
+    s.render.slices = 512;
     s.camera = scene.camera;
     let fine = renderer.read_frame(gpu, &s).unwrap();
     let differs = verdict_differs(&exact_distances(&scene, &built), &distances(&fine), SAME);
@@ -449,12 +461,18 @@ fn curves_colour_and_transparency_toggle_what_they_should() {
     let shot = |s: &ViewSettings| viewer::screenshot(gpu, &asset, s).unwrap();
     let with = shot(&base);
     let without = shot(&ViewSettings {
-        curves: false,
+        render: RenderSettings {
+            curves: false,
+            ..base.render
+        },
         ..base
     });
     let bare = shot(&ViewSettings {
-        curves: false,
-        silhouettes: false,
+        render: RenderSettings {
+            curves: false,
+            silhouettes: false,
+            ..base.render
+        },
         ..base
     });
     // Silhouettes are drawn where the surfaces turn away: the pixels they change are within
@@ -463,9 +481,12 @@ fn curves_colour_and_transparency_toggle_what_they_should() {
     // without (where a halo has cut away the sheet in front of a silhouette, the CPU
     // renderer draws it too).
     let unhidden = shot(&ViewSettings {
-        curves: false,
-        silhouettes: false,
-        halos: false,
+        render: RenderSettings {
+            curves: false,
+            silhouettes: false,
+            halos: false,
+            ..base.render
+        },
         ..base
     });
     let jump = {
@@ -575,16 +596,22 @@ fn curves_colour_and_transparency_toggle_what_they_should() {
     };
     assert!(!neutral(&without));
     assert!(neutral(&shot(&ViewSettings {
+        render: RenderSettings {
+            curves: false,
+            ..base.render
+        },
         colour_by_w: false,
-        curves: false,
         ..base
     })));
     // Transparent surfaces let the background through: the picture is lighter, and no
     // distance is reported.
     let clear = shot(&ViewSettings {
+        render: RenderSettings {
+            curves: false,
+            silhouettes: false,
+            ..base.render
+        },
         transparent: true,
-        curves: false,
-        silhouettes: false,
         ..base
     });
     let brightness = |f: &viewer::Frame| f.picture.rgb.iter().map(|&c| u64::from(c)).sum::<u64>();
@@ -655,11 +682,25 @@ fn malformed_and_foreign_files_get_a_clear_message() {
     assert_eq!(bare.tet_count(), 0);
     assert!(!bare.surfaces_without_halo.is_empty());
     let s = ViewSettings {
-        curves: false,
+        render: RenderSettings {
+            curves: false,
+            ..settings(&scene, HaloMode::Grid, 64).render
+        },
         ..settings(&scene, HaloMode::Grid, 64)
     };
     let gpu = gpu();
-    let off = viewer::screenshot(gpu, &asset, &ViewSettings { halos: false, ..s }).unwrap();
+    let off = viewer::screenshot(
+        gpu,
+        &asset,
+        &ViewSettings {
+            render: RenderSettings {
+                halos: false,
+                ..s.render
+            },
+            ..s
+        },
+    )
+    .unwrap();
     assert_eq!(
         viewer::screenshot(gpu, &bare, &s).unwrap().picture,
         off.picture
@@ -941,7 +982,10 @@ fn a_glb_turns_in_4d_as_its_scene_does_and_one_without_the_4d_mesh_in_3d() {
     view.rotation.xw += 25.0;
     view.rotation.zw -= 40.0;
     let s = ViewSettings {
-        curves: false,
+        render: RenderSettings {
+            curves: false,
+            ..settings(&scene, HaloMode::Grid, 128).render
+        },
         ..settings(&scene, HaloMode::Grid, 128)
     };
     let frames = [&from_file, &from_scene]
@@ -988,7 +1032,10 @@ fn supersampling_draws_what_the_cpu_renderer_draws_with_as_many_samples() {
             gpu,
             &asset,
             &ViewSettings {
-                samples,
+                render: RenderSettings {
+                    samples,
+                    ..settings(&scene, HaloMode::Grid, 256).render
+                },
                 ..settings(&scene, HaloMode::Grid, 256)
             },
         )
@@ -1019,7 +1066,10 @@ fn supersampling_draws_what_the_cpu_renderer_draws_with_as_many_samples() {
             gpu,
             &asset,
             &ViewSettings {
-                samples: 3,
+                render: RenderSettings {
+                    samples: 3,
+                    ..settings(&scene, HaloMode::Grid, 64).render
+                },
                 ..settings(&scene, HaloMode::Grid, 64)
             }
         )
@@ -1092,10 +1142,13 @@ fn stipple_tile_difference(scene: &Scene, view: Option<&halo4d::view::View>) -> 
         &source,
         view,
         &ViewSettings {
-            style: halo4d::render::Style::Stipple,
-            stipple: scene.render.stipple,
-            curves: false,
-            silhouettes: false,
+            render: RenderSettings {
+                style: halo4d::render::Style::Stipple,
+                stipple: scene.render.stipple,
+                curves: false,
+                silhouettes: false,
+                ..settings(&scene, HaloMode::Grid, 256).render
+            },
             ..settings(&scene, HaloMode::Grid, 256)
         },
     )
@@ -1164,7 +1217,10 @@ fn the_stipple_style_is_refused_for_a_glb_without_its_4d_mesh() {
         &source,
         None,
         &ViewSettings {
-            style: halo4d::render::Style::Stipple,
+            render: RenderSettings {
+                style: halo4d::render::Style::Stipple,
+                ..settings(&scene, HaloMode::Grid, 64).render
+            },
             ..settings(&scene, HaloMode::Grid, 64)
         },
     )

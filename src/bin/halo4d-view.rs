@@ -1,12 +1,11 @@
 //! `halo4d-view`: the wgpu viewer and 4D explorer of scenes and `.glb` files (see
 //! `halo4d::viewer`).
 
-use clap::{Parser, ValueEnum};
+use clap::Parser;
 use halo4d::limits::FieldError;
+use halo4d::render::{CameraProjection, CameraSettings, Colormap, RenderSettings, Style};
+use halo4d::view::View;
 use halo4d::viewer::{self, Gpu, HaloMode, SLICE_COUNTS, Source, ViewSettings, ViewerError};
-use halo4d::{
-    render::CameraProjection, render::CameraSettings, render::Colormap, render::Style, view::View,
-};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -46,8 +45,8 @@ struct Args {
     #[arg(long)]
     samples: Option<u32>,
     /// How the halo depth is sliced: once into a 3D grid, or per frame along the view.
-    #[arg(long, value_enum, default_value_t = Mode::Grid)]
-    mode: Mode,
+    #[arg(long, value_enum, default_value_t = HaloMode::Grid)]
+    mode: HaloMode,
     /// Camera azimuth in degrees (default: the scene's camera, else 35).
     #[arg(long, allow_negative_numbers = true)]
     azimuth: Option<f64>,
@@ -80,8 +79,8 @@ struct Args {
     #[arg(long)]
     grey: bool,
     /// The colour scale of w.
-    #[arg(long, value_enum, default_value_t = Map::Diverging)]
-    colormap: Map,
+    #[arg(long, value_enum, default_value_t = Colormap::Diverging)]
+    colormap: Colormap,
     /// Shaded surfaces, or stipples (paper 003) on the first surface the halos leave
     /// visible, with the scene's render.stipple (default: the scene's render.style).
     #[arg(long, value_enum)]
@@ -98,19 +97,6 @@ struct Args {
     /// count the share of covered pixels where what is visible differs.
     #[arg(long)]
     compare: bool,
-}
-
-#[derive(Clone, Copy, Debug, ValueEnum)]
-enum Mode {
-    Grid,
-    View,
-}
-
-#[derive(Clone, Copy, Debug, ValueEnum)]
-enum Map {
-    Diverging,
-    Viridis,
-    Gray,
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -206,8 +192,21 @@ fn run(args: &Args) -> Result<(), ViewerError> {
     let recorded = source.camera();
     let render = source.render_settings();
     let settings = ViewSettings {
-        width: args.size.0,
-        height: args.size.1,
+        // The scene's picture, with the flags over it.
+        render: RenderSettings {
+            width: args.size.0,
+            height: args.size.1,
+            slices: args.slices,
+            samples: args
+                .samples
+                .unwrap_or(if args.screenshot.is_some() { 4 } else { 1 }),
+            halos: !args.no_halos,
+            curves: !args.no_curves,
+            silhouettes: !args.no_silhouettes,
+            colormap: args.colormap,
+            style: args.style.unwrap_or(render.style),
+            ..render
+        },
         camera: CameraSettings {
             azimuth: args.azimuth.unwrap_or(recorded.azimuth),
             elevation: args.elevation.unwrap_or(recorded.elevation),
@@ -219,27 +218,9 @@ fn run(args: &Args) -> Result<(), ViewerError> {
                 recorded.projection
             },
         },
-        slices: args.slices,
-        samples: args
-            .samples
-            .unwrap_or(if args.screenshot.is_some() { 4 } else { 1 }),
-        mode: match args.mode {
-            Mode::Grid => HaloMode::Grid,
-            Mode::View => HaloMode::View,
-        },
-        halos: !args.no_halos,
-        curves: !args.no_curves,
-        silhouettes: !args.no_silhouettes,
+        mode: args.mode,
         transparent: args.transparent,
         colour_by_w: !args.grey,
-        colormap: match args.colormap {
-            Map::Diverging => Colormap::Diverging,
-            Map::Viridis => Colormap::Viridis,
-            Map::Gray => Colormap::Gray,
-        },
-        style: args.style.unwrap_or(render.style),
-        clip: render.clip,
-        stipple: render.stipple,
     };
     settings.check()?;
     if let (Some(out), Source::Model(model), Some(view)) = (&args.save_scene, &source, &view) {
@@ -267,14 +248,14 @@ fn run(args: &Args) -> Result<(), ViewerError> {
         println!(
             "{}: {}x{}, {}, {} {} slices, {:.1} ms{} on {}",
             out.display(),
-            settings.width,
-            settings.height,
-            match settings.style {
+            settings.render.width,
+            settings.render.height,
+            match settings.render.style {
                 Style::Shaded => "shaded",
                 Style::Stipple => "stipples",
             },
             settings.mode.name(),
-            settings.slices,
+            settings.render.slices,
             frame.times.frame_ms,
             frame
                 .times
@@ -312,8 +293,8 @@ fn bench(
     println!(
         "{}: {triangles} triangles, {tets} tetrahedra, {}x{}, {frames} frames per motion, on {}",
         source.name(),
-        settings.width,
-        settings.height,
+        settings.render.width,
+        settings.render.height,
         gpu.describe()
     );
     println!(
@@ -324,7 +305,7 @@ fn bench(
     // The stipple rows, where the source has a 4D mesh to fix stipples to; `--style` asks
     // for one style's rows only.
     let clock = std::time::Instant::now();
-    let st = settings.stipple;
+    let st = settings.render.stipple;
     let made = match style {
         Some(Style::Shaded) => Err(ViewerError::Setting(FieldError::new(
             "--style",
@@ -390,8 +371,8 @@ fn compare(
     println!(
         "{}: {}x{}, against the CPU renderer's exact mode (one sample per pixel), on {}",
         source.name(),
-        settings.width,
-        settings.height,
+        settings.render.width,
+        settings.render.height,
         gpu.describe()
     );
     println!("| mode | slices | verdict differs | ms (GPU frame) |");

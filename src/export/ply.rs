@@ -94,8 +94,9 @@ pub fn to_stipples_ply(stipples: &[Drawn], scene_name: &str) -> Vec<u8> {
 
 /// Builds a binary little-endian PLY of the intersection curves (`<name>-curves.ply`): per
 /// curve point x, y, z, `quality` (dw, the far sheet's w minus the near sheet's, which
-/// MeshLab keeps as its per-vertex scalar), `w_near`, `w_far` and `curve` (the curve's index),
-/// all float; per line segment an `edge` of `int vertex1, int vertex2` (consecutive points,
+/// MeshLab keeps as its per-vertex scalar), `w_near`, `w_far` and `curve` (the curve's index):
+/// the point and both w as double, which keeps the refined curves' 1e-15, the quality and
+/// the index as float; per line segment an `edge` of `int vertex1, int vertex2` (consecutive points,
 /// and a closed curve's last back to its first). No curves give a valid file with no vertex
 /// and no edge.
 pub fn to_curves_ply(curves: &Curves, scene_name: &str) -> Vec<u8> {
@@ -105,8 +106,8 @@ pub fn to_curves_ply(curves: &Curves, scene_name: &str) -> Vec<u8> {
         "ply\nformat binary_little_endian 1.0\n\
          comment halo4d {}: scene {scene_name}; intersection curves, quality is w_far - w_near\n\
          element vertex {vertices}\n\
-         property float x\nproperty float y\nproperty float z\n\
-         property float quality\nproperty float w_near\nproperty float w_far\n\
+         property double x\nproperty double y\nproperty double z\n\
+         property float quality\nproperty double w_near\nproperty double w_far\n\
          property float curve\n\
          element edge {}\n\
          property int vertex1\nproperty int vertex2\n\
@@ -115,22 +116,19 @@ pub fn to_curves_ply(curves: &Curves, scene_name: &str) -> Vec<u8> {
         segments.len(),
     );
     let mut out = header.into_bytes();
-    out.reserve(vertices * 28 + segments.len() * 8);
+    out.reserve(vertices * 48 + segments.len() * 8);
     for (k, c) in curves.curves.iter().enumerate() {
         for p in &c.points {
+            // The points and both sheets' w in f64, as refined (to about 1e-15); the quality
+            // and the curve's number, which only colour and group, in f32.
             let near = p.near();
-            let floats = [
-                p.position.x,
-                p.position.y,
-                p.position.z,
-                p.dw(),
-                p.w[near],
-                p.w[1 - near],
-                k as f64,
-            ];
-            for f in floats {
-                out.extend_from_slice(&(f as f32).to_le_bytes());
+            for x in p.position.to_array() {
+                out.extend_from_slice(&x.to_le_bytes());
             }
+            out.extend_from_slice(&(p.dw() as f32).to_le_bytes());
+            out.extend_from_slice(&p.w[near].to_le_bytes());
+            out.extend_from_slice(&p.w[1 - near].to_le_bytes());
+            out.extend_from_slice(&(k as f32).to_le_bytes());
         }
     }
     for s in segments {

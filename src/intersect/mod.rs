@@ -208,9 +208,10 @@ impl CurvesReport {
         );
         if let Some(r) = &self.refinement {
             out += &format!(
-                "\ncurves refined onto the surfaces: {} points ({} cross-caps), {} not converged, {} pole ends kept; max residual {:.1e}, max shift {:.1e}; triple points {} refined, {} not",
+                "\ncurves refined onto the surfaces: {} points ({} cross-caps, {} trimmed beyond them), {} not converged, {} pole ends kept; max residual {:.1e}, max shift {:.1e}; triple points {} refined, {} not",
                 r.refined,
                 r.cross_caps,
+                r.trimmed,
                 r.not_converged,
                 r.pole_ends,
                 r.max_residual,

@@ -136,6 +136,9 @@ fn progress(len: usize, quiet: bool) -> ProgressBar {
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
+    // Redrawn on its own: a stage of many seconds (sampling a fine tolerance, the halos of
+    // a million triangles) shows its time passing, never a frozen line.
+    bar.enable_steady_tick(std::time::Duration::from_millis(250));
     bar
 }
 

@@ -121,20 +121,23 @@ impl SamplingReport {
     }
 }
 
-/// The warning a build prints for a mesh file that is not a manifold (the sampler's meshes
-/// always are): what the halos and curves meet there is what the file gives.
-pub(super) fn mesh_file_warning(
-    surface: &str,
-    source: &Source,
-    stats: &MeshStats,
-) -> Option<String> {
-    if !matches!(source, Source::Mesh(_)) || stats.is_manifold() {
-        return None;
+/// The warnings a build prints for a surface as it is: a mesh file that is not a manifold
+/// (the sampler's meshes always are: what the halos and curves meet there is what the file
+/// gives), a formula whose open sides meet ([`crate::surfaces::Formula::meeting_sides`]:
+/// it builds as an open surface).
+pub(super) fn surface_warnings(surface: &str, source: &Source, stats: &MeshStats) -> Vec<String> {
+    match source {
+        Source::Mesh(_) if !stats.is_manifold() => vec![format!(
+            "surface `{surface}`: the mesh file is not a manifold: {} edges in more than two triangles, {} triangles of zero area; halos and curves follow the triangles as they are, and verification may call samples there ambiguous",
+            stats.non_manifold_edges, stats.degenerate_triangles
+        )],
+        Source::Parametric(crate::surfaces::Surface::Formula(f)) => f
+            .meeting_sides()
+            .into_iter()
+            .map(|w| format!("surface `{surface}`: {w}"))
+            .collect(),
+        _ => Vec::new(),
     }
-    Some(format!(
-        "surface `{surface}`: the mesh file is not a manifold: {} edges in more than two triangles, {} triangles of zero area; halos and curves follow the triangles as they are, and verification may call samples there ambiguous",
-        stats.non_manifold_edges, stats.degenerate_triangles
-    ))
 }
 
 /// Milliseconds spent in each stage.

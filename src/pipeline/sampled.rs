@@ -1,7 +1,7 @@
 //! A scene's surfaces sampled once ([`Sampled`]), and the curves a build shows of 4D meshes
 //! ([`shown_curves`]).
 
-use super::report::{SamplingReport, Timings, mesh_file_warning};
+use super::report::{SamplingReport, Timings, surface_warnings};
 use super::{Built, Stages, built::in_view, ms};
 use crate::error::Error;
 use crate::intersect::{self, Curves, Sheet};
@@ -177,7 +177,7 @@ pub(super) fn sample_with(scene: &Scene, bar: &ProgressBar) -> Sampled {
         }
         let mesh = sampled.mesh;
         let stats = mesh.validate();
-        if let Some(w) = mesh_file_warning(&name, &entry.surface, &stats) {
+        for w in surface_warnings(&name, &entry.surface, &stats) {
             bar.suspend(|| eprintln!("warning: {w}"));
         }
         bar.inc(1);

@@ -1,7 +1,7 @@
 //! A build's files: written under temporary names side by side, moved into place together,
 //! with `report.json`.
 
-use super::report::{MemoryReport, PictureReport, Report, mesh_file_warning, surface_report};
+use super::report::{MemoryReport, PictureReport, Report, surface_report, surface_warnings};
 use super::{Built, ms};
 use crate::error::Error;
 use crate::export::{self, SurfaceData};
@@ -157,8 +157,8 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
         warnings: products
             .iter()
             .flat_map(|p| {
-                let file = mesh_file_warning(&p.name, &p.surface, &p.stats);
-                p.sampling.warning(&p.name).into_iter().chain(file)
+                let surface = surface_warnings(&p.name, &p.surface, &p.stats);
+                p.sampling.warning(&p.name).into_iter().chain(surface)
             })
             .collect(),
         picture: picture_report,

@@ -94,7 +94,7 @@ pub enum RenderMode {
 }
 
 /// The colour scale of w-depth.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum Colormap {
     /// Blue (near) through light grey to orange (far).

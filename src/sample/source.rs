@@ -122,7 +122,7 @@ impl Source {
     /// with its parameters or an example.
     pub fn listing() -> String {
         format!(
-            "{}{:<20} a 4D triangle mesh from a file, not sampled: Geomview 4OFF or nOFF with dimension 4 (ASCII or BINARY), OBJ with `v x y z w`, PLY with vertex properties x y z w; the path relative to the scene file\n{:<20} example: {{\"type\":\"mesh\",\"path\":\"torus.4off\"}}\n",
+            "{}{:<20} a 4D triangle mesh from a file, not sampled: Geomview 4OFF or nOFF with dimension 4 (ASCII or BINARY), OBJ with `v x y z w`, PLY with vertex properties x y z w; the path relative to the scene file (this scene's, for a scene saved in halo4d's folder)\n{:<20} a scene: {{\"name\":\"my-mesh\",\"surfaces\":[{{\"surface\":{{\"type\":\"mesh\",\"path\":\"fixtures/meshes/clifford-torus.4off\"}}}}]}}\n",
             Surface::catalogue_listing(),
             "mesh",
             ""

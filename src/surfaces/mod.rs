@@ -376,11 +376,12 @@ impl Surface {
         }
         let example = Surface::Formula(Formula::example());
         out += &format!("{:<20} {}\n", example.type_name(), example.description());
-        out += &format!(
-            "{:<20} example: {}\n",
-            "",
-            serde_json::to_value(&example).unwrap_or_default()
-        );
+        // A whole scene, which builds as it is when saved as a file.
+        let scene = serde_json::json!({
+            "name": "my-formula",
+            "surfaces": [{ "surface": serde_json::to_value(&example).unwrap_or_default() }],
+        });
+        out += &format!("{:<20} a scene: {scene}\n", "");
         out
     }
 
@@ -503,9 +504,53 @@ impl Surface {
         (patch, u, v, false)
     }
 
-    /// Checks the parameters: names the first bad field.
+    /// Checks the parameters: names the first bad field. A catalogue surface's size
+    /// parameters must also keep it within [`crate::limits::MAX_COORDINATE`] (a formula's
+    /// own check walks a grid of its own).
     pub fn check(&self) -> Result<(), FieldError> {
-        dispatch!(self, s => s.check())
+        dispatch!(self, s => s.check())?;
+        if matches!(self, Surface::Formula(_)) {
+            return Ok(());
+        }
+        self.check_extent()
+    }
+
+    /// The surface measured on a coarse grid of every patch before anything is sampled: a
+    /// point beyond [`crate::limits::MAX_COORDINATE`], or not finite, is refused at once, so
+    /// that a size of 1e308 does not sample for half a minute to fail in the view.
+    fn check_extent(&self) -> Result<(), FieldError> {
+        const STEPS: usize = 8;
+        for patch in 0..self.patch_count() {
+            let d = self.domain(patch);
+            for i in 0..=STEPS {
+                for j in 0..=STEPS {
+                    let t = |r: [f64; 2], k: usize| r[0] + (r[1] - r[0]) * k as f64 / STEPS as f64;
+                    let (u, v) = (t(d.u, i), t(d.v, j));
+                    let largest = self.point(patch, u, v).abs().max_element();
+                    if largest.is_nan() || largest > crate::limits::MAX_COORDINATE {
+                        // The parameter that scales the surface.
+                        let size = match self {
+                            Surface::FlatTorus(_) => "r1",
+                            Surface::KleinBottle(_) => "major_radius",
+                            Surface::ProjectivePlane(_) => "radius",
+                            Surface::SpunTrefoil(_) | Surface::TwistSpunTrefoil(_) => "scale",
+                            Surface::Fermat(_) => "y_range",
+                            Surface::ProductPolynomial(_) => "u_range",
+                            Surface::Patches(_) => "size",
+                            Surface::Formula(_) => "x",
+                        };
+                        return Err(FieldError::new(
+                            size,
+                            format!(
+                                "reaches a coordinate of {largest:.3e} (patch {patch}, u = {u:.3}, v = {v:.3}), beyond {:e}, where the files' f32 and the exact predicates stay exact; make it smaller",
+                                crate::limits::MAX_COORDINATE
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        Ok(())
     }
 }
 

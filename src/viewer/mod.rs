@@ -70,7 +70,7 @@ use std::path::Path;
 pub const SLICE_COUNTS: [u32; 4] = [64, 128, 256, 512];
 
 /// How the halo depth is sliced.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum HaloMode {
     /// Once per asset, into a 3D texture that every camera reuses.
     #[default]
@@ -92,61 +92,47 @@ impl HaloMode {
 /// What a frame shows.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ViewSettings {
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels.
-    pub height: u32,
+    /// The picture, as a scene's `render` says it: the size, the samples per pixel (a
+    /// square grid, the frame drawn that many times larger and averaged), the slices of the
+    /// halo depth (N planes, N voxels across the grid), whether halos hide anything and
+    /// whether the curves and silhouettes are drawn, the colour scale of w, the style
+    /// (stipples on the first surface the halos leave visible, which must be given to the
+    /// renderer: [`Renderer::set_stipples`]), the cutaway (what lies beyond every plane is
+    /// not drawn, as the CPU renderer removes it) and the stipples' size and colour (their
+    /// count and seed make the set: [`Source::stipples`]). The explorer draws those; the
+    /// rest of `render` (opacity, lighting, ribbons, legend, stereo) is the CPU renderer's.
+    pub render: RenderSettings,
     /// The camera, as in a scene file.
     pub camera: CameraSettings,
-    /// Slices of the halo depth (N planes, N voxels across the grid).
-    pub slices: u32,
-    /// Samples per pixel on a square grid (1, 4, 9 or 16), as the CPU renderer's: the frame
-    /// is drawn that many times larger and averaged.
-    pub samples: u32,
     /// How the halo depth is sliced.
     pub mode: HaloMode,
-    /// Whether halos hide anything.
-    pub halos: bool,
-    /// Whether the curves are drawn.
-    pub curves: bool,
-    /// Whether the silhouettes are drawn (edges between a triangle facing the eye and one
-    /// facing away, as the CPU renderer draws them).
-    pub silhouettes: bool,
     /// Whether surfaces are half transparent (composited in any order, weighted by depth).
     pub transparent: bool,
     /// Colour by w (else one grey).
     pub colour_by_w: bool,
-    /// The colour scale of w.
-    pub colormap: Colormap,
-    /// Shaded surfaces, or stipples on the first surface the halos leave visible (the
-    /// stipples must be given to the renderer: [`Renderer::set_stipples`]).
-    pub style: Style,
-    /// The scene's cutaway (`render.clip`): what lies beyond every plane is not drawn
-    /// (surfaces, curves, silhouettes, stipples), as the CPU renderer removes it.
-    pub clip: Option<crate::render::clip::Clip>,
-    /// The stipples' size and colour, drawn per frame, and their count and seed, with which
-    /// the set is made ([`Source::stipples`]).
-    pub stipple: StippleSettings,
 }
 
 impl Default for ViewSettings {
     fn default() -> Self {
         ViewSettings {
-            width: 1024,
-            height: 1024,
+            render: RenderSettings {
+                width: 1024,
+                height: 1024,
+                slices: 256,
+                samples: 1,
+                halos: true,
+                curves: true,
+                silhouettes: true,
+                colormap: Colormap::Diverging,
+                style: Style::Shaded,
+                clip: None,
+                stipple: StippleSettings::default(),
+                ..RenderSettings::default()
+            },
             camera: CameraSettings::default(),
-            slices: 256,
-            samples: 1,
             mode: HaloMode::Grid,
-            halos: true,
-            curves: true,
-            silhouettes: true,
             transparent: false,
             colour_by_w: true,
-            colormap: Colormap::Diverging,
-            style: Style::Shaded,
-            clip: None,
-            stipple: StippleSettings::default(),
         }
     }
 }
@@ -157,36 +143,41 @@ impl ViewSettings {
         let bad = |field: &str, message: String| {
             Err(ViewerError::Setting(FieldError::new(field, message)))
         };
-        if !PICTURE_SIDE.contains(&self.width) || !PICTURE_SIDE.contains(&self.height) {
+        if !PICTURE_SIDE.contains(&self.render.width) || !PICTURE_SIDE.contains(&self.render.height)
+        {
             return bad(
                 "size",
                 format!(
                     "{}x{} is not between {lo}x{lo} and {hi}x{hi}",
-                    self.width,
-                    self.height,
+                    self.render.width,
+                    self.render.height,
                     lo = PICTURE_SIDE.start(),
                     hi = PICTURE_SIDE.end()
                 ),
             );
         }
-        if !VIEWER_SLICES.contains(&self.slices) {
+        if !VIEWER_SLICES.contains(&self.render.slices) {
             return bad(
                 "slices",
                 format!(
                     "{} is not between {} and {} (the viewer offers {SLICE_COUNTS:?})",
-                    self.slices,
+                    self.render.slices,
                     VIEWER_SLICES.start(),
                     VIEWER_SLICES.end()
                 ),
             );
         }
-        if !SAMPLES.contains(&self.samples) {
+        if !SAMPLES.contains(&self.render.samples) {
             return bad(
                 "samples",
-                format!("{} is not 1, 4, 9 or 16 (a square grid)", self.samples),
+                format!(
+                    "{} is not 1, 4, 9 or 16 (a square grid)",
+                    self.render.samples
+                ),
             );
         }
-        self.stipple
+        self.render
+            .stipple
             .check()
             .map_err(|e| ViewerError::Setting(e.within("stipple")))?;
         self.camera
@@ -295,6 +286,9 @@ pub struct Asset {
     pub name: String,
     /// The camera recorded with the scene, if any.
     pub camera: Option<CameraSettings>,
+    /// The picture settings the scene records (`render`), the defaults where the file
+    /// records no scene.
+    pub render: RenderSettings,
     /// The surfaces' bounding box (absolute), as the CPU renderer computes it.
     pub bounds: (DVec3, DVec3),
     /// The surfaces' vertices (absolute, as the CPU renderer reads them), which a fitted
@@ -456,6 +450,8 @@ impl Asset {
         Ok(Asset {
             name,
             camera: scene.camera,
+            // Set by [`Source::open`], which reads the scene once.
+            render: RenderSettings::default(),
             bounds,
             fit_points,
             w_range,
@@ -588,12 +584,16 @@ pub(crate) struct GpuCamera {
 impl GpuCamera {
     /// The camera of `settings` framing `asset`, as the CPU renderer places it.
     pub fn new(settings: &ViewSettings, asset: &Asset) -> Result<GpuCamera, ViewerError> {
-        let placement = asset.placement(&settings.camera, settings.width, settings.height);
+        let placement = asset.placement(
+            &settings.camera,
+            settings.render.width,
+            settings.render.height,
+        );
         let cam = Camera::new(
             &settings.camera,
             &placement,
-            settings.width,
-            settings.height,
+            settings.render.width,
+            settings.render.height,
             0.0,
         )?;
         let bounds = asset.bounds;
@@ -700,7 +700,7 @@ impl Source {
                 .collect();
             return Ok((Source::Model(Model::new(scene)?.into()), notes));
         }
-        let (imported, asset) = Asset::read(path)?;
+        let (imported, mut asset) = Asset::read(path)?;
         let mut notes = Vec::new();
         if !asset.surfaces_without_halo.is_empty() {
             notes.push(format!(
@@ -729,6 +729,9 @@ impl Source {
                     .map_err(|e| format!("surface {}: {e}", s.name))
             })
             .collect();
+        if let Ok(scene) = &scene {
+            asset.render = scene.render;
+        }
         let why = match (scene, meshes) {
             (Ok(scene), Ok(meshes)) if meshes.len() == scene.surfaces.len() => {
                 return Ok((
@@ -760,12 +763,7 @@ impl Source {
     pub fn render_settings(&self) -> RenderSettings {
         match self {
             Source::Model(m) => m.scene.render,
-            Source::Asset(a) => {
-                a.0.scene
-                    .as_ref()
-                    .and_then(|json| crate::scene::Scene::parse(&json.to_string(), "scene").ok())
-                    .map_or_else(RenderSettings::default, |scene| scene.render)
-            }
+            Source::Asset(a) => a.1.render,
         }
     }
 
@@ -851,9 +849,14 @@ pub fn screenshot_of(
     settings: &ViewSettings,
 ) -> Result<Frame, ViewerError> {
     settings.check()?;
-    let mut renderer = source.renderer(gpu, view, settings.curves, renderer::OFFSCREEN_FORMAT)?;
-    if settings.style == Style::Stipple {
-        let st = settings.stipple;
+    let mut renderer = source.renderer(
+        gpu,
+        view,
+        settings.render.curves,
+        renderer::OFFSCREEN_FORMAT,
+    )?;
+    if settings.render.style == Style::Stipple {
+        let st = settings.render.stipple;
         renderer.set_stipples(gpu, &source.stipples(st.count, st.seed)?)?;
     }
     renderer.read_frame(gpu, settings)
@@ -960,14 +963,19 @@ pub fn bench(
     progress: &mut dyn FnMut(&BenchRow),
 ) -> Result<Vec<BenchRow>, ViewerError> {
     settings.check()?;
-    let mut renderer = source.renderer(gpu, view, settings.curves, renderer::OFFSCREEN_FORMAT)?;
+    let mut renderer = source.renderer(
+        gpu,
+        view,
+        settings.render.curves,
+        renderer::OFFSCREEN_FORMAT,
+    )?;
     if let Some(set) = stipples {
         renderer.set_stipples(gpu, set)?;
     }
     let target = renderer::frame_texture(
         gpu,
         "bench frame",
-        (settings.width, settings.height),
+        (settings.render.width, settings.render.height),
         renderer::OFFSCREEN_FORMAT,
         wgpu::TextureUsages::RENDER_ATTACHMENT,
     );
@@ -977,16 +985,14 @@ pub fn bench(
     let shaded = [HaloMode::Grid, HaloMode::View]
         .into_iter()
         .flat_map(|mode| slices.iter().map(move |&n| (Style::Shaded, mode, n)));
-    let stippled = stipples
-        .is_some()
-        .then_some((Style::Stipple, settings.mode, settings.slices));
+    let stippled =
+        stipples
+            .is_some()
+            .then_some((Style::Stipple, settings.mode, settings.render.slices));
     for (style, mode, n) in shaded.chain(stippled) {
-        let mut s = ViewSettings {
-            mode,
-            slices: n,
-            style,
-            ..*settings
-        };
+        let mut s = ViewSettings { mode, ..*settings };
+        s.render.slices = n;
+        s.render.style = style;
         let grid_ms = renderer.render(gpu, &target, &s)?.grid_ms;
         let orbit = |f: u32| settings.camera.azimuth + 360.0 * f64::from(f) / f64::from(frames);
         if slices.first() == Some(&n) || style == Style::Stipple {
@@ -1147,14 +1153,14 @@ fn exact_distances(
     settings: &ViewSettings,
 ) -> Result<(Vec<f64>, f64), ViewerError> {
     let cpu_settings = crate::render::RenderSettings {
-        width: settings.width,
-        height: settings.height,
+        width: settings.render.width,
+        height: settings.render.height,
         samples: 1,
         mode: crate::render::RenderMode::Exact,
-        halos: settings.halos,
+        halos: settings.render.halos,
         curves: false,
         silhouettes: false,
-        colormap: settings.colormap,
+        colormap: settings.render.colormap,
         ..Default::default()
     };
     let start = std::time::Instant::now();
@@ -1175,13 +1181,13 @@ fn compare_rows(
     let mut rows = Vec::new();
     for mode in [HaloMode::Grid, HaloMode::View] {
         for &n in slices {
-            let s = ViewSettings {
-                mode,
+            let mut s = ViewSettings { mode, ..*settings };
+            s.render = RenderSettings {
                 slices: n,
                 curves: false,
                 silhouettes: false,
                 samples: 1,
-                ..*settings
+                ..s.render
             };
             let start = std::time::Instant::now();
             let frame = renderer.read_frame(gpu, &s)?;

@@ -128,16 +128,22 @@ pub struct Renderer {
     stipples: Option<(wgpu::Buffer, wgpu::Buffer, u32)>,
 }
 
-impl Renderer {
-    /// Uploads `asset` and builds the pipelines, drawing into `colour_format`.
-    pub fn new(
-        gpu: &Gpu,
-        asset: &Asset,
-        colour_format: wgpu::TextureFormat,
-    ) -> Result<Renderer, ViewerError> {
+/// The asset's buffers on the GPU.
+struct AssetBuffers {
+    vertices: wgpu::Buffer,
+    triangles: wgpu::Buffer,
+    curve_points: wgpu::Buffer,
+    curve_segments: wgpu::Buffer,
+    halo_vertices: wgpu::Buffer,
+    tets: wgpu::Buffer,
+    edges: wgpu::Buffer,
+    face_normals: wgpu::Buffer,
+}
+
+impl AssetBuffers {
+    /// Uploads the asset's vertices, triangles, curves, halos, edges and face normals.
+    fn upload(gpu: &Gpu, asset: &Asset) -> Result<AssetBuffers, ViewerError> {
         use wgpu::BufferUsages as U;
-        let device = &gpu.device;
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let storage = U::STORAGE;
         let vertices = gpu.buffer(
             "surface vertices",
@@ -175,11 +181,37 @@ impl Renderer {
             bytemuck::cast_slice(&asset.face_normals),
             storage,
         )?;
-        let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("view"),
-            contents: bytemuck::bytes_of(&ViewUniform::zeroed()),
-            usage: U::UNIFORM | U::COPY_DST,
-        });
+        Ok(AssetBuffers {
+            vertices,
+            triangles,
+            curve_points,
+            curve_segments,
+            halo_vertices,
+            tets,
+            edges,
+            face_normals,
+        })
+    }
+}
+
+/// The renderer's pipelines, all from one shader module.
+struct Pipelines {
+    surface_grid: wgpu::RenderPipeline,
+    surface_view: wgpu::RenderPipeline,
+    surface_grid_blend: wgpu::RenderPipeline,
+    surface_view_blend: wgpu::RenderPipeline,
+    composite: wgpu::RenderPipeline,
+    curves: wgpu::RenderPipeline,
+    silhouettes: wgpu::RenderPipeline,
+    downsample: wgpu::RenderPipeline,
+    cut: wgpu::RenderPipeline,
+    voxelize: wgpu::ComputePipeline,
+    stipple_pipeline: wgpu::RenderPipeline,
+}
+
+impl Pipelines {
+    /// Compiles the shaders and builds every pipeline, drawing into `colour_format`.
+    fn new(device: &wgpu::Device, colour_format: wgpu::TextureFormat) -> Pipelines {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("viewer.wgsl"),
             source: wgpu::ShaderSource::Wgsl(
@@ -377,6 +409,59 @@ impl Renderer {
             compilation_options: Default::default(),
             cache: None,
         });
+        Pipelines {
+            surface_grid,
+            surface_view,
+            surface_grid_blend,
+            surface_view_blend,
+            composite,
+            curves,
+            silhouettes,
+            downsample,
+            cut,
+            voxelize,
+            stipple_pipeline,
+        }
+    }
+}
+
+impl Renderer {
+    /// Uploads `asset` and builds the pipelines, drawing into `colour_format`.
+    pub fn new(
+        gpu: &Gpu,
+        asset: &Asset,
+        colour_format: wgpu::TextureFormat,
+    ) -> Result<Renderer, ViewerError> {
+        let device = &gpu.device;
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let AssetBuffers {
+            vertices,
+            triangles,
+            curve_points,
+            curve_segments,
+            halo_vertices,
+            tets,
+            edges,
+            face_normals,
+        } = AssetBuffers::upload(gpu, asset)?;
+        let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("view"),
+            contents: bytemuck::bytes_of(&ViewUniform::zeroed()),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let Pipelines {
+            surface_grid,
+            surface_view,
+            surface_grid_blend,
+            surface_view_blend,
+            composite,
+            curves,
+            silhouettes,
+            downsample,
+            cut,
+            voxelize,
+            stipple_pipeline,
+        } = Pipelines::new(device, colour_format);
         let empty_grid = device
             .create_texture(&wgpu::TextureDescriptor {
                 label: Some("no grid"),
@@ -554,7 +639,7 @@ impl Renderer {
         settings: &ViewSettings,
     ) -> Result<FrameTimes, ViewerError> {
         settings.check()?;
-        let stipple = settings.style == Style::Stipple;
+        let stipple = settings.render.style == Style::Stipple;
         if stipple && self.stipples.is_none() {
             return Err(ViewerError::Setting(FieldError::new(
                 "style",
@@ -563,49 +648,52 @@ impl Renderer {
         }
         let start = Instant::now();
         let mut times = FrameTimes::default();
-        let halos = settings.halos && !self.asset.tets.is_empty();
+        let halos = settings.render.halos && !self.asset.tets.is_empty();
         if halos
             && settings.mode == HaloMode::Grid
             && self
                 .grid
                 .as_ref()
-                .is_none_or(|g| g.slices != settings.slices)
+                .is_none_or(|g| g.slices != settings.render.slices)
         {
             let t = Instant::now();
             // The old grid's memory goes before the new one is made.
             self.grid = None;
-            self.grid = Some(self.build_grid(gpu, settings.slices)?);
+            self.grid = Some(self.build_grid(gpu, settings.render.slices)?);
             times.grid_ms = Some(t.elapsed().as_secs_f64() * 1e3);
         }
         let prepare = Instant::now();
         // Supersampling: the frame is drawn k times larger, then averaged k x k.
-        let k = settings.samples.isqrt();
+        let k = settings.render.samples.isqrt();
         let max = gpu.limits().max_texture_dimension_2d;
-        if settings.width * k > max || settings.height * k > max {
+        if settings.render.width * k > max || settings.render.height * k > max {
             return Err(ViewerError::Setting(FieldError::new(
                 "samples",
                 format!(
                     "{}x{} at {} samples per pixel is larger than this GPU's {max}-pixel textures; use fewer samples or a smaller size",
-                    settings.width, settings.height, settings.samples
+                    settings.render.width, settings.render.height, settings.render.samples
                 ),
             )));
         }
         let final_target = target;
         // Stipples lie on opaque white surfaces.
         let settings = &ViewSettings {
-            width: settings.width * k,
-            height: settings.height * k,
+            render: crate::render::RenderSettings {
+                width: settings.render.width * k,
+                height: settings.render.height * k,
+                ..settings.render
+            },
             transparent: settings.transparent && !stipple,
             ..*settings
         };
-        self.ensure_targets(gpu, (settings.width, settings.height), k > 1);
+        self.ensure_targets(gpu, (settings.render.width, settings.render.height), k > 1);
         let camera = GpuCamera::new(settings, &self.asset)?;
-        let slabs = self.slabs(&camera, settings.slices);
+        let slabs = self.slabs(&camera, settings.render.slices);
         let uniform = self.uniform(&camera, settings, halos, slabs, self.grid.as_ref());
         gpu.queue
             .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
         let lists = (settings.mode == HaloMode::View)
-            .then(|| self.slab_lists(gpu, &camera, (slabs, settings.slices), halos))
+            .then(|| self.slab_lists(gpu, &camera, (slabs, settings.render.slices), halos))
             .transpose()?;
         times.prepare_ms = prepare.elapsed().as_secs_f64() * 1e3;
 
@@ -613,132 +701,186 @@ impl Renderer {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let targets = self.targets.as_ref().expect("targets made above");
         let target = targets.samples_view.as_ref().unwrap_or(final_target);
-        let triangle_count = self.asset.triangles.len() as u32 * 3;
         match &lists {
-            None => {
-                let pipeline = if settings.transparent {
-                    &self.surface_grid_blend
-                } else {
-                    &self.surface_grid
-                };
-                let grid = self.grid.as_ref().map_or(&self.empty_grid, |g| &g.view);
-                let bind = self.bind(
-                    gpu,
-                    pipeline.get_bind_group_layout(0),
-                    &[
-                        (1, self.vertices.as_entire_binding()),
-                        (2, wgpu::BindingResource::TextureView(grid)),
-                    ],
-                );
-                let mut pass = if settings.transparent {
-                    blend_pass(&mut encoder, targets, true)
-                } else {
-                    opaque_pass(&mut encoder, target, targets, true)
-                };
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &bind, &[]);
-                pass.set_index_buffer(self.triangles.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..triangle_count, 0, 0..1);
+            None => self.surfaces_grid(gpu, &mut encoder, target, targets, settings),
+            Some(lists) => self.surfaces_view(gpu, &mut encoder, target, targets, settings, lists),
+        }
+        if stipple {
+            self.stipples_pass(gpu, &mut encoder, target, targets);
+        }
+        self.lines(gpu, &mut encoder, target, targets, settings);
+        if let Some(samples) = &targets.samples_view {
+            self.downsample(gpu, &mut encoder, final_target, samples);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(ViewerError::Gpu(e.to_string()));
+        }
+        gpu.finish()?;
+        times.frame_ms = start.elapsed().as_secs_f64() * 1e3 - times.grid_ms.unwrap_or(0.0);
+        Ok(times)
+    }
+
+    /// The surfaces, hidden by the halo-depth grid (or by nothing).
+    fn surfaces_grid(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        targets: &Targets,
+        settings: &ViewSettings,
+    ) {
+        let pipeline = if settings.transparent {
+            &self.surface_grid_blend
+        } else {
+            &self.surface_grid
+        };
+        let grid = self.grid.as_ref().map_or(&self.empty_grid, |g| &g.view);
+        let bind = self.bind(
+            gpu,
+            pipeline.get_bind_group_layout(0),
+            &[
+                (1, self.vertices.as_entire_binding()),
+                (2, wgpu::BindingResource::TextureView(grid)),
+            ],
+        );
+        let mut pass = if settings.transparent {
+            blend_pass(encoder, targets, true)
+        } else {
+            opaque_pass(encoder, target, targets, true)
+        };
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.set_index_buffer(self.triangles.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..self.asset.triangles.len() as u32 * 3, 0, 0..1);
+    }
+
+    /// The surfaces slab by slab along the view, each slab's halos cut into the halo depth
+    /// first.
+    fn surfaces_view(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        targets: &Targets,
+        settings: &ViewSettings,
+        lists: &SlabLists,
+    ) {
+        let pipeline = if settings.transparent {
+            &self.surface_view_blend
+        } else {
+            &self.surface_view
+        };
+        let surface_bind = self.bind(
+            gpu,
+            pipeline.get_bind_group_layout(0),
+            &[
+                (1, self.vertices.as_entire_binding()),
+                (3, wgpu::BindingResource::TextureView(&targets.halo_view)),
+            ],
+        );
+        let cut_bind = self.bind(
+            gpu,
+            self.cut.get_bind_group_layout(0),
+            &[
+                (5, self.halo_vertices.as_entire_binding()),
+                (6, self.tets.as_entire_binding()),
+                (
+                    7,
+                    self.slab_items
+                        .as_ref()
+                        .expect("slab lists made above")
+                        .as_entire_binding(),
+                ),
+            ],
+        );
+        let indices = self.slab_triangles.as_ref().expect("slab lists made above");
+        let mut first = true;
+        for k in 0..settings.render.slices as usize {
+            let tris = lists.triangles[k]..lists.triangles[k + 1];
+            if tris.is_empty() && !first {
+                continue;
             }
-            Some(lists) => {
-                let pipeline = if settings.transparent {
-                    &self.surface_view_blend
-                } else {
-                    &self.surface_view
-                };
-                let surface_bind = self.bind(
-                    gpu,
-                    pipeline.get_bind_group_layout(0),
-                    &[
-                        (1, self.vertices.as_entire_binding()),
-                        (3, wgpu::BindingResource::TextureView(&targets.halo_view)),
-                    ],
-                );
-                let cut_bind = self.bind(
-                    gpu,
-                    self.cut.get_bind_group_layout(0),
-                    &[
-                        (5, self.halo_vertices.as_entire_binding()),
-                        (6, self.tets.as_entire_binding()),
-                        (
-                            7,
-                            self.slab_items
-                                .as_ref()
-                                .expect("slab lists made above")
-                                .as_entire_binding(),
-                        ),
-                    ],
-                );
-                let indices = self.slab_triangles.as_ref().expect("slab lists made above");
-                let mut first = true;
-                for k in 0..settings.slices as usize {
-                    let tris = lists.triangles[k]..lists.triangles[k + 1];
-                    if tris.is_empty() && !first {
-                        continue;
-                    }
-                    {
-                        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                            label: Some("halo cut"),
-                            color_attachments: &[],
-                            depth_stencil_attachment: Some(
-                                wgpu::RenderPassDepthStencilAttachment {
-                                    view: &targets.halo_view,
-                                    depth_ops: Some(wgpu::Operations {
-                                        load: wgpu::LoadOp::Clear(1.0),
-                                        store: wgpu::StoreOp::Store,
-                                    }),
-                                    stencil_ops: None,
-                                },
-                            ),
-                            ..Default::default()
-                        });
-                        let items = lists.items[k]..lists.items[k + 1];
-                        if !items.is_empty() {
-                            pass.set_pipeline(&self.cut);
-                            pass.set_bind_group(0, &cut_bind, &[]);
-                            pass.draw(0..6, items);
-                        }
-                    }
-                    let mut pass = if settings.transparent {
-                        blend_pass(&mut encoder, targets, first)
-                    } else {
-                        opaque_pass(&mut encoder, target, targets, first)
-                    };
-                    first = false;
-                    pass.set_pipeline(pipeline);
-                    pass.set_bind_group(0, &surface_bind, &[]);
-                    pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
-                    pass.draw_indexed(tris, 0, k as u32..k as u32 + 1);
+            {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("halo cut"),
+                    color_attachments: &[],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &targets.halo_view,
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(1.0),
+                            store: wgpu::StoreOp::Store,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    ..Default::default()
+                });
+                let items = lists.items[k]..lists.items[k + 1];
+                if !items.is_empty() {
+                    pass.set_pipeline(&self.cut);
+                    pass.set_bind_group(0, &cut_bind, &[]);
+                    pass.draw(0..6, items);
                 }
             }
+            let mut pass = if settings.transparent {
+                blend_pass(encoder, targets, first)
+            } else {
+                opaque_pass(encoder, target, targets, first)
+            };
+            first = false;
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &surface_bind, &[]);
+            pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(tris, 0, k as u32..k as u32 + 1);
         }
-        if let (true, Some((instances, ratio, count))) = (stipple, &self.stipples) {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("stipples"),
-                color_attachments: &[attachment(target, false, wgpu::Color::WHITE)],
-                ..Default::default()
-            });
-            self.draw(
-                gpu,
-                &mut pass,
-                &self.stipple_pipeline,
-                &[
-                    (1, self.vertices.as_entire_binding()),
-                    (13, self.face_normals.as_entire_binding()),
-                    (14, wgpu::BindingResource::TextureView(&targets.depth_view)),
-                    (16, instances.as_entire_binding()),
-                    (17, self.triangles.as_entire_binding()),
-                    (18, ratio.as_entire_binding()),
-                ],
-                (0..3 * *count, 0..1),
-            );
-        }
-        // The transparency composite, then the lines.
+    }
+
+    /// The stipples, on the opaque surfaces drawn before.
+    fn stipples_pass(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        targets: &Targets,
+    ) {
+        let Some((instances, ratio, count)) = &self.stipples else {
+            return;
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("stipples"),
+            color_attachments: &[attachment(target, false, wgpu::Color::WHITE)],
+            ..Default::default()
+        });
+        self.draw(
+            gpu,
+            &mut pass,
+            &self.stipple_pipeline,
+            &[
+                (1, self.vertices.as_entire_binding()),
+                (13, self.face_normals.as_entire_binding()),
+                (14, wgpu::BindingResource::TextureView(&targets.depth_view)),
+                (16, instances.as_entire_binding()),
+                (17, self.triangles.as_entire_binding()),
+                (18, ratio.as_entire_binding()),
+            ],
+            (0..3 * *count, 0..1),
+        );
+    }
+
+    /// The transparency composite, then the curves and silhouettes.
+    fn lines(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        targets: &Targets,
+        settings: &ViewSettings,
+    ) {
         let composite = settings.transparent;
-        let curves = settings.curves && !self.asset.curve_segments.is_empty();
-        let silhouettes = settings.silhouettes && !self.asset.edges.is_empty();
+        let curves = settings.render.curves && !self.asset.curve_segments.is_empty();
+        let silhouettes = settings.render.silhouettes && !self.asset.edges.is_empty();
         if composite || curves || silhouettes {
-            let mut pass = lines_pass(&mut encoder, target, targets, composite);
+            let mut pass = lines_pass(encoder, target, targets, composite);
             let depth = wgpu::BindingResource::TextureView(&targets.depth_view);
             if composite {
                 self.draw(
@@ -780,27 +922,28 @@ impl Renderer {
                 );
             }
         }
-        if let Some(samples) = &targets.samples_view {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("downsample"),
-                color_attachments: &[attachment(final_target, true, wgpu::Color::WHITE)],
-                ..Default::default()
-            });
-            self.draw(
-                gpu,
-                &mut pass,
-                &self.downsample,
-                &[(15, wgpu::BindingResource::TextureView(samples))],
-                (0..3, 0..1),
-            );
-        }
-        gpu.queue.submit([encoder.finish()]);
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(ViewerError::Gpu(e.to_string()));
-        }
-        gpu.finish()?;
-        times.frame_ms = start.elapsed().as_secs_f64() * 1e3 - times.grid_ms.unwrap_or(0.0);
-        Ok(times)
+    }
+
+    /// The supersampled picture averaged into `target`.
+    fn downsample(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        samples: &wgpu::TextureView,
+    ) {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("downsample"),
+            color_attachments: &[attachment(target, true, wgpu::Color::WHITE)],
+            ..Default::default()
+        });
+        self.draw(
+            gpu,
+            &mut pass,
+            &self.downsample,
+            &[(15, wgpu::BindingResource::TextureView(samples))],
+            (0..3, 0..1),
+        );
     }
 
     /// Renders one frame offscreen and reads it back with its distances.
@@ -809,7 +952,7 @@ impl Renderer {
         let colour = frame_texture(
             gpu,
             "frame",
-            (settings.width, settings.height),
+            (settings.render.width, settings.render.height),
             self.colour_format,
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
         );
@@ -833,8 +976,11 @@ impl Renderer {
         let all = gpu.read_texture(&targets.distance)?;
         // Each pixel's distance from its centre sample (of k x k, the one at (k/2, k/2), as
         // the CPU renderer takes it).
-        let k = settings.samples.isqrt() as usize;
-        let (w, h) = (settings.width as usize, settings.height as usize);
+        let k = settings.render.samples.isqrt() as usize;
+        let (w, h) = (
+            settings.render.width as usize,
+            settings.render.height as usize,
+        );
         let distance = (0..w * h)
             .map(|i| {
                 let (x, y) = (i % w, i / w);
@@ -844,8 +990,8 @@ impl Renderer {
             .collect();
         Ok(Frame {
             picture: Picture {
-                width: settings.width,
-                height: settings.height,
+                width: settings.render.width,
+                height: settings.render.height,
                 rgb,
             },
             distance,
@@ -952,7 +1098,7 @@ impl Renderer {
         let span = if w1 > w0 { w1 - w0 } else { 1.0 };
         let (d0, d1) = self.asset.depth_range;
         let depth_scale = 1.0 / (d1 - d0).max(f64::MIN_POSITIVE) * 0.999;
-        let stops = shade::stops(settings.colormap);
+        let stops = shade::stops(settings.render.colormap);
         let mut stop_array = [[0.0f32; 4]; 8];
         for (slot, s) in stop_array.iter_mut().zip(stops) {
             *slot = [s[0] as f32, s[1] as f32, s[2] as f32, 1.0];
@@ -967,7 +1113,7 @@ impl Renderer {
             crate::render::CameraProjection::Orthographic => 1.0,
         };
         // Lines test the surfaces' depth, which transparent frames do not write.
-        let stipple = settings.style == Style::Stipple;
+        let stipple = settings.render.style == Style::Stipple;
         let flags = u32::from(halos)
             | (u32::from(settings.colour_by_w) << 1)
             | (u32::from(!settings.transparent) << 2)
@@ -995,15 +1141,18 @@ impl Renderer {
             slabs: [
                 near as f32,
                 step as f32,
-                settings.slices as f32,
-                (step * f64::from(settings.slices)) as f32,
+                settings.render.slices as f32,
+                (step * f64::from(settings.render.slices)) as f32,
             ],
             grid_dims: [dims[0], dims[1], dims[2], dims[0].next_multiple_of(64)],
             options: [
                 flags,
                 stops.len() as u32,
-                settings.clip.map_or(0, |c| c.planes().count() as u32),
-                settings.samples.isqrt(),
+                settings
+                    .render
+                    .clip
+                    .map_or(0, |c| c.planes().count() as u32),
+                settings.render.samples.isqrt(),
             ],
             band: [0; 4],
             depth_proj: {
@@ -1011,15 +1160,15 @@ impl Renderer {
                 [near as f32, far as f32, 0.0, 0.0]
             },
             viewport: [
-                settings.width as f32,
-                settings.height as f32,
-                CURVE_WIDTH * 0.5 * settings.samples.isqrt() as f32,
-                (2.0 * cam.half_height / f64::from(settings.height)) as f32,
+                settings.render.width as f32,
+                settings.render.height as f32,
+                CURVE_WIDTH * 0.5 * settings.render.samples.isqrt() as f32,
+                (2.0 * cam.half_height / f64::from(settings.render.height)) as f32,
             ],
             // A stipple's size in pixels of the (supersampled) frame.
             stipple: [
-                (settings.stipple.size * f64::from(settings.samples.isqrt())) as f32,
-                f32::from(u8::from(settings.stipple.colour)),
+                (settings.render.stipple.size * f64::from(settings.render.samples.isqrt())) as f32,
+                f32::from(u8::from(settings.render.stipple.colour)),
                 0.0,
                 0.0,
             ],
@@ -1030,7 +1179,7 @@ impl Renderer {
                 let mut cuts = [[0.0f32; 4]; 2];
                 for (slot, plane) in cuts
                     .iter_mut()
-                    .zip(settings.clip.iter().flat_map(|c| c.planes()))
+                    .zip(settings.render.clip.iter().flat_map(|c| c.planes()))
                 {
                     let n = DVec3::from(plane.normal);
                     *slot = v4(n, plane.offset - n.dot(centre));
@@ -1043,22 +1192,7 @@ impl Renderer {
     /// Builds the halo-depth grid: `slices` voxels across the halos' longest side, in bands
     /// of z layers as large as one storage binding holds.
     fn build_grid(&mut self, gpu: &Gpu, slices: u32) -> Result<Grid, ViewerError> {
-        let (lo, hi) = self
-            .asset
-            .halo_vertices
-            .iter()
-            .map(|v| DVec3::from(v.pos.map(f64::from)))
-            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
-                (lo.min(p), hi.max(p))
-            });
-        let side = (hi - lo).max_element().max(f64::MIN_POSITIVE);
-        let voxel = side / f64::from(slices);
-        let dims = ((hi - lo) / voxel)
-            .ceil()
-            .max(DVec3::ONE)
-            .as_uvec3()
-            .min(glam::UVec3::splat(slices))
-            .to_array();
+        let (lo, voxel, dims) = grid_placement(&self.asset, slices);
         let row = dims[0].next_multiple_of(64);
         let layer_bytes = u64::from(row) * u64::from(dims[1]) * 4;
         let limits = gpu.limits();
@@ -1086,36 +1220,7 @@ impl Renderer {
                 ),
             )));
         }
-        // Work items (tetrahedron, z layer) for every layer of voxel centres a
-        // tetrahedron's box spans, sorted by layer.
-        let mut spans = Vec::with_capacity(self.asset.tets.len());
-        let mut per_layer = vec![0usize; dims[2] as usize + 1];
-        for (i, k) in self.asset.tets.iter().enumerate() {
-            let z = k.map(|v| f64::from(self.asset.halo_vertices[v as usize].pos[2]));
-            let z0 = z.iter().copied().fold(f64::INFINITY, f64::min);
-            let z1 = z.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            let first = ((z0 - lo.z) / voxel - 0.5).ceil().max(0.0);
-            let last = ((z1 - lo.z) / voxel - 0.5)
-                .floor()
-                .min(f64::from(dims[2]) - 1.0);
-            if first <= last {
-                for layer in first as usize..=last as usize {
-                    per_layer[layer + 1] += 1;
-                }
-                spans.push((i as u32, first as u32, last as u32));
-            }
-        }
-        for layer in 0..dims[2] as usize {
-            per_layer[layer + 1] += per_layer[layer];
-        }
-        let mut fill = per_layer.clone();
-        let mut items = vec![[0u32; 2]; per_layer[dims[2] as usize]];
-        for &(tet, first, last) in &spans {
-            for layer in first..=last {
-                items[fill[layer as usize]] = [tet, layer];
-                fill[layer as usize] += 1;
-            }
-        }
+        let (items, per_layer) = layer_items(&self.asset, lo, voxel, dims);
         let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let grid_buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("halo-depth grid band"),
@@ -1467,4 +1572,66 @@ fn blend_pass<'e>(
         ],
         ..Default::default()
     })
+}
+
+/// The halo-depth grid of `slices` across the halos' box: its low corner, the voxel's side
+/// and the voxels along each axis (at most `slices`).
+fn grid_placement(asset: &Asset, slices: u32) -> (DVec3, f64, [u32; 3]) {
+    let (lo, hi) = asset
+        .halo_vertices
+        .iter()
+        .map(|v| DVec3::from(v.pos.map(f64::from)))
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p), hi.max(p))
+        });
+    let side = (hi - lo).max_element().max(f64::MIN_POSITIVE);
+    let voxel = side / f64::from(slices);
+    let dims = ((hi - lo) / voxel)
+        .ceil()
+        .max(DVec3::ONE)
+        .as_uvec3()
+        .min(glam::UVec3::splat(slices))
+        .to_array();
+    (lo, voxel, dims)
+}
+
+/// Work items (tetrahedron, z layer) for every layer of voxel centres a tetrahedron's box
+/// spans, sorted by layer, and where each layer's items begin (one more entry than layers).
+fn layer_items(
+    asset: &Asset,
+    lo: DVec3,
+    voxel: f64,
+    dims: [u32; 3],
+) -> (Vec<[u32; 2]>, Vec<usize>) {
+    // Work items (tetrahedron, z layer) for every layer of voxel centres a
+    // tetrahedron's box spans, sorted by layer.
+    let mut spans = Vec::with_capacity(asset.tets.len());
+    let mut per_layer = vec![0usize; dims[2] as usize + 1];
+    for (i, k) in asset.tets.iter().enumerate() {
+        let z = k.map(|v| f64::from(asset.halo_vertices[v as usize].pos[2]));
+        let z0 = z.iter().copied().fold(f64::INFINITY, f64::min);
+        let z1 = z.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let first = ((z0 - lo.z) / voxel - 0.5).ceil().max(0.0);
+        let last = ((z1 - lo.z) / voxel - 0.5)
+            .floor()
+            .min(f64::from(dims[2]) - 1.0);
+        if first <= last {
+            for layer in first as usize..=last as usize {
+                per_layer[layer + 1] += 1;
+            }
+            spans.push((i as u32, first as u32, last as u32));
+        }
+    }
+    for layer in 0..dims[2] as usize {
+        per_layer[layer + 1] += per_layer[layer];
+    }
+    let mut fill = per_layer.clone();
+    let mut items = vec![[0u32; 2]; per_layer[dims[2] as usize]];
+    for &(tet, first, last) in &spans {
+        for layer in first..=last {
+            items[fill[layer as usize]] = [tet, layer];
+            fill[layer as usize] += 1;
+        }
+    }
+    (items, per_layer)
 }

@@ -102,6 +102,7 @@ impl Model {
         let mut asset = super::Asset {
             name: self.scene.name.clone(),
             camera: Some(self.scene.camera),
+            render: self.scene.render,
             bounds: (DVec3::splat(-1.0), DVec3::ONE),
             fit_points: Vec::new(),
             w_range: (0.0, 1.0),

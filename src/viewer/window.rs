@@ -130,8 +130,8 @@ impl App {
         let attributes = Window::default_attributes()
             .with_title(format!("halo4d-view: {}", self.source.name()))
             .with_inner_size(winit::dpi::PhysicalSize::new(
-                self.settings.width,
-                self.settings.height,
+                self.settings.render.width,
+                self.settings.render.height,
             ));
         let window = Arc::new(
             event_loop
@@ -166,11 +166,61 @@ impl App {
     }
 
     fn redraw(&mut self) -> Result<(), ViewerError> {
+        self.turn()?;
+        self.poll_curves()?;
+        self.poll_jobs();
+        self.poll_stipples()?;
         let Some(state) = &mut self.state else {
             return Ok(());
         };
-        // A new 4D view: the surfaces and halos rebuilt on the GPU (a view that cannot be
-        // drawn is refused, the last one kept, the reason in the title).
+        let making = self.settings.render.style == Style::Stipple && !state.renderer.has_stipples();
+        let frame = match state.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(f)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                state.surface.configure(&state.gpu.device, &state.config);
+                state.window.request_redraw();
+                return Ok(());
+            }
+            _ => return Ok(()),
+        };
+        self.settings.render.width = state.config.width;
+        self.settings.render.height = state.config.height;
+        let view = frame.texture.create_view(&Default::default());
+        let mut drawn = self.settings;
+        if making {
+            drawn.render.style = Style::Shaded;
+        }
+        let times = match state.renderer.render(&state.gpu, &view, &drawn) {
+            Ok(times) => times,
+            // A setting this GPU cannot do (a grid too large, say): back to the last one
+            // that rendered, with the reason in the title; anything else ends the viewer.
+            Err(e @ (ViewerError::TooLarge { .. } | ViewerError::Setting(_))) => {
+                let (width, height) = (self.settings.render.width, self.settings.render.height);
+                self.settings = self.last_good;
+                self.settings.render.width = width;
+                self.settings.render.height = height;
+                state.window.set_title(&format!("halo4d-view: {e}"));
+                return Ok(());
+            }
+            Err(e) => return Err(e),
+        };
+        state.gpu.queue.present(frame);
+        self.last_good = self.settings;
+        self.last_ms = times.frame_ms;
+        let title = self.title(&times, making);
+        if let Some(state) = &self.state {
+            state.window.set_title(&title);
+        }
+        Ok(())
+    }
+
+    /// A new 4D view: the surfaces and halos rebuilt on the GPU (a view that cannot be drawn
+    /// is refused, the last one kept, the reason in the title).
+    fn turn(&mut self) -> Result<(), ViewerError> {
+        let Some(state) = &mut self.state else {
+            return Ok(());
+        };
         if let (Source::Model(model), Some(view)) = (&self.source, self.view)
             && self.drawn_view != Some(view)
         {
@@ -186,8 +236,15 @@ impl App {
                 Err(e) => return Err(e),
             }
         }
-        // The curves: the finished job's, when they are of the view drawn; a new job when
-        // the drawn view has none, none is running and the curves are shown.
+        Ok(())
+    }
+
+    /// The curves: the finished job's, when they are of the view drawn; a new job when the
+    /// drawn view has none, none is running and the curves are shown.
+    fn poll_curves(&mut self) -> Result<(), ViewerError> {
+        let Some(state) = &mut self.state else {
+            return Ok(());
+        };
         if let Some(rx) = &self.curves.running
             && let Ok((view, curves)) = rx.try_recv()
         {
@@ -202,7 +259,7 @@ impl App {
             }
         }
         if let (Source::Model(model), Some(view)) = (&self.source, self.drawn_view)
-            && self.settings.curves
+            && self.settings.render.curves
             && self.curves.running.is_none()
             && self.curves.shown != Some(view)
         {
@@ -214,6 +271,11 @@ impl App {
             });
             self.curves.running = Some(rx);
         }
+        Ok(())
+    }
+
+    /// The outcome of a build or a view search running in the background, when done.
+    fn poll_jobs(&mut self) {
         if let Some(rx) = &self.build
             && let Ok(outcome) = rx.try_recv()
         {
@@ -235,20 +297,28 @@ impl App {
                         "view search: {:.2} of the curves in view (was {:.2})",
                         found.visible_curve_share, found.start_share
                     );
-                    state.window.request_redraw();
+                    if let Some(state) = &self.state {
+                        state.window.request_redraw();
+                    }
                 }
                 Err(e) => self.note = e,
             }
         }
-        // The stipples: made once, in the background; shaded until they are ready, and
-        // back to shaded, the reason in the title, where the source has no 4D mesh.
-        let stippled = self.settings.style == Style::Stipple;
+    }
+
+    /// The stipples: made once, in the background; shaded until they are ready, and back to
+    /// shaded, the reason in the title, where the source has no 4D mesh.
+    fn poll_stipples(&mut self) -> Result<(), ViewerError> {
+        let Some(state) = &mut self.state else {
+            return Ok(());
+        };
+        let stippled = self.settings.render.style == Style::Stipple;
         if stippled && !state.renderer.has_stipples() {
             match &self.stipples {
                 None => {
                     let (tx, rx) = channel();
                     let (source, window) = (self.source.clone(), Arc::clone(&state.window));
-                    let st = self.settings.stipple;
+                    let st = self.settings.render.stipple;
                     std::thread::spawn(move || {
                         let _ = tx.send(source.stipples(st.count, st.seed));
                         window.request_redraw();
@@ -262,58 +332,27 @@ impl App {
                             Ok(set) => state.renderer.set_stipples(&state.gpu, &set)?,
                             Err(e) => {
                                 self.note = e.to_string();
-                                self.settings.style = Style::Shaded;
+                                self.settings.render.style = Style::Shaded;
                             }
                         }
                     }
                 }
             }
         }
-        let making = self.settings.style == Style::Stipple && !state.renderer.has_stipples();
-        let frame = match state.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(f)
-            | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
-            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
-                state.surface.configure(&state.gpu.device, &state.config);
-                state.window.request_redraw();
-                return Ok(());
-            }
-            _ => return Ok(()),
+        Ok(())
+    }
+
+    /// The window's title: the settings, the camera, the frame's time, the 4D view.
+    fn title(&self, times: &super::FrameTimes, making: bool) -> String {
+        let Some(state) = &self.state else {
+            return String::new();
         };
-        self.settings.width = state.config.width;
-        self.settings.height = state.config.height;
-        let view = frame.texture.create_view(&Default::default());
-        let drawn = ViewSettings {
-            style: if making {
-                Style::Shaded
-            } else {
-                self.settings.style
-            },
-            ..self.settings
-        };
-        let times = match state.renderer.render(&state.gpu, &view, &drawn) {
-            Ok(times) => times,
-            // A setting this GPU cannot do (a grid too large, say): back to the last one
-            // that rendered, with the reason in the title; anything else ends the viewer.
-            Err(e @ (ViewerError::TooLarge { .. } | ViewerError::Setting(_))) => {
-                self.settings = ViewSettings {
-                    width: self.settings.width,
-                    height: self.settings.height,
-                    ..self.last_good
-                };
-                state.window.set_title(&format!("halo4d-view: {e}"));
-                return Ok(());
-            }
-            Err(e) => return Err(e),
-        };
-        state.gpu.queue.present(frame);
-        self.last_good = self.settings;
-        self.last_ms = times.frame_ms;
         let s = &self.settings;
-        let placement = state
-            .renderer
-            .asset()
-            .placement(&s.camera, s.width, s.height);
+        let placement =
+            state
+                .renderer
+                .asset()
+                .placement(&s.camera, s.render.width, s.render.height);
         let on = |b: bool| if b { "on" } else { "off" };
         let four = match self.drawn_view {
             None if self.note.is_empty() => String::new(),
@@ -328,28 +367,32 @@ impl App {
                 } else {
                     format!(" | {}", self.note)
                 },
-                if !s.curves || self.curves.shown == Some(v) {
+                if !s.render.curves || self.curves.shown == Some(v) {
                     "settled"
                 } else {
                     "computing the curves"
                 }
             ),
         };
-        state.window.set_title(&format!(
+        format!(
             "halo4d-view: {} | {} | {} {} slices | {} spp | halos {} | curves {} | silhouettes {} | {} | colour {} | azimuth {:.0} elevation {:.0} distance {:.2}{} | {:.1} ms{}{four}",
             self.source.name(),
-            match (s.style, making) {
+            match (s.render.style, making) {
                 (Style::Shaded, _) => "shaded",
                 (Style::Stipple, false) => "stipples",
                 (Style::Stipple, true) => "making the stipples",
             },
             s.mode.name(),
-            s.slices,
-            s.samples,
-            on(s.halos),
-            on(s.curves),
-            on(s.silhouettes),
-            if s.transparent { "transparent" } else { "opaque" },
+            s.render.slices,
+            s.render.samples,
+            on(s.render.halos),
+            on(s.render.curves),
+            on(s.render.silhouettes),
+            if s.transparent {
+                "transparent"
+            } else {
+                "opaque"
+            },
             if s.colour_by_w { "by w" } else { "grey" },
             s.camera.azimuth,
             s.camera.elevation,
@@ -359,8 +402,7 @@ impl App {
             times
                 .grid_ms
                 .map_or_else(String::new, |g| format!(" (grid built in {g:.0} ms)")),
-        ));
-        Ok(())
+        )
     }
 
     /// Applies a key; whether it changed anything.
@@ -375,8 +417,8 @@ impl App {
                 "q" => event_loop.exit(),
                 "r" => s.camera = self.initial.camera,
                 "s" => {
-                    let i = SLICE_COUNTS.iter().position(|&n| n == s.slices);
-                    s.slices = SLICE_COUNTS[i.map_or(0, |i| (i + 1) % SLICE_COUNTS.len())];
+                    let i = SLICE_COUNTS.iter().position(|&n| n == s.render.slices);
+                    s.render.slices = SLICE_COUNTS[i.map_or(0, |i| (i + 1) % SLICE_COUNTS.len())];
                 }
                 "m" => {
                     s.mode = match s.mode {
@@ -384,13 +426,13 @@ impl App {
                         HaloMode::View => HaloMode::Grid,
                     }
                 }
-                "h" => s.halos = !s.halos,
-                "c" => s.curves = !s.curves,
-                "o" => s.silhouettes = !s.silhouettes,
+                "h" => s.render.halos = !s.render.halos,
+                "c" => s.render.curves = !s.render.curves,
+                "o" => s.render.silhouettes = !s.render.silhouettes,
                 "t" => s.transparent = !s.transparent,
                 "w" => s.colour_by_w = !s.colour_by_w,
                 "d" => {
-                    s.style = match s.style {
+                    s.render.style = match s.render.style {
                         Style::Shaded => Style::Stipple,
                         Style::Stipple => Style::Shaded,
                     }
@@ -538,8 +580,8 @@ impl App {
         let asset = state.renderer.asset();
         let (camera, width, height) = (
             &self.settings.camera,
-            self.settings.width,
-            self.settings.height,
+            self.settings.render.width,
+            self.settings.render.height,
         );
         let placement = asset.placement(camera, width, height);
         let Ok(camera) = crate::render::camera::Camera::new(camera, &placement, width, height, 0.0)
@@ -651,7 +693,7 @@ impl ApplicationHandler for App {
                     let from = state
                         .renderer
                         .asset()
-                        .placement(&s.camera, s.width, s.height)
+                        .placement(&s.camera, s.render.width, s.render.height)
                         .distance;
                     self.settings.camera.distance =
                         Some((from * 0.9f64.powf(steps)).clamp(0.2, 50.0));

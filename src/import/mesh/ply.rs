@@ -1,4 +1,9 @@
 //! PLY 1.0 with `x y z w` vertex properties: ascii and both binary byte orders.
+//!
+//! Read by hand rather than with `ply-rs` (0.1.3, with which the tests read halo4d's own PLY
+//! files back): `ply-rs` keeps every element as a map from property name to value (a map per
+//! vertex, where halo4d keeps four numbers) and its binary errors name no byte offset, while
+//! a mesh file's error here names the line or the byte, as the other formats' do.
 
 use super::*;
 

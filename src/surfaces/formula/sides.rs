@@ -160,6 +160,63 @@ pub(super) fn topology(kinds: [Kind; 4]) -> Topology {
     }
 }
 
+/// Points compared along each pair of sides.
+const SIDE_SAMPLES: usize = 16;
+
+impl super::Formula {
+    /// What the open sides of the rectangle would be glued by, where they meet: for u and
+    /// for v whose two sides are both open, the points along them compared at
+    /// [`SIDE_SAMPLES`] + 1 values of the other parameter; equal (within 1e-9 of the largest
+    /// coordinate there) they meet as `periodic`, equal with the other parameter reversed
+    /// as `flip`. Gives a warning for each: such a surface builds as an open one, its
+    /// boundary edges and curve ends where the sides meet.
+    pub fn meeting_sides(&self) -> Vec<String> {
+        use crate::surfaces::Parametric;
+        let kinds = self.kinds();
+        let d = self.domain(0);
+        let mut out = Vec::new();
+        for (along_u, key, [lo, hi], [a, b]) in [(true, "u", d.u, d.v), (false, "v", d.v, d.u)] {
+            let (k0, k1) = if along_u {
+                (kinds[0], kinds[1])
+            } else {
+                (kinds[2], kinds[3])
+            };
+            if k0 != Kind::Open || k1 != Kind::Open {
+                continue;
+            }
+            let at = |side: f64, t: f64| {
+                if along_u {
+                    self.point(0, side, t)
+                } else {
+                    self.point(0, t, side)
+                }
+            };
+            let ts: Vec<f64> = (0..=SIDE_SAMPLES)
+                .map(|k| a + (b - a) * k as f64 / SIDE_SAMPLES as f64)
+                .collect();
+            let meets = |reversed: bool| {
+                ts.iter().all(|&t| {
+                    let (p, q) = (at(lo, t), at(hi, if reversed { a + b - t } else { t }));
+                    let scale = p.abs().max(q.abs()).max_element().max(1.0);
+                    (p - q).abs().max_element() <= 1e-9 * scale
+                })
+            };
+            let rule = if meets(false) {
+                "periodic"
+            } else if meets(true) {
+                "flip"
+            } else {
+                continue;
+            };
+            out.push(format!(
+                "its sides {key} = {lo} and {key} = {hi} meet point for point{}, but are open: it builds as a surface with a boundary there (boundary edges, curves that end on it); `\"sides\": {{\"{key}\": \"{rule}\"}}` glues them",
+                if rule == "flip" { ", the other parameter reversed" } else { "" }
+            ));
+        }
+        out
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
