@@ -339,6 +339,26 @@ impl Scene {
                     continue;
                 }
             };
+            if let Sampling::Adaptive {
+                absolute_tolerance: Some(tolerance),
+                ..
+            } = *sampling
+            {
+                // Relative to the surface's size, as `tolerance` is bounded: far below, the
+                // mesh's error is rounding and the sampler fills its budget for nothing.
+                let diagonal = crate::sample::bounding_diagonal(surface);
+                let lowest = *crate::limits::RELATIVE_TOLERANCE.start() * diagonal;
+                if tolerance < lowest {
+                    return Err(FieldError::new(
+                        format!("{field}.absolute_tolerance"),
+                        format!(
+                            "{tolerance:e} is {:.1e} of the surface's 4D diagonal ({diagonal:.3}), below the {:e} of it where the mesh's error is rounding; ask for at least {lowest:.1e}, or give `tolerance` relative to the diagonal",
+                            tolerance / diagonal,
+                            crate::limits::RELATIVE_TOLERANCE.start()
+                        ),
+                    ));
+                }
+            }
             if let Sampling::Uniform { u, v } = *sampling {
                 let [min_u, min_v] = surface.min_cells();
                 if u < min_u || v < min_v {
