@@ -341,13 +341,43 @@ impl FieldError {
     }
 
     /// The same failure seen from the value that holds the checked one at `parent`: the
-    /// field `u` of `sampling` becomes `sampling.u`.
+    /// field `u` of `sampling` becomes `sampling.u`, the field `[1].normal` of `clip`
+    /// becomes `clip[1].normal`.
     pub fn within(self, parent: &str) -> Self {
-        FieldError {
-            field: format!("{parent}.{}", self.field),
-            ..self
+        let field = if self.field.is_empty() {
+            parent.to_string()
+        } else if self.field.starts_with('[') {
+            format!("{parent}{}", self.field)
+        } else {
+            format!("{parent}.{}", self.field)
+        };
+        FieldError { field, ..self }
+    }
+
+    /// A failure that serde reports at `path` (serde_path_to_error's path, `.` at the top)
+    /// with `message`. A value that reads its own fields in its `Deserialize` (a surface, a
+    /// formula, a mesh file's settings) reports a failure of one of them as a
+    /// [`FieldError`]'s text, `x: message`, which serde carries as its message: that field
+    /// joins `path`, so that the error names `surfaces[0].surface.x` as the checks do. Any
+    /// other message stays at `path`.
+    pub fn from_serde(path: &str, message: &str) -> FieldError {
+        let at = |field: &str, message: &str| {
+            let e = FieldError::new(field, message);
+            if path == "." { e } else { e.within(path) }
+        };
+        match message.split_once(": ") {
+            Some((field, rest)) if is_path(field) => at(field, rest),
+            _ => at("", message),
         }
     }
+}
+
+/// Whether `s` is a field's path as [`FieldError`] and serde_path_to_error write it
+/// (`x`, `sides.u_min`, `u[0]`, `[1].normal`): serde's own messages begin with words.
+fn is_path(s: &str) -> bool {
+    s.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_' || c == '[')
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_.[]".contains(c))
 }
 
 impl fmt::Display for FieldError {
@@ -521,6 +551,33 @@ mod tests {
             .within("sampling")
             .within("surfaces[0]");
         assert_eq!(e.to_string(), "surfaces[0].sampling.u: must be even");
+        let e = FieldError::new("[1].normal", "must be three numbers").within("clip");
+        assert_eq!(e.field, "clip[1].normal");
+    }
+
+    #[test]
+    fn a_nested_value_s_failure_joins_serde_s_path() {
+        let text = FieldError::new("x", "cannot read the formula at character 7: unmatched `)`")
+            .to_string();
+        assert_eq!(
+            FieldError::from_serde("surfaces[0].surface", &text).to_string(),
+            "surfaces[0].surface.x: cannot read the formula at character 7: unmatched `)`"
+        );
+        let e = FieldError::from_serde("surfaces[0].surface", "v[1]: not u or v");
+        assert_eq!(e.field, "surfaces[0].surface.v[1]");
+        for message in [
+            "invalid type: string \"a\", expected f64",
+            "missing field `w`",
+            "unknown field `a: b`, expected `x`",
+        ] {
+            let e = FieldError::from_serde("surfaces[0].surface", message);
+            assert_eq!(
+                (e.field.as_str(), e.message.as_str()),
+                ("surfaces[0].surface", message)
+            );
+        }
+        assert_eq!(FieldError::from_serde(".", "x: bad").field, "x");
+        assert_eq!(FieldError::from_serde(".", "trailing characters").field, "");
     }
 
     #[test]

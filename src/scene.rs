@@ -221,23 +221,28 @@ impl Scene {
     /// Parses and validates scene text; `file` names it in errors, and its folder is where
     /// the paths of mesh files start.
     pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
-        let syntax = |field: String, inner: serde_json::Error| SceneError::Syntax {
-            file: file.to_string(),
-            field,
-            message: strip_position(&inner.to_string()),
-            line: inner.line(),
-            column: inner.column(),
+        // A surface's own field joins the path (`surfaces[0].surface.x`), as its checks
+        // name it.
+        let syntax = |path: &str, inner: serde_json::Error| {
+            let FieldError { field, message } =
+                FieldError::from_serde(path, &strip_position(&inner.to_string()));
+            SceneError::Syntax {
+                file: file.to_string(),
+                field,
+                message,
+                line: inner.line(),
+                column: inner.column(),
+            }
         };
         let mut de = serde_json::Deserializer::from_str(text);
         let mut scene: Scene = serde_path_to_error::deserialize(&mut de).map_err(|e| {
-            let field = match e.path().to_string() {
+            let path = match e.path().to_string() {
                 p if p == "." => "(top level)".to_string(),
                 p => p,
             };
-            syntax(field, e.into_inner())
+            syntax(&path, e.into_inner())
         })?;
-        de.end()
-            .map_err(|e| syntax("(after the scene)".into(), e))?;
+        de.end().map_err(|e| syntax("(after the scene)", e))?;
         let folder = Path::new(file).parent().unwrap_or(Path::new(""));
         let invalid = |FieldError { field, message }| SceneError::Invalid {
             file: file.to_string(),
