@@ -9,7 +9,7 @@ use crate::animation::Animation;
 use crate::halo::HaloParams;
 use crate::intersect::CurveSettings;
 use crate::limits::shorten;
-use crate::limits::{FieldError, NAME_LENGTH, SURFACES, TRIANGLES};
+use crate::limits::{FieldError, NAME_LENGTH, SURFACES, TRIANGLES, TUBE_RADIUS};
 use crate::render::{CameraSettings, RenderSettings};
 use crate::sample::{Sampling, Source};
 use crate::view::View;
@@ -132,16 +132,7 @@ impl Outputs {
                 "halo files (glb, vtk) are always verified; remove `verify: false`, or set `glb` and `vtk` to false",
             ));
         }
-        if !(self.curve_radius.is_finite() && self.curve_radius > 0.0 && self.curve_radius <= 0.05)
-        {
-            return Err(FieldError::new(
-                "curve_radius",
-                format!(
-                    "must be greater than 0 and at most 0.05 (a share of the scene's diagonal), got {}",
-                    self.curve_radius
-                ),
-            ));
-        }
+        TUBE_RADIUS.check("curve_radius", self.curve_radius)?;
         Ok(())
     }
 }
@@ -291,17 +282,7 @@ impl Scene {
     /// Checks every value; names the first bad field.
     pub fn validate(&self) -> Result<(), FieldError> {
         check_name(&self.name).map_err(|m| FieldError::new("name", m))?;
-        if !SURFACES.contains(&self.surfaces.len()) {
-            return Err(FieldError::new(
-                "surfaces",
-                format!(
-                    "must list {} to {} surfaces, got {}",
-                    SURFACES.start(),
-                    SURFACES.end(),
-                    self.surfaces.len()
-                ),
-            ));
-        }
+        SURFACES.check("surfaces", self.surfaces.len())?;
         self.sampling.check().map_err(|e| e.within("sampling"))?;
         let mut names = Vec::new();
         let mut triangles = 0usize;
@@ -361,12 +342,12 @@ impl Scene {
                 triangles = triangles.saturating_add(sampling.max_triangles(surface.patch_count()));
             }
         }
-        if triangles > *TRIANGLES.end() {
+        if triangles > TRIANGLES.hi {
             return Err(FieldError::new(
                 "sampling",
                 format!(
                     "the scene's grids and mesh files make {triangles} triangles, more than the limit of {}; lower u and v",
-                    TRIANGLES.end()
+                    TRIANGLES.hi
                 ),
             ));
         }
@@ -384,7 +365,7 @@ impl Scene {
 }
 
 fn check_name(name: &str) -> Result<(), String> {
-    let ok = NAME_LENGTH.contains(&name.len())
+    let ok = NAME_LENGTH.contains(name.len())
         && !name.starts_with('.')
         && name
             .chars()
@@ -393,9 +374,8 @@ fn check_name(name: &str) -> Result<(), String> {
         Ok(())
     } else {
         Err(format!(
-            "`{name}` is not a usable name: use {} to {} letters, digits, `-`, `_` or `.`, not starting with `.`",
-            NAME_LENGTH.start(),
-            NAME_LENGTH.end()
+            "`{name}` is not a usable name: use {} letters, digits, `-`, `_` or `.`, not starting with `.`",
+            NAME_LENGTH.range_words()
         ))
     }
 }

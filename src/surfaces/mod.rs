@@ -508,15 +508,3 @@ impl Surface {
         dispatch!(self, s => s.check())
     }
 }
-
-/// Checks that a parameter is finite and positive.
-pub(crate) fn positive(field: &'static str, x: f64) -> Result<(), FieldError> {
-    if x.is_finite() && x > 0.0 {
-        Ok(())
-    } else {
-        Err(FieldError::new(
-            field,
-            format!("must be a finite number greater than 0, got {x}"),
-        ))
-    }
-}
