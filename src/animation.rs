@@ -30,7 +30,7 @@
 //! whole turn plays round without a repeated frame. After the last key of a number the path
 //! keeps its value.
 
-use crate::limits::{ANIMATION_FRAMES, FPS, FieldError, KEYFRAMES};
+use crate::limits::{ANIMATION_FRAMES, Bound, FPS, FieldError, KEYFRAME_TIME, KEYFRAMES};
 use crate::render::{CameraProjection, CameraSettings};
 use crate::view::{Projection, View};
 use serde::{Deserialize, Serialize};
@@ -278,57 +278,27 @@ impl Animation {
     /// keyframes' times and values, and every frame's view and camera. Names the first bad
     /// field (`keyframes[2].camera.elevation`).
     pub fn check(&self, view: &View, camera: &CameraSettings) -> Result<(), FieldError> {
-        if !ANIMATION_FRAMES.contains(&self.frames) {
-            return Err(FieldError::new(
-                "frames",
-                format!(
-                    "must be {} to {} frames, got {}",
-                    ANIMATION_FRAMES.start(),
-                    ANIMATION_FRAMES.end(),
-                    self.frames
-                ),
-            ));
-        }
-        if !FPS.contains(&self.fps) {
-            return Err(FieldError::new(
-                "fps",
-                format!(
-                    "must be {} to {} frames per second, got {}",
-                    FPS.start(),
-                    FPS.end(),
-                    self.fps
-                ),
-            ));
-        }
-        if !KEYFRAMES.contains(&self.keyframes.len()) {
-            return Err(FieldError::new(
-                "keyframes",
-                format!(
-                    "must list {} to {} keyframes, got {}",
-                    KEYFRAMES.start(),
-                    KEYFRAMES.end(),
-                    self.keyframes.len()
-                ),
-            ));
-        }
+        ANIMATION_FRAMES.check("frames", self.frames)?;
+        FPS.check("fps", self.fps)?;
+        KEYFRAMES.check("keyframes", self.keyframes.len())?;
         for (i, key) in self.keyframes.iter().enumerate() {
             let field = |name: &str| format!("keyframes[{i}].{name}");
-            if !(key.time.is_finite() && (0.0..=1.0).contains(&key.time)) {
-                return Err(FieldError::new(
-                    field("time"),
-                    format!("must be in [0, 1], got {}", key.time),
-                ));
-            }
-            if i > 0 && key.time <= self.keyframes[i - 1].time {
-                return Err(FieldError::new(
-                    field("time"),
-                    format!(
-                        "must be later than keyframes[{}]'s time {}, got {}; list the keyframes in order of time",
-                        i - 1,
-                        self.keyframes[i - 1].time,
-                        key.time
+            KEYFRAME_TIME.check(&field("time"), key.time)?;
+            if i > 0 {
+                let before = self.keyframes[i - 1].time;
+                Bound {
+                    lo: before,
+                    lo_included: false,
+                    ..KEYFRAME_TIME
+                }
+                .check_with(
+                    &field("time"),
+                    key.time,
+                    &format!(
+                        "later than keyframes[{}]'s time; list the keyframes in order of time",
+                        i - 1
                     ),
-                ));
+                )?;
             }
             if let Some(p) = key.view.projection
                 && std::mem::discriminant(&p) != std::mem::discriminant(&view.projection)

@@ -28,7 +28,7 @@
 //! are counted. Vertices are rounded to f32, what the files store, before they are checked.
 
 use crate::check::{CheckStats, TetMesh, check_parts};
-use crate::limits::{FieldError, MAX_GAP_PX};
+use crate::limits::{DELTA_D, DELTA_T, FieldError, HALO_GAP_PX, HALO_RHO, Number};
 use crate::tets::{self, Corners, Split, SplitStats};
 use crate::view::Projected;
 use glam::DVec3;
@@ -84,14 +84,6 @@ impl Default for HaloParams {
     }
 }
 
-/// The smallest `rho`, a share of the scene's diagonal: f32, which the files store,
-/// resolves about 6e-8 of it, and the halo needs its two offsets apart.
-pub const MIN_RHO: f64 = 1e-6;
-
-/// The largest `rho`, a share of the scene's diagonal (so that a halo is thinner than the
-/// scene it hides parts of).
-pub const MAX_RHO: f64 = 0.49;
-
 /// The gap a halo cuts on each side of a crossing, in pixels of the scene's picture, when a
 /// scene gives neither `halo.rho` nor `halo.gap_px`: wide enough to read at a glance beside
 /// a curve line of the default width (2.5 px).
@@ -100,12 +92,12 @@ pub const DEFAULT_GAP_PX: f64 = 8.0;
 impl HaloParams {
     /// The halo's half-width in scene units, for a projected scene of bounding `diagonal`
     /// whose picture has pixels of side `pixel_size` (scene units) at the depth the camera
-    /// looks at; no larger than `halo::MAX_RHO` of the diagonal.
+    /// looks at; within [`HALO_RHO`] of the diagonal.
     pub fn half_width(&self, diagonal: f64, pixel_size: f64) -> f64 {
         match self.rho {
             Some(rho) => rho * diagonal,
             None => (self.gap_px.unwrap_or(DEFAULT_GAP_PX) * pixel_size)
-                .clamp(MIN_RHO * diagonal, MAX_RHO * diagonal),
+                .clamp(HALO_RHO.lo * diagonal, HALO_RHO.hi * diagonal),
         }
     }
 
@@ -117,39 +109,21 @@ impl HaloParams {
                 "give one of halo.rho (a share of the scene's diagonal) and halo.gap_px (pixels of the picture), not both".to_string(),
             ));
         }
-        if let Some(rho) = self.rho
-            && !(rho.is_finite() && (MIN_RHO..=MAX_RHO).contains(&rho))
-        {
-            return Err(FieldError::new(
+        if let Some(rho) = self.rho {
+            HALO_RHO.check_with(
                 "rho",
-                format!(
-                    "must be greater than 0: at least {MIN_RHO:e} (below that the two offsets round to one point in f32, which the files store), and at most {MAX_RHO} (a share of the scene's diagonal), got {rho:?}"
+                rho,
+                &format!(
+                    "below {} the two offsets round to one point in f32, which the files store",
+                    HALO_RHO.lo.text()
                 ),
-            ));
+            )?;
         }
-        if let Some(gap) = self.gap_px
-            && !(gap.is_finite() && gap > 0.0 && gap <= MAX_GAP_PX)
-        {
-            return Err(FieldError::new(
-                "gap_px",
-                format!("must be more than 0 and at most {MAX_GAP_PX} pixels, got {gap:?}"),
-            ));
+        if let Some(gap) = self.gap_px {
+            HALO_GAP_PX.check("gap_px", gap)?;
         }
-        if !(self.delta_d.is_finite() && self.delta_d >= 0.0) {
-            return Err(FieldError::new(
-                "delta_d",
-                format!(
-                    "must be a finite number of at least 0, got {}",
-                    self.delta_d
-                ),
-            ));
-        }
-        if !(self.delta_t.is_finite() && (0.0..1.0).contains(&self.delta_t)) {
-            return Err(FieldError::new(
-                "delta_t",
-                format!("must be in [0, 1), got {}", self.delta_t),
-            ));
-        }
+        DELTA_D.check("delta_d", self.delta_d)?;
+        DELTA_T.check("delta_t", self.delta_t)?;
         Ok(())
     }
 }

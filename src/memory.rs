@@ -7,6 +7,8 @@
 //! The limit is `HALO4D_MAX_MEMORY` (gigabytes) when set, else three quarters of this
 //! machine's memory (`MemTotal` of `/proc/meminfo`), else 16 GB where that cannot be read.
 
+use crate::limits::MAX_MEMORY;
+
 /// Bytes in a gigabyte, as the limit and the messages count them.
 pub const GB: f64 = 1e9;
 
@@ -20,12 +22,16 @@ pub const BUILD_BYTES_PER_TRIANGLE: f64 = 1100.0;
 /// The limit in bytes, and where it comes from (for messages).
 pub fn limit() -> Result<(f64, &'static str), String> {
     if let Ok(text) = std::env::var("HALO4D_MAX_MEMORY") {
-        return match text.trim().parse::<f64>() {
-            Ok(gb) if gb.is_finite() && gb > 0.0 => Ok((gb * GB, "HALO4D_MAX_MEMORY")),
-            _ => Err(format!(
-                "HALO4D_MAX_MEMORY must be a number of gigabytes greater than 0, got {text:?}"
-            )),
-        };
+        let gb = text.trim().parse::<f64>().map_err(|_| {
+            format!(
+                "HALO4D_MAX_MEMORY: {text:?} is not a number; give {}",
+                MAX_MEMORY.words()
+            )
+        })?;
+        MAX_MEMORY
+            .check("HALO4D_MAX_MEMORY", gb)
+            .map_err(|e| e.to_string())?;
+        return Ok((gb * GB, "HALO4D_MAX_MEMORY"));
     }
     let total = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
         let line = m.lines().find(|l| l.starts_with("MemTotal:"))?;

@@ -9,7 +9,7 @@ use crate::animation::Animation;
 use crate::halo::HaloParams;
 use crate::intersect::CurveSettings;
 use crate::limits::shorten;
-use crate::limits::{FieldError, NAME_LENGTH, SURFACES, TRIANGLES};
+use crate::limits::{FieldError, NAME_LENGTH, SURFACES, TRIANGLES, TUBE_RADIUS};
 use crate::render::{CameraSettings, RenderSettings};
 use crate::sample::{Sampling, Source};
 use crate::view::View;
@@ -132,16 +132,7 @@ impl Outputs {
                 "halo files (glb, vtk) are always verified; remove `verify: false`, or set `glb` and `vtk` to false",
             ));
         }
-        if !(self.curve_radius.is_finite() && self.curve_radius > 0.0 && self.curve_radius <= 0.05)
-        {
-            return Err(FieldError::new(
-                "curve_radius",
-                format!(
-                    "must be greater than 0 and at most 0.05 (a share of the scene's diagonal), got {}",
-                    self.curve_radius
-                ),
-            ));
-        }
+        TUBE_RADIUS.check("curve_radius", self.curve_radius)?;
         Ok(())
     }
 }
@@ -221,23 +212,28 @@ impl Scene {
     /// Parses and validates scene text; `file` names it in errors, and its folder is where
     /// the paths of mesh files start.
     pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
-        let syntax = |field: String, inner: serde_json::Error| SceneError::Syntax {
-            file: file.to_string(),
-            field,
-            message: strip_position(&inner.to_string()),
-            line: inner.line(),
-            column: inner.column(),
+        // A surface's own field joins the path (`surfaces[0].surface.x`), as its checks
+        // name it.
+        let syntax = |path: &str, inner: serde_json::Error| {
+            let FieldError { field, message } =
+                FieldError::from_serde(path, &strip_position(&inner.to_string()));
+            SceneError::Syntax {
+                file: file.to_string(),
+                field,
+                message,
+                line: inner.line(),
+                column: inner.column(),
+            }
         };
         let mut de = serde_json::Deserializer::from_str(text);
         let mut scene: Scene = serde_path_to_error::deserialize(&mut de).map_err(|e| {
-            let field = match e.path().to_string() {
+            let path = match e.path().to_string() {
                 p if p == "." => "(top level)".to_string(),
                 p => p,
             };
-            syntax(field, e.into_inner())
+            syntax(&path, e.into_inner())
         })?;
-        de.end()
-            .map_err(|e| syntax("(after the scene)".into(), e))?;
+        de.end().map_err(|e| syntax("(after the scene)", e))?;
         let folder = Path::new(file).parent().unwrap_or(Path::new(""));
         let invalid = |FieldError { field, message }| SceneError::Invalid {
             file: file.to_string(),
@@ -286,17 +282,7 @@ impl Scene {
     /// Checks every value; names the first bad field.
     pub fn validate(&self) -> Result<(), FieldError> {
         check_name(&self.name).map_err(|m| FieldError::new("name", m))?;
-        if !SURFACES.contains(&self.surfaces.len()) {
-            return Err(FieldError::new(
-                "surfaces",
-                format!(
-                    "must list {} to {} surfaces, got {}",
-                    SURFACES.start(),
-                    SURFACES.end(),
-                    self.surfaces.len()
-                ),
-            ));
-        }
+        SURFACES.check("surfaces", self.surfaces.len())?;
         self.sampling.check().map_err(|e| e.within("sampling"))?;
         let mut names = Vec::new();
         let mut triangles = 0usize;
@@ -347,14 +333,14 @@ impl Scene {
                 // Relative to the surface's size, as `tolerance` is bounded: far below, the
                 // mesh's error is rounding and the sampler fills its budget for nothing.
                 let diagonal = crate::sample::bounding_diagonal(surface);
-                let lowest = *crate::limits::RELATIVE_TOLERANCE.start() * diagonal;
+                let lowest = crate::limits::RELATIVE_TOLERANCE.lo * diagonal;
                 if tolerance < lowest {
                     return Err(FieldError::new(
                         format!("{field}.absolute_tolerance"),
                         format!(
                             "{tolerance:e} is {:.1e} of the surface's 4D diagonal ({diagonal:.3}), below the {:e} of it where the mesh's error is rounding; ask for at least {lowest:.1e}, or give `tolerance` relative to the diagonal",
                             tolerance / diagonal,
-                            crate::limits::RELATIVE_TOLERANCE.start()
+                            crate::limits::RELATIVE_TOLERANCE.lo
                         ),
                     ));
                 }
@@ -376,12 +362,12 @@ impl Scene {
                 triangles = triangles.saturating_add(sampling.max_triangles(surface.patch_count()));
             }
         }
-        if triangles > *TRIANGLES.end() {
+        if triangles > TRIANGLES.hi {
             return Err(FieldError::new(
                 "sampling",
                 format!(
                     "the scene's grids and mesh files make {triangles} triangles, more than the limit of {}; lower u and v",
-                    TRIANGLES.end()
+                    TRIANGLES.hi
                 ),
             ));
         }
@@ -399,7 +385,7 @@ impl Scene {
 }
 
 fn check_name(name: &str) -> Result<(), String> {
-    let ok = NAME_LENGTH.contains(&name.len())
+    let ok = NAME_LENGTH.contains(name.len())
         && !name.starts_with('.')
         && name
             .chars()
@@ -408,9 +394,8 @@ fn check_name(name: &str) -> Result<(), String> {
         Ok(())
     } else {
         Err(format!(
-            "`{name}` is not a usable name: use {} to {} letters, digits, `-`, `_` or `.`, not starting with `.`",
-            NAME_LENGTH.start(),
-            NAME_LENGTH.end()
+            "`{name}` is not a usable name: use {} letters, digits, `-`, `_` or `.`, not starting with `.`",
+            NAME_LENGTH.range_words()
         ))
     }
 }

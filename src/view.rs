@@ -12,7 +12,7 @@
 //! the w-depth of a vertex is its w after rotation and translation: smaller is nearer the
 //! eye. A point at or behind the eye is an error, never a NaN.
 
-use crate::limits::FieldError;
+use crate::limits::{EYE_DISTANCE, FINITE, FieldError};
 use crate::sample::Mesh4;
 use crate::surfaces::{Eval4, Jet};
 use glam::{DMat4, DVec3, DVec4};
@@ -302,28 +302,13 @@ impl View {
     /// Checks the numbers: names the first bad field.
     pub fn check(&self) -> Result<(), FieldError> {
         for (name, deg) in self.rotation.planes() {
-            if !deg.is_finite() {
-                return Err(FieldError::new(
-                    format!("rotation.{name}"),
-                    format!("must be a finite angle in degrees, got {deg}"),
-                ));
-            }
+            FINITE.check(&format!("rotation.{name}"), deg)?;
         }
-        for (i, t) in self.translation.iter().enumerate() {
-            if !t.is_finite() {
-                return Err(FieldError::new(
-                    format!("translation[{i}]"),
-                    format!("must be finite, got {t}"),
-                ));
-            }
+        for (i, &t) in self.translation.iter().enumerate() {
+            FINITE.check(&format!("translation[{i}]"), t)?;
         }
-        if let Projection::Perspective { eye_distance } = self.projection
-            && !(eye_distance.is_finite() && eye_distance > 0.0)
-        {
-            return Err(FieldError::new(
-                "projection.eye_distance",
-                format!("must be a finite number greater than 0, got {eye_distance}"),
-            ));
+        if let Projection::Perspective { eye_distance } = self.projection {
+            EYE_DISTANCE.check("projection.eye_distance", eye_distance)?;
         }
         Ok(())
     }

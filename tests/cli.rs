@@ -202,7 +202,8 @@ fn sweep_writes_csv_and_plot_for_a_scene() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
-        err.contains("--max-triangles: 64") && err.contains("`fermat`") && err.contains("512"),
+        err.contains("--max-triangles: must be 512 to 20000000 triangles, got 64")
+            && err.contains("the coarsest grid of `fermat`"),
         "{err}"
     );
 }

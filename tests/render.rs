@@ -619,7 +619,10 @@ fn a_picture_beyond_the_memory_limit_is_refused_before_it_allocates() {
     assert!(!dir.path().join("p.png").exists());
     let out = run("abc", "exact");
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("HALO4D_MAX_MEMORY must be a number"), "{err}");
+    assert!(
+        err.contains("HALO4D_MAX_MEMORY: \"abc\" is not a number"),
+        "{err}"
+    );
     let out = run("0.3", "exact");
     assert!(
         out.status.success(),

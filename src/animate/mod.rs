@@ -32,7 +32,7 @@ pub use assemble::{Assembled, Status, assemble, status};
 
 use crate::error::Error;
 use crate::export;
-use crate::limits::FieldError;
+use crate::limits::{Bound, FieldError, SHARDS};
 use crate::pipeline::{self, Sampled, Stages, Timings};
 use crate::render::CameraSettings;
 use crate::scene::Scene;
@@ -90,15 +90,17 @@ impl FromStr for Shard {
             i.trim().parse().map_err(|_| usage())?,
             n.trim().parse().map_err(|_| usage())?,
         );
-        if count == 0 {
-            return Err(format!("`{s}`: the number of shards N must be at least 1"));
-        }
-        if index >= count {
-            return Err(format!(
-                "`{s}`: the index must be below the number of shards, 0 to {}",
-                count - 1
-            ));
-        }
+        let shown = crate::limits::shorten(s);
+        SHARDS
+            .check("N", count)
+            .and_then(|()| {
+                Bound::closed(0, count - 1, "").check_with(
+                    "I",
+                    index,
+                    "the index counts from 0, below the number of shards N",
+                )
+            })
+            .map_err(|e| format!("`{shown}`: {e}"))?;
         Ok(Shard { index, count })
     }
 }

@@ -2,7 +2,7 @@
 //! `halo4d::viewer`).
 
 use clap::Parser;
-use halo4d::limits::FieldError;
+use halo4d::limits::{BENCH_FRAMES, FINITE, FieldError};
 use halo4d::render::{CameraProjection, CameraSettings, Colormap, RenderSettings, Style};
 use halo4d::view::View;
 use halo4d::viewer::{self, Gpu, HaloMode, SLICE_COUNTS, Source, ViewSettings, ViewerError};
@@ -128,9 +128,9 @@ fn parse_rotate(s: &str) -> Result<(String, f64), String> {
         .trim()
         .parse()
         .map_err(|_| format!("`{degrees}` in `{s}` is not a number of degrees"))?;
-    if !degrees.is_finite() {
-        return Err(format!("`{s}`: the angle must be finite"));
-    }
+    FINITE
+        .check("DEGREES", degrees)
+        .map_err(|e| format!("`{s}`: {e}"))?;
     Ok((plane, degrees))
 }
 
@@ -279,12 +279,9 @@ fn bench(
     frames: u32,
     style: Option<Style>,
 ) -> Result<(), ViewerError> {
-    if frames == 0 {
-        return Err(ViewerError::Setting(FieldError::new(
-            "--frames",
-            "must be at least 1",
-        )));
-    }
+    BENCH_FRAMES
+        .check("--frames", frames)
+        .map_err(ViewerError::Setting)?;
     let gpu = Gpu::headless()?;
     let (triangles, tets) = match source {
         Source::Model(m) => (m.triangle_count(), 6 * m.triangle_count()),

@@ -8,7 +8,7 @@
 //! still hide what they hide, so the gaps at the crossings stay. The cut edges, where the
 //! surfaces meet the boundary of the removed region, are drawn as lines.
 
-use crate::limits::FieldError;
+use crate::limits::{FINITE, FieldError};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
@@ -126,12 +126,7 @@ impl Clip {
                     ),
                 ));
             }
-            if !p.offset.is_finite() {
-                return Err(FieldError::new(
-                    format!("{field}.offset").trim_start_matches('.'),
-                    format!("must be a finite number, got {}", p.offset),
-                ));
-            }
+            FINITE.check(format!("{field}.offset").trim_start_matches('.'), p.offset)?;
         }
         Ok(())
     }

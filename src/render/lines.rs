@@ -63,6 +63,7 @@
 //! its ends recede (a line a fifth of the largest width ends about 1.4 sigma before its last
 //! pixel). Along a single line whose width changes slowly the band is exact.
 
+use crate::limits::PICTURE_SIDE;
 use glam::DVec2;
 use rayon::prelude::*;
 use rustfft::num_complex::Complex;
@@ -72,7 +73,7 @@ use std::sync::Arc;
 /// The largest image side accepted, in pixels: a picture's
 /// ([`crate::limits::PICTURE_SIDE`]). Broadening holds about six f32 images of the mask's
 /// size.
-pub const MAX_SIDE: usize = *crate::limits::PICTURE_SIDE.end() as usize;
+pub const MAX_SIDE: usize = PICTURE_SIDE.hi as usize;
 
 /// The farthest a segment's endpoint may lie from the origin, in pixels. Further out, f64
 /// cannot place the clipped segment to a small fraction of a pixel.
@@ -98,7 +99,10 @@ const TASK_SAMPLES: usize = 1 << 16;
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum LinesError {
     /// The image has a side of 0 or more than [`MAX_SIDE`] pixels.
-    #[error("image of {width} x {height} px: each side must be between 1 and {MAX_SIDE} px")]
+    #[error(
+        "image of {width} x {height} px: each side must be {}",
+        PICTURE_SIDE.words()
+    )]
     BadSize {
         /// Requested width.
         width: usize,
@@ -156,7 +160,8 @@ pub struct Mask {
 impl Mask {
     /// An empty mask of `width` × `height` pixels.
     pub fn new(width: usize, height: usize) -> Result<Self, LinesError> {
-        if !(1..=MAX_SIDE).contains(&width) || !(1..=MAX_SIDE).contains(&height) {
+        let side = |n: usize| u32::try_from(n).is_ok_and(|n| PICTURE_SIDE.contains(n));
+        if !side(width) || !side(height) {
             return Err(LinesError::BadSize { width, height });
         }
         Ok(Self {

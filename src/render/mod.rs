@@ -26,8 +26,9 @@ pub(crate) mod trace;
 pub(crate) mod visible;
 
 use crate::limits::{
-    CAMERA_DISTANCE, ELEVATION, EYE_SEPARATION, FOV, FieldError, PICTURE_SIDE, RIBBON_COUNT,
-    RIBBON_GAP, SAMPLES, SLICES,
+    CAMERA_DISTANCE, COLOUR, ELEVATION, EYE_SEPARATION, FINITE, FOV, FieldError, HITHER, OPACITY,
+    PICTURE_SIDE, RIBBON_COUNT, RIBBON_GAP, SLICES, STIPPLE_SIZE, STIPPLES, check_samples,
+    line_width,
 };
 pub use clip::{Clip, ClipPlane};
 pub use compare::Comparison;
@@ -176,8 +177,8 @@ impl StippleSettings {
     /// Checks the size and the count ([`crate::limits::STIPPLE_SIZE`],
     /// [`crate::limits::STIPPLES`]): the renderer's and the explorer's one check.
     pub fn check(&self) -> Result<(), FieldError> {
-        crate::limits::STIPPLE_SIZE.check("size", self.size)?;
-        crate::limits::STIPPLES.check("count", self.count)
+        STIPPLE_SIZE.check("size", self.size)?;
+        STIPPLES.check("count", self.count)
     }
 }
 
@@ -306,61 +307,17 @@ impl Default for RenderSettings {
 impl RenderSettings {
     /// Checks the numbers: names the first bad field.
     pub fn check(&self) -> Result<(), FieldError> {
-        for (field, side) in [("width", self.width), ("height", self.height)] {
-            if !PICTURE_SIDE.contains(&side) {
-                return Err(FieldError::new(
-                    field,
-                    format!(
-                        "must be {} to {} pixels, got {side}",
-                        PICTURE_SIDE.start(),
-                        PICTURE_SIDE.end()
-                    ),
-                ));
-            }
-        }
-        if !SLICES.contains(&self.slices) {
-            return Err(FieldError::new(
-                "slices",
-                format!(
-                    "must be {} to {}, got {}",
-                    SLICES.start(),
-                    SLICES.end(),
-                    self.slices
-                ),
-            ));
-        }
-        if !SAMPLES.contains(&self.samples) {
-            return Err(FieldError::new(
-                "samples",
-                format!(
-                    "must be 1, 4, 9 or 16 (a square grid), got {}",
-                    self.samples
-                ),
-            ));
-        }
+        PICTURE_SIDE.check("width", self.width)?;
+        PICTURE_SIDE.check("height", self.height)?;
+        SLICES.check("slices", self.slices)?;
+        check_samples("samples", self.samples)?;
         self.stipple.check().map_err(|e| e.within("stipple"))?;
-        let unit = |v: f64| v.is_finite() && v > 0.0 && v <= 1.0;
-        if !unit(self.opacity) {
-            return Err(FieldError::new(
-                "opacity",
-                format!("must be in (0, 1], got {}", self.opacity),
-            ));
+        OPACITY.check("opacity", self.opacity)?;
+        if let Some(o) = self.opacity_far {
+            OPACITY.check("opacity_far", o)?;
         }
-        if let Some(o) = self.opacity_far
-            && !unit(o)
-        {
-            return Err(FieldError::new(
-                "opacity_far",
-                format!("must be in (0, 1], got {o}"),
-            ));
-        }
-        if let Some(h) = self.hither
-            && !(h.is_finite() && h >= 0.0)
-        {
-            return Err(FieldError::new(
-                "hither",
-                format!("must be a distance >= 0, got {h}"),
-            ));
+        if let Some(h) = self.hither {
+            HITHER.check("hither", h)?;
         }
         if let Some(r) = self.ribbons {
             RIBBON_COUNT.check("ribbons.count", r.count)?;
@@ -370,20 +327,19 @@ impl RenderSettings {
             c.check().map_err(|e| e.within("clip"))?;
         }
         let side = self.width.min(self.height);
-        let max_width = (f64::from(side) / 4.0).max(0.5);
+        let width = line_width(side);
         for (field, w) in [
             ("line_width", Some(self.line_width)),
             ("line_width_far", self.line_width_far),
         ] {
-            if let Some(w) = w
-                && !(w.is_finite() && w >= 0.5 && w <= max_width)
-            {
-                return Err(FieldError::new(
+            if let Some(w) = w {
+                width.check_with(
                     field,
-                    format!(
-                        "must be 0.5 to {max_width} pixels (at most a quarter of the picture's smaller side, {side} pixels, or 0.5), got {w}: make the lines thinner or the picture larger"
+                    w,
+                    &format!(
+                        "at most a quarter of the picture's smaller side ({side} pixels); make the lines thinner or the picture larger"
                     ),
-                ));
+                )?;
             }
         }
         EYE_SEPARATION.check("eye_separation", self.eye_separation)?;
@@ -391,14 +347,8 @@ impl RenderSettings {
             ("background", Some(self.background)),
             ("broken_edge_colour", self.broken_edge_colour),
         ] {
-            if let Some(c) = colour
-                && c.iter()
-                    .any(|c| !(c.is_finite() && (0.0..=1.0).contains(c)))
-            {
-                return Err(FieldError::new(
-                    field,
-                    format!("must be three numbers in [0, 1], got {c:?}"),
-                ));
+            for (i, &c) in colour.iter().flatten().enumerate() {
+                COLOUR.check(&format!("{field}[{i}]"), c)?;
             }
         }
         Ok(())
@@ -408,23 +358,14 @@ impl RenderSettings {
 impl CameraSettings {
     /// Checks the numbers: names the first bad field.
     pub fn check(&self) -> Result<(), FieldError> {
-        if !self.azimuth.is_finite() {
-            return Err(FieldError::new(
-                "azimuth",
-                format!("must be finite, got {}", self.azimuth),
-            ));
-        }
+        FINITE.check("azimuth", self.azimuth)?;
         ELEVATION.check("elevation", self.elevation)?;
         if let Some(d) = self.distance {
-            CAMERA_DISTANCE.check("distance", d).map_err(|e| {
-                FieldError::new(
-                    e.field,
-                    format!(
-                        "{}; or absent, for a camera fitted to the surfaces",
-                        e.message
-                    ),
-                )
-            })?;
+            CAMERA_DISTANCE.check_with(
+                "distance",
+                d,
+                "or absent, for a camera fitted to the surfaces",
+            )?;
         }
         FOV.check("fov", self.fov)
     }

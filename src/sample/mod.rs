@@ -24,7 +24,7 @@ pub use audit::{AUDIT_POINTS, Audit, audit};
 pub use source::{MeshData4, MeshSurface, Source, mesh_from_data, mesh_tangents, mesh_topology};
 pub use uniform::sample_uniform;
 
-use crate::limits::{FieldError, GRID_CELLS, RELATIVE_TOLERANCE, TRIANGLES};
+use crate::limits::{ABSOLUTE_TOLERANCE, FieldError, GRID_CELLS, RELATIVE_TOLERANCE, TRIANGLES};
 use crate::surfaces::{Eval4, Surface};
 use glam::DVec4;
 use serde::{Deserialize, Serialize};
@@ -112,47 +112,22 @@ impl Sampling {
                         "give either `tolerance` (relative to the bounding diagonal) or `absolute_tolerance`, not both",
                     ));
                 }
-                if let Some(t) = tolerance
-                    && !RELATIVE_TOLERANCE.contains(&t)
-                {
-                    return Err(FieldError::new(
-                        "tolerance",
-                        format!(
-                            "must be from {:?} to {:?} (a share of the 4D bounding diagonal), got {t}",
-                            RELATIVE_TOLERANCE.start(),
-                            RELATIVE_TOLERANCE.end()
-                        ),
-                    ));
+                if let Some(t) = tolerance {
+                    RELATIVE_TOLERANCE.check("tolerance", t)?;
                 }
-                if let Some(a) = absolute_tolerance
-                    && !(a.is_finite() && a > 0.0)
-                {
-                    return Err(FieldError::new(
-                        "absolute_tolerance",
-                        format!("must be a finite length greater than 0, got {a}"),
-                    ));
+                if let Some(a) = absolute_tolerance {
+                    ABSOLUTE_TOLERANCE.check("absolute_tolerance", a)?;
                 }
-                if !TRIANGLES.contains(&max_triangles) {
-                    return Err(FieldError::new(
-                        "max_triangles",
-                        format!(
-                            "must be from {} to {}, got {max_triangles}",
-                            TRIANGLES.start(),
-                            TRIANGLES.end()
-                        ),
-                    ));
-                }
-                Ok(())
+                TRIANGLES.check("max_triangles", max_triangles)
             }
             Sampling::Uniform { u, v } => {
                 for (field, n) in [("u", u), ("v", v)] {
-                    if !GRID_CELLS.contains(&n) || n % 2 != 0 {
+                    GRID_CELLS.check(field, n)?;
+                    if n % 2 != 0 {
                         return Err(FieldError::new(
                             field,
                             format!(
-                                "must be an even number of cells from {} to {} (seams glued at half a side need a node there), got {n}",
-                                GRID_CELLS.start(),
-                                GRID_CELLS.end()
+                                "must be an even number of cells (seams glued at half a side need a node there), got {n}"
                             ),
                         ));
                     }
@@ -210,8 +185,7 @@ pub fn sample(surface: &Surface, sampling: &Sampling) -> Sampled {
 pub fn uniform_error(surface: &Surface, triangles: usize) -> f64 {
     let [min_u, min_v] = surface.min_cells();
     let side = (triangles as f64 / (2 * surface.patch_count().max(1)) as f64).sqrt();
-    let even =
-        |min: usize| ((side / 2.0).round() as usize * 2).clamp(min.max(4), *GRID_CELLS.end());
+    let even = |min: usize| ((side / 2.0).round() as usize * 2).clamp(min.max(4), GRID_CELLS.hi);
     audit(surface, &sample_uniform(surface, even(min_u), even(min_v))).max_error
 }
 

@@ -112,7 +112,7 @@ impl<'de> Deserialize<'de> for Source {
             .map(Source::Mesh)
             .map_err(|e| match e.path().to_string().as_str() {
                 "." => D::Error::custom(e.inner()),
-                path => D::Error::custom(format!("{path}: {}", e.inner())),
+                path => D::Error::custom(FieldError::new(path, e.inner().to_string())),
             })
     }
 }

@@ -5,12 +5,12 @@
 //! f'' by the Cauchy-Riemann equations: ∂u f = f', ∂v f = i f', ∂uu f = f'', ∂uv f = i f'',
 //! ∂vv f = -f''.
 
-use super::{Domain, Eval4, Glue, Jet, Parametric, Side, SideRule, Topology, positive};
-use crate::limits::FieldError;
+use super::{Domain, Eval4, Glue, Jet, Parametric, Side, SideRule, Topology};
+use crate::limits::{FERMAT_N, FERMAT_Y_RANGE, FieldError, PRODUCT_U_RANGE};
 use glam::DVec4;
 use num_complex::Complex64 as C64;
 use serde::{Deserialize, Serialize};
-use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use std::f64::consts::{FRAC_PI_2, TAU};
 
 /// Real and imaginary part of a holomorphic function of ζ = u + iv as jets in (u, v).
 fn holomorphic(f: C64, f1: C64, f2: C64) -> (Jet, Jet) {
@@ -201,23 +201,12 @@ impl Parametric for Fermat {
         }
     }
     fn check(&self) -> Result<(), FieldError> {
-        if !(2..=6).contains(&self.n) {
-            return Err(FieldError::new(
-                "n",
-                format!("must be between 2 and 6, got {}", self.n),
-            ));
-        }
-        crate::limits::FERMAT_Y_RANGE
-            .check("y_range", self.y_range)
-            .map_err(|e| {
-                FieldError::new(
-                    e.field,
-                    format!(
-                        "{} (coordinates grow like e^(2a/n); a narrower strip is a sliver with nothing to show)",
-                        e.message
-                    ),
-                )
-            })
+        FERMAT_N.check("n", self.n)?;
+        FERMAT_Y_RANGE.check_with(
+            "y_range",
+            self.y_range,
+            "coordinates grow like e^(2a/n); a narrower strip is a sliver with nothing to show",
+        )
     }
 }
 
@@ -256,16 +245,6 @@ impl Parametric for ProductPolynomial {
         }
     }
     fn check(&self) -> Result<(), FieldError> {
-        positive("u_range", self.u_range)?;
-        if self.u_range > PI {
-            return Err(FieldError::new(
-                "u_range",
-                format!(
-                    "must be at most π (coordinates grow like e^a), got {}",
-                    self.u_range
-                ),
-            ));
-        }
-        Ok(())
+        PRODUCT_U_RANGE.check_with("u_range", self.u_range, "coordinates grow like e^a")
     }
 }

@@ -20,8 +20,8 @@
 //! on that line, and the pieces meet it vertically to second order, so the turned arc stays
 //! embedded and the surface stays twice differentiable.
 
-use super::{Domain, Eval4, Jet, Parametric, Side, SideRule, Topology, positive};
-use crate::limits::FieldError;
+use super::{Domain, Eval4, Jet, Parametric, Side, SideRule, Topology};
+use crate::limits::{FieldError, SURFACE_LENGTH, TWISTS};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, TAU};
 
@@ -185,7 +185,7 @@ impl Parametric for SpunTrefoil {
         SPHERE
     }
     fn check(&self) -> Result<(), FieldError> {
-        positive("scale", self.scale)
+        SURFACE_LENGTH.check("scale", self.scale)
     }
 }
 
@@ -223,17 +223,12 @@ impl Parametric for TwistSpunTrefoil {
         SPHERE
     }
     fn check(&self) -> Result<(), FieldError> {
-        positive("scale", self.scale)?;
-        if !(2..=12).contains(&self.twists) {
-            return Err(FieldError::new(
-                "twists",
-                format!(
-                    "must be between 2 and 12 (the 0-twist spin is `spun_trefoil`, the 1-twist spin is unknotted), got {}",
-                    self.twists
-                ),
-            ));
-        }
-        Ok(())
+        SURFACE_LENGTH.check("scale", self.scale)?;
+        TWISTS.check_with(
+            "twists",
+            self.twists,
+            "the 0-twist spin is `spun_trefoil`, the 1-twist spin is unknotted",
+        )
     }
 }
 

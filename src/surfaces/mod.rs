@@ -269,7 +269,7 @@ impl<'de> Deserialize<'de> for Surface {
         fn read<T: serde::de::DeserializeOwned, E: Error>(v: serde_json::Value) -> Result<T, E> {
             serde_path_to_error::deserialize(v).map_err(|e| match e.path().to_string().as_str() {
                 "." => E::custom(e.inner()),
-                path => E::custom(format!("{path}: {}", e.inner())),
+                path => E::custom(FieldError::new(path, e.inner().to_string())),
             })
         }
         Ok(match ty.as_str() {
@@ -282,7 +282,7 @@ impl<'de> Deserialize<'de> for Surface {
             "product_polynomial" => Surface::ProductPolynomial(read(params)?),
             "patches" => Surface::Patches(read(params)?),
             // Parsed in two steps too: a formula's error names its own field (`x: cannot
-            // read the formula ...`) with a caret, which a path prefix would only repeat.
+            // read the formula ...`, which the scene joins to its path) with a caret.
             "formula" => {
                 let source: FormulaSource = read(params)?;
                 Surface::Formula(Formula::new(source).map_err(D::Error::custom)?)
@@ -551,17 +551,5 @@ impl Surface {
             }
         }
         Ok(())
-    }
-}
-
-/// Checks that a parameter is finite and positive.
-pub(crate) fn positive(field: &'static str, x: f64) -> Result<(), FieldError> {
-    if x.is_finite() && x > 0.0 {
-        Ok(())
-    } else {
-        Err(FieldError::new(
-            field,
-            format!("must be a finite number greater than 0, got {x}"),
-        ))
     }
 }

@@ -1,8 +1,8 @@
 //! The classical closed surfaces of Fourphront (paper 001) and the planar test scene of
 //! paper 000 fig. 1.
 
-use super::{Domain, Eval4, Glue, Jet, Parametric, Side, SideRule, Topology, positive};
-use crate::limits::FieldError;
+use super::{Domain, Eval4, Glue, Jet, Parametric, Side, SideRule, Topology};
+use crate::limits::{Bound, FieldError, PATCH_COUNT, SURFACE_LENGTH};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, TAU};
 
@@ -49,8 +49,8 @@ impl Parametric for FlatTorus {
         }
     }
     fn check(&self) -> Result<(), FieldError> {
-        positive("r1", self.r1)?;
-        positive("r2", self.r2)
+        SURFACE_LENGTH.check("r1", self.r1)?;
+        SURFACE_LENGTH.check("r2", self.r2)
     }
 }
 
@@ -104,18 +104,13 @@ impl Parametric for KleinBottle {
         }
     }
     fn check(&self) -> Result<(), FieldError> {
-        positive("major_radius", self.major_radius)?;
-        positive("minor_radius", self.minor_radius)?;
-        if self.minor_radius >= self.major_radius {
-            return Err(FieldError::new(
-                "minor_radius",
-                format!(
-                    "must be smaller than major_radius ({}) or the surface is not embedded, got {}",
-                    self.major_radius, self.minor_radius
-                ),
-            ));
-        }
-        Ok(())
+        SURFACE_LENGTH.check("major_radius", self.major_radius)?;
+        SURFACE_LENGTH.check("minor_radius", self.minor_radius)?;
+        Bound::open(0.0, self.major_radius, "").check_with(
+            "minor_radius",
+            self.minor_radius,
+            "a minor_radius smaller than major_radius keeps the surface embedded",
+        )
     }
 }
 
@@ -184,7 +179,7 @@ impl Parametric for ProjectivePlane {
         [4, 6]
     }
     fn check(&self) -> Result<(), FieldError> {
-        positive("radius", self.radius)
+        SURFACE_LENGTH.check("radius", self.radius)
     }
 }
 
@@ -259,13 +254,8 @@ impl Parametric for Patches {
         }
     }
     fn check(&self) -> Result<(), FieldError> {
-        if !(1..=16).contains(&self.count) {
-            return Err(FieldError::new(
-                "count",
-                format!("must be between 1 and 16, got {}", self.count),
-            ));
-        }
-        positive("size", self.size)?;
-        positive("spacing", self.spacing)
+        PATCH_COUNT.check("count", self.count)?;
+        SURFACE_LENGTH.check("size", self.size)?;
+        SURFACE_LENGTH.check("spacing", self.spacing)
     }
 }

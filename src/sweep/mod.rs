@@ -25,7 +25,7 @@ pub use plot::PlotError;
 
 use crate::error::Error;
 use crate::intersect::{self, Analytic, Sheet};
-use crate::limits::{self, FieldError, GRID_CELLS, RELATIVE_TOLERANCE};
+use crate::limits::{self, Bound, FieldError, GRID_CELLS, RELATIVE_TOLERANCE};
 use crate::render::RenderError;
 use crate::sample::{self, Mesh4, audit, bounding_diagonal, sample_adaptive, sample_uniform};
 use crate::scene::Scene;
@@ -110,42 +110,25 @@ impl Settings {
     /// [`limits::RELATIVE_TOLERANCE`], the budget within [`limits::TRIANGLES`] and at least
     /// the coarsest grid of every surface ([`coarsest_grid_triangles`]).
     pub fn check(&self, surfaces: &[(String, Surface)]) -> Result<(), FieldError> {
-        if let Some(bad) = self
-            .tolerances
-            .iter()
-            .find(|t| !RELATIVE_TOLERANCE.contains(*t))
-        {
-            return Err(FieldError::new(
-                "tolerances",
-                format!(
-                    "every tolerance must be from {:?} to {:?} (a share of the bounding diagonal), got {bad}",
-                    RELATIVE_TOLERANCE.start(),
-                    RELATIVE_TOLERANCE.end()
-                ),
-            ));
+        for (i, &t) in self.tolerances.iter().enumerate() {
+            RELATIVE_TOLERANCE.check(&format!("tolerances[{i}]"), t)?;
         }
         let max = self.max_triangles;
-        if !limits::TRIANGLES.contains(&max) {
-            return Err(FieldError::new(
-                "max_triangles",
-                format!(
-                    "must be from {} to {}, got {max}",
-                    limits::TRIANGLES.start(),
-                    limits::TRIANGLES.end()
-                ),
-            ));
-        }
+        limits::TRIANGLES.check("max_triangles", max)?;
         for (name, surface) in surfaces {
-            let least = coarsest_grid_triangles(surface);
-            if max < least {
-                return Err(FieldError::new(
-                    "max_triangles",
-                    format!(
-                        "{max} is less than the {least} triangles of the coarsest grid of `{name}` ({} patches); give at least {least}",
-                        surface.patch_count()
-                    ),
-                ));
-            }
+            let least = Bound {
+                lo: coarsest_grid_triangles(surface),
+                ..limits::TRIANGLES
+            };
+            least.check_with(
+                "max_triangles",
+                max,
+                &format!(
+                    "the coarsest grid of `{name}` ({} patches) has {} triangles",
+                    surface.patch_count(),
+                    least.lo
+                ),
+            )?;
         }
         Ok(())
     }
@@ -360,12 +343,8 @@ impl<'a> GridSearch<'a> {
     fn cells(&self, k: f64, aspect: f64) -> [usize; 2] {
         let [min_u, min_v] = self.surface.min_cells();
         let even = |x: f64, min: usize| {
-            let n = (x
-                .round()
-                .clamp(*GRID_CELLS.start() as f64, *GRID_CELLS.end() as f64)
-                as usize)
-                .max(min);
-            (n + n % 2).min(*GRID_CELLS.end())
+            let n = (x.round().clamp(GRID_CELLS.lo as f64, GRID_CELLS.hi as f64) as usize).max(min);
+            (n + n % 2).min(GRID_CELLS.hi)
         };
         [
             even(k * aspect.sqrt(), min_u),
@@ -403,7 +382,7 @@ impl<'a> GridSearch<'a> {
         let mut k = 8.0;
         for _ in 0..24 {
             let cells = self.cells(k, aspect);
-            if self.triangles(cells) > self.max_triangles || cells.contains(GRID_CELLS.end()) {
+            if self.triangles(cells) > self.max_triangles || cells.contains(&GRID_CELLS.hi) {
                 // Beyond the budget: step back towards the last failing size, or down
                 // towards the coarsest grid while nothing was measured, or stop.
                 match (fail, pass) {

@@ -1,7 +1,7 @@
 //! The picture's speed against error: the multi-slice mode against the exact one.
 
 use super::{SweepError, plot, write_files};
-use crate::limits::{FieldError, SLICES};
+use crate::limits::SLICES;
 use crate::pipeline::{Sampled, Stages};
 use crate::render::compare::{self, Comparison};
 use crate::scene::Scene;
@@ -17,16 +17,8 @@ pub fn picture_sweep(
     out_dir: &Path,
     progress: &mut dyn FnMut(&Comparison),
 ) -> Result<(Vec<Comparison>, Vec<PathBuf>), SweepError> {
-    if let Some(bad) = slices.iter().find(|n| !SLICES.contains(*n)) {
-        return Err(FieldError::new(
-            "slices",
-            format!(
-                "every count must be {} to {}, got {bad}",
-                SLICES.start(),
-                SLICES.end()
-            ),
-        )
-        .into());
+    for (i, &n) in slices.iter().enumerate() {
+        SLICES.check(&format!("slices[{i}]"), n)?;
     }
     let built = Sampled::of(scene).into_built(scene, Stages::picture(scene))?;
     let rows = compare::compare(

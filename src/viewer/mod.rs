@@ -56,7 +56,7 @@ pub use turn::{Framing, Model};
 
 use crate::import::{ImportError, ImportedScene};
 use crate::limits::{
-    FieldError, PICTURE_SIDE, SAMPLES, VIEWER_SLICES, VIEWER_TETRAHEDRA, VIEWER_TRIANGLES,
+    FieldError, PICTURE_SIDE, VIEWER_SLICES, VIEWER_TETRAHEDRA, VIEWER_TRIANGLES, check_samples,
 };
 use crate::render::camera::{Camera, Placement, bounding_radius};
 use crate::render::overlay::{AGREE, interior_edges};
@@ -140,42 +140,21 @@ impl Default for ViewSettings {
 impl ViewSettings {
     /// Checks the settings, naming the one that is wrong.
     pub fn check(&self) -> Result<(), ViewerError> {
-        let bad = |field: &str, message: String| {
-            Err(ViewerError::Setting(FieldError::new(field, message)))
-        };
-        if !PICTURE_SIDE.contains(&self.render.width) || !PICTURE_SIDE.contains(&self.render.height)
-        {
-            return bad(
-                "size",
-                format!(
-                    "{}x{} is not between {lo}x{lo} and {hi}x{hi}",
-                    self.render.width,
-                    self.render.height,
-                    lo = PICTURE_SIDE.start(),
-                    hi = PICTURE_SIDE.end()
-                ),
-            );
-        }
-        if !VIEWER_SLICES.contains(&self.render.slices) {
-            return bad(
-                "slices",
-                format!(
-                    "{} is not between {} and {} (the viewer offers {SLICE_COUNTS:?})",
+        let size = format!("{}x{}", self.render.width, self.render.height);
+        PICTURE_SIDE
+            .check_with("size", self.render.width, &format!("the width of {size}"))
+            .and_then(|()| {
+                PICTURE_SIDE.check_with("size", self.render.height, &format!("the height of {size}"))
+            })
+            .and_then(|()| {
+                VIEWER_SLICES.check_with(
+                    "slices",
                     self.render.slices,
-                    VIEWER_SLICES.start(),
-                    VIEWER_SLICES.end()
-                ),
-            );
-        }
-        if !SAMPLES.contains(&self.render.samples) {
-            return bad(
-                "samples",
-                format!(
-                    "{} is not 1, 4, 9 or 16 (a square grid)",
-                    self.render.samples
-                ),
-            );
-        }
+                    &format!("the viewer offers {SLICE_COUNTS:?}"),
+                )
+            })
+            .and_then(|()| check_samples("samples", self.render.samples))
+            .map_err(ViewerError::Setting)?;
         self.render
             .stipple
             .check()

@@ -150,7 +150,7 @@ pub fn parse_mesh4(
 }
 
 /// The most vertices, faces or triangles a file may declare.
-const MAX_COUNT: usize = *TRIANGLES.end();
+const MAX_COUNT: usize = TRIANGLES.hi;
 
 type Result<T> = std::result::Result<T, MeshFileError>;
 

@@ -40,7 +40,7 @@ mod parser;
 mod sides;
 
 use super::{Domain, Eval4, Jet, Parametric, Topology};
-use crate::limits::{FieldError, shorten};
+use crate::limits::{FINITE, FieldError, shorten};
 use compiler::{Op, Program, Shared, function};
 use glam::DVec4;
 use serde::{Deserialize, Serialize};
@@ -236,12 +236,7 @@ impl Formula {
         for (name, value) in &source.parameters {
             let field = format!("parameters.{}", shorten(name));
             check_parameter_name(name).map_err(|m| FieldError::new(&field, m))?;
-            if !value.is_finite() {
-                return Err(FieldError::new(
-                    field,
-                    format!("must be a finite number, got {value}"),
-                ));
-            }
+            FINITE.check(&field, *value)?;
         }
         let s = &source.sides;
         for (pair, lo, hi, name) in [
