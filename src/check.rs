@@ -506,42 +506,128 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
 ) -> CheckStats {
     let n = surface_vertices;
     let nv = positions.len();
-    let at = |i: usize| -> [f64; 3] { positions[i].into() };
-    let collapsed: Vec<bool> = (0..n).map(|v| n + v < nv && at(v) == at(n + v)).collect();
-    // `canon`: collapsed vertices under one index, the negative offset's (a surface vertex
-    // at another point than its collapsed offsets keeps its own); `mid`: surface vertex x's
-    // own vertex (2n + x) under that index; `partner`: the offset of the same surface vertex
-    // on the other side (itself when collapsed); `surface_vertex`: the surface vertex an
-    // offset or surface vertex stands for.
-    let canon = |i: u32| {
+    let layout = Layout::new(positions, n);
+
+    // Every tetrahedron under canonical indices, sorted, with its parity.
+    let (tets, odd): (Vec<[u32; 4]>, Vec<bool>) = tets
+        .par_iter()
+        .map(|t| sorted_tet(t.map(|i| layout.canon(i)), nv))
+        .unzip();
+    let (scaled, volume_scale, tiny) = scaled(positions);
+    let mut s = tet_stats(&tets, odd, &scaled, &tiny);
+    s.collapsed_vertices = layout.collapsed.iter().filter(|&&c| c).count();
+
+    // Every face counted at its smallest vertex; boundary faces kept with their
+    // tetrahedron's fourth vertex, in increasing order.
+    let (incidence, faces, boundary) = face_uses(&tets, nv);
+    drop(tets);
+    s.duplicate_tets = faces.duplicate_tets;
+    s.interior_faces = faces.interior_faces;
+    s.overshared_faces = faces.overshared_faces;
+    s.boundary_faces = boundary.len();
+
+    let (boundary_volume, offset_faces, others) = classify_boundary(boundary, &scaled, &layout);
+    s.boundary_volume = boundary_volume;
+    let offset_faces = bucket_sort(offset_faces, n, |f| f.0[0]);
+    if !surface_triangles.is_empty() {
+        count_missing_given(
+            &mut s,
+            surface_triangles,
+            &offset_faces,
+            &layout,
+            &incidence,
+        );
+    }
+    let edges = surface_edges(&mut s, offset_faces, &layout, &incidence);
+    let open = check_quads(&mut s, edges, &layout, &incidence);
+    s.unexpected_boundary_faces = unexpected_boundary_faces(&others, &open, &layout);
+    finish_volumes(&mut s, volume_scale);
+    s
+}
+
+/// The halo layout of a mesh's vertices (see the module documentation): which surface
+/// vertices are collapsed, and the maps between a vertex, its partner and its surface vertex.
+struct Layout<'a, P> {
+    /// Surface vertices n.
+    n: usize,
+    /// The positions as given (not scaled): collapsed vertices are found by equality.
+    positions: &'a [P],
+    /// For each surface vertex, whether its two offsets have identical coordinates.
+    collapsed: Vec<bool>,
+}
+
+impl<'a, P: Copy + Into<[f64; 3]>> Layout<'a, P> {
+    fn new(positions: &'a [P], n: usize) -> Self {
+        let nv = positions.len();
+        let at = |i: usize| -> [f64; 3] { positions[i].into() };
+        let collapsed: Vec<bool> = (0..n).map(|v| n + v < nv && at(v) == at(n + v)).collect();
+        Layout {
+            n,
+            positions,
+            collapsed,
+        }
+    }
+
+    fn at(&self, i: usize) -> [f64; 3] {
+        self.positions[i].into()
+    }
+
+    /// Vertex i with collapsed vertices under one index, the negative offset's (a surface
+    /// vertex at another point than its collapsed offsets keeps its own).
+    fn canon(&self, i: u32) -> u32 {
+        let (n, nv) = (self.n, self.positions.len());
         let i = i as usize;
         if i < n || i >= 3 * n {
             return i as u32;
         }
         let v = if i < 2 * n { i - n } else { i - 2 * n };
-        let folded = collapsed[v] && (i < 2 * n || (i < nv && at(i) == at(v)));
+        let folded = self.collapsed[v] && (i < 2 * n || (i < nv && self.at(i) == self.at(v)));
         if folded { v as u32 } else { i as u32 }
-    };
-    let mid = |x: u32| canon(2 * n as u32 + x);
-    let partner = |i: u32| {
+    }
+
+    /// Surface vertex x's own vertex (2n + x) under its [`Self::canon`] index.
+    fn mid(&self, x: u32) -> u32 {
+        self.canon(2 * self.n as u32 + x)
+    }
+
+    /// The offset of the same surface vertex on the other side (itself when collapsed).
+    fn partner(&self, i: u32) -> u32 {
+        let n = self.n;
         let i = i as usize;
         match i {
-            _ if i < n && collapsed[i] => i as u32,
+            _ if i < n && self.collapsed[i] => i as u32,
             _ if i < n => (i + n) as u32,
             _ => (i - n) as u32,
         }
-    };
-    let offset = |i: u32| (i as usize) < 2 * n;
-    let surface_vertex = |i: u32| ((i as usize) < 3 * n).then(|| (i as usize % n.max(1)) as u32);
+    }
 
-    // Every tetrahedron under canonical indices, sorted, with its parity.
-    let tet_count = tets.len();
-    let (tets, odd): (Vec<[u32; 4]>, Vec<bool>) = tets
-        .par_iter()
-        .map(|t| sorted_tet(t.map(canon), nv))
-        .unzip();
-    let (scaled, volume_scale, tiny) = scaled(positions);
-    let (positions, tiny) = (&scaled, &tiny);
+    /// Whether vertex i is an offset.
+    fn offset(&self, i: u32) -> bool {
+        (i as usize) < 2 * self.n
+    }
+
+    /// The surface vertex an offset or surface vertex stands for.
+    fn surface_vertex(&self, i: u32) -> Option<u32> {
+        let n = self.n;
+        ((i as usize) < 3 * n).then(|| (i as usize % n.max(1)) as u32)
+    }
+
+    /// Whether two offsets lie on the same side (both negative or both positive).
+    fn same_side(&self, a: u32, b: u32) -> bool {
+        let n = self.n as u32;
+        (a < n) == (b < n)
+    }
+}
+
+/// The checks of each tetrahedron on its own (sorted, with its parity, on the positions
+/// [`scaled`]): orientation, degeneracy, volume and angles, with the vertex and tetrahedron
+/// counts.
+fn tet_stats(
+    tets: &[[u32; 4]],
+    odd: Vec<bool>,
+    positions: &[[f64; 3]],
+    tiny: &[bool],
+) -> CheckStats {
     // Runs of CHECK_RUN tetrahedra on the cores, summed in order: the volume's rounding
     // depends on the runs only, not on the number of threads.
     let partials: Vec<CheckStats> = tets
@@ -551,9 +637,8 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
         .collect();
     drop(odd);
     let mut s = CheckStats {
-        vertices: nv,
-        tets: tet_count,
-        collapsed_vertices: collapsed.iter().filter(|&&c| c).count(),
+        vertices: positions.len(),
+        tets: tets.len(),
         min_volume: f64::INFINITY,
         max_volume: f64::NEG_INFINITY,
         min_dihedral_deg: 180.0,
@@ -572,22 +657,18 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
     if s.tets == s.degenerate {
         (s.min_volume, s.max_volume, s.min_dihedral_deg) = (0.0, 0.0, 0.0);
     }
+    s
+}
 
-    // Every face counted at its smallest vertex; boundary faces kept with their
-    // tetrahedron's fourth vertex, in increasing order.
-    let (incidence, faces, boundary) = face_uses(&tets, nv);
-    drop(tets);
-    s.duplicate_tets = faces.duplicate_tets;
-    s.interior_faces = faces.interior_faces;
-    s.overshared_faces = faces.overshared_faces;
-    s.boundary_faces = boundary.len();
-    let count = |f: [u32; 3]| incidence.count(f);
-    // Whether two offsets lie on the same side (both negative or both positive).
-    let same_side = |a: u32, b: u32| (a < n as u32) == (b < n as u32);
-
-    // Offset faces (three offsets of three surface vertices) by surface triangle; the other
-    // boundary faces to classify once the open edges are known. In runs of a fixed size,
-    // the boundary's volume summed in order.
+/// Sorts the boundary faces into offset faces (three offsets of three surface vertices), by
+/// surface triangle, and the other faces, to classify once the open edges are known; gives
+/// the volume the boundary encloses, on the positions [`scaled`], with them. In runs of a
+/// fixed size, the volume summed in order.
+fn classify_boundary<P: Copy + Into<[f64; 3]> + Sync>(
+    boundary: Vec<Face>,
+    positions: &[[f64; 3]],
+    layout: &Layout<P>,
+) -> (f64, Vec<OffsetFace>, Vec<[u32; 3]>) {
     let classified: Vec<(f64, Vec<OffsetFace>, Vec<[u32; 3]>)> = boundary
         .par_chunks(CHECK_RUN)
         .map(|part| {
@@ -603,9 +684,9 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
                 let [a, b, c] = f.map(|i| positions[i as usize]);
                 // The divergence theorem, signed for that orientation.
                 volume -= dot(a, cross(b, c)) / 6.0;
-                match k.map(surface_vertex) {
+                match k.map(|i| layout.surface_vertex(i)) {
                     [Some(x), Some(y), Some(z)]
-                        if x != y && y != z && x != z && k.iter().all(|&i| offset(i)) =>
+                        if x != y && y != z && x != z && k.iter().all(|&i| layout.offset(i)) =>
                     {
                         offset_faces.push((key([x, y, z]), k));
                     }
@@ -616,47 +697,75 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
         })
         .collect();
     drop(boundary);
-    let (mut offset_faces, mut others) = (Vec::new(), Vec::new());
+    let (mut boundary_volume, mut offset_faces, mut others) = (0.0, Vec::new(), Vec::new());
     for (volume, o, k) in classified {
-        s.boundary_volume += volume;
+        boundary_volume += volume;
         offset_faces.extend(o);
         others.extend(k);
     }
-    let offset_faces = bucket_sort(offset_faces, n, |f| f.0[0]);
-    // The surface's own triangles, where given: one whose offset faces are not on the
-    // boundary at all (its prism missing, or its faces buried) is counted missing, and its
-    // surface face too unless two tetrahedra share it. A triangle whose three corners are
-    // collapsed has a flat prism and no offset face.
-    if !surface_triangles.is_empty() {
-        let over: std::collections::HashSet<[u32; 3]> = offset_faces.iter().map(|f| f.0).collect();
-        for &t in surface_triangles {
-            let k = key(t);
-            let flat = t.iter().all(|&v| (v as usize) < n && collapsed[v as usize]);
-            if !flat && !over.contains(&k) && t.iter().all(|&v| (v as usize) < n) {
-                s.missing_offset_faces += 1;
-                s.missing_surface_faces += usize::from(count(k.map(mid)) != 2);
-            }
+    (boundary_volume, offset_faces, others)
+}
+
+/// Counts the surface's own triangles, as given, whose offset faces are not on the boundary
+/// at all (their prism missing, or their faces buried) as missing, and their surface face
+/// too unless two tetrahedra share it. A triangle whose three corners are collapsed has a
+/// flat prism and no offset face.
+fn count_missing_given<P: Copy + Into<[f64; 3]> + Sync>(
+    s: &mut CheckStats,
+    surface_triangles: &[[u32; 3]],
+    offset_faces: &[OffsetFace],
+    layout: &Layout<P>,
+    incidence: &Incidence,
+) {
+    let n = layout.n;
+    let over: std::collections::HashSet<[u32; 3]> = offset_faces.iter().map(|f| f.0).collect();
+    for &t in surface_triangles {
+        let k = key(t);
+        let flat = t
+            .iter()
+            .all(|&v| (v as usize) < n && layout.collapsed[v as usize]);
+        if !flat && !over.contains(&k) && t.iter().all(|&v| (v as usize) < n) {
+            s.missing_offset_faces += 1;
+            s.missing_surface_faces += usize::from(incidence.count(k.map(|x| layout.mid(x))) != 2);
         }
     }
-    // Surface edges, each with the side pairing of the offset face's edge over it: `true`
-    // when that edge joins two offsets on the same side (its quad's perimeter runs
-    // straight, so the diagonals cross sides), `None` at a collapsed end.
-    type Edge = ([u32; 2], Option<bool>);
+}
+
+/// A surface edge with the side pairing of the offset face's edge over it: `true` when that
+/// edge joins two offsets on the same side (its quad's perimeter runs straight, so the
+/// diagonals cross sides), `None` at a collapsed end.
+type Edge = ([u32; 2], Option<bool>);
+
+/// The surface triangles of the offset faces (sorted by triangle): counts those without
+/// exactly two opposite offset faces, or whose surface face is not between two tetrahedra,
+/// as missing; gives their edges, sorted.
+fn surface_edges<P: Copy + Into<[f64; 3]> + Sync>(
+    s: &mut CheckStats,
+    offset_faces: Vec<OffsetFace>,
+    layout: &Layout<P>,
+    incidence: &Incidence,
+) -> Vec<Edge> {
     let triangles: Vec<(bool, bool, [Edge; 3])> = offset_faces
         .par_chunk_by(|a, b| a.0 == b.0)
         .map(|group| {
-            let opposite = group.len() == 2 && key(group[0].1.map(partner)) == group[1].1;
+            let opposite =
+                group.len() == 2 && key(group[0].1.map(|i| layout.partner(i))) == group[1].1;
             let face = group[0].1;
             let edges = [(0, 1), (0, 2), (1, 2)].map(|(i, j)| {
                 let (a, b) = (face[i], face[j]);
                 let (x, y) = (
-                    surface_vertex(a).unwrap_or(0),
-                    surface_vertex(b).unwrap_or(0),
+                    layout.surface_vertex(a).unwrap_or(0),
+                    layout.surface_vertex(b).unwrap_or(0),
                 );
-                let straight = (partner(a) != a && partner(b) != b).then(|| same_side(a, b));
+                let straight = (layout.partner(a) != a && layout.partner(b) != b)
+                    .then(|| layout.same_side(a, b));
                 ([x.min(y), x.max(y)], straight)
             });
-            (!opposite, count(group[0].0.map(mid)) != 2, edges)
+            (
+                !opposite,
+                incidence.count(group[0].0.map(|x| layout.mid(x))) != 2,
+                edges,
+            )
         })
         .collect();
     drop(offset_faces);
@@ -666,63 +775,90 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
         s.missing_surface_faces += missing_surface as usize;
         edges.extend(e);
     }
-    let edges = bucket_sort(edges, n, |e| e.0[0]);
+    bucket_sort(edges, layout.n, |e| e.0[0])
+}
 
-    // Quads over surface edges (whether each is split right); the edges used by one
-    // surface triangle are open.
+/// Checks the quads over the surface edges (sorted), counting those not split right as
+/// `quad_mismatches`; gives the open edges, those used by one surface triangle, in
+/// increasing order.
+fn check_quads<P: Copy + Into<[f64; 3]> + Sync>(
+    s: &mut CheckStats,
+    edges: Vec<Edge>,
+    layout: &Layout<P>,
+    incidence: &Incidence,
+) -> Vec<[u32; 2]> {
     let quads: Vec<(bool, Option<[u32; 2]>)> = edges
         .par_chunk_by(|a, b| a.0 == b.0)
         .map(|group| {
-            let [x, y] = group[0].0;
-            let expected = if group.len() >= 2 { 2 } else { 1 };
-            let open = (group.len() == 1).then_some([x, y]);
-            let (x1, y1) = (partner(x), partner(y));
-            if x1 == x && y1 == y {
-                return (true, open);
-            }
-            // Each half of the quad, from an offset edge (a, b) to the surface edge: split
-            // along a diagonal, the two faces on one of them each used `expected` times and
-            // the other two unused, or, with a collapsed end, one triangle used `expected`
-            // times. The offset edges join offsets on one side where the offset faces' edges
-            // do (else the halves cross sides, at a twist); every prism over the edge must
-            // see the same.
-            let straight = group[0].1;
-            let agree = group.iter().all(|e| e.1 == straight);
-            let split = |a: u32, b: u32, c: u32, d: u32| {
-                // Diagonal (a, b); the other diagonal (c, d).
-                count([a, b, c]) == expected
-                    && count([a, b, d]) == expected
-                    && count([c, d, a]) == 0
-                    && count([c, d, b]) == 0
-            };
-            let half = |a: u32, b: u32| {
-                let (ma, mb) = (
-                    mid(surface_vertex(a).unwrap_or(0)),
-                    mid(surface_vertex(b).unwrap_or(0)),
-                );
-                match (ma == a, mb == b) {
-                    (true, true) => true,
-                    (true, false) => count([a, b, mb]) == expected,
-                    (false, true) => count([a, b, ma]) == expected,
-                    (false, false) => split(a, mb, b, ma) || split(b, ma, a, mb),
-                }
-            };
-            let quad = agree
-                && if straight == Some(false) {
-                    half(x, y1) && half(x1, y)
-                } else {
-                    half(x, y) && half(x1, y1)
-                };
-            (quad, open)
+            let open = (group.len() == 1).then_some(group[0].0);
+            (quad_split_right(group, layout, incidence), open)
         })
         .collect();
     drop(edges);
     s.quad_mismatches = quads.iter().filter(|q| !q.0).count();
-    let open: Vec<[u32; 2]> = quads.into_iter().filter_map(|q| q.1).collect();
-    s.unexpected_boundary_faces = others
+    quads.into_iter().filter_map(|q| q.1).collect()
+}
+
+/// Whether the quad over one surface edge (`group`: the edge once for each offset face over
+/// it) is split right.
+fn quad_split_right<P: Copy + Into<[f64; 3]> + Sync>(
+    group: &[Edge],
+    layout: &Layout<P>,
+    incidence: &Incidence,
+) -> bool {
+    let count = |f: [u32; 3]| incidence.count(f);
+    let mid = |x: u32| layout.mid(x);
+    let [x, y] = group[0].0;
+    let expected = if group.len() >= 2 { 2 } else { 1 };
+    let (x1, y1) = (layout.partner(x), layout.partner(y));
+    if x1 == x && y1 == y {
+        return true;
+    }
+    // Each half of the quad, from an offset edge (a, b) to the surface edge: split along a
+    // diagonal, the two faces on one of them each used `expected` times and the other two
+    // unused, or, with a collapsed end, one triangle used `expected` times. The offset edges
+    // join offsets on one side where the offset faces' edges do (else the halves cross
+    // sides, at a twist); every prism over the edge must see the same.
+    let straight = group[0].1;
+    let agree = group.iter().all(|e| e.1 == straight);
+    let split = |a: u32, b: u32, c: u32, d: u32| {
+        // Diagonal (a, b); the other diagonal (c, d).
+        count([a, b, c]) == expected
+            && count([a, b, d]) == expected
+            && count([c, d, a]) == 0
+            && count([c, d, b]) == 0
+    };
+    let half = |a: u32, b: u32| {
+        let (ma, mb) = (
+            mid(layout.surface_vertex(a).unwrap_or(0)),
+            mid(layout.surface_vertex(b).unwrap_or(0)),
+        );
+        match (ma == a, mb == b) {
+            (true, true) => true,
+            (true, false) => count([a, b, mb]) == expected,
+            (false, true) => count([a, b, ma]) == expected,
+            (false, false) => split(a, mb, b, ma) || split(b, ma, a, mb),
+        }
+    };
+    agree
+        && if straight == Some(false) {
+            half(x, y1) && half(x1, y)
+        } else {
+            half(x, y) && half(x1, y1)
+        }
+}
+
+/// How many of the boundary faces that are not offset faces are not side walls either: a
+/// side wall lies over exactly two surface vertices, an edge among the `open` ones (sorted).
+fn unexpected_boundary_faces<P: Copy + Into<[f64; 3]> + Sync>(
+    others: &[[u32; 3]],
+    open: &[[u32; 2]],
+    layout: &Layout<P>,
+) -> usize {
+    others
         .par_iter()
         .filter(|k| {
-            let wall = match k.map(surface_vertex) {
+            let wall = match k.map(|i| layout.surface_vertex(i)) {
                 [Some(a), Some(b), Some(c)] => {
                     // Over exactly two surface vertices, an open edge.
                     let mut e = [a, b, c];
@@ -740,7 +876,12 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
             };
             !wall
         })
-        .count();
+        .count()
+}
+
+/// The volume defect, then the volumes back in the mesh's own units (infinite or zero where
+/// they do not fit an f64) by `volume_scale`, the factor [`scaled`] gives.
+fn finish_volumes(s: &mut CheckStats, volume_scale: f64) {
     let boundary_volume = s.boundary_volume;
     s.volume_defect = if boundary_volume.abs() > 0.0 {
         (s.volume - boundary_volume).abs() / boundary_volume.abs()
@@ -749,7 +890,6 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
     } else {
         f64::INFINITY
     };
-    // Volumes in the mesh's own units (infinite or zero where they do not fit an f64).
     for v in [
         &mut s.volume,
         &mut s.boundary_volume,
@@ -758,5 +898,4 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
     ] {
         *v *= volume_scale;
     }
-    s
 }

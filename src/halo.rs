@@ -501,7 +501,32 @@ struct Offsets<'a> {
     collapsed: Vec<bool>,
 }
 
-impl Offsets<'_> {
+impl<'a> Offsets<'a> {
+    /// Every vertex's offsets placed at `rho` along its direction `dir`, or at 0 where the
+    /// vertex is `singular` and folds are shrunk.
+    fn new(
+        projected: &'a Projected,
+        dir: Vec<DVec3>,
+        singular: &[bool],
+        rho: f64,
+        shrink: bool,
+    ) -> Self {
+        let n = projected.positions.len();
+        let mut offsets = Offsets {
+            projected,
+            rho: (0..n)
+                .map(|v| if shrink && singular[v] { 0.0 } else { rho })
+                .collect(),
+            dir,
+            positions: [vec![DVec3::ZERO; 2 * n], projected.positions.clone()].concat(),
+            collapsed: vec![false; n],
+        };
+        for v in 0..n {
+            offsets.place(v);
+        }
+        offsets
+    }
+
     /// Places vertex v's two offsets at ∓rho[v] along its direction; where they round to one
     /// point, the vertex collapses.
     fn place(&mut self, v: usize) {
@@ -575,24 +600,7 @@ pub fn build_halo(
     let stars = Stars::new(n, triangles);
     let frame = frame(projected, triangles, &stars);
     let shrink = params.fold == Fold::Shrink;
-    let mut offsets = Offsets {
-        projected,
-        rho: (0..n)
-            .map(|v| {
-                if shrink && frame.singular[v] {
-                    0.0
-                } else {
-                    rho
-                }
-            })
-            .collect(),
-        dir: frame.dir,
-        positions: [vec![DVec3::ZERO; 2 * n], projected.positions.clone()].concat(),
-        collapsed: vec![false; n],
-    };
-    for v in 0..n {
-        offsets.place(v);
-    }
+    let mut offsets = Offsets::new(projected, frame.dir, &frame.singular, rho, shrink);
     let mut corners: Vec<Corners> = triangles
         .iter()
         .zip(&frame.flip)
@@ -603,87 +611,17 @@ pub fn build_halo(
     lap(&mut stage_ms.plan);
 
     if shrink {
-        // Halve rho at the corners of inverted tetrahedra, re-examining only the prisms
-        // around them, until none is left; a vertex halved HALVINGS times collapses.
-        let floor = rho * 0.5f64.powi(HALVINGS as i32);
-        let mut bad = Vec::new();
-        for (c, f) in corners.iter().zip(&forward) {
-            inverted_corners(c, *f, &offsets.positions, &mut bad);
-        }
-        let mut stamp = vec![usize::MAX; triangles.len()];
-        let mut round = 0;
-        let mut reexamine = |touched: &[u32], offsets: &Offsets, bad: &mut Vec<u32>| {
-            round += 1;
-            for &v in touched {
-                for &(t, _) in stars.of(v as usize) {
-                    let t = t as usize;
-                    if stamp[t] != round {
-                        stamp[t] = round;
-                        corners[t] = offsets.corners(triangles[t], frame.flip[t]);
-                        inverted_corners(&corners[t], forward[t], &offsets.positions, bad);
-                    }
-                }
-            }
+        let surface = Surface {
+            triangles,
+            stars: &stars,
+            flip: &frame.flip,
         };
-        // Each round lowers the rho of every corner of an inverted tetrahedron (halved, or
-        // zero from the floor on), so the loop ends: every vertex can be lowered at most
-        // HALVINGS + 1 times. A round that lowers nothing (every corner already collapsed:
-        // the prism is as thin as it can be) ends it too, and the checker counts what is
-        // left. No grading of rho between neighbours is needed: the surface triangle is a
-        // face of both layers, so however rho varies the surface keeps t = 1/2.
-        // Then rho is graded around every lowered vertex ([`grade`]); where that inverts a
-        // tetrahedron (rho only falls, but unevenly), the halving starts again. Both only
-        // lower rho, so this ends too.
-        loop {
-            loop {
-                bad.sort_unstable();
-                bad.dedup();
-                bad.retain(|&v| offsets.rho[v as usize] > 0.0);
-                if bad.is_empty() {
-                    break;
-                }
-                for &v in &bad {
-                    let v = v as usize;
-                    offsets.rho[v] = if offsets.rho[v] > floor {
-                        0.5 * offsets.rho[v]
-                    } else {
-                        0.0
-                    };
-                    offsets.place(v);
-                }
-                let touched = std::mem::take(&mut bad);
-                reexamine(&touched, &offsets, &mut bad);
-            }
-            let lowered = grade(&mut offsets.rho, &projected.positions, triangles, &stars);
-            if lowered.is_empty() {
-                break;
-            }
-            for &v in &lowered {
-                offsets.place(v as usize);
-            }
-            reexamine(&lowered, &offsets, &mut bad);
-        }
+        shrink_folds(&mut offsets, &mut corners, &forward, &surface, rho);
     }
     lap(&mut stage_ms.shrink);
     let tets = tets::emit(&corners, &forward, &offsets.positions, n, stats);
 
-    let mut t = [vec![0.0; n], vec![1.0; n], vec![0.5; n]].concat();
-    for v in (0..n).filter(|&v| offsets.collapsed[v]) {
-        (t[v], t[n + v]) = (0.5, 0.5);
-    }
-    let mut d_orig = projected.w.repeat(3);
-    for (&tri, over) in tets.inserted_in.iter().zip(&tets.inserted_over) {
-        // Means rounded to f32 like every value the files store.
-        let layer_t = over.iter().map(|&i| t[i as usize]).sum::<f64>() / 6.0;
-        let corners = triangles[tri as usize];
-        let mean = corners
-            .iter()
-            .map(|&i| projected.w[i as usize])
-            .sum::<f64>()
-            / 3.0;
-        t.push(layer_t as f32 as f64);
-        d_orig.push(mean as f32 as f64);
-    }
+    let (t, d_orig) = t_and_depth(&offsets.collapsed, &projected.w, triangles, &tets);
     let mut positions = offsets.positions;
     positions.extend_from_slice(&tets.inserted);
     let halo = Halo {
@@ -719,6 +657,121 @@ pub fn build_halo(
         stage_ms,
     };
     (halo, report)
+}
+
+/// The surface as the shrinking walks it: its triangles, the triangles around each vertex,
+/// and each triangle's corners whose offset direction disagrees with its winding.
+struct Surface<'a> {
+    triangles: &'a [[u32; 3]],
+    stars: &'a Stars,
+    flip: &'a [[bool; 3]],
+}
+
+/// `fold: shrink`: halves rho (from `rho`, the asked one) at the corners of inverted
+/// tetrahedra, re-examining only the prisms around them, until none is left (a vertex halved
+/// [`HALVINGS`] times collapses), then grades rho and starts again where that inverts a
+/// tetrahedron. Updates the offsets and the prisms' corners; the diagonals (`forward`) stay.
+fn shrink_folds(
+    offsets: &mut Offsets,
+    corners: &mut [Corners],
+    forward: &[[bool; 3]],
+    surface: &Surface,
+    rho: f64,
+) {
+    let Surface {
+        triangles,
+        stars,
+        flip,
+    } = *surface;
+    let floor = rho * 0.5f64.powi(HALVINGS as i32);
+    let mut bad = Vec::new();
+    for (c, f) in corners.iter().zip(forward) {
+        inverted_corners(c, *f, &offsets.positions, &mut bad);
+    }
+    let mut stamp = vec![usize::MAX; triangles.len()];
+    let mut round = 0;
+    let mut reexamine = |touched: &[u32], offsets: &Offsets, bad: &mut Vec<u32>| {
+        round += 1;
+        for &v in touched {
+            for &(t, _) in stars.of(v as usize) {
+                let t = t as usize;
+                if stamp[t] != round {
+                    stamp[t] = round;
+                    corners[t] = offsets.corners(triangles[t], flip[t]);
+                    inverted_corners(&corners[t], forward[t], &offsets.positions, bad);
+                }
+            }
+        }
+    };
+    // Each round lowers the rho of every corner of an inverted tetrahedron (halved, or
+    // zero from the floor on), so the loop ends: every vertex can be lowered at most
+    // HALVINGS + 1 times. A round that lowers nothing (every corner already collapsed:
+    // the prism is as thin as it can be) ends it too, and the checker counts what is
+    // left. No grading of rho between neighbours is needed: the surface triangle is a
+    // face of both layers, so however rho varies the surface keeps t = 1/2.
+    // Then rho is graded around every lowered vertex ([`grade`]); where that inverts a
+    // tetrahedron (rho only falls, but unevenly), the halving starts again. Both only
+    // lower rho, so this ends too.
+    loop {
+        loop {
+            bad.sort_unstable();
+            bad.dedup();
+            bad.retain(|&v| offsets.rho[v as usize] > 0.0);
+            if bad.is_empty() {
+                break;
+            }
+            for &v in &bad {
+                let v = v as usize;
+                offsets.rho[v] = if offsets.rho[v] > floor {
+                    0.5 * offsets.rho[v]
+                } else {
+                    0.0
+                };
+                offsets.place(v);
+            }
+            let touched = std::mem::take(&mut bad);
+            reexamine(&touched, offsets, &mut bad);
+        }
+        let lowered = grade(
+            &mut offsets.rho,
+            &offsets.projected.positions,
+            triangles,
+            stars,
+        );
+        if lowered.is_empty() {
+            break;
+        }
+        for &v in &lowered {
+            offsets.place(v as usize);
+        }
+        reexamine(&lowered, offsets, &mut bad);
+    }
+}
+
+/// The t and d_orig of every halo vertex: t = 0, 1 and 1/2 on the negative offsets, the
+/// positive offsets and the surface (1/2 at both offsets of a `collapsed` vertex), the
+/// w-depth `w` of the surface vertex; at a vertex inserted in a prism, the mean t of its layer
+/// and the mean depth of its triangle, rounded to f32 like every value the files store.
+fn t_and_depth(
+    collapsed: &[bool],
+    w: &[f64],
+    triangles: &[[u32; 3]],
+    tets: &tets::Tetrahedra,
+) -> (Vec<f64>, Vec<f64>) {
+    let n = collapsed.len();
+    let mut t = [vec![0.0; n], vec![1.0; n], vec![0.5; n]].concat();
+    for v in (0..n).filter(|&v| collapsed[v]) {
+        (t[v], t[n + v]) = (0.5, 0.5);
+    }
+    let mut d_orig = w.repeat(3);
+    for (&tri, over) in tets.inserted_in.iter().zip(&tets.inserted_over) {
+        let layer_t = over.iter().map(|&i| t[i as usize]).sum::<f64>() / 6.0;
+        let corners = triangles[tri as usize];
+        let mean = corners.iter().map(|&i| w[i as usize]).sum::<f64>() / 3.0;
+        t.push(layer_t as f32 as f64);
+        d_orig.push(mean as f32 as f64);
+    }
+    (t, d_orig)
 }
 
 #[cfg(test)]

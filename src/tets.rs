@@ -424,125 +424,156 @@ pub fn plan(
             .map(|c| [0, 1, 2].map(|k| c.up(k, true)))
             .collect(),
     };
-    let up = |forward: &[[bool; 3]], t: u32, k: u8| {
-        corners[t as usize].up(k as usize, forward[t as usize][k as usize])
-    };
-    let mismatched = |forward: &[[bool; 3]], uses: &[(u32, u8)]| {
-        let (t0, k0) = uses[0];
-        !corners[t0 as usize].degenerate(k0 as usize)
-            && uses
-                .iter()
-                .any(|&(t, k)| up(forward, t, k) != up(forward, t0, k0))
-    };
-    stats.mismatches_initial = edges.iter().filter(|u| mismatched(&forward, u)).count();
-
+    stats.mismatches_initial = edges
+        .iter()
+        .filter(|u| mismatched(corners, &forward, u))
+        .count();
     match split {
         Split::GlobalOrder => {}
-        Split::Paper => {
-            // Fig. 4b: flip a prism's diagonal on the shared quad when it stays splittable.
-            let mut changed = true;
-            while changed {
-                changed = false;
-                for uses in edges.iter() {
-                    if !mismatched(&forward, uses) {
-                        continue;
-                    }
-                    let (t0, k0) = uses[0];
-                    for &(t, k) in &uses[1..] {
-                        if up(&forward, t, k) == up(&forward, t0, k0) {
-                            continue;
-                        }
-                        let mut f = forward[t as usize];
-                        f[k as usize] = !f[k as usize];
-                        if corners[t as usize].splittable(f) {
-                            forward[t as usize] = f;
-                            stats.flips += 1;
-                            changed = true;
-                            continue;
-                        }
-                        // The first prism flips instead, if that leaves it and every other
-                        // user of the edge consistent.
-                        let mut f0 = forward[t0 as usize];
-                        f0[k0 as usize] = !f0[k0 as usize];
-                        if uses.len() == 2 && corners[t0 as usize].splittable(f0) {
-                            forward[t0 as usize] = f0;
-                            stats.flips += 1;
-                            changed = true;
-                        }
-                    }
-                }
+        Split::Paper => paper_flips(corners, &edges, &mut forward, &mut stats),
+        Split::Quality => quality_flips(corners, &edges, positions, n, &mut forward, &mut stats),
+    }
+    stats.mismatches_final = edges
+        .iter()
+        .filter(|u| mismatched(corners, &forward, u))
+        .count();
+    (forward, stats)
+}
+
+/// Whether edge k of prism t goes up, with the prisms' edges oriented by `forward`.
+fn edge_up(corners: &[Corners], forward: &[[bool; 3]], t: u32, k: u8) -> bool {
+    corners[t as usize].up(k as usize, forward[t as usize][k as usize])
+}
+
+/// Whether the prisms using one edge (`uses`) split its quad differently.
+fn mismatched(corners: &[Corners], forward: &[[bool; 3]], uses: &[(u32, u8)]) -> bool {
+    let (t0, k0) = uses[0];
+    !corners[t0 as usize].degenerate(k0 as usize)
+        && uses
+            .iter()
+            .any(|&(t, k)| edge_up(corners, forward, t, k) != edge_up(corners, forward, t0, k0))
+}
+
+/// `Split::Paper`: flips diagonals where prisms disagree and one of them stays splittable
+/// (Fig. 4b), then makes the second prism of each edge still mismatched take the first's
+/// diagonal, cyclic (Fig. 4d).
+fn paper_flips(
+    corners: &[Corners],
+    edges: &Edges,
+    forward: &mut [[bool; 3]],
+    stats: &mut SplitStats,
+) {
+    let up = |forward: &[[bool; 3]], t: u32, k: u8| edge_up(corners, forward, t, k);
+    // Fig. 4b: flip a prism's diagonal on the shared quad when it stays splittable.
+    let mut changed = true;
+    while changed {
+        changed = false;
+        for uses in edges.iter() {
+            if !mismatched(corners, forward, uses) {
+                continue;
             }
-            // Fig. 4d: where neither prism can flip, the second takes the first's diagonal and
-            // becomes cyclic; it gets an inserted vertex.
-            for uses in edges.iter() {
-                if !mismatched(&forward, uses) {
+            let (t0, k0) = uses[0];
+            for &(t, k) in &uses[1..] {
+                if up(forward, t, k) == up(forward, t0, k0) {
                     continue;
                 }
-                let (t0, k0) = uses[0];
-                for &(t, k) in &uses[1..] {
-                    if up(&forward, t, k) != up(&forward, t0, k0) {
-                        forward[t as usize][k as usize] = !forward[t as usize][k as usize];
-                    }
+                let mut f = forward[t as usize];
+                f[k as usize] = !f[k as usize];
+                if corners[t as usize].splittable(f) {
+                    forward[t as usize] = f;
+                    stats.flips += 1;
+                    changed = true;
+                    continue;
                 }
-            }
-        }
-        Split::Quality => {
-            let prism_quality = |t: usize, f: [bool; 3]| -> f64 {
-                let f = corners[t].effective(f);
-                corners[t]
-                    .layers(n as u32)
-                    .into_iter()
-                    .flat_map(|v| prism_tets(v, f, u32::MAX))
-                    .map(|tet| {
-                        let p = tet.map(|i| positions[i as usize]);
-                        // Inverted is worst.
-                        if signed_volume(p) <= 0.0 {
-                            -1.0
-                        } else {
-                            min_dihedral(p)
-                        }
-                    })
-                    .fold(f64::INFINITY, f64::min)
-            };
-            // Each prism's worst tetrahedron, kept up to date as diagonals flip.
-            let mut quality: Vec<f64> = (0..corners.len())
-                .map(|t| prism_quality(t, forward[t]))
-                .collect();
-            for _pass in 0..2 {
-                for uses in edges.iter() {
-                    if corners[uses[0].0 as usize].degenerate(uses[0].1 as usize) {
-                        continue;
-                    }
-                    let flipped: Vec<(usize, [bool; 3])> = uses
-                        .iter()
-                        .map(|&(t, k)| {
-                            let mut f = forward[t as usize];
-                            f[k as usize] = !f[k as usize];
-                            (t as usize, f)
-                        })
-                        .collect();
-                    if flipped.iter().any(|&(t, f)| !corners[t].splittable(f)) {
-                        continue;
-                    }
-                    let before = flipped
-                        .iter()
-                        .map(|&(t, _)| quality[t])
-                        .fold(f64::INFINITY, f64::min);
-                    let after: Vec<f64> =
-                        flipped.iter().map(|&(t, f)| prism_quality(t, f)).collect();
-                    if after.iter().copied().fold(f64::INFINITY, f64::min) > before + 1e-12 {
-                        for ((t, f), q) in flipped.into_iter().zip(after) {
-                            forward[t] = f;
-                            quality[t] = q;
-                        }
-                        stats.flips += 1;
-                    }
+                // The first prism flips instead, if that leaves it and every other
+                // user of the edge consistent.
+                let mut f0 = forward[t0 as usize];
+                f0[k0 as usize] = !f0[k0 as usize];
+                if uses.len() == 2 && corners[t0 as usize].splittable(f0) {
+                    forward[t0 as usize] = f0;
+                    stats.flips += 1;
+                    changed = true;
                 }
             }
         }
     }
-    stats.mismatches_final = edges.iter().filter(|u| mismatched(&forward, u)).count();
-    (forward, stats)
+    // Fig. 4d: where neither prism can flip, the second takes the first's diagonal and
+    // becomes cyclic; it gets an inserted vertex.
+    for uses in edges.iter() {
+        if !mismatched(corners, forward, uses) {
+            continue;
+        }
+        let (t0, k0) = uses[0];
+        for &(t, k) in &uses[1..] {
+            if up(forward, t, k) != up(forward, t0, k0) {
+                forward[t as usize][k as usize] = !forward[t as usize][k as usize];
+            }
+        }
+    }
+}
+
+/// `Split::Quality`: in two passes over the edges, flips an edge's diagonal in every prism
+/// using it where that keeps them splittable and improves their worst tetrahedron (on the
+/// halo vertices `positions` of a surface of `n` vertices).
+fn quality_flips(
+    corners: &[Corners],
+    edges: &Edges,
+    positions: &[DVec3],
+    n: usize,
+    forward: &mut [[bool; 3]],
+    stats: &mut SplitStats,
+) {
+    let prism_quality = |t: usize, f: [bool; 3]| -> f64 {
+        let f = corners[t].effective(f);
+        corners[t]
+            .layers(n as u32)
+            .into_iter()
+            .flat_map(|v| prism_tets(v, f, u32::MAX))
+            .map(|tet| {
+                let p = tet.map(|i| positions[i as usize]);
+                // Inverted is worst.
+                if signed_volume(p) <= 0.0 {
+                    -1.0
+                } else {
+                    min_dihedral(p)
+                }
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    // Each prism's worst tetrahedron, kept up to date as diagonals flip.
+    let mut quality: Vec<f64> = (0..corners.len())
+        .map(|t| prism_quality(t, forward[t]))
+        .collect();
+    for _pass in 0..2 {
+        for uses in edges.iter() {
+            if corners[uses[0].0 as usize].degenerate(uses[0].1 as usize) {
+                continue;
+            }
+            let flipped: Vec<(usize, [bool; 3])> = uses
+                .iter()
+                .map(|&(t, k)| {
+                    let mut f = forward[t as usize];
+                    f[k as usize] = !f[k as usize];
+                    (t as usize, f)
+                })
+                .collect();
+            if flipped.iter().any(|&(t, f)| !corners[t].splittable(f)) {
+                continue;
+            }
+            let before = flipped
+                .iter()
+                .map(|&(t, _)| quality[t])
+                .fold(f64::INFINITY, f64::min);
+            let after: Vec<f64> = flipped.iter().map(|&(t, f)| prism_quality(t, f)).collect();
+            if after.iter().copied().fold(f64::INFINITY, f64::min) > before + 1e-12 {
+                for ((t, f), q) in flipped.into_iter().zip(after) {
+                    forward[t] = f;
+                    quality[t] = q;
+                }
+                stats.flips += 1;
+            }
+        }
+    }
 }
 
 /// The tetrahedra of both layers of every prism, with a vertex inserted at the centre of each

@@ -140,18 +140,7 @@ pub fn search(scene: &Scene, quiet: bool) -> Result<Found, SearchError> {
     let start = std::time::Instant::now();
     let meshes = coarse_meshes(scene);
     let triangles = meshes.iter().map(|m| m.triangles.len()).sum();
-    let bar = if quiet {
-        ProgressBar::hidden()
-    } else {
-        let bar = ProgressBar::new(SEARCH_VIEWS as u64);
-        bar.set_style(
-            ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} 4D views ({elapsed})")
-                .expect("a valid template")
-                .progress_chars("=> "),
-        );
-        bar.set_message("view search");
-        bar
-    };
+    let bar = progress_bar(quiet);
     let mut settings = scene.render;
     (settings.width, settings.height, settings.samples) = (SEARCH_SIDE, SEARCH_SIDE, 1);
     settings.halos = false;
@@ -191,25 +180,7 @@ pub fn search(scene: &Scene, quiet: bool) -> Result<Found, SearchError> {
         let Some((centre, _, score)) = best else {
             break;
         };
-        let mut moves: Vec<[f64; 6]> = Vec::new();
-        for d in 0..6 {
-            for sign in [-1.0, 1.0] {
-                let mut a = centre.angles;
-                a[d] = crate::view::wrap_degrees(a[d] + sign * step);
-                moves.push(a);
-            }
-        }
-        let cameras: Vec<(f64, f64)> = [-1.0, 0.0, 1.0]
-            .iter()
-            .flat_map(|&da| {
-                [-1.0, 0.0, 1.0].iter().map(move |&de| {
-                    (
-                        crate::view::wrap_degrees(centre.azimuth + da * step),
-                        (centre.elevation + de * step).clamp(-80.0, 80.0),
-                    )
-                })
-            })
-            .collect();
+        let (mut moves, cameras) = pattern_moves(&centre, step);
         let remaining = SEARCH_VIEWS - evaluated;
         moves.truncate(remaining);
         evaluated += moves.len();
@@ -230,13 +201,8 @@ pub fn search(scene: &Scene, quiet: bool) -> Result<Found, SearchError> {
             "every view put a surface behind the 4D eye or left nothing to draw".into(),
         ));
     };
-    let names = Rotation4::default().planes().map(|(n, _)| n);
-    let mut rotation = Rotation4::default();
-    for (name, angle) in names.iter().zip(found.angles) {
-        *rotation.angle_mut(name).expect("a plane's name") = angle;
-    }
     Ok(Found {
-        rotation,
+        rotation: rotation_of(found.angles),
         azimuth: found.azimuth,
         elevation: found.elevation,
         visible_curve_share: share,
@@ -247,6 +213,56 @@ pub fn search(scene: &Scene, quiet: bool) -> Result<Found, SearchError> {
         triangles,
         ms: start.elapsed().as_secs_f64() * 1e3,
     })
+}
+
+/// The search's progress bar over [`SEARCH_VIEWS`] views, hidden when `quiet`.
+fn progress_bar(quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(SEARCH_VIEWS as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} 4D views ({elapsed})")
+            .expect("a valid template")
+            .progress_chars("=> "),
+    );
+    bar.set_message("view search");
+    bar
+}
+
+/// The pattern search's moves from `centre` by `step` degrees: each 4D angle in turn moved
+/// by minus and plus the step, and the nine cameras around the centre's.
+fn pattern_moves(centre: &Candidate, step: f64) -> (Vec<[f64; 6]>, Vec<(f64, f64)>) {
+    let mut moves: Vec<[f64; 6]> = Vec::new();
+    for d in 0..6 {
+        for sign in [-1.0, 1.0] {
+            let mut a = centre.angles;
+            a[d] = crate::view::wrap_degrees(a[d] + sign * step);
+            moves.push(a);
+        }
+    }
+    let cameras: Vec<(f64, f64)> = [-1.0, 0.0, 1.0]
+        .iter()
+        .flat_map(|&da| {
+            [-1.0, 0.0, 1.0].iter().map(move |&de| {
+                (
+                    crate::view::wrap_degrees(centre.azimuth + da * step),
+                    (centre.elevation + de * step).clamp(-80.0, 80.0),
+                )
+            })
+        })
+        .collect();
+    (moves, cameras)
+}
+
+/// The rotation of the six plane angles, in [`Rotation4::planes`]'s order.
+fn rotation_of(angles: [f64; 6]) -> Rotation4 {
+    let names = Rotation4::default().planes().map(|(n, _)| n);
+    let mut rotation = Rotation4::default();
+    for (name, angle) in names.iter().zip(angles) {
+        *rotation.angle_mut(name).expect("a plane's name") = angle;
+    }
+    rotation
 }
 
 /// Keeps in `best` the candidate of highest score of `results` (the first of equal ones).

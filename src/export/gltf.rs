@@ -47,7 +47,7 @@ use gltf_json as json;
 use json::validation::Checked::Valid;
 use json::validation::USize64;
 use rayon::prelude::*;
-use serde_json::value::to_raw_value;
+use serde_json::value::{RawValue, to_raw_value};
 use std::io::{self, Write};
 
 /// Base colours of the surfaces' materials, in turn.
@@ -280,12 +280,11 @@ pub fn glb_chunks(
     stipples: &[Drawn],
     asset: &serde_json::Value,
 ) -> Result<(Vec<u8>, Vec<u8>), String> {
-    let extras = |v: serde_json::Value| to_raw_value(&v).map(Some).map_err(|e| e.to_string());
     let mut b = Builder {
         root: json::Root {
             asset: json::Asset {
                 generator: Some(format!("halo4d {}", env!("CARGO_PKG_VERSION"))),
-                extras: extras(serde_json::json!({ "halo4d": asset }))?,
+                extras: raw_extras(serde_json::json!({ "halo4d": asset }))?,
                 ..Default::default()
             },
             ..Default::default()
@@ -294,81 +293,7 @@ pub fn glb_chunks(
     };
     let mut nodes = Vec::new();
     for (k, s) in surfaces.iter().enumerate() {
-        let p = s.projected;
-        let scalar = |f: &dyn Fn(usize) -> f64| {
-            (0..p.positions.len())
-                .map(|i| f(i) as f32)
-                .collect::<Vec<f32>>()
-        };
-        use json::accessor::Type::Scalar;
-        use json::mesh::Semantic;
-        let mut attributes = vec![
-            (Semantic::Positions, b.positions(&p.positions)),
-            (Semantic::Normals, b.normals(&p.normals)),
-            (
-                Semantic::Extras("W".into()),
-                b.floats(&scalar(&|i| p.w[i]), Scalar, None),
-            ),
-            (
-                Semantic::Extras("U".into()),
-                b.floats(&scalar(&|i| s.mesh.uv[i][0]), Scalar, None),
-            ),
-            (
-                Semantic::Extras("V".into()),
-                b.floats(&scalar(&|i| s.mesh.uv[i][1]), Scalar, None),
-            ),
-            (
-                Semantic::Extras("PATCH".into()),
-                b.floats(&scalar(&|i| f64::from(s.mesh.patch[i])), Scalar, None),
-            ),
-        ];
-        // The 4D mesh before the view, a SCALAR per coordinate (see `crate::convention`).
-        let columns = [&s.mesh.positions, &s.mesh.tangent_u, &s.mesh.tangent_v];
-        for (column, names) in columns.iter().zip(MESH_4D) {
-            for (c, name) in names.iter().enumerate() {
-                let values: Vec<f32> = column.iter().map(|p| p[c] as f32).collect();
-                attributes.push((
-                    Semantic::Extras((*name).into()),
-                    b.floats(&values, Scalar, None),
-                ));
-            }
-        }
-        let triangles: Vec<u32> = s.mesh.triangles.iter().flatten().copied().collect();
-        let index_accessor = b.indices(
-            &triangles,
-            Some(json::buffer::Target::ElementArrayBuffer),
-            None,
-        );
-        let material = b.root.push(json::Material {
-            name: Some(s.name.to_string()),
-            double_sided: true,
-            pbr_metallic_roughness: json::material::PbrMetallicRoughness {
-                base_color_factor: json::material::PbrBaseColorFactor(PALETTE[k % PALETTE.len()]),
-                metallic_factor: json::material::StrengthFactor(0.0),
-                roughness_factor: json::material::StrengthFactor(0.6),
-                ..Default::default()
-            },
-            ..Default::default()
-        });
-        let mesh = b.root.push(json::Mesh {
-            name: Some(s.name.to_string()),
-            extras: extras(serde_json::json!({
-                "surface": s.surface_type,
-                "patches": s.patches,
-                "w_range": p.w_range(),
-            }))?,
-            extensions: None,
-            primitives: vec![json::mesh::Primitive {
-                attributes: attributes.into_iter().map(|(k, v)| (Valid(k), v)).collect(),
-                extensions: None,
-                extras: None,
-                indices: Some(index_accessor),
-                material: Some(material),
-                mode: Valid(json::mesh::Mode::Triangles),
-                targets: None,
-            }],
-            weights: None,
-        });
+        let mesh = surface_mesh(&mut b, s, PALETTE[k % PALETTE.len()])?;
         nodes.push(b.root.push(json::Node {
             mesh: Some(mesh),
             name: Some(s.name.to_string()),
@@ -414,6 +339,96 @@ pub fn glb_chunks(
     });
     let text = b.root.to_vec().map_err(|e| e.to_string())?;
     Ok((text, b.bin))
+}
+
+/// Appends the mesh of surface `s`: its projected positions and normals, W, U, V and PATCH,
+/// the 4D mesh before the view, its triangles, and a material of base colour `colour`.
+fn surface_mesh(
+    b: &mut Builder,
+    s: &SurfaceData,
+    colour: [f32; 4],
+) -> Result<json::Index<json::Mesh>, String> {
+    let p = s.projected;
+    let scalar = |f: &dyn Fn(usize) -> f64| {
+        (0..p.positions.len())
+            .map(|i| f(i) as f32)
+            .collect::<Vec<f32>>()
+    };
+    use json::accessor::Type::Scalar;
+    use json::mesh::Semantic;
+    let mut attributes = vec![
+        (Semantic::Positions, b.positions(&p.positions)),
+        (Semantic::Normals, b.normals(&p.normals)),
+        (
+            Semantic::Extras("W".into()),
+            b.floats(&scalar(&|i| p.w[i]), Scalar, None),
+        ),
+        (
+            Semantic::Extras("U".into()),
+            b.floats(&scalar(&|i| s.mesh.uv[i][0]), Scalar, None),
+        ),
+        (
+            Semantic::Extras("V".into()),
+            b.floats(&scalar(&|i| s.mesh.uv[i][1]), Scalar, None),
+        ),
+        (
+            Semantic::Extras("PATCH".into()),
+            b.floats(&scalar(&|i| f64::from(s.mesh.patch[i])), Scalar, None),
+        ),
+    ];
+    // The 4D mesh before the view, a SCALAR per coordinate (see `crate::convention`).
+    let columns = [&s.mesh.positions, &s.mesh.tangent_u, &s.mesh.tangent_v];
+    for (column, names) in columns.iter().zip(MESH_4D) {
+        for (c, name) in names.iter().enumerate() {
+            let values: Vec<f32> = column.iter().map(|p| p[c] as f32).collect();
+            attributes.push((
+                Semantic::Extras((*name).into()),
+                b.floats(&values, Scalar, None),
+            ));
+        }
+    }
+    let triangles: Vec<u32> = s.mesh.triangles.iter().flatten().copied().collect();
+    let index_accessor = b.indices(
+        &triangles,
+        Some(json::buffer::Target::ElementArrayBuffer),
+        None,
+    );
+    let material = b.root.push(json::Material {
+        name: Some(s.name.to_string()),
+        double_sided: true,
+        pbr_metallic_roughness: json::material::PbrMetallicRoughness {
+            base_color_factor: json::material::PbrBaseColorFactor(colour),
+            metallic_factor: json::material::StrengthFactor(0.0),
+            roughness_factor: json::material::StrengthFactor(0.6),
+            ..Default::default()
+        },
+        ..Default::default()
+    });
+    let mesh = b.root.push(json::Mesh {
+        name: Some(s.name.to_string()),
+        extras: raw_extras(serde_json::json!({
+            "surface": s.surface_type,
+            "patches": s.patches,
+            "w_range": p.w_range(),
+        }))?,
+        extensions: None,
+        primitives: vec![json::mesh::Primitive {
+            attributes: attributes.into_iter().map(|(k, v)| (Valid(k), v)).collect(),
+            extensions: None,
+            extras: None,
+            indices: Some(index_accessor),
+            material: Some(material),
+            mode: Valid(json::mesh::Mode::Triangles),
+            targets: None,
+        }],
+        weights: None,
+    });
+    Ok(mesh)
+}
+
+/// A JSON value as glTF extras.
+fn raw_extras(v: serde_json::Value) -> Result<Option<Box<RawValue>>, String> {
+    to_raw_value(&v).map(Some).map_err(|e| e.to_string())
 }
 
 /// Appends the stipples as a mesh of POINTS: positions, `_RADIUS` (each disc's radius in

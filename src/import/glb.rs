@@ -83,52 +83,7 @@ pub fn read_scene_glb(bytes: &[u8]) -> Result<ImportedScene> {
             continue;
         };
         let halo = doc.halo(i, mesh, extras, mesh_name(mesh, i))?.validate()?;
-        let bad = |message: String| ImportError::BadHalo {
-            name: halo.name.clone(),
-            message,
-        };
-        let m = index(
-            extras,
-            "surface_mesh",
-            &format!("meshes[{i}].extras.halo"),
-            None,
-        )?;
-        let s = usize::try_from(m)
-            .ok()
-            .and_then(|m| surface_of.get(m).copied().flatten())
-            .ok_or_else(|| {
-                bad(format!(
-                    "surface_mesh = {m} is not one of the file's surface meshes"
-                ))
-            })?;
-        let surface = &surfaces[s];
-        if surface.halo.is_some() {
-            return Err(bad(format!(
-                "surface `{}` (meshes[{m}]) has a halo already",
-                surface.name
-            )));
-        }
-        if halo.mesh.surface_vertices != surface.positions.len() {
-            return Err(bad(format!(
-                "surface_vertices = {}, but its surface `{}` has {} vertices",
-                halo.mesh.surface_vertices,
-                surface.name,
-                surface.positions.len()
-            )));
-        }
-        for (what, present) in [
-            ("the attribute _T (t)", halo.t.is_some()),
-            ("the attribute _D (d_orig)", halo.d_orig.is_some()),
-            ("delta_d in its extras", halo.params.delta_d.is_some()),
-            ("delta_t in its extras", halo.params.delta_t.is_some()),
-        ] {
-            if !present {
-                return Err(bad(format!(
-                    "has no {what}, which the halo depth of paper 000 eq. 3 needs"
-                )));
-            }
-        }
-        surfaces[s].halo = Some(halo);
+        attach_halo(&mut surfaces, &surface_of, extras, i, halo)?;
     }
     let asset = extras(&root.asset.extras);
     let name = asset
@@ -160,6 +115,66 @@ pub fn read_scene_glb(bytes: &[u8]) -> Result<ImportedScene> {
         camera,
         scene: asset.pointer("/halo4d/scene").cloned(),
     })
+}
+
+/// Gives `halo`, the halo of glTF mesh `i` whose extras are `extras`, to the surface its
+/// `surface_mesh` names (`surface_of`: the surface each mesh is, if any), after checking that
+/// the surface has no halo yet, that their vertices agree, and that the halo has what the
+/// halo depth needs.
+fn attach_halo(
+    surfaces: &mut [ImportedSurface],
+    surface_of: &[Option<usize>],
+    extras: &Value,
+    i: usize,
+    halo: ImportedHalo,
+) -> Result<()> {
+    let bad = |message: String| ImportError::BadHalo {
+        name: halo.name.clone(),
+        message,
+    };
+    let m = index(
+        extras,
+        "surface_mesh",
+        &format!("meshes[{i}].extras.halo"),
+        None,
+    )?;
+    let s = usize::try_from(m)
+        .ok()
+        .and_then(|m| surface_of.get(m).copied().flatten())
+        .ok_or_else(|| {
+            bad(format!(
+                "surface_mesh = {m} is not one of the file's surface meshes"
+            ))
+        })?;
+    let surface = &surfaces[s];
+    if surface.halo.is_some() {
+        return Err(bad(format!(
+            "surface `{}` (meshes[{m}]) has a halo already",
+            surface.name
+        )));
+    }
+    if halo.mesh.surface_vertices != surface.positions.len() {
+        return Err(bad(format!(
+            "surface_vertices = {}, but its surface `{}` has {} vertices",
+            halo.mesh.surface_vertices,
+            surface.name,
+            surface.positions.len()
+        )));
+    }
+    for (what, present) in [
+        ("the attribute _T (t)", halo.t.is_some()),
+        ("the attribute _D (d_orig)", halo.d_orig.is_some()),
+        ("delta_d in its extras", halo.params.delta_d.is_some()),
+        ("delta_t in its extras", halo.params.delta_t.is_some()),
+    ] {
+        if !present {
+            return Err(bad(format!(
+                "has no {what}, which the halo depth of paper 000 eq. 3 needs"
+            )));
+        }
+    }
+    surfaces[s].halo = Some(halo);
+    Ok(())
 }
 
 /// The JSON chunk as `gltf-json`'s document; an error names the field.

@@ -22,6 +22,49 @@ const VTK_TETRA: f64 = 10.0;
 
 /// Reads the halo of a legacy VTK file (see [`crate::export::write_vtk`]).
 pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
+    let (mut r, title) = header(bytes)?;
+    let grid = r.grid()?;
+    let name = title
+        .split_once(": ")
+        .map_or(title.as_str(), |(head, _)| head)
+        .trim();
+    let name = if name.is_empty() { "halo" } else { name }.to_string();
+    let field = |key: &str| grid.field.get(key).and_then(|v| v.first().copied());
+    let n = surface_vertices(&grid.field)?;
+    for key in ["rho", "delta_d", "delta_t"] {
+        if let Some(v) = field(key).filter(|v| !v.is_finite()) {
+            return Err(err(format!(
+                "the FIELD value {key} is {v}, not a finite number"
+            )));
+        }
+    }
+    let surface_triangles = surface_triangles(&grid.field, n)?;
+    ImportedHalo {
+        name,
+        mesh: TetMesh {
+            positions: grid.points,
+            surface_vertices: n as usize,
+            tets: grid.tets,
+            surface_triangles,
+        },
+        t: grid.t,
+        d_orig: grid.d_orig,
+        params: FileParams {
+            rho: field("rho"),
+            delta_d: field("delta_d"),
+            delta_t: field("delta_t"),
+            split: None,
+            surface_mesh: None,
+            surface_mesh_vertices: None,
+            layers: field("layers"),
+        },
+    }
+    .validate()
+}
+
+/// Reads the header: the magic line with the file version, the title, ASCII or BINARY and
+/// `DATASET UNSTRUCTURED_GRID`. Gives the reader of the rest, and the title.
+fn header(bytes: &[u8]) -> Result<(Reader<'_>, String)> {
     let mut c = Cursor { bytes, pos: 0 };
     let magic = c.line().unwrap_or_default();
     let version = magic
@@ -73,83 +116,60 @@ pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
             )));
         }
     }
-    let grid = r.grid()?;
-    let name = title
-        .split_once(": ")
-        .map_or(title.as_str(), |(head, _)| head)
-        .trim();
-    let name = if name.is_empty() { "halo" } else { name }.to_string();
-    let field = |key: &str| grid.field.get(key).and_then(|v| v.first().copied());
-    let n = field("surface_vertices").ok_or_else(|| {
-        ImportError::NoHalo(format!(
-            "the file lacks the halo layout: its FIELD data has no `surface_vertices` (halo4d build writes it), so the two offset surfaces cannot be told apart; fields present: {}",
-            if grid.field.is_empty() {
-                "none".to_string()
-            } else {
-                let mut keys: Vec<&str> = grid.field.keys().map(String::as_str).collect();
-                keys.sort_unstable();
-                keys.join(", ")
-            }
-        ))
-    })?;
+    Ok((r, title))
+}
+
+/// The halo layout's number of surface vertices, from the FIELD data: a whole number that
+/// fits a u32 (kept as the f64 read).
+fn surface_vertices(field: &HashMap<String, Vec<f64>>) -> Result<f64> {
+    let n = field
+        .get("surface_vertices")
+        .and_then(|v| v.first().copied())
+        .ok_or_else(|| {
+            ImportError::NoHalo(format!(
+                "the file lacks the halo layout: its FIELD data has no `surface_vertices` (halo4d build writes it), so the two offset surfaces cannot be told apart; fields present: {}",
+                if field.is_empty() {
+                    "none".to_string()
+                } else {
+                    let mut keys: Vec<&str> = field.keys().map(String::as_str).collect();
+                    keys.sort_unstable();
+                    keys.join(", ")
+                }
+            ))
+        })?;
     if !(n >= 0.0 && n.fract() == 0.0 && n <= u32::MAX as f64) {
         return Err(err(format!(
             "surface_vertices must be a non-negative integer, found {n}"
         )));
     }
-    for key in ["rho", "delta_d", "delta_t"] {
-        if let Some(v) = field(key).filter(|v| !v.is_finite()) {
-            return Err(err(format!(
-                "the FIELD value {key} is {v}, not a finite number"
-            )));
-        }
-    }
-    // The surface's triangles, where the file lists them (halo4d writes them since the
-    // checker needs them to see a missing prism; an older file has none).
-    let surface_triangles = match grid.field.get("surface_triangles") {
-        None => Vec::new(),
-        Some(v) => {
-            if v.len() % 3 != 0 {
-                return Err(err(format!(
-                    "the FIELD array surface_triangles has {} values, not three per triangle",
-                    v.len()
-                )));
-            }
-            if let Some(x) = v
-                .iter()
-                .find(|x| !(**x >= 0.0 && x.fract() == 0.0 && **x < n))
-            {
-                return Err(err(format!(
-                    "the FIELD array surface_triangles names {x}, not a surface vertex (0 to {})",
-                    n - 1.0
-                )));
-            }
-            v.chunks_exact(3)
-                .map(|c| [c[0] as u32, c[1] as u32, c[2] as u32])
-                .collect()
-        }
+    Ok(n)
+}
+
+/// The surface's triangles, where the FIELD data lists them (halo4d writes them since the
+/// checker needs them to see a missing prism; an older file has none), each a triple of
+/// surface vertices below `n`.
+fn surface_triangles(field: &HashMap<String, Vec<f64>>, n: f64) -> Result<Vec<[u32; 3]>> {
+    let Some(v) = field.get("surface_triangles") else {
+        return Ok(Vec::new());
     };
-    ImportedHalo {
-        name,
-        mesh: TetMesh {
-            positions: grid.points,
-            surface_vertices: n as usize,
-            tets: grid.tets,
-            surface_triangles,
-        },
-        t: grid.t,
-        d_orig: grid.d_orig,
-        params: FileParams {
-            rho: field("rho"),
-            delta_d: field("delta_d"),
-            delta_t: field("delta_t"),
-            split: None,
-            surface_mesh: None,
-            surface_mesh_vertices: None,
-            layers: field("layers"),
-        },
+    if v.len() % 3 != 0 {
+        return Err(err(format!(
+            "the FIELD array surface_triangles has {} values, not three per triangle",
+            v.len()
+        )));
     }
-    .validate()
+    if let Some(x) = v
+        .iter()
+        .find(|x| !(**x >= 0.0 && x.fract() == 0.0 && **x < n))
+    {
+        return Err(err(format!(
+            "the FIELD array surface_triangles names {x}, not a surface vertex (0 to {})",
+            n - 1.0
+        )));
+    }
+    Ok(v.chunks_exact(3)
+        .map(|c| [c[0] as u32, c[1] as u32, c[2] as u32])
+        .collect())
 }
 
 /// A position in the file's bytes.

@@ -271,7 +271,6 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
     let (mut soup, tri_start) = merge(sheets);
     soup.prepare();
     report.triangles = soup.tris.len();
-    let proper = |t: &[u32; 3]| t[0] != t[1] && t[1] != t[2] && t[2] != t[0];
     report.degenerate_triangles = soup.tris.iter().filter(|t| !proper(t)).count();
 
     // Candidate pairs go to the exact tests as the broad phase finds them, on the cores,
@@ -280,80 +279,8 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
     // tasks' results are joined in the order a descent on one core finds them, so the curves
     // do not depend on the number of threads.
     let found = match broad_phase {
-        BroadPhase::Bvh => {
-            let boxes: Vec<_> = soup
-                .tris
-                .iter()
-                .map(|t| {
-                    if !proper(t) {
-                        // Touches nothing.
-                        return Aabb::INVALID;
-                    }
-                    let p = t.map(|v| soup.positions[v as usize]);
-                    broad::outward(p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
-                })
-                .collect();
-            let groups = groups(&soup.tris);
-            let group_boxes: Vec<_> = groups
-                .windows(2)
-                .map(|g| {
-                    boxes[g[0] as usize..g[1] as usize]
-                        .iter()
-                        .fold(Aabb::INVALID, |u, b| u.union(b))
-                })
-                .collect();
-            let bvh = broad::build(&group_boxes, 2);
-            report.bvh_ms = ms(start);
-            let t = Instant::now();
-            let test = |found: &mut Found, a: u32, b: u32| {
-                if boxes[a as usize].intersect_aabb(&boxes[b as usize]) {
-                    found.push(&soup, a.min(b), a.max(b));
-                }
-            };
-            // Neighbours within a run of triangles, then the runs whose boxes touch.
-            let within: Vec<Found> = groups
-                .par_windows(2)
-                .chunks(GROUPS_PER_TASK)
-                .map(|chunk| {
-                    let mut found = Found::default();
-                    for g in chunk {
-                        for a in g[0]..g[1] {
-                            for b in a + 1..g[1] {
-                                test(&mut found, a, b);
-                            }
-                        }
-                    }
-                    found
-                })
-                .collect();
-            let across =
-                broad::self_pairs_par(&bvh, &group_boxes, Found::default, |found, ga, gb| {
-                    for a in groups[ga as usize]..groups[ga as usize + 1] {
-                        for b in groups[gb as usize]..groups[gb as usize + 1] {
-                            test(found, a, b);
-                        }
-                    }
-                });
-            let found = Found::join(&soup, within.into_iter().chain(across).collect());
-            report.traverse_ms = ms(t);
-            found
-        }
-        BroadPhase::AllPairs => {
-            let ok: Vec<u32> = (0..soup.tris.len() as u32)
-                .filter(|&t| proper(&soup.tris[t as usize]))
-                .collect();
-            let rows: Vec<Found> = (0..ok.len())
-                .into_par_iter()
-                .map(|i| {
-                    let mut found = Found::default();
-                    for &b in &ok[i + 1..] {
-                        found.push(&soup, ok[i], b);
-                    }
-                    found
-                })
-                .collect();
-            Found::join(&soup, rows)
-        }
+        BroadPhase::Bvh => bvh_segments(&soup, start, &mut report),
+        BroadPhase::AllPairs => all_pairs_segments(&soup),
     };
     let Found {
         candidates,
@@ -377,11 +304,113 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
     };
     let (curves, branches) = chain::chain(&soup, &segments, face);
     report.unresolved += branches;
+    count_curves(&curves, &soup, &mut report);
+    let (triple_points, undecided) = triple_points(&soup, &segments, face);
+    report.triple_points = triple_points.len();
+    report.unresolved += undecided;
+    report.chain_ms = ms(t);
+    report.ms = ms(start);
+    Curves {
+        curves,
+        triple_points,
+        report,
+    }
+}
+
+/// Whether a triangle has three distinct vertices (a degenerate one touches nothing).
+fn proper(t: &[u32; 3]) -> bool {
+    t[0] != t[1] && t[1] != t[2] && t[2] != t[0]
+}
+
+/// The segments of the pairs of triangles whose boxes touch, found with a BVH over runs of
+/// neighbouring triangles: within each run, then across the runs whose boxes touch. Puts
+/// the time since `start` to build the BVH and the time to traverse it in the report.
+fn bvh_segments(soup: &Soup, start: Instant, report: &mut CurvesReport) -> Found {
+    let boxes: Vec<_> = soup
+        .tris
+        .iter()
+        .map(|t| {
+            if !proper(t) {
+                // Touches nothing.
+                return Aabb::INVALID;
+            }
+            let p = t.map(|v| soup.positions[v as usize]);
+            broad::outward(p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
+        })
+        .collect();
+    let groups = groups(&soup.tris);
+    let group_boxes: Vec<_> = groups
+        .windows(2)
+        .map(|g| {
+            boxes[g[0] as usize..g[1] as usize]
+                .iter()
+                .fold(Aabb::INVALID, |u, b| u.union(b))
+        })
+        .collect();
+    let bvh = broad::build(&group_boxes, 2);
+    report.bvh_ms = ms(start);
+    let t = Instant::now();
+    let test = |found: &mut Found, a: u32, b: u32| {
+        if boxes[a as usize].intersect_aabb(&boxes[b as usize]) {
+            found.push(soup, a.min(b), a.max(b));
+        }
+    };
+    // Neighbours within a run of triangles, then the runs whose boxes touch.
+    let within: Vec<Found> = groups
+        .par_windows(2)
+        .chunks(GROUPS_PER_TASK)
+        .map(|chunk| {
+            let mut found = Found::default();
+            for g in chunk {
+                for a in g[0]..g[1] {
+                    for b in a + 1..g[1] {
+                        test(&mut found, a, b);
+                    }
+                }
+            }
+            found
+        })
+        .collect();
+    let across = broad::self_pairs_par(&bvh, &group_boxes, Found::default, |found, ga, gb| {
+        for a in groups[ga as usize]..groups[ga as usize + 1] {
+            for b in groups[gb as usize]..groups[gb as usize + 1] {
+                test(found, a, b);
+            }
+        }
+    });
+    let found = Found::join(soup, within.into_iter().chain(across).collect());
+    report.traverse_ms = ms(t);
+    found
+}
+
+/// The segments of every pair of proper triangles, each tested exactly (a reference for
+/// the BVH).
+fn all_pairs_segments(soup: &Soup) -> Found {
+    let ok: Vec<u32> = (0..soup.tris.len() as u32)
+        .filter(|&t| proper(&soup.tris[t as usize]))
+        .collect();
+    let rows: Vec<Found> = (0..ok.len())
+        .into_par_iter()
+        .map(|i| {
+            let mut found = Found::default();
+            for &b in &ok[i + 1..] {
+                found.push(soup, ok[i], b);
+            }
+            found
+        })
+        .collect();
+    Found::join(soup, rows)
+}
+
+/// Counts the curves, their points and their ends in the report: closed and open curves,
+/// ends on a mesh boundary or at a branch point, and ends that should be on a boundary but
+/// are not (unresolved).
+fn count_curves(curves: &[Curve], soup: &Soup, report: &mut CurvesReport) {
     let boundary = curves
         .iter()
         .any(|c| c.ends.contains(&End::Boundary))
-        .then(|| BoundaryEdges::new(&soup));
-    for c in &curves {
+        .then(|| BoundaryEdges::new(soup));
+    for c in curves {
         report.points += c.points.len();
         for p in &c.points {
             report.coplanar += usize::from(p.coplanar);
@@ -413,16 +442,6 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
         }
     }
     report.count = curves.len();
-    let (triple_points, undecided) = triple_points(&soup, &segments, face);
-    report.triple_points = triple_points.len();
-    report.unresolved += undecided;
-    report.chain_ms = ms(t);
-    report.ms = ms(start);
-    Curves {
-        curves,
-        triple_points,
-        report,
-    }
 }
 
 /// Runs of triangles one task of the exact tests within runs takes.

@@ -611,55 +611,8 @@ impl<'a> Solver<'a> {
             residual = (1..k)
                 .map(|i| x0.distance(solved[i].mapped.position))
                 .fold(0.0, f64::max);
-            // The equations: x0 - xi for each other point, then the fourth.
-            let mut jac = [[0.0; N]; N];
-            let mut rhs = [0.0; N];
-            for i in 1..k {
-                let d = x0 - solved[i].mapped.position;
-                for r in 0..3 {
-                    let row = 3 * (i - 1) + r;
-                    rhs[row] = -d[r];
-                    jac[row][0] = solved[0].mapped.tangents[0][r];
-                    jac[row][1] = solved[0].mapped.tangents[1][r];
-                    jac[row][2 * i] = -solved[i].mapped.tangents[0][r];
-                    jac[row][2 * i + 1] = -solved[i].mapped.tangents[1][r];
-                }
-            }
-            if let Some(Fourth::Across { origin, along }) = fourth {
-                let normal = |s: &Solved| s.mapped.tangents[0].cross(s.mapped.tangents[1]);
-                let (na, nb) = (normal(&solved[0]), normal(&solved[1]));
-                let across = na.cross(nb);
-                let normal = if across.length() > 1e-8 * na.length() * nb.length() {
-                    across
-                } else {
-                    along
-                };
-                fourth = Some(Fourth::Plane {
-                    origin,
-                    normal: normal.try_normalize().ok_or(Failure::Other)?,
-                });
-            }
-            let mut fourth_ok = true;
-            if let Some(f) = fourth {
-                let last = N - 1;
-                match f {
-                    Fourth::Across { .. } => unreachable!("made a plane above"),
-                    Fourth::Plane { origin, normal } => {
-                        let c = normal.dot(x0 - origin);
-                        rhs[last] = -c;
-                        jac[last][0] = normal.dot(solved[0].mapped.tangents[0]);
-                        jac[last][1] = normal.dot(solved[0].mapped.tangents[1]);
-                        fourth_ok = c.abs() <= self.residual;
-                    }
-                    Fourth::Fixed { index, value } => {
-                        let p = &params[index / 2];
-                        let current = if index % 2 == 0 { p.u } else { p.v };
-                        rhs[last] = value - current;
-                        jac[last][index] = 1.0;
-                        fourth_ok = current == value;
-                    }
-                }
-            }
+            let mut system = Linear::<N>::coincidence(&solved);
+            let fourth_ok = self.fourth_equation(&mut system, &mut fourth, &solved, &params)?;
             // Within the limit: done at rounding, or when a step no longer gains much
             // (Newton's quadratic convergence gains orders of magnitude until rounding).
             if residual <= self.residual
@@ -672,65 +625,12 @@ impl<'a> Solver<'a> {
             if step == MAX_STEPS {
                 break;
             }
-            // Deflation: G = M F with M the product of the factors, so
-            // dG = M dF + F (dM)^T and dM = M sum(dm / m). -F is the right-hand side.
-            let mut grad = [0.0; N];
-            let mut factor = 1.0;
-            for &(i, j, s) in &same {
-                let d = solved[i].point - solved[j].point;
-                let d2 = d.length_squared();
-                if d2 == 0.0 || s == 0.0 {
-                    continue;
-                }
-                let m = 1.0 + s * s / d2;
-                // dm = -(s^2 / d2^2) d(d2), d(d2) = 2 d . (dPi, -dPj).
-                let c = -s * s / (d2 * d2) * 2.0 / m;
-                for t in 0..2 {
-                    grad[2 * i + t] += c * d.dot(solved[i].tangents[t]);
-                    grad[2 * j + t] -= c * d.dot(solved[j].tangents[t]);
-                }
-                factor *= m;
-            }
-            if factor != 1.0 {
-                // dG / M = dF + F grad^T (grad holding dM / M); G / M = F.
-                for r in 0..N {
-                    for c in 0..N {
-                        jac[r][c] -= rhs[r] * grad[c];
-                    }
-                }
-            }
-            let Some(mut delta) = solve(jac, rhs) else {
+            system.deflate(&same, &solved);
+            let Some(mut delta) = solve(system.jac, system.rhs) else {
                 break;
             };
-            // No point moves by more than half its reach.
-            let longest = (0..k)
-                .map(|i| {
-                    let t = solved[i].tangents;
-                    (t[0] * delta[2 * i] + t[1] * delta[2 * i + 1]).length()
-                        / (0.5 * starts[i].reach)
-                })
-                .fold(0.0, f64::max);
-            if longest > 1.0 {
-                delta.iter_mut().for_each(|d| *d /= longest);
-            }
-            for (i, p) in params.iter_mut().enumerate() {
-                let (patch, u, v, ok) = self.surface(p.sheet).chart(
-                    p.patch,
-                    p.u + delta[2 * i],
-                    p.v + delta[2 * i + 1],
-                );
-                (p.patch, p.u, p.v) = (patch, u, v);
-                inside[i] = ok;
-            }
-            if let Some(Fourth::Fixed { index, value }) = fourth {
-                // Exactly on the boundary, not a rounding off it.
-                let p = &mut params[index / 2];
-                if index % 2 == 0 {
-                    p.u = value;
-                } else {
-                    p.v = value;
-                }
-            }
+            limit_step(&mut delta, &solved, starts);
+            self.take_step(&mut params, &mut inside, &delta, fourth);
         }
         let near = |i: usize| solved[i].point.distance(starts[i].centre) <= starts[i].reach;
         let apart = |&(i, j, s): &(usize, usize, f64)| {
@@ -755,6 +655,83 @@ impl<'a> Solver<'a> {
             });
         }
         Ok((solved.clone(), residual))
+    }
+
+    /// Puts the fourth equation, if any, in the last row of `system`, at the points `solved`
+    /// (of parameters `params`); `Across` becomes the plane across the curve there. Gives
+    /// whether the equation holds, to within the accepted residual.
+    fn fourth_equation<const N: usize>(
+        &self,
+        system: &mut Linear<N>,
+        fourth: &mut Option<Fourth>,
+        solved: &[Solved],
+        params: &[Param],
+    ) -> Result<bool, Failure> {
+        if let Some(Fourth::Across { origin, along }) = *fourth {
+            let normal = |s: &Solved| s.mapped.tangents[0].cross(s.mapped.tangents[1]);
+            let (na, nb) = (normal(&solved[0]), normal(&solved[1]));
+            let across = na.cross(nb);
+            let normal = if across.length() > 1e-8 * na.length() * nb.length() {
+                across
+            } else {
+                along
+            };
+            *fourth = Some(Fourth::Plane {
+                origin,
+                normal: normal.try_normalize().ok_or(Failure::Other)?,
+            });
+        }
+        let mut fourth_ok = true;
+        if let Some(f) = *fourth {
+            let (jac, rhs) = (&mut system.jac, &mut system.rhs);
+            let last = N - 1;
+            match f {
+                Fourth::Across { .. } => unreachable!("made a plane above"),
+                Fourth::Plane { origin, normal } => {
+                    let c = normal.dot(solved[0].mapped.position - origin);
+                    rhs[last] = -c;
+                    jac[last][0] = normal.dot(solved[0].mapped.tangents[0]);
+                    jac[last][1] = normal.dot(solved[0].mapped.tangents[1]);
+                    fourth_ok = c.abs() <= self.residual;
+                }
+                Fourth::Fixed { index, value } => {
+                    let p = &params[index / 2];
+                    let current = if index % 2 == 0 { p.u } else { p.v };
+                    rhs[last] = value - current;
+                    jac[last][index] = 1.0;
+                    fourth_ok = current == value;
+                }
+            }
+        }
+        Ok(fourth_ok)
+    }
+
+    /// Moves the parameter points by the Newton step `delta`, across patches where the
+    /// surface's charts do, and records which stay inside their patch; a point with a
+    /// `Fixed` fourth equation is put exactly on its boundary.
+    fn take_step(
+        &self,
+        params: &mut [Param],
+        inside: &mut [bool],
+        delta: &[f64],
+        fourth: Option<Fourth>,
+    ) {
+        for (i, p) in params.iter_mut().enumerate() {
+            let (patch, u, v, ok) =
+                self.surface(p.sheet)
+                    .chart(p.patch, p.u + delta[2 * i], p.v + delta[2 * i + 1]);
+            (p.patch, p.u, p.v) = (patch, u, v);
+            inside[i] = ok;
+        }
+        if let Some(Fourth::Fixed { index, value }) = fourth {
+            // Exactly on the boundary, not a rounding off it.
+            let p = &mut params[index / 2];
+            if index % 2 == 0 {
+                p.u = value;
+            } else {
+                p.v = value;
+            }
+        }
     }
 
     /// The cross-cap near the mesh vertex `global` where the curve point `p` ends its
@@ -907,6 +884,84 @@ fn solve<const N: usize>(mut a: [[f64; N]; N], mut b: [f64; N]) -> Option<[f64; 
         x[row] = (b[row] - s) / a[row][row];
     }
     x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
+/// The linear system of one Newton step for `N / 2` points: the Jacobian and the
+/// right-hand side, minus the equations' values.
+struct Linear<const N: usize> {
+    jac: [[f64; N]; N],
+    rhs: [f64; N],
+}
+
+impl<const N: usize> Linear<N> {
+    /// The equations that the points `solved` project to one point, x0 - xi for each other
+    /// point, three rows each; the last row is left for the fourth equation.
+    fn coincidence(solved: &[Solved]) -> Self {
+        let k = N / 2;
+        let x0 = solved[0].mapped.position;
+        let mut jac = [[0.0; N]; N];
+        let mut rhs = [0.0; N];
+        for i in 1..k {
+            let d = x0 - solved[i].mapped.position;
+            for r in 0..3 {
+                let row = 3 * (i - 1) + r;
+                rhs[row] = -d[r];
+                jac[row][0] = solved[0].mapped.tangents[0][r];
+                jac[row][1] = solved[0].mapped.tangents[1][r];
+                jac[row][2 * i] = -solved[i].mapped.tangents[0][r];
+                jac[row][2 * i + 1] = -solved[i].mapped.tangents[1][r];
+            }
+        }
+        Linear { jac, rhs }
+    }
+
+    /// Deflates the equations at the trivial solutions of the pairs of points on one
+    /// surface (`same`, with their distance at the start; see [`Solver::newton`]).
+    fn deflate(&mut self, same: &[(usize, usize, f64)], solved: &[Solved]) {
+        // Deflation: G = M F with M the product of the factors, so
+        // dG = M dF + F (dM)^T and dM = M sum(dm / m). -F is the right-hand side.
+        let mut grad = [0.0; N];
+        let mut factor = 1.0;
+        for &(i, j, s) in same {
+            let d = solved[i].point - solved[j].point;
+            let d2 = d.length_squared();
+            if d2 == 0.0 || s == 0.0 {
+                continue;
+            }
+            let m = 1.0 + s * s / d2;
+            // dm = -(s^2 / d2^2) d(d2), d(d2) = 2 d . (dPi, -dPj).
+            let c = -s * s / (d2 * d2) * 2.0 / m;
+            for t in 0..2 {
+                grad[2 * i + t] += c * d.dot(solved[i].tangents[t]);
+                grad[2 * j + t] -= c * d.dot(solved[j].tangents[t]);
+            }
+            factor *= m;
+        }
+        if factor != 1.0 {
+            // dG / M = dF + F grad^T (grad holding dM / M); G / M = F.
+            let Linear { jac, rhs } = self;
+            for r in 0..N {
+                for c in 0..N {
+                    jac[r][c] -= rhs[r] * grad[c];
+                }
+            }
+        }
+    }
+}
+
+/// Shortens the Newton step `delta` so that no point (of `solved`, from `starts`) moves by
+/// more than half its reach.
+fn limit_step<const N: usize>(delta: &mut [f64; N], solved: &[Solved], starts: &[Start]) {
+    let k = N / 2;
+    let longest = (0..k)
+        .map(|i| {
+            let t = solved[i].tangents;
+            (t[0] * delta[2 * i] + t[1] * delta[2 * i + 1]).length() / (0.5 * starts[i].reach)
+        })
+        .fold(0.0, f64::max);
+    if longest > 1.0 {
+        delta.iter_mut().for_each(|d| *d /= longest);
+    }
 }
 
 #[cfg(test)]

@@ -196,47 +196,8 @@ pub(super) fn in_view(
         memory,
     } = scale;
     let mut products = Vec::with_capacity(projections.len());
-    for InView {
-        entry,
-        sample:
-            Sample {
-                name,
-                mesh,
-                stats,
-                report,
-            },
-        projected,
-    } in projections
-    {
-        let (halo, halo_report) = if stages.halos {
-            bar.set_message(format!("halo of {name}"));
-            let start = Instant::now();
-            let built = build_halo(&projected, &mesh.triangles, rho, &scene.halo);
-            timings.halo += ms(start);
-            built
-        } else {
-            Default::default()
-        };
-        bar.inc(1);
-        let stipples = stages.stipples.then(|| {
-            bar.set_message(format!("stipples of {name}"));
-            let start = Instant::now();
-            let st = &scene.render.stipple;
-            let set = Stipples::generate(&mesh.positions, &mesh.triangles, st.count, st.seed);
-            timings.stipples += ms(start);
-            set
-        });
-        products.push(SurfaceProduct {
-            name,
-            surface: entry.surface.clone(),
-            mesh,
-            stats,
-            sampling: report,
-            projected,
-            halo,
-            halo_report,
-            stipples,
-        });
+    for view in projections {
+        products.push(surface_product(scene, view, stages, rho, &mut timings, bar));
     }
     let mut curves = Curves::default();
     if stages.curves {
@@ -277,6 +238,58 @@ pub(super) fn in_view(
         timings,
         stages,
     })
+}
+
+/// One surface's product: its halo at half-width `rho` and its stipples, where the stages
+/// ask for them, with their times added to `timings`.
+fn surface_product(
+    scene: &Scene,
+    view: InView,
+    stages: Stages,
+    rho: f64,
+    timings: &mut Timings,
+    bar: &ProgressBar,
+) -> SurfaceProduct {
+    let InView {
+        entry,
+        sample:
+            Sample {
+                name,
+                mesh,
+                stats,
+                report,
+            },
+        projected,
+    } = view;
+    let (halo, halo_report) = if stages.halos {
+        bar.set_message(format!("halo of {name}"));
+        let start = Instant::now();
+        let built = build_halo(&projected, &mesh.triangles, rho, &scene.halo);
+        timings.halo += ms(start);
+        built
+    } else {
+        Default::default()
+    };
+    bar.inc(1);
+    let stipples = stages.stipples.then(|| {
+        bar.set_message(format!("stipples of {name}"));
+        let start = Instant::now();
+        let st = &scene.render.stipple;
+        let set = Stipples::generate(&mesh.positions, &mesh.triangles, st.count, st.seed);
+        timings.stipples += ms(start);
+        set
+    });
+    SurfaceProduct {
+        name,
+        surface: entry.surface.clone(),
+        mesh,
+        stats,
+        sampling: report,
+        projected,
+        halo,
+        halo_report,
+        stipples,
+    }
 }
 
 /// Each sample in the scene's view, its coordinates checked against the files' range.

@@ -1,7 +1,9 @@
 //! A build's files: written under temporary names side by side, moved into place together,
 //! with `report.json`.
 
-use super::report::{MemoryReport, PictureReport, Report, surface_report, surface_warnings};
+use super::report::{
+    MemoryReport, PictureReport, Report, Timings, surface_report, surface_warnings,
+};
 use super::{Built, ms};
 use crate::error::Error;
 use crate::export::{self, SurfaceData};
@@ -15,19 +17,55 @@ use std::time::Instant;
 /// `out_dir`, and returns the report (also written as `report.json` when asked for). The
 /// export time is added to the build's timings, and the total is the sum of the stages.
 pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Error> {
-    let products = &built.surfaces;
     let mut timings = built.timings;
     let export_start = Instant::now();
     // Every file under a temporary name until all were made: a failure leaves the folder
     // as it was.
     let staged = export::Staged::new(out_dir).map_err(staged_error)?;
-    let data: Vec<SurfaceData> = products.iter().map(|p| p.data(&scene.halo)).collect();
+    let data: Vec<SurfaceData> = built.surfaces.iter().map(|p| p.data(&scene.halo)).collect();
+    let failures = built.failures();
+    let stipples = file_stipples(scene, built)?;
+    let mut files = write_meshes(scene, built, &staged, &data, &stipples, &failures)?;
+    timings.export = ms(export_start);
+    let mut picture_report = None;
+    if scene.outputs.png || scene.outputs.svg {
+        let (picture, written) = write_picture(scene, built, &staged, &mut timings.render)?;
+        files.extend(written);
+        picture_report = Some(picture);
+    }
+    if scene.outputs.report {
+        files.push("report.json".into());
+    }
+    timings.total = total(&timings);
+    let report = assemble_report(scene, built, timings, picture_report, failures, files);
+    if scene.outputs.report {
+        let text = serde_json::to_vec_pretty(&report).map_err(|e| Error::Internal {
+            stage: "export",
+            message: e.to_string(),
+        })?;
+        staged
+            .write("report.json".into(), &text)
+            .map_err(staged_error)?;
+    }
+    staged.commit().map_err(staged_error)?;
+    Ok(report)
+}
+
+/// Writes the mesh files the scene asks for (`.glb`, `.ply`, stipples, `.obj`, `.4off`,
+/// `.vtk`), staged, from the surfaces' `data`, the `stipples` and the build's verdict
+/// (`failures`); gives their names in the report's order.
+fn write_meshes(
+    scene: &Scene,
+    built: &Built,
+    staged: &export::Staged,
+    data: &[SurfaceData],
+    stipples: &[render::stipple::Drawn],
+    failures: &[String],
+) -> Result<Vec<String>, Error> {
     let write = |file: String, bytes: &[u8]| -> Result<String, Error> {
         staged.write(file, bytes).map_err(staged_error)
     };
     let name = &scene.name;
-    let failures = built.failures();
-    let stipples = file_stipples(scene, built)?;
     // The files are made on the cores side by side, each written as it is made (a halo's
     // `.vtk` streamed, the `.glb`'s chunks written as they are, with no copy of the whole
     // file in memory); the report lists them in this order.
@@ -35,7 +73,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     let mut jobs: Vec<Job> = Vec::new();
     if scene.outputs.glb {
         jobs.push(Box::new(|| {
-            let (text, bin) = glb_chunks(scene, built, &data, &stipples, &failures)?;
+            let (text, bin) = glb_chunks(scene, built, data, stipples, failures)?;
             let file = staged
                 .stream(format!("{name}.glb"), |w| {
                     export::write_glb_container(w, &text, &bin)
@@ -47,7 +85,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     if scene.outputs.ply {
         jobs.push(Box::new(|| {
             Ok(vec![
-                write(format!("{name}.ply"), &export::to_ply(&data, name))?,
+                write(format!("{name}.ply"), &export::to_ply(data, name))?,
                 write(
                     format!("{name}-curves.ply"),
                     &export::to_curves_ply(built.shown_curves(), name),
@@ -59,7 +97,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
         jobs.push(Box::new(|| {
             Ok(vec![write(
                 format!("{name}-stipples.ply"),
-                &export::to_stipples_ply(&stipples, name),
+                &export::to_stipples_ply(stipples, name),
             )?])
         }));
     }
@@ -67,12 +105,12 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
         jobs.push(Box::new(|| {
             Ok(vec![write(
                 format!("{name}.obj"),
-                export::to_obj(&data, name).as_bytes(),
+                export::to_obj(data, name).as_bytes(),
             )?])
         }));
     }
     if scene.outputs.off4 {
-        for p in products {
+        for p in &built.surfaces {
             let file = per_surface(name, &p.name, data.len(), ".4off");
             jobs.push(Box::new(move || {
                 let text = export::to_4off(&p.mesh.positions, &p.mesh.triangles, &p.name);
@@ -81,9 +119,8 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
         }
     }
     if scene.outputs.vtk {
-        for d in &data {
+        for d in data {
             let file = per_surface(name, d.name, data.len(), "-halo.vtk");
-            let staged = &staged;
             jobs.push(Box::new(move || {
                 let file = staged
                     .stream(file, |w| export::write_vtk(w, d, name))
@@ -93,40 +130,53 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
         }
     }
     let written: Result<Vec<Vec<String>>, Error> = jobs.into_par_iter().map(|job| job()).collect();
-    let mut files: Vec<String> = written?.into_iter().flatten().collect();
-    timings.export = ms(export_start);
-    let mut picture_report = None;
-    if scene.outputs.png || scene.outputs.svg {
-        let start = Instant::now();
-        let rendered = render::render_for_build(
-            &built.parts(&scene.halo),
-            &scene.render,
-            &scene.camera,
-            scene.outputs.svg,
-        )
-        .map_err(|source| Error::Render {
-            scene: scene.name.clone(),
-            source,
-        })?;
-        timings.render = ms(start);
-        if scene.outputs.png {
-            files.push(write(format!("{name}.png"), &rendered.picture.png())?);
-        }
-        if let Some(svg) = &rendered.svg {
-            files.push(write(format!("{name}.svg"), svg.as_bytes())?);
-        }
-        picture_report = Some(PictureReport {
-            camera: rendered.camera,
-            clip: scene.render.clip,
-            rho: built.rho,
-            gap_px: built.rho / built.pixel_size,
-            curves: rendered.curves,
-        });
+    Ok(written?.into_iter().flatten().collect())
+}
+
+/// Renders the picture and writes it as `.png` and/or `.svg`, staged, with the render time
+/// in `render_ms`: the picture's report and the files written.
+fn write_picture(
+    scene: &Scene,
+    built: &Built,
+    staged: &export::Staged,
+    render_ms: &mut f64,
+) -> Result<(PictureReport, Vec<String>), Error> {
+    let write = |file: String, bytes: &[u8]| -> Result<String, Error> {
+        staged.write(file, bytes).map_err(staged_error)
+    };
+    let name = &scene.name;
+    let mut files = Vec::new();
+    let start = Instant::now();
+    let rendered = render::render_for_build(
+        &built.parts(&scene.halo),
+        &scene.render,
+        &scene.camera,
+        scene.outputs.svg,
+    )
+    .map_err(|source| Error::Render {
+        scene: scene.name.clone(),
+        source,
+    })?;
+    *render_ms = ms(start);
+    if scene.outputs.png {
+        files.push(write(format!("{name}.png"), &rendered.picture.png())?);
     }
-    if scene.outputs.report {
-        files.push("report.json".into());
+    if let Some(svg) = &rendered.svg {
+        files.push(write(format!("{name}.svg"), svg.as_bytes())?);
     }
-    timings.total = timings.sample
+    let picture = PictureReport {
+        camera: rendered.camera,
+        clip: scene.render.clip,
+        rho: built.rho,
+        gap_px: built.rho / built.pixel_size,
+        curves: rendered.curves,
+    };
+    Ok((picture, files))
+}
+
+/// The sum of the stages' times, in the stages' order.
+fn total(timings: &Timings) -> f64 {
+    timings.sample
         + timings.audit
         + timings.view
         + timings.halo
@@ -135,8 +185,22 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
         + timings.verify
         + timings.stipples
         + timings.render
-        + timings.export;
-    let report = Report {
+        + timings.export
+}
+
+/// The build's report: the scene, each surface, the stages that ran, the curves and the
+/// verification, the `timings`, the memory (with the peak so far), the warnings, the
+/// `picture`, the verdict (`failures`) and the `files` written.
+fn assemble_report(
+    scene: &Scene,
+    built: &Built,
+    timings: Timings,
+    picture: Option<PictureReport>,
+    failures: Vec<String>,
+    files: Vec<String>,
+) -> Report {
+    let products = &built.surfaces;
+    Report {
         halo4d: env!("CARGO_PKG_VERSION"),
         scene_name: scene.name.clone(),
         surfaces: products
@@ -161,21 +225,12 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
                 p.sampling.warning(&p.name).into_iter().chain(surface)
             })
             .collect(),
-        picture: picture_report,
+        picture,
         verified: failures.is_empty(),
         failures,
         files,
         scene: scene.clone(),
-    };
-    if scene.outputs.report {
-        let text = serde_json::to_vec_pretty(&report).map_err(|e| Error::Internal {
-            stage: "export",
-            message: e.to_string(),
-        })?;
-        write("report.json".into(), &text)?;
     }
-    staged.commit().map_err(staged_error)?;
-    Ok(report)
 }
 
 /// The file of one of a scene's `surfaces` surfaces: `<scene><ending>` when it has one,

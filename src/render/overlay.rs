@@ -202,31 +202,7 @@ impl Scene<'_> {
                 });
             }
         }
-        let mut polylines: Vec<(InkClass, Vec<LinePoint>)> = Vec::new();
-        if s.curves {
-            for c in &self.input.curves.curves {
-                polylines.extend(curve_polylines(c, s.curve_colours, self.w_range));
-            }
-        }
-        if s.silhouettes {
-            polylines.extend(
-                self.silhouette_edges(cam)
-                    .into_iter()
-                    .map(|[a, b]| (0, vec![LinePoint::plain(a), LinePoint::plain(b)])),
-            );
-        }
-        if let Some(clip) = &s.clip {
-            let mut cuts = Vec::new();
-            for surf in &self.input.surfaces {
-                for t in surf.triangles {
-                    clip.cut_edges(t.map(|v| surf.positions[v as usize]), &mut cuts);
-                }
-            }
-            polylines.extend(
-                cuts.into_iter()
-                    .map(|[a, b]| (0, vec![LinePoint::plain(a), LinePoint::plain(b)])),
-            );
-        }
+        let polylines = self.polylines(cam);
         let depth_of = |p: DVec3| (p - cam.eye).dot(cam.forward);
         let (near, far) = {
             let c = depth_of(self.centre);
@@ -292,6 +268,38 @@ impl Scene<'_> {
             flush(&mut run);
         }
         Ok(out)
+    }
+
+    /// The scene's lines in space, each with its ink class: the curves (banded by depth when
+    /// the settings colour them), the silhouettes seen from `cam` and the edges the clip cuts.
+    fn polylines(&self, cam: &Camera) -> Vec<(InkClass, Vec<LinePoint>)> {
+        let s = self.settings;
+        let mut polylines: Vec<(InkClass, Vec<LinePoint>)> = Vec::new();
+        if s.curves {
+            for c in &self.input.curves.curves {
+                polylines.extend(curve_polylines(c, s.curve_colours, self.w_range));
+            }
+        }
+        if s.silhouettes {
+            polylines.extend(
+                self.silhouette_edges(cam)
+                    .into_iter()
+                    .map(|[a, b]| (0, vec![LinePoint::plain(a), LinePoint::plain(b)])),
+            );
+        }
+        if let Some(clip) = &s.clip {
+            let mut cuts = Vec::new();
+            for surf in &self.input.surfaces {
+                for t in surf.triangles {
+                    clip.cut_edges(t.map(|v| surf.positions[v as usize]), &mut cuts);
+                }
+            }
+            polylines.extend(
+                cuts.into_iter()
+                    .map(|[a, b]| (0, vec![LinePoint::plain(a), LinePoint::plain(b)])),
+            );
+        }
+        polylines
     }
 
     /// Whether a surface the halos leave visible lies between the eye and `p` (surfaces

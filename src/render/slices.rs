@@ -45,45 +45,11 @@ pub fn hidden(
     let depth = |p: DVec3| (p - cam.eye).dot(cam.forward);
     let slice_of = |z: f64| (((z - near) / step).floor().max(0.0) as usize).min(n - 1);
     // Probes and tetrahedra bucketed by slice (CSR).
-    let mut probe_start = vec![0u32; n + 1];
     let probe_slice: Vec<usize> = probes.iter().map(|p| slice_of(depth(p.x))).collect();
-    for &k in &probe_slice {
-        probe_start[k + 1] += 1;
-    }
-    for k in 0..n {
-        probe_start[k + 1] += probe_start[k];
-    }
-    let mut fill = probe_start.clone();
-    let mut by_slice = vec![0u32; probes.len()];
-    for (i, &k) in probe_slice.iter().enumerate() {
-        by_slice[fill[k] as usize] = i as u32;
-        fill[k] += 1;
-    }
-    // Each tetrahedron is cut by the planes (k + 1/2) step between its depths: (first,
-    // last, tetrahedron).
-    let spans: Vec<(u32, u32, u32)> = (0..index.len() as u32)
-        .filter_map(|g| {
-            let z = index.tet(g).0.map(depth);
-            let lo = z.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = z.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            let first = ((lo - near) / step - 0.5).ceil().max(0.0);
-            let last = ((hi - near) / step - 0.5).floor().min(n as f64 - 1.0);
-            (first <= last).then_some((first as u32, last as u32, g))
-        })
-        .collect();
-    let mut tet_start = vec![0u32; n + 1];
-    for &(first, _, _) in &spans {
-        tet_start[first as usize + 1] += 1;
-    }
-    for k in 0..n {
-        tet_start[k + 1] += tet_start[k];
-    }
-    let mut fill = tet_start.clone();
-    let mut starting = vec![0u32; spans.len()];
-    for (i, &(first, _, _)) in spans.iter().enumerate() {
-        starting[fill[first as usize] as usize] = i as u32;
-        fill[first as usize] += 1;
-    }
+    let (probe_start, by_slice) = buckets(&probe_slice, n);
+    let spans = tet_spans(index, depth, (near, step), n);
+    let first_slice: Vec<usize> = spans.iter().map(|s| s.0 as usize).collect();
+    let (tet_start, starting) = buckets(&first_slice, n);
 
     let (w, h) = (width as usize, height as usize);
     // Runs of `per` consecutive slices, each swept with one slice image and one active set;
@@ -145,6 +111,46 @@ pub fn hidden(
         }
     }
     out
+}
+
+/// Items bucketed by their key below `n` (compressed rows): where each key's items start
+/// (n + 1 entries), and the items' indices, key after key, each key's in their order.
+fn buckets(keys: &[usize], n: usize) -> (Vec<u32>, Vec<u32>) {
+    let mut start = vec![0u32; n + 1];
+    for &k in keys {
+        start[k + 1] += 1;
+    }
+    for k in 0..n {
+        start[k + 1] += start[k];
+    }
+    let mut fill = start.clone();
+    let mut order = vec![0u32; keys.len()];
+    for (i, &k) in keys.iter().enumerate() {
+        order[fill[k] as usize] = i as u32;
+        fill[k] += 1;
+    }
+    (start, order)
+}
+
+/// The slices that cut each tetrahedron, the planes (k + 1/2) `step` past `near` between
+/// its view depths (`depth`), of the `n`: (first, last, tetrahedron), for those some plane
+/// cuts.
+fn tet_spans(
+    index: &HaloIndex,
+    depth: impl Fn(DVec3) -> f64,
+    (near, step): (f64, f64),
+    n: usize,
+) -> Vec<(u32, u32, u32)> {
+    (0..index.len() as u32)
+        .filter_map(|g| {
+            let z = index.tet(g).0.map(&depth);
+            let lo = z.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = z.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let first = ((lo - near) / step - 0.5).ceil().max(0.0);
+            let last = ((hi - near) / step - 0.5).floor().min(n as f64 - 1.0);
+            (first <= last).then_some((first as u32, last as u32, g))
+        })
+        .collect()
 }
 
 /// Writes the cut of tetrahedron `g` by the plane at view depth `plane` into `image`:

@@ -155,63 +155,12 @@ struct Segment {
 impl Scene<'_> {
     /// How much of the curves the picture through `cam` shows.
     pub(super) fn curve_visibility(&self, cam: &Camera) -> CurveVisibility {
-        let (w, h) = (self.settings.width, self.settings.height);
-        // Each segment with the sine of the sheets' angle and the halo's half-width of the
-        // sheet passing over, at its first point.
-        let mut segments: Vec<Segment> = Vec::new();
-        for c in &self.input.curves.curves {
-            let points: Vec<Segment> = c
-                .points
-                .iter()
-                .map(|p| Segment {
-                    ends: [(p.position, p.on_mesh); 2],
-                    sine: self.crossing_sine(p.faces),
-                    rho: self.half_width(p.faces[p.near()]),
-                })
-                .collect();
-            let join = |a: &Segment, b: &Segment| Segment {
-                ends: [a.ends[0], b.ends[0]],
-                ..*a
-            };
-            segments.extend(points.windows(2).map(|s| join(&s[0], &s[1])));
-            if c.closed && points.len() > 2 {
-                segments.push(join(&points[points.len() - 1], &points[0]));
-            }
-        }
+        let segments = self.curve_segments();
         // Per segment on the cores, summed in order: the same total on any number of threads.
         let pieces: Vec<(f64, f64, f64, f64)> = segments
             .par_iter()
             .map_init(Vec::new, |hits, segment| {
-                let Segment {
-                    ends: [(a, sa), (b, sb)],
-                    sine,
-                    rho,
-                } = *segment;
-                let (Some((pa, depth)), Some((pb, _))) =
-                    (cam.project(a, w, h), cam.project(b, w, h))
-                else {
-                    return (0.0, 0.0, 0.0, 0.0);
-                };
-                let length = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
-                let steps = (length.ceil() as usize).clamp(1, 4096);
-                let piece = length / steps as f64;
-                let mut seen = 0.0;
-                for k in 0..steps {
-                    let f = (k as f64 + 0.5) / steps as f64;
-                    let (p, s) = (a + (b - a) * f, sa + (sb - sa) * f);
-                    let Some((xy, _)) = cam.project(p, w, h) else {
-                        continue;
-                    };
-                    let inside = xy[0] >= 0.0
-                        && xy[1] >= 0.0
-                        && xy[0] < f64::from(w)
-                        && xy[1] < f64::from(h);
-                    let clipped = self.settings.clip.is_some_and(|c| c.removes(p));
-                    if inside && !clipped {
-                        seen += piece * self.transmittance(cam, s, hits);
-                    }
-                }
-                (length, seen, seen * sine, rho / pixel_size(cam, depth, h))
+                self.segment_seen(cam, segment, hits)
             })
             .collect();
         let (projected, visible, transversal) = pieces
@@ -237,7 +186,95 @@ impl Scene<'_> {
             gaps.last().map_or(0.0, |g| g.0)
         };
         let (gap_p10, gap_median) = (quantile(0.1), quantile(0.5));
-        // The curves' ends at branch points, and the triple points, each seen or not.
+        let (branch_points, seen) = self.marks_seen(cam);
+        let count = |s: &[bool]| s.iter().filter(|&&v| v).count();
+        CurveVisibility {
+            gap_px_p10: gap_p10,
+            gap_px_median: gap_median,
+            branch_points,
+            branch_points_visible: count(&seen[..branch_points]),
+            triple_points: seen.len() - branch_points,
+            triple_points_visible: count(&seen[branch_points..]),
+            curves_projected_px: projected,
+            curves_visible_px: visible,
+            visible_curve_share: if projected > 0.0 {
+                visible / projected
+            } else {
+                0.0
+            },
+            transversal_visible_px: transversal,
+        }
+    }
+
+    /// The curves' segments, each with the sine of the sheets' angle and the halo's
+    /// half-width of the sheet passing over, at its first point.
+    fn curve_segments(&self) -> Vec<Segment> {
+        let mut segments: Vec<Segment> = Vec::new();
+        for c in &self.input.curves.curves {
+            let points: Vec<Segment> = c
+                .points
+                .iter()
+                .map(|p| Segment {
+                    ends: [(p.position, p.on_mesh); 2],
+                    sine: self.crossing_sine(p.faces),
+                    rho: self.half_width(p.faces[p.near()]),
+                })
+                .collect();
+            let join = |a: &Segment, b: &Segment| Segment {
+                ends: [a.ends[0], b.ends[0]],
+                ..*a
+            };
+            segments.extend(points.windows(2).map(|s| join(&s[0], &s[1])));
+            if c.closed && points.len() > 2 {
+                segments.push(join(&points[points.len() - 1], &points[0]));
+            }
+        }
+        segments
+    }
+
+    /// One segment in the picture through `cam`, sampled once per pixel of its length: its
+    /// projected length, the length seen, that length times the sine of the sheets' angle,
+    /// and the halo's gap in pixels at its first end. `hits` is scratch.
+    fn segment_seen(
+        &self,
+        cam: &Camera,
+        segment: &Segment,
+        hits: &mut Vec<Hit>,
+    ) -> (f64, f64, f64, f64) {
+        let (w, h) = (self.settings.width, self.settings.height);
+        let Segment {
+            ends: [(a, sa), (b, sb)],
+            sine,
+            rho,
+        } = *segment;
+        let (Some((pa, depth)), Some((pb, _))) = (cam.project(a, w, h), cam.project(b, w, h))
+        else {
+            return (0.0, 0.0, 0.0, 0.0);
+        };
+        let length = (pb[0] - pa[0]).hypot(pb[1] - pa[1]);
+        let steps = (length.ceil() as usize).clamp(1, 4096);
+        let piece = length / steps as f64;
+        let mut seen = 0.0;
+        for k in 0..steps {
+            let f = (k as f64 + 0.5) / steps as f64;
+            let (p, s) = (a + (b - a) * f, sa + (sb - sa) * f);
+            let Some((xy, _)) = cam.project(p, w, h) else {
+                continue;
+            };
+            let inside =
+                xy[0] >= 0.0 && xy[1] >= 0.0 && xy[0] < f64::from(w) && xy[1] < f64::from(h);
+            let clipped = self.settings.clip.is_some_and(|c| c.removes(p));
+            if inside && !clipped {
+                seen += piece * self.transmittance(cam, s, hits);
+            }
+        }
+        (length, seen, seen * sine, rho / pixel_size(cam, depth, h))
+    }
+
+    /// The curves' ends at branch points, then the triple points, each seen or not through
+    /// `cam`; gives how many branch points lead the list.
+    fn marks_seen(&self, cam: &Camera) -> (usize, Vec<bool>) {
+        let (w, h) = (self.settings.width, self.settings.height);
         let mut marks: Vec<DVec3> = Vec::new();
         for c in &self.input.curves.curves {
             for (end, p) in c.ends.iter().zip([c.points.first(), c.points.last()]) {
@@ -259,23 +296,7 @@ impl Scene<'_> {
                     && self.transmittance(cam, p, hits) > 0.5
             })
             .collect();
-        let count = |s: &[bool]| s.iter().filter(|&&v| v).count();
-        CurveVisibility {
-            gap_px_p10: gap_p10,
-            gap_px_median: gap_median,
-            branch_points,
-            branch_points_visible: count(&seen[..branch_points]),
-            triple_points: marks.len() - branch_points,
-            triple_points_visible: count(&seen[branch_points..]),
-            curves_projected_px: projected,
-            curves_visible_px: visible,
-            visible_curve_share: if projected > 0.0 {
-                visible / projected
-            } else {
-                0.0
-            },
-            transversal_visible_px: transversal,
-        }
+        (branch_points, seen)
     }
 
     /// The half-width of the halo of `face`'s surface at that face: the mean over its

@@ -153,14 +153,6 @@ pub(super) fn curves_vs_error_png(rows: &[Row], title: &str) -> Result<Vec<u8>, 
         .copied()
         .filter(|r| r.curve_points > 0 && r.curve_error.is_finite())
         .collect();
-    let residual = |r: &Row| {
-        if r.refined_residual.is_finite() {
-            r.refined_residual.max(RESIDUAL_FLOOR)
-        } else {
-            RESIDUAL_FLOOR
-        }
-    };
-    let error = |r: &Row| r.curve_error.max(RESIDUAL_FLOOR);
     let (mut x0, mut x1) = (f64::MAX, 0.0f64);
     for r in &meshes {
         x0 = x0.min(r.triangles as f64);
@@ -172,7 +164,7 @@ pub(super) fn curves_vs_error_png(rows: &[Row], title: &str) -> Result<Vec<u8>, 
     } else {
         curved
             .iter()
-            .map(|r| error(r).max(residual(r)))
+            .map(|r| shown_curve_error(r).max(shown_residual(r)))
             .fold(RESIDUAL_FLOOR * 10.0, f64::max)
     };
     let draw = |rgb: &mut [u8]| -> Result<(), Box<dyn std::error::Error>> {
@@ -222,64 +214,7 @@ pub(super) fn curves_vs_error_png(rows: &[Row], title: &str) -> Result<Vec<u8>, 
                     continue;
                 }
                 mine.sort_by_key(|r| r.triangles);
-                let adaptive = method == "adaptive";
-                for (quantity, value) in [
-                    ("curve error", &error as &dyn Fn(&Row) -> f64),
-                    ("refined residual", &residual),
-                ] {
-                    let pts: Vec<(f64, f64, bool)> = mine
-                        .iter()
-                        .map(|r| (r.triangles as f64, value(r), r.met))
-                        .collect();
-                    let line = pts.iter().map(|p| (p.0, p.1));
-                    let label = format!("{surface} {quantity} ({method})");
-                    let series = if adaptive {
-                        chart.draw_series(LineSeries::new(line, colour.stroke_width(2)))?
-                    } else {
-                        chart.draw_series(DashedLineSeries::new(
-                            line,
-                            8,
-                            5,
-                            colour.stroke_width(1),
-                        ))?
-                    };
-                    // The legend's line as in `speed_vs_error_png`, with the marker on it.
-                    let (length, width) = if adaptive { (24, 2) } else { (8, 1) };
-                    let style = colour.stroke_width(2);
-                    let entry = move |(x, y): (i32, i32)| {
-                        EmptyElement::at((x, y))
-                            + PathElement::new(
-                                vec![(0, 0), (length, 0)],
-                                colour.stroke_width(width),
-                            )
-                    };
-                    let mid = (length / 2, 0);
-                    let series = series.label(label);
-                    match (quantity, adaptive) {
-                        ("curve error", true) => {
-                            series
-                                .legend(move |at| entry(at) + Circle::new(mid, 4, style.filled()));
-                            chart.draw_series(
-                                pts.iter()
-                                    .map(|p| Circle::new((p.0, p.1), 4, style.filled_if(p.2))),
-                            )?;
-                        }
-                        ("curve error", false) => {
-                            series.legend(move |at| entry(at) + Cross::new(mid, 5, style));
-                            chart.draw_series(
-                                pts.iter().map(|p| Cross::new((p.0, p.1), 5, style)),
-                            )?;
-                        }
-                        (_, filled) => {
-                            series.legend(move |at| {
-                                entry(at) + TriangleMarker::new(mid, 5, style.filled_if(filled))
-                            });
-                            chart.draw_series(pts.iter().map(|p| {
-                                TriangleMarker::new((p.0, p.1), 5, style.filled_if(filled))
-                            }))?;
-                        }
-                    }
-                }
+                draw_curve_rows(&mut chart, &mine, surface, method, colour)?;
             }
         }
         chart
@@ -294,6 +229,81 @@ pub(super) fn curves_vs_error_png(rows: &[Row], title: &str) -> Result<Vec<u8>, 
     };
     draw(&mut rgb).map_err(|e| PlotError::Draw(e.to_string()))?;
     encode_png(&rgb, w, h)
+}
+
+/// A row's refined residual as plotted: on [`RESIDUAL_FLOOR`] when below it or not finite.
+fn shown_residual(r: &Row) -> f64 {
+    if r.refined_residual.is_finite() {
+        r.refined_residual.max(RESIDUAL_FLOOR)
+    } else {
+        RESIDUAL_FLOOR
+    }
+}
+
+/// A row's mesh curve error as plotted: on [`RESIDUAL_FLOOR`] when below it.
+fn shown_curve_error(r: &Row) -> f64 {
+    r.curve_error.max(RESIDUAL_FLOOR)
+}
+
+/// Draws the rows of one surface and one method (`mine`, by triangles) on the curves plot:
+/// the mesh curve's error and the refined residual, each a line with its markers and its
+/// legend entry, in the surface's `colour`.
+fn draw_curve_rows<'a, 'b: 'a>(
+    chart: &mut LogLogChart<'a, 'b>,
+    mine: &[&Row],
+    surface: &str,
+    method: &str,
+    colour: RGBColor,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let adaptive = method == "adaptive";
+    for (quantity, value) in [
+        ("curve error", shown_curve_error as fn(&Row) -> f64),
+        ("refined residual", shown_residual),
+    ] {
+        let pts: Vec<(f64, f64, bool)> = mine
+            .iter()
+            .map(|r| (r.triangles as f64, value(r), r.met))
+            .collect();
+        let line = pts.iter().map(|p| (p.0, p.1));
+        let label = format!("{surface} {quantity} ({method})");
+        let series = if adaptive {
+            chart.draw_series(LineSeries::new(line, colour.stroke_width(2)))?
+        } else {
+            chart.draw_series(DashedLineSeries::new(line, 8, 5, colour.stroke_width(1)))?
+        };
+        // The legend's line as in `speed_vs_error_png`, with the marker on it.
+        let (length, width) = if adaptive { (24, 2) } else { (8, 1) };
+        let style = colour.stroke_width(2);
+        let entry = move |(x, y): (i32, i32)| {
+            EmptyElement::at((x, y))
+                + PathElement::new(vec![(0, 0), (length, 0)], colour.stroke_width(width))
+        };
+        let mid = (length / 2, 0);
+        let series = series.label(label);
+        match (quantity, adaptive) {
+            ("curve error", true) => {
+                series.legend(move |at| entry(at) + Circle::new(mid, 4, style.filled()));
+                chart.draw_series(
+                    pts.iter()
+                        .map(|p| Circle::new((p.0, p.1), 4, style.filled_if(p.2))),
+                )?;
+            }
+            ("curve error", false) => {
+                series.legend(move |at| entry(at) + Cross::new(mid, 5, style));
+                chart.draw_series(pts.iter().map(|p| Cross::new((p.0, p.1), 5, style)))?;
+            }
+            (_, filled) => {
+                series.legend(move |at| {
+                    entry(at) + TriangleMarker::new(mid, 5, style.filled_if(filled))
+                });
+                chart.draw_series(
+                    pts.iter()
+                        .map(|p| TriangleMarker::new((p.0, p.1), 5, style.filled_if(filled))),
+                )?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The multi-slice mode against the exact one: render time (left) and the share of covered
@@ -321,108 +331,126 @@ pub(super) fn render_speed_vs_error_png(
         .iter()
         .map(|r| f64::from(r.slices))
         .fold(0.0, f64::max);
-    let t1 = sliced
-        .iter()
-        .map(|r| r.ms)
-        .chain(exact_ms)
-        .fold(0.0, f64::max);
-    let e1 = sliced
-        .iter()
-        .map(|r| (100.0 * r.verdict_differs).max(100.0 * r.p99_diff))
-        .fold(0.0, f64::max)
-        .max(1.0);
     let draw = |rgb: &mut [u8]| -> Result<(), Box<dyn std::error::Error>> {
         let root = BitMapBackend::with_buffer(rgb, (w, h)).into_drawing_area();
         root.fill(&WHITE)?;
         let root = root.titled(title, (FAMILY, 24))?;
         let (left, right) = root.split_horizontally(w / 2);
-        let xs = (x0 / 1.3..x1 * 1.3).log_scale();
-        let mut time = ChartBuilder::on(&left)
-            .margin(20)
-            .x_label_area_size(50)
-            .y_label_area_size(80)
-            .build_cartesian_2d(xs.clone(), 0.0..t1 * 1.15)?;
-        time.configure_mesh()
-            .x_desc("slices")
-            .y_desc("render time (ms)")
-            .label_style((FAMILY, 15))
-            .axis_desc_style((FAMILY, 17))
-            .x_label_formatter(&|x| format!("{x:.0}"))
-            .draw()?;
-        let pts: Vec<(f64, f64)> = sliced.iter().map(|r| (f64::from(r.slices), r.ms)).collect();
-        time.draw_series(LineSeries::new(pts.clone(), COLOURS[0].stroke_width(2)))?
-            .label("slices")
-            .legend(|(x, y)| {
-                PathElement::new(vec![(x, y), (x + 24, y)], COLOURS[0].stroke_width(2))
-            });
-        time.draw_series(pts.iter().map(|&p| Circle::new(p, 4, COLOURS[0].filled())))?;
-        if let Some(e) = exact_ms {
-            time.draw_series(DashedLineSeries::new(
-                vec![(x0 / 1.3, e), (x1 * 1.3, e)],
-                8,
-                5,
-                COLOURS[1].stroke_width(2),
-            ))?
-            .label("exact")
-            .legend(|(x, y)| {
-                PathElement::new(vec![(x, y), (x + 8, y)], COLOURS[1].stroke_width(2))
-            });
-        }
-        time.configure_series_labels()
-            .label_font((FAMILY, 15))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperLeft)
-            .draw()?;
-        let mut error = ChartBuilder::on(&right)
-            .margin(20)
-            .x_label_area_size(50)
-            .y_label_area_size(80)
-            .build_cartesian_2d(xs, 0.0..e1 * 1.15)?;
-        error
-            .configure_mesh()
-            .x_desc("slices")
-            .y_desc("difference to the exact mode (%)")
-            .label_style((FAMILY, 15))
-            .axis_desc_style((FAMILY, 17))
-            .x_label_formatter(&|x| format!("{x:.0}"))
-            .draw()?;
-        for (k, (label, f)) in [
-            (
-                "pixels whose verdict differs",
-                (|r: &crate::render::compare::Comparison| r.verdict_differs)
-                    as fn(&crate::render::compare::Comparison) -> f64,
-            ),
-            ("99th percentile pixel difference", |r| r.p99_diff),
-        ]
-        .into_iter()
-        .enumerate()
-        {
-            let colour = COLOURS[(k + 2) % COLOURS.len()];
-            let pts: Vec<(f64, f64)> = sliced
-                .iter()
-                .map(|r| (f64::from(r.slices), 100.0 * f(r)))
-                .collect();
-            error
-                .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?
-                .label(label)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(2))
-                });
-            error.draw_series(pts.iter().map(|&p| Circle::new(p, 4, colour.filled())))?;
-        }
-        error
-            .configure_series_labels()
-            .label_font((FAMILY, 15))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()?;
+        draw_render_time(&left, &sliced, exact_ms, (x0, x1))?;
+        draw_render_difference(&right, &sliced, (x0, x1))?;
         root.present()?;
         Ok(())
     };
     draw(&mut rgb).map_err(|e| PlotError::Draw(e.to_string()))?;
     encode_png(&rgb, w, h)
+}
+
+/// The left panel of [`render_speed_vs_error_png`]: render time against slices (`x`, the
+/// smallest and largest count), the exact mode's time as a dashed line.
+fn draw_render_time(
+    area: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+    sliced: &[&Comparison],
+    exact_ms: Option<f64>,
+    (x0, x1): (f64, f64),
+) -> Result<(), Box<dyn std::error::Error>> {
+    let t1 = sliced
+        .iter()
+        .map(|r| r.ms)
+        .chain(exact_ms)
+        .fold(0.0, f64::max);
+    let mut time = ChartBuilder::on(area)
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(80)
+        .build_cartesian_2d((x0 / 1.3..x1 * 1.3).log_scale(), 0.0..t1 * 1.15)?;
+    time.configure_mesh()
+        .x_desc("slices")
+        .y_desc("render time (ms)")
+        .label_style((FAMILY, 15))
+        .axis_desc_style((FAMILY, 17))
+        .x_label_formatter(&|x| format!("{x:.0}"))
+        .draw()?;
+    let pts: Vec<(f64, f64)> = sliced.iter().map(|r| (f64::from(r.slices), r.ms)).collect();
+    time.draw_series(LineSeries::new(pts.clone(), COLOURS[0].stroke_width(2)))?
+        .label("slices")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], COLOURS[0].stroke_width(2)));
+    time.draw_series(pts.iter().map(|&p| Circle::new(p, 4, COLOURS[0].filled())))?;
+    if let Some(e) = exact_ms {
+        time.draw_series(DashedLineSeries::new(
+            vec![(x0 / 1.3, e), (x1 * 1.3, e)],
+            8,
+            5,
+            COLOURS[1].stroke_width(2),
+        ))?
+        .label("exact")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 8, y)], COLOURS[1].stroke_width(2)));
+    }
+    time.configure_series_labels()
+        .label_font((FAMILY, 15))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()?;
+    Ok(())
+}
+
+/// The right panel of [`render_speed_vs_error_png`]: against slices (`x`, the smallest and
+/// largest count), the share of pixels whose verdict differs from the exact mode's and the
+/// 99th-percentile pixel difference, in percent.
+fn draw_render_difference(
+    area: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+    sliced: &[&Comparison],
+    (x0, x1): (f64, f64),
+) -> Result<(), Box<dyn std::error::Error>> {
+    let e1 = sliced
+        .iter()
+        .map(|r| (100.0 * r.verdict_differs).max(100.0 * r.p99_diff))
+        .fold(0.0, f64::max)
+        .max(1.0);
+    let mut error = ChartBuilder::on(area)
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(80)
+        .build_cartesian_2d((x0 / 1.3..x1 * 1.3).log_scale(), 0.0..e1 * 1.15)?;
+    error
+        .configure_mesh()
+        .x_desc("slices")
+        .y_desc("difference to the exact mode (%)")
+        .label_style((FAMILY, 15))
+        .axis_desc_style((FAMILY, 17))
+        .x_label_formatter(&|x| format!("{x:.0}"))
+        .draw()?;
+    for (k, (label, f)) in [
+        (
+            "pixels whose verdict differs",
+            (|r: &Comparison| r.verdict_differs) as fn(&Comparison) -> f64,
+        ),
+        ("99th percentile pixel difference", |r| r.p99_diff),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let colour = COLOURS[(k + 2) % COLOURS.len()];
+        let pts: Vec<(f64, f64)> = sliced
+            .iter()
+            .map(|r| (f64::from(r.slices), 100.0 * f(r)))
+            .collect();
+        error
+            .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?
+            .label(label)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(2))
+            });
+        error.draw_series(pts.iter().map(|&p| Circle::new(p, 4, colour.filled())))?;
+    }
+    error
+        .configure_series_labels()
+        .label_font((FAMILY, 15))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()?;
+    Ok(())
 }
 
 /// A style filled or not.

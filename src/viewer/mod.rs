@@ -144,7 +144,11 @@ impl ViewSettings {
         PICTURE_SIDE
             .check_with("size", self.render.width, &format!("the width of {size}"))
             .and_then(|()| {
-                PICTURE_SIDE.check_with("size", self.render.height, &format!("the height of {size}"))
+                PICTURE_SIDE.check_with(
+                    "size",
+                    self.render.height,
+                    &format!("the height of {size}"),
+                )
             })
             .and_then(|()| {
                 VIEWER_SLICES.check_with(

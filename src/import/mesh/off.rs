@@ -75,32 +75,7 @@ impl OffKind {
 }
 
 pub(super) fn off(bytes: &[u8], cx: Cx) -> Result<MeshData4> {
-    // The header keyword: the first line with something other than a comment.
-    let mut pos = 0;
-    let mut line = 0;
-    let (header_line, header, body) = loop {
-        if pos >= bytes.len() {
-            return Err(cx.line(
-                line.max(1),
-                "the file has no header: an OFF mesh in R^4 starts with `4OFF` (or `nOFF` and the dimension 4)",
-            ));
-        }
-        line += 1;
-        let end = bytes[pos..]
-            .iter()
-            .position(|&b| b == b'\n')
-            .map_or(bytes.len(), |k| pos + k);
-        let content = &bytes[pos..end];
-        let content = content
-            .iter()
-            .position(|&b| b == b'#')
-            .map_or(content, |k| &content[..k]);
-        let next = (end + 1).min(bytes.len());
-        if content.iter().any(|b| !b.is_ascii_whitespace()) {
-            break (line, content, next);
-        }
-        pos = next;
-    };
+    let (header_line, header, body) = header_line(bytes, cx)?;
     let header = utf8(header, header_line, cx)?;
     let mut words = header.split_whitespace();
     let keyword = words.next().unwrap_or_default();
@@ -128,8 +103,65 @@ pub(super) fn off(bytes: &[u8], cx: Cx) -> Result<MeshData4> {
     }
     let text = utf8(&bytes[body..], header_line + 1, cx)?;
     let mut lines = Lines::new(text, header_line + 1, true);
+    let (nv, nf) = text_counts(&mut lines, rest, kind, keyword, header_line, cx)?;
 
-    // The dimension (nOFF) and the counts, on the header line or the lines after it.
+    // A vertex takes at least 8 bytes of text, a face at least 8.
+    let mut build = Build::with_capacity(nv.min(text.len() / 8), nf.min(text.len() / 8));
+    text_vertices(&mut lines, nv, kind, keyword, &mut build, cx)?;
+    text_faces(&mut lines, nf, &mut build, cx)?;
+    if let Some((n, words)) = lines.next() {
+        return Err(cx.line(
+            n,
+            format!(
+                "text after the {nv} vertices and {nf} faces the header declares: `{}`; fix the counts, or remove the text",
+                shorten(&words.join(" "))
+            ),
+        ));
+    }
+    build.finish().map_err(|m| cx.line(lines.last(), m))
+}
+
+/// The header keyword's line: the first line with something other than a comment. Gives its
+/// number, its bytes without the comment, and the offset of the line after it.
+fn header_line<'a>(bytes: &'a [u8], cx: Cx) -> Result<(usize, &'a [u8], usize)> {
+    let mut pos = 0;
+    let mut line = 0;
+    loop {
+        if pos >= bytes.len() {
+            return Err(cx.line(
+                line.max(1),
+                "the file has no header: an OFF mesh in R^4 starts with `4OFF` (or `nOFF` and the dimension 4)",
+            ));
+        }
+        line += 1;
+        let end = bytes[pos..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .map_or(bytes.len(), |k| pos + k);
+        let content = &bytes[pos..end];
+        let content = content
+            .iter()
+            .position(|&b| b == b'#')
+            .map_or(content, |k| &content[..k]);
+        let next = (end + 1).min(bytes.len());
+        if content.iter().any(|b| !b.is_ascii_whitespace()) {
+            return Ok((line, content, next));
+        }
+        pos = next;
+    }
+}
+
+/// The dimension (nOFF) and the counts of a text file, on the header line (`rest`, the words
+/// after the keyword) or the lines after it; checks the dimension and gives the numbers of
+/// vertices and faces.
+fn text_counts(
+    lines: &mut Lines,
+    rest: Vec<&str>,
+    kind: OffKind,
+    keyword: &str,
+    header_line: usize,
+    cx: Cx,
+) -> Result<(usize, usize)> {
     let need = kind.dimension_follows as usize + 2;
     let mut ints: Vec<&str> = rest;
     let mut counts_line = header_line;
@@ -178,9 +210,19 @@ pub(super) fn off(bytes: &[u8], cx: Cx) -> Result<MeshData4> {
         .map_err(|m| cx.line(header_line, m))?;
     let nv = count(ints[0], "vertices").map_err(|m| cx.line(counts_line, m))?;
     let nf = count(ints[1], "faces").map_err(|m| cx.line(counts_line, m))?;
+    Ok((nv, nf))
+}
 
-    // A vertex takes at least 8 bytes of text, a face at least 8.
-    let mut build = Build::with_capacity(nv.min(text.len() / 8), nf.min(text.len() / 8));
+/// Reads `nv` vertices of a text file, one a line: four finite coordinates, then the numbers
+/// `kind` adds, which are checked and dropped.
+fn text_vertices(
+    lines: &mut Lines,
+    nv: usize,
+    kind: OffKind,
+    keyword: &str,
+    build: &mut Build,
+    cx: Cx,
+) -> Result<()> {
     let per = 4 + kind.extras();
     for v in 0..nv {
         let (n, words) = lines
@@ -205,6 +247,12 @@ pub(super) fn off(bytes: &[u8], cx: Cx) -> Result<MeshData4> {
         }
         build.mesh.positions.push(DVec4::from_array(p));
     }
+    Ok(())
+}
+
+/// Reads `nf` faces of a text file, one a line: `n i1 ... in`, then a colour, which is
+/// ignored.
+fn text_faces(lines: &mut Lines, nf: usize, build: &mut Build, cx: Cx) -> Result<()> {
     let mut raw = Vec::new();
     for f in 0..nf {
         let (n, words) = lines
@@ -240,16 +288,7 @@ pub(super) fn off(bytes: &[u8], cx: Cx) -> Result<MeshData4> {
         // Numbers after the indices are the face's colour.
         build.face(&raw, f, false).map_err(|m| cx.line(n, m))?;
     }
-    if let Some((n, words)) = lines.next() {
-        return Err(cx.line(
-            n,
-            format!(
-                "text after the {nv} vertices and {nf} faces the header declares: `{}`; fix the counts, or remove the text",
-                shorten(&words.join(" "))
-            ),
-        ));
-    }
-    build.finish().map_err(|m| cx.line(lines.last(), m))
+    Ok(())
 }
 
 fn off_binary(

@@ -141,8 +141,33 @@ enum Role {
     Corners,
 }
 
+/// The header of a PLY file: how its body is encoded, its elements, and where the body starts.
+struct Header {
+    encoding: Encoding,
+    elements: Vec<Element>,
+    /// The byte offset of the body.
+    pos: usize,
+    /// The number of the header's last line, `end_header`.
+    line: usize,
+}
+
+/// Which elements are the vertices and the faces, and what each property of each element is
+/// for.
+struct Layout {
+    vertex: usize,
+    face: usize,
+    roles: Vec<Vec<Role>>,
+}
+
 pub(super) fn ply(bytes: &[u8], cx: Cx) -> Result<MeshData4> {
-    // The header: text lines up to `end_header`.
+    let header = header(bytes, cx)?;
+    let layout = layout(&header.elements, header.line, cx)?;
+    body(bytes, &header, &layout, cx)
+}
+
+/// Reads the header, the text lines up to `end_header`: the format and the elements with
+/// their properties.
+fn header(bytes: &[u8], cx: Cx) -> Result<Header> {
     let mut pos = 0;
     let mut line = 0;
     let mut encoding = None;
@@ -178,93 +203,10 @@ pub(super) fn ply(bytes: &[u8], cx: Cx) -> Result<MeshData4> {
             [] => {}
             ["end_header"] => break,
             ["comment" | "obj_info", ..] => {}
-            ["format", name, version] => {
-                if *version != "1.0" {
-                    return Err(cx.line(
-                        line,
-                        format!(
-                            "PLY version `{}`; halo4d reads version 1.0",
-                            shorten(version)
-                        ),
-                    ));
-                }
-                encoding = Some(match *name {
-                    "ascii" => Encoding::Ascii,
-                    "binary_little_endian" => Encoding::Little,
-                    "binary_big_endian" => Encoding::Big,
-                    other => {
-                        return Err(cx.line(
-                            line,
-                            format!(
-                                "unknown PLY format `{}`: ascii, binary_little_endian or binary_big_endian",
-                                shorten(other)
-                            ),
-                        ));
-                    }
-                });
-            }
-            ["element", name, n] => {
-                let count = n.parse::<u64>().map_err(|_| {
-                    cx.line(
-                        line,
-                        format!(
-                            "element `{}` has the count `{}`, not a whole number",
-                            shorten(name),
-                            shorten(n)
-                        ),
-                    )
-                })?;
-                let el = Element {
-                    name: name.to_string(),
-                    count,
-                    line,
-                    props: Vec::new(),
-                };
-                if matches!(*name, "vertex" | "face") && count > MAX_COUNT as u64 {
-                    return Err(cx.line(
-                        line,
-                        format!(
-                            "the file declares {count} {}; halo4d reads at most {MAX_COUNT}",
-                            el.plural()
-                        ),
-                    ));
-                }
-                elements.push(el);
-            }
+            ["format", name, version] => encoding = Some(format_line(name, version, line, cx)?),
+            ["element", name, n] => elements.push(element_line(name, n, line, cx)?),
             ["property", rest @ ..] => {
-                let ty = |name: &str| {
-                    Ty::parse(name).ok_or_else(|| {
-                        cx.line(
-                            line,
-                            format!(
-                                "unknown property type `{}`: PLY's types are char, uchar, short, ushort, int, uint, float, double (or int8 to float64)",
-                                shorten(name)
-                            ),
-                        )
-                    })
-                };
-                let (name, prop) = match rest {
-                    ["list", count, item, name] => {
-                        let (count, item) = (ty(count)?, ty(item)?);
-                        if !count.integer() {
-                            return Err(cx.line(
-                                line,
-                                "a list's count type must be an integer type (uchar, int, ...)",
-                            ));
-                        }
-                        (*name, Prop::List(count, item))
-                    }
-                    [t, name] if *t != "list" => (*name, Prop::Scalar(ty(t)?)),
-                    _ => {
-                        return Err(cx.line(
-                            line,
-                            format!(
-                                "malformed property `{}`: `property TYPE NAME` or `property list COUNT_TYPE ITEM_TYPE NAME`",
-                                shorten(text.trim())
-                            ),
-                        ));
-                    }
-                };
+                let (name, prop) = property_line(rest, text, line, cx)?;
                 let el = elements
                     .last_mut()
                     .ok_or_else(|| cx.line(line, "a property before any `element` line"))?;
@@ -287,8 +229,113 @@ pub(super) fn ply(bytes: &[u8], cx: Cx) -> Result<MeshData4> {
             "the header has no `format` line (`format ascii 1.0`, `format binary_little_endian 1.0` or `format binary_big_endian 1.0`)",
         )
     })?;
+    Ok(Header {
+        encoding,
+        elements,
+        pos,
+        line,
+    })
+}
 
-    // What each element's properties are for.
+/// The encoding a `format NAME VERSION` header line names.
+fn format_line(name: &str, version: &str, line: usize, cx: Cx) -> Result<Encoding> {
+    if version != "1.0" {
+        return Err(cx.line(
+            line,
+            format!(
+                "PLY version `{}`; halo4d reads version 1.0",
+                shorten(version)
+            ),
+        ));
+    }
+    Ok(match name {
+        "ascii" => Encoding::Ascii,
+        "binary_little_endian" => Encoding::Little,
+        "binary_big_endian" => Encoding::Big,
+        other => {
+            return Err(cx.line(
+                line,
+                format!(
+                    "unknown PLY format `{}`: ascii, binary_little_endian or binary_big_endian",
+                    shorten(other)
+                ),
+            ));
+        }
+    })
+}
+
+/// The element an `element NAME COUNT` header line declares, still without properties; at
+/// most [`MAX_COUNT`] vertices or faces.
+fn element_line(name: &str, n: &str, line: usize, cx: Cx) -> Result<Element> {
+    let count = n.parse::<u64>().map_err(|_| {
+        cx.line(
+            line,
+            format!(
+                "element `{}` has the count `{}`, not a whole number",
+                shorten(name),
+                shorten(n)
+            ),
+        )
+    })?;
+    let el = Element {
+        name: name.to_string(),
+        count,
+        line,
+        props: Vec::new(),
+    };
+    if matches!(name, "vertex" | "face") && count > MAX_COUNT as u64 {
+        return Err(cx.line(
+            line,
+            format!(
+                "the file declares {count} {}; halo4d reads at most {MAX_COUNT}",
+                el.plural()
+            ),
+        ));
+    }
+    Ok(el)
+}
+
+/// The name and type of the property a `property ...` header line declares; `rest` is the
+/// words after `property`, `text` the whole line.
+fn property_line<'w>(rest: &[&'w str], text: &str, line: usize, cx: Cx) -> Result<(&'w str, Prop)> {
+    let ty = |name: &str| {
+        Ty::parse(name).ok_or_else(|| {
+            cx.line(
+                line,
+                format!(
+                    "unknown property type `{}`: PLY's types are char, uchar, short, ushort, int, uint, float, double (or int8 to float64)",
+                    shorten(name)
+                ),
+            )
+        })
+    };
+    Ok(match rest {
+        ["list", count, item, name] => {
+            let (count, item) = (ty(count)?, ty(item)?);
+            if !count.integer() {
+                return Err(cx.line(
+                    line,
+                    "a list's count type must be an integer type (uchar, int, ...)",
+                ));
+            }
+            (*name, Prop::List(count, item))
+        }
+        [t, name] if *t != "list" => (*name, Prop::Scalar(ty(t)?)),
+        _ => {
+            return Err(cx.line(
+                line,
+                format!(
+                    "malformed property `{}`: `property TYPE NAME` or `property list COUNT_TYPE ITEM_TYPE NAME`",
+                    shorten(text.trim())
+                ),
+            ));
+        }
+    })
+}
+
+/// Finds the vertex and face elements and what each of their properties is for; every other
+/// property is skipped. `line` is the header's last line, where a missing element is reported.
+fn layout(elements: &[Element], line: usize, cx: Cx) -> Result<Layout> {
     let vertex = elements
         .iter()
         .position(|e| e.name == "vertex")
@@ -311,11 +358,21 @@ pub(super) fn ply(bytes: &[u8], cx: Cx) -> Result<MeshData4> {
         .iter()
         .map(|e| vec![Role::Skip; e.props.len()])
         .collect();
-    let v = &elements[vertex];
+    axis_roles(&elements[vertex], &mut roles[vertex], cx)?;
+    corner_role(&elements[face], &mut roles[face], cx)?;
+    Ok(Layout {
+        vertex,
+        face,
+        roles,
+    })
+}
+
+/// Marks the vertex properties `x y z w` as the four axes; each must be a scalar.
+fn axis_roles(v: &Element, roles: &mut [Role], cx: Cx) -> Result<()> {
     for (axis, name) in ["x", "y", "z", "w"].into_iter().enumerate() {
         let k = v.props.iter().position(|(n, _)| n == name);
         match k.map(|k| (k, v.props[k].1)) {
-            Some((k, Prop::Scalar(_))) => roles[vertex][k] = Role::Axis(axis),
+            Some((k, Prop::Scalar(_))) => roles[k] = Role::Axis(axis),
             Some(_) => {
                 return Err(cx.line(
                     v.line,
@@ -338,7 +395,12 @@ pub(super) fn ply(bytes: &[u8], cx: Cx) -> Result<MeshData4> {
             }
         }
     }
-    let fe = &elements[face];
+    Ok(())
+}
+
+/// Marks the face property `vertex_indices` (or `vertex_index`), a list of integers, as the
+/// corners.
+fn corner_role(fe: &Element, roles: &mut [Role], cx: Cx) -> Result<()> {
     let k = fe
         .props
         .iter()
@@ -353,7 +415,7 @@ pub(super) fn ply(bytes: &[u8], cx: Cx) -> Result<MeshData4> {
             )
         })?;
     match fe.props[k].1 {
-        Prop::List(_, item) if item.integer() => roles[face][k] = Role::Corners,
+        Prop::List(_, item) if item.integer() => roles[k] = Role::Corners,
         _ => {
             return Err(cx.line(
                 fe.line,
@@ -364,7 +426,23 @@ pub(super) fn ply(bytes: &[u8], cx: Cx) -> Result<MeshData4> {
             ));
         }
     }
+    Ok(())
+}
 
+/// Reads the body after the header, every element in order, into the mesh; nothing but
+/// whitespace may follow the last element.
+fn body(bytes: &[u8], header: &Header, layout: &Layout, cx: Cx) -> Result<MeshData4> {
+    let Header {
+        encoding,
+        ref elements,
+        pos,
+        line,
+    } = *header;
+    let Layout {
+        vertex,
+        face,
+        ref roles,
+    } = *layout;
     let left = bytes.len() - pos;
     let nv = elements[vertex].count as usize;
     let nf = elements[face].count as usize;
@@ -386,7 +464,7 @@ pub(super) fn ply(bytes: &[u8], cx: Cx) -> Result<MeshData4> {
         let text = utf8(&bytes[pos..], line + 1, cx)?;
         body.lines = Some(Lines::new(text, line + 1, false));
     }
-    for (el, roles) in elements.iter().zip(&roles) {
+    for (el, roles) in elements.iter().zip(roles) {
         body.element(el, roles, &mut build)?;
     }
     match body.lines.as_mut() {
@@ -427,6 +505,21 @@ struct Body<'a> {
     cx: Cx<'a>,
 }
 
+/// An element being read: its declaration, what each property is for, and whether it is the
+/// vertex or the face element.
+struct Reading<'e> {
+    el: &'e Element,
+    roles: &'e [Role],
+    is_vertex: bool,
+    is_face: bool,
+}
+
+/// What is kept of one element: its point (a vertex) and its corners (a face).
+struct Values {
+    p: [f64; 4],
+    corners: Vec<i64>,
+}
+
 impl Body<'_> {
     /// Reads the elements of `el`: vertices into the mesh, faces into its triangles, others
     /// past.
@@ -442,152 +535,180 @@ impl Body<'_> {
             && !is_face
             && el.props.iter().all(|(_, p)| matches!(p, Prop::Scalar(_)))
         {
-            let size = el.min_size();
-            let at = self.bin.pos;
-            let bytes = (el.count as usize).checked_mul(size);
-            if bytes.is_none_or(|b| b > self.bin.left()) {
-                return Err(self.cx.byte(
-                    at,
-                    ends(self.bin.left() / size, el.count as usize, &el.plural()),
-                ));
-            }
-            self.bin.pos += el.count as usize * size;
-            return Ok(());
+            return self.skip(el);
         }
-        let mut corners: Vec<i64> = Vec::new();
-        let total = el.count as usize;
-        for k in 0..total {
-            let mut p = [0.0; 4];
-            corners.clear();
-            match self.encoding {
-                Encoding::Ascii => {
-                    let cx = self.cx;
-                    let lines = self.lines.as_mut().expect("ascii body has lines");
-                    let (n, words) = lines
-                        .next()
-                        .ok_or_else(|| cx.line(lines.last(), ends(k, total, &el.plural())))?;
-                    let what = if is_vertex {
-                        format!("vertex {k}")
-                    } else if is_face {
-                        format!("face {k}")
-                    } else {
-                        format!("element `{}` {k}", shorten(&el.name))
-                    };
-                    let mut words = words.into_iter();
-                    let mut next = |ty: Ty, name: &str| -> Result<f64> {
-                        let w = words.next().ok_or_else(|| {
-                            cx.line(
-                                n,
-                                format!(
-                                    "{what}: too few numbers on the line, `{}` is missing (properties: {})",
-                                    shorten(name),
-                                    el.names()
-                                ),
-                            )
-                        })?;
-                        ty.parse_text(w).ok_or_else(|| {
-                            cx.line(
-                                n,
-                                format!(
-                                    "{what}: `{}` is not a number of the type of `{}`",
-                                    shorten(w),
-                                    shorten(name)
-                                ),
-                            )
-                        })
-                    };
-                    for ((name, prop), role) in el.props.iter().zip(roles) {
-                        match *prop {
-                            Prop::Scalar(ty) => {
-                                let x = next(ty, name)?;
-                                if let Role::Axis(axis) = *role {
-                                    p[axis] = x;
-                                }
-                            }
-                            Prop::List(count, item) => {
-                                let c = next(count, name)?;
-                                if !(c >= 0.0 && c.fract() == 0.0) {
-                                    return Err(cx.line(
-                                        n,
-                                        format!(
-                                            "{what}: the list `{}` has the count {c}",
-                                            shorten(name)
-                                        ),
-                                    ));
-                                }
-                                for _ in 0..c as u64 {
-                                    let x = next(item, name)?;
-                                    if *role == Role::Corners {
-                                        corners.push(x as i64);
-                                    }
-                                }
-                            }
-                        }
-                    }
-                    if words.next().is_some() {
-                        return Err(cx.line(
-                            n,
-                            format!(
-                                "{what}: more numbers on the line than its properties ({}) declare",
-                                el.names()
-                            ),
-                        ));
-                    }
-                    if is_vertex {
-                        self.vertex(p, k, MeshFileLocation::Line(n), build)?;
-                    }
-                    if is_face {
-                        build.face(&corners, k, false).map_err(|m| cx.line(n, m))?;
-                    }
-                }
-                Encoding::Little | Encoding::Big => {
-                    let at = self.bin.pos;
-                    let cx = self.cx;
-                    let truncated = || cx.byte(at, ends(k, total, &el.plural()));
-                    for ((name, prop), role) in el.props.iter().zip(roles) {
-                        match *prop {
-                            Prop::Scalar(ty) => {
-                                let x = ty.read(&mut self.bin).ok_or_else(truncated)?;
-                                if let Role::Axis(axis) = *role {
-                                    p[axis] = x;
-                                }
-                            }
-                            Prop::List(count, item) => {
-                                let c_at = self.bin.pos;
-                                let c = count.read(&mut self.bin).ok_or_else(truncated)?;
-                                if c < 0.0 {
-                                    return Err(cx.byte(
-                                        c_at,
-                                        format!(
-                                            "the list `{}` of {} {k} has the count {c}",
-                                            shorten(name),
-                                            el.name
-                                        ),
-                                    ));
-                                }
-                                let c = c as usize;
-                                if c.saturating_mul(item.size()) > self.bin.left() {
-                                    return Err(truncated());
-                                }
-                                for _ in 0..c {
-                                    let x = item.read(&mut self.bin).ok_or_else(truncated)?;
-                                    if *role == Role::Corners {
-                                        corners.push(x as i64);
-                                    }
-                                }
-                            }
-                        }
-                    }
-                    if is_vertex {
-                        self.vertex(p, k, MeshFileLocation::Byte(at), build)?;
-                    }
-                    if is_face {
-                        build.face(&corners, k, false).map_err(|m| cx.byte(at, m))?;
-                    }
-                }
+        let r = Reading {
+            el,
+            roles,
+            is_vertex,
+            is_face,
+        };
+        let mut values = Values {
+            p: [0.0; 4],
+            corners: Vec::new(),
+        };
+        for k in 0..el.count as usize {
+            values.p = [0.0; 4];
+            values.corners.clear();
+            let at = match self.encoding {
+                Encoding::Ascii => self.ascii_values(&r, k, &mut values)?,
+                Encoding::Little | Encoding::Big => self.binary_values(&r, k, &mut values)?,
+            };
+            if is_vertex {
+                self.vertex(values.p, k, at, build)?;
+            }
+            if is_face {
+                build
+                    .face(&values.corners, k, false)
+                    .map_err(|m| self.cx.err(at, m))?;
             }
         }
         Ok(())
+    }
+
+    /// Moves past the binary elements `el`, all of fixed size, in one step.
+    fn skip(&mut self, el: &Element) -> Result<()> {
+        let size = el.min_size();
+        let at = self.bin.pos;
+        let bytes = (el.count as usize).checked_mul(size);
+        if bytes.is_none_or(|b| b > self.bin.left()) {
+            return Err(self.cx.byte(
+                at,
+                ends(self.bin.left() / size, el.count as usize, &el.plural()),
+            ));
+        }
+        self.bin.pos += el.count as usize * size;
+        Ok(())
+    }
+
+    /// Reads element `k` of an ASCII body, one line, into `out`; gives the line.
+    fn ascii_values(
+        &mut self,
+        r: &Reading,
+        k: usize,
+        out: &mut Values,
+    ) -> Result<MeshFileLocation> {
+        let el = r.el;
+        let total = el.count as usize;
+        let cx = self.cx;
+        let lines = self.lines.as_mut().expect("ascii body has lines");
+        let (n, words) = lines
+            .next()
+            .ok_or_else(|| cx.line(lines.last(), ends(k, total, &el.plural())))?;
+        let what = if r.is_vertex {
+            format!("vertex {k}")
+        } else if r.is_face {
+            format!("face {k}")
+        } else {
+            format!("element `{}` {k}", shorten(&el.name))
+        };
+        let mut words = words.into_iter();
+        let mut next = |ty: Ty, name: &str| -> Result<f64> {
+            let w = words.next().ok_or_else(|| {
+                cx.line(
+                    n,
+                    format!(
+                        "{what}: too few numbers on the line, `{}` is missing (properties: {})",
+                        shorten(name),
+                        el.names()
+                    ),
+                )
+            })?;
+            ty.parse_text(w).ok_or_else(|| {
+                cx.line(
+                    n,
+                    format!(
+                        "{what}: `{}` is not a number of the type of `{}`",
+                        shorten(w),
+                        shorten(name)
+                    ),
+                )
+            })
+        };
+        for ((name, prop), role) in el.props.iter().zip(r.roles) {
+            match *prop {
+                Prop::Scalar(ty) => {
+                    let x = next(ty, name)?;
+                    if let Role::Axis(axis) = *role {
+                        out.p[axis] = x;
+                    }
+                }
+                Prop::List(count, item) => {
+                    let c = next(count, name)?;
+                    if !(c >= 0.0 && c.fract() == 0.0) {
+                        return Err(cx.line(
+                            n,
+                            format!("{what}: the list `{}` has the count {c}", shorten(name)),
+                        ));
+                    }
+                    for _ in 0..c as u64 {
+                        let x = next(item, name)?;
+                        if *role == Role::Corners {
+                            out.corners.push(x as i64);
+                        }
+                    }
+                }
+            }
+        }
+        if words.next().is_some() {
+            return Err(cx.line(
+                n,
+                format!(
+                    "{what}: more numbers on the line than its properties ({}) declare",
+                    el.names()
+                ),
+            ));
+        }
+        Ok(MeshFileLocation::Line(n))
+    }
+
+    /// Reads element `k` of a binary body into `out`; gives the byte it starts at.
+    fn binary_values(
+        &mut self,
+        r: &Reading,
+        k: usize,
+        out: &mut Values,
+    ) -> Result<MeshFileLocation> {
+        let el = r.el;
+        let total = el.count as usize;
+        let at = self.bin.pos;
+        let cx = self.cx;
+        let truncated = || cx.byte(at, ends(k, total, &el.plural()));
+        for ((name, prop), role) in el.props.iter().zip(r.roles) {
+            match *prop {
+                Prop::Scalar(ty) => {
+                    let x = ty.read(&mut self.bin).ok_or_else(truncated)?;
+                    if let Role::Axis(axis) = *role {
+                        out.p[axis] = x;
+                    }
+                }
+                Prop::List(count, item) => {
+                    let c_at = self.bin.pos;
+                    let c = count.read(&mut self.bin).ok_or_else(truncated)?;
+                    if c < 0.0 {
+                        return Err(cx.byte(
+                            c_at,
+                            format!(
+                                "the list `{}` of {} {k} has the count {c}",
+                                shorten(name),
+                                el.name
+                            ),
+                        ));
+                    }
+                    let c = c as usize;
+                    if c.saturating_mul(item.size()) > self.bin.left() {
+                        return Err(truncated());
+                    }
+                    for _ in 0..c {
+                        let x = item.read(&mut self.bin).ok_or_else(truncated)?;
+                        if *role == Role::Corners {
+                            out.corners.push(x as i64);
+                        }
+                    }
+                }
+            }
+        }
+        Ok(MeshFileLocation::Byte(at))
     }
 
     fn vertex(&self, p: [f64; 4], k: usize, at: MeshFileLocation, build: &mut Build) -> Result<()> {
