@@ -700,6 +700,13 @@ macro_rules! limit {
 /// Every limit, in the order of the README's table: each [`Bound`] with the settings it
 /// bounds, then the sizes and tolerances that no setting sets.
 pub fn all() -> Vec<Limit> {
+    let mut out = settings();
+    out.extend(fixed());
+    out
+}
+
+/// The ranges of the settings, the flags and the environment, each a [`Bound`].
+fn settings() -> Vec<Limit> {
     vec![
         limit!(
             RELATIVE_TOLERANCE,
@@ -769,6 +776,12 @@ pub fn all() -> Vec<Limit> {
         limit!(VIEWER_SLICES, "the viewer's slices"),
         limit!(BENCH_FRAMES, "`halo4d-view --bench --frames`"),
         limit!(MAX_MEMORY, "`HALO4D_MAX_MEMORY`"),
+    ]
+}
+
+/// The sizes and tolerances that no setting sets.
+fn fixed() -> Vec<Limit> {
+    vec![
         limit!(
             SAMPLES,
             "`render.samples`, the viewer's samples",
