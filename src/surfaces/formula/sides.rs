@@ -166,7 +166,7 @@ const SIDE_SAMPLES: usize = 16;
 impl super::Formula {
     /// What the open sides of the rectangle would be glued by, where they meet: for u and
     /// for v whose two sides are both open, the points along them compared at
-    /// [`SIDE_SAMPLES`] + 1 values of the other parameter; equal (within 1e-9 of the largest
+    /// 17 values of the other parameter; equal (within 1e-9 of the largest
     /// coordinate there) they meet as `periodic`, equal with the other parameter reversed
     /// as `flip`. Gives a warning for each: such a surface builds as an open one, its
     /// boundary edges and curve ends where the sides meet.
