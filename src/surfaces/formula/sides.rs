@@ -6,6 +6,7 @@
 
 use super::{FormulaEdge, FormulaSeam, FormulaSides};
 use crate::surfaces::{Domain, Glue, Side, SideRule, Topology};
+use glam::DVec4;
 
 /// The rule of one side once the keys are resolved.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -194,12 +195,24 @@ impl super::Formula {
             let ts: Vec<f64> = (0..=SIDE_SAMPLES)
                 .map(|k| a + (b - a) * k as f64 / SIDE_SAMPLES as f64)
                 .collect();
+            // Each side's points once; "meet" within 1e-9 of the largest coordinate along
+            // both, whatever the surface's size.
+            let (first, last): (Vec<DVec4>, Vec<DVec4>) =
+                ts.iter().map(|&t| (at(lo, t), at(hi, t))).unzip();
+            let extent = first
+                .iter()
+                .chain(&last)
+                .map(|p| p.abs().max_element())
+                .fold(0.0, f64::max);
             let meets = |reversed: bool| {
-                ts.iter().all(|&t| {
-                    let (p, q) = (at(lo, t), at(hi, if reversed { a + b - t } else { t }));
-                    let scale = p.abs().max(q.abs()).max_element().max(1.0);
-                    (p - q).abs().max_element() <= 1e-9 * scale
-                })
+                let across = |k: usize| {
+                    if reversed {
+                        &last[ts.len() - 1 - k]
+                    } else {
+                        &last[k]
+                    }
+                };
+                (0..ts.len()).all(|k| (first[k] - *across(k)).abs().max_element() <= 1e-9 * extent)
             };
             let rule = if meets(false) {
                 "periodic"
