@@ -58,6 +58,17 @@ pub enum Error {
         /// The cause.
         source: std::io::Error,
     },
+    /// The build would take far longer than a build of its size: its triangles are slivers
+    /// whose boxes pile up, or its halos overlap themselves many times over (they keep
+    /// their folds), so every query of the curves, the verification and the picture tests
+    /// hundreds of them.
+    #[error("scene `{}`: {message}", shorten(.scene))]
+    Work {
+        /// The scene.
+        scene: String,
+        /// What makes it slow, and what to change.
+        message: String,
+    },
     /// Another build is writing into the output folder.
     #[error(transparent)]
     Busy(crate::export::StagedError),

@@ -16,6 +16,7 @@ mod lines;
 mod own;
 mod readme;
 mod refine;
+mod refused;
 mod render;
 mod sample;
 mod scene;

@@ -1,9 +1,9 @@
 //! What a build computes before writing ([`Built`]): the stages from the view on, run on a
 //! scene's samples.
 
-use super::report::{MemoryReport, SamplingReport, Timings};
+use super::report::{CrowdingReport, MemoryReport, SamplingReport, Timings};
 use super::sampled::{Sample, Sampled, refine_curves};
-use super::{Stages, ms};
+use super::{Stages, ms, work};
 use crate::error::Error;
 use crate::export::SurfaceData;
 use crate::halo::{Halo, HaloParams, HaloReport, build_halo};
@@ -67,6 +67,9 @@ pub struct Built {
     pub rho: f64,
     /// The memory the stages from the halos on were estimated to need, and the limit.
     pub memory: MemoryReport,
+    /// How many boxes pile up at the surfaces' points, measured before the stages that
+    /// query them.
+    pub crowding: CrowdingReport,
     /// Which stages after the projection ran.
     pub stages: Stages,
 }
@@ -119,7 +122,11 @@ impl Built {
 }
 
 /// The one place a build's products become the hand-off.
-fn parts<'a>(surfaces: &'a [SurfaceProduct], halo: &HaloParams, curves: &'a Curves) -> Parts<'a> {
+pub(super) fn parts<'a>(
+    surfaces: &'a [SurfaceProduct],
+    halo: &HaloParams,
+    curves: &'a Curves,
+) -> Parts<'a> {
     Parts {
         surfaces: surfaces
             .iter()
@@ -168,10 +175,10 @@ impl SurfaceProduct {
 }
 
 /// One surface sampled and projected: what the stages from the halos on take.
-struct InView<'a> {
-    entry: &'a SceneSurface,
-    sample: Sample,
-    projected: Projected,
+pub(super) struct InView<'a> {
+    pub(super) entry: &'a SceneSurface,
+    pub(super) sample: Sample,
+    pub(super) projected: Projected,
 }
 
 /// The stages from the view on, from the scene's samples.
@@ -189,6 +196,10 @@ pub(super) fn in_view(
     let mut timings = samples.timings;
     let projections = project(scene, samples.surfaces, &mut timings, bar)?;
     let scale = Scale::of(scene, &projections, stages)?;
+    let mut crowding = CrowdingReport {
+        triangles: work::surface_crowding(scene, &projections)?,
+        halos: Vec::new(),
+    };
     let Scale {
         diagonal,
         pixel,
@@ -198,6 +209,9 @@ pub(super) fn in_view(
     let mut products = Vec::with_capacity(projections.len());
     for view in projections {
         products.push(surface_product(scene, view, stages, rho, &mut timings, bar));
+    }
+    if stages.halos {
+        crowding.halos = work::halo_crowding(scene, &products, diagonal)?;
     }
     let mut curves = Curves::default();
     if stages.curves {
@@ -232,6 +246,7 @@ pub(super) fn in_view(
         pixel_size: pixel,
         rho,
         memory,
+        crowding,
         curves,
         refined,
         verification,

@@ -9,6 +9,7 @@
 mod built;
 pub mod report;
 mod sampled;
+mod work;
 mod write;
 
 pub use built::{Built, SurfaceProduct};
@@ -24,8 +25,9 @@ use built::in_view;
 use indicatif::{ProgressBar, ProgressStyle};
 use sampled::sample_with;
 use serde::Serialize;
+use std::io::IsTerminal;
 use std::path::Path;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Which stages after the projection a build runs: those whose products an output the
 /// scene asks for uses (`report.json`'s `stages`).
@@ -91,12 +93,19 @@ pub fn render_to(scene: &Scene, out: &Path, quiet: bool) -> Result<(Picture, f64
     };
     // The settings first: a bad one stops the command before the build.
     (scene.render.check()).map_err(|e| render_error(RenderError::Setting(e.within("render"))))?;
-    let built = run_stages(scene, Stages::picture(scene), quiet)?;
-    let start = Instant::now();
-    let picture = built
-        .render(&scene.halo, &scene.render, &scene.camera)
-        .map_err(render_error)?;
-    let took = ms(start);
+    let (built, picture, took) = run_stages(
+        scene,
+        Stages::picture(scene),
+        quiet,
+        "the picture",
+        |built| {
+            let start = Instant::now();
+            let picture = built
+                .render(&scene.halo, &scene.render, &scene.camera)
+                .map_err(render_error)?;
+            Ok((built, picture, ms(start)))
+        },
+    )?;
     if scene.render.style == Style::Stipple {
         let parts = built.parts(&scene.halo);
         let drawn =
@@ -138,24 +147,67 @@ fn progress(len: usize, quiet: bool) -> ProgressBar {
     );
     // Redrawn on its own: a stage of many seconds (sampling a fine tolerance, the halos of
     // a million triangles) shows its time passing, never a frozen line.
-    bar.enable_steady_tick(std::time::Duration::from_millis(250));
+    bar.enable_steady_tick(Duration::from_millis(250));
+    if !std::io::stderr().is_terminal() {
+        heartbeat(bar.clone());
+    }
     bar
 }
 
-/// The stages `stages` of a build of `scene`, with a progress bar unless `quiet`.
-fn run_stages(scene: &Scene, stages: Stages, quiet: bool) -> Result<Built, Error> {
-    let bar = progress(scene.surfaces.len() * 3 + 2, quiet);
+/// Where stderr is not a terminal (a log, a pipe), indicatif draws nothing: a line every
+/// [`HEARTBEAT`] with the stage and the time, until the bar finishes, so that a long build
+/// never sits silent in a log.
+fn heartbeat(bar: ProgressBar) {
+    std::thread::spawn(move || {
+        let start = Instant::now();
+        let mut next = HEARTBEAT;
+        while !bar.is_finished() {
+            std::thread::sleep(Duration::from_millis(100));
+            if start.elapsed() >= next {
+                eprintln!(
+                    "halo4d: {:.0} s, stage {}/{}: {}",
+                    start.elapsed().as_secs_f64(),
+                    bar.position(),
+                    bar.length().unwrap_or(0),
+                    bar.message()
+                );
+                next += HEARTBEAT;
+            }
+        }
+    });
+}
+
+/// How often a build whose stderr is not a terminal says what it is doing.
+const HEARTBEAT: Duration = Duration::from_secs(10);
+
+/// The stages `stages` of a build of `scene`, then `finish` (the files, the picture) with
+/// the bar at its last step and `last` as its message; with a progress bar unless `quiet`.
+fn run_stages<T>(
+    scene: &Scene,
+    stages: Stages,
+    quiet: bool,
+    last: &str,
+    finish: impl FnOnce(Built) -> Result<T, Error>,
+) -> Result<T, Error> {
+    let bar = progress(scene.surfaces.len() * 3 + 3, quiet);
     let samples = sample_with(scene, &bar);
-    let built = in_view(scene, samples, stages, &bar);
+    let done = in_view(scene, samples, stages, &bar).and_then(|built| {
+        bar.set_position(bar.length().unwrap_or(1) - 1);
+        bar.set_message(last.to_string());
+        finish(built)
+    });
     bar.finish_and_clear();
-    built
+    done
 }
 
 /// Builds a scene into `out_dir`: runs the stages and writes the outputs the scene asks for.
 pub fn build(scene: &Scene, out_dir: &Path, quiet: bool) -> Result<Report, Error> {
-    write(
-        scene,
-        &run_stages(scene, Stages::of(scene), quiet)?,
-        out_dir,
-    )
+    let last = if scene.outputs.png || scene.outputs.svg {
+        "the picture and the files"
+    } else {
+        "the files"
+    };
+    run_stages(scene, Stages::of(scene), quiet, last, |built| {
+        write(scene, &built, out_dir)
+    })
 }

@@ -27,6 +27,20 @@ pub struct MemoryReport {
     pub peak_gb: Option<f64>,
 }
 
+/// `report.json`'s `crowding`: per surface, on average over points spread over it by area,
+/// how many triangles' boxes hold the point (`triangles`) and how many halo tetrahedra's
+/// boxes, of all the halos (`halos`, empty without halos): what a query of the curves, the
+/// verification and the picture costs there. A build is refused beyond
+/// [`SURFACE_CROWDING`](crate::limits::SURFACE_CROWDING) and
+/// [`HALO_CROWDING`](crate::limits::HALO_CROWDING).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct CrowdingReport {
+    /// Triangles, per surface.
+    pub triangles: Vec<f64>,
+    /// Halo tetrahedra, per surface.
+    pub halos: Vec<f64>,
+}
+
 /// How a surface was sampled, and the audit of the mesh (`report.json`'s `sampling`).
 #[derive(Clone, Debug, Serialize)]
 pub struct SamplingReport {
@@ -248,6 +262,8 @@ pub struct Report {
     pub timings_ms: Timings,
     /// Memory estimated before the halos, against the limit.
     pub memory: MemoryReport,
+    /// The boxes piled up at the surfaces' points.
+    pub crowding: CrowdingReport,
     /// Warnings, also printed on stderr.
     pub warnings: Vec<String>,
     /// The picture: its camera, halo width and how much of the curves it shows (absent when

@@ -218,6 +218,7 @@ fn assemble_report(
             peak_gb: crate::memory::peak_resident().map(|b| b / crate::memory::GB),
             ..built.memory
         },
+        crowding: built.crowding.clone(),
         warnings: products
             .iter()
             .flat_map(|p| {
