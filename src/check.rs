@@ -495,6 +495,56 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
     )
 }
 
+/// The checks that need no halo layout, on any tetrahedra (another program's mesh): every
+/// tetrahedron positively oriented, with four distinct vertices and no repeat; every face in
+/// one or two tetrahedra; the volumes adding up to the volume the boundary encloses. The
+/// counts only a halo has (offset faces, quads, surface faces, collapsed vertices) are 0.
+pub fn check_tetrahedra<P: Copy + Into<[f64; 3]> + Sync>(
+    positions: &[P],
+    tets: &[[u32; 4]],
+) -> CheckStats {
+    let nv = positions.len();
+    let (tets, odd): (Vec<[u32; 4]>, Vec<bool>) =
+        tets.par_iter().map(|&t| sorted_tet(t, nv)).unzip();
+    let (scaled, volume_scale, tiny) = scaled(positions);
+    let mut s = tet_stats(&tets, odd, &scaled, &tiny);
+    let (_, faces, boundary) = face_uses(&tets, nv);
+    s.duplicate_tets = faces.duplicate_tets;
+    s.interior_faces = faces.interior_faces;
+    s.overshared_faces = faces.overshared_faces;
+    s.boundary_faces = boundary.len();
+    s.boundary_volume = boundary
+        .par_chunks(CHECK_RUN)
+        .map(|part| part.iter().map(|&f| enclosed(f, &scaled)).sum::<f64>())
+        .collect::<Vec<f64>>()
+        .iter()
+        .sum();
+    finish_volumes(&mut s, volume_scale);
+    s
+}
+
+/// A boundary face's share of the volume the boundary encloses (the divergence theorem),
+/// the face turned outward: away from its tetrahedron's fourth vertex.
+fn enclosed((face, opposite): Face, positions: &[[f64; 3]]) -> f64 {
+    let mut f = face;
+    let [pa, pb, pc, po] = [f[0], f[1], f[2], opposite].map(|i| c3(positions[i as usize]));
+    if robust::orient3d(pa, pb, pc, po) > 0.0 {
+        f.swap(1, 2);
+    }
+    let [a, b, c] = f.map(|i| positions[i as usize]);
+    -dot(a, cross(b, c)) / 6.0
+}
+
+/// The statistics only a halo has ([`check_tetrahedra`] leaves them 0): `halo4d check`
+/// leaves them out for tetrahedra without halo4d's layout.
+pub const HALO_ONLY: [&str; 5] = [
+    "quad_mismatches",
+    "missing_offset_faces",
+    "unexpected_boundary_faces",
+    "missing_surface_faces",
+    "collapsed_vertices",
+];
+
 /// [`check`] on borrowed parts: vertex positions, the number n of surface vertices, the
 /// tetrahedra and the surface's triangles (empty where unknown; what [`TetMesh`] holds), so
 /// that a halo is checked without a copy of it.
@@ -674,16 +724,7 @@ fn classify_boundary<P: Copy + Into<[f64; 3]> + Sync>(
         .map(|part| {
             let (mut volume, mut offset_faces, mut others) = (0.0, Vec::new(), Vec::new());
             for &(k, o) in part {
-                // Turned so that the opposite vertex lies above it: outward, clockwise seen
-                // from outside.
-                let mut f = k;
-                let [pa, pb, pc, po] = [k[0], k[1], k[2], o].map(|i| c3(positions[i as usize]));
-                if robust::orient3d(pa, pb, pc, po) > 0.0 {
-                    f.swap(1, 2);
-                }
-                let [a, b, c] = f.map(|i| positions[i as usize]);
-                // The divergence theorem, signed for that orientation.
-                volume -= dot(a, cross(b, c)) / 6.0;
+                volume += enclosed((k, o), positions);
                 match k.map(|i| layout.surface_vertex(i)) {
                     [Some(x), Some(y), Some(z)]
                         if x != y && y != z && x != z && k.iter().all(|&i| layout.offset(i)) =>

@@ -1,6 +1,7 @@
 //! `halo4d check`: what a build wrote, checked again from the files alone.
 //!
-//! Takes: a `.glb` or legacy `.vtk` file ([`check_file`]), or a build's output folder with
+//! Takes: a `.glb` or legacy `.vtk` file ([`check_file`]; a `.vtk` without halo4d's layout
+//! gets the checks that need none, [`check_tetrahedra`]), or a build's output folder with
 //! its one scene `.glb` ([`check_dir`]). Gives: [`Checked`], each halo's [`CheckStats`] and,
 //! for a folder, the intersection curves recomputed from the file's surfaces and the halos'
 //! [`Verification`] against them.
@@ -8,8 +9,8 @@
 //! from the same library functions: [`CheckStats::verdict`], [`CurvesReport::failures`],
 //! [`Verification::failures`].
 
-use crate::check::{CheckStats, check};
-use crate::import::{self, ImportError, ImportedHalo, ImportedScene};
+use crate::check::{CheckStats, HALO_ONLY, check, check_tetrahedra};
+use crate::import::{self, FileTetrahedra, ImportError, ImportedHalo, ImportedScene};
 use crate::intersect::{self, Curves, CurvesReport};
 use crate::verify::{self, Verification};
 use std::fmt::Write;
@@ -22,8 +23,13 @@ pub struct Checked {
     pub file: PathBuf,
     /// The scene's name, when the file records it.
     pub scene: Option<String>,
-    /// Each halo's name and the checker's statistics.
+    /// Each halo's name and the checker's statistics (for a file without halo4d's layout,
+    /// its tetrahedra's, from [`check_tetrahedra`]).
     pub halos: Vec<(String, CheckStats)>,
+    /// For a `.vtk` without halo4d's layout: why it is not read as a halo. Its tetrahedra
+    /// get the checks that need no layout; the halo's own (offset faces, quads, surface
+    /// faces) cannot be made.
+    pub plain: Option<String>,
     /// For a folder: the curves recomputed from the file's surfaces, and the halos
     /// verified against them.
     pub verification: Option<(CurvesReport, Verification)>,
@@ -52,14 +58,25 @@ pub enum InspectError {
 
 /// Checks the halos of a `.glb` or `.vtk` file with the independent checker.
 pub fn check_file(file: &Path) -> Result<Checked, InspectError> {
-    let halos = import::read(file).map_err(|source| InspectError::File {
+    let read = import::read(file).map_err(|source| InspectError::File {
         file: file.to_path_buf(),
         source,
     })?;
+    let (halos, plain) = match read {
+        FileTetrahedra::Halos(halos) => (check_halos(halos.iter()), None),
+        FileTetrahedra::Plain(mesh) => (
+            vec![(
+                mesh.name.clone(),
+                check_tetrahedra(&mesh.positions, &mesh.tets),
+            )],
+            Some(mesh.why),
+        ),
+    };
     Ok(Checked {
         file: file.to_path_buf(),
         scene: None,
-        halos: check_halos(halos.iter()),
+        halos,
+        plain,
         verification: None,
     })
 }
@@ -85,6 +102,7 @@ pub fn check_dir(dir: &Path) -> Result<Checked, InspectError> {
         file,
         scene: scene.name.clone(),
         halos,
+        plain: None,
         verification: Some((curves.report, verification)),
     })
 }
@@ -129,10 +147,15 @@ impl Checked {
                 None => out += &format!("{}\n", self.file.display()),
             }
         }
+        if let Some(why) = &self.plain {
+            out += &format!(
+                "not a halo: {why}. Checked as tetrahedra: orientation, repeated tetrahedra, faces in more than two, the volume against the boundary's; not checked: the halo's offset faces, quads and surface faces\n"
+            );
+        }
         if self.halos.is_empty() {
             out += "no halo in the file\n";
         } else {
-            out += &stats_table(&self.halos);
+            out += &stats_table(&self.halos, self.plain.is_some());
         }
         if let Some((curves, v)) = &self.verification {
             out += &format!("\n{}\n", curves.summary());
@@ -147,7 +170,9 @@ impl Checked {
         for f in &failures {
             out += &format!("FAILED {f}\n");
         }
-        if failures.is_empty() {
+        if failures.is_empty() && self.plain.is_some() {
+            out += "ok: no inverted, flat or repeated tetrahedron, no face in more than two, and the tetrahedra fill the volume their boundary encloses\n";
+        } else if failures.is_empty() {
             let n = self.halos.len();
             let conform = if n == 1 {
                 "1 halo conforms".to_string()
@@ -203,9 +228,17 @@ fn scene_glb(dir: &Path) -> Result<PathBuf, String> {
 }
 
 /// The checker's statistics as a table: a row per statistic, in the struct's order, and a
-/// column per halo.
-fn stats_table(halos: &[(String, CheckStats)]) -> String {
-    let columns: Vec<Vec<(String, String)>> = halos.iter().map(|(_, s)| stat_rows(s)).collect();
+/// column per halo; for tetrahedra without a halo layout (`plain`), headed `mesh`, without
+/// the rows only a halo has.
+fn stats_table(halos: &[(String, CheckStats)], plain: bool) -> String {
+    let columns: Vec<Vec<(String, String)>> = halos
+        .iter()
+        .map(|(_, s)| {
+            let mut rows = stat_rows(s);
+            rows.retain(|(k, _)| !(plain && HALO_ONLY.contains(&k.as_str())));
+            rows
+        })
+        .collect();
     let labels: Vec<&str> = columns
         .first()
         .map(|c| c.iter().map(|(k, _)| k.as_str()).collect())
@@ -222,7 +255,7 @@ fn stats_table(halos: &[(String, CheckStats)]) -> String {
                 .max(n.len())
         })
         .collect();
-    let mut out = format!("{:<label_width$}", "halo");
+    let mut out = format!("{:<label_width$}", if plain { "mesh" } else { "halo" });
     for ((n, _), w) in halos.iter().zip(&widths) {
         let _ = write!(out, "  {n:>w$}");
     }

@@ -4,40 +4,47 @@
 //! Each target starts from valid inputs and applies a short list of mutations that know the
 //! format. proptest draws the lists from a fixed ChaCha seed (the same cases on every run, no
 //! persistence files) and shrinks a failing list to a minimal one:
-//! - scenes: the fixture scenes, the default scene with every field written out and the
-//!   surface catalogue, as JSON trees whose numbers are set to extremes (0, -0, 5e-324,
+//! - scenes: the fixture scenes (formula surfaces among them) and animated scenes, the
+//!   default scene with every field written out and the surface catalogue, as JSON trees whose numbers are set to extremes (0, -0, 5e-324,
 //!   1e308, 1e400, huge integers, `NaN`), whose keys are deleted, duplicated, renamed or
 //!   inserted, whose values change type or are grafted from elsewhere; then the text is cut
-//!   or given stray characters;
+//!   or given stray characters (formula surfaces built, and 4D mesh files, are fuzzed in
+//!   [`crate::fuzz_build`]);
 //! - `.glb`: the patches fixture built once (8 x 8 grid); its JSON chunk mutated as a tree
 //!   (accessor counts, offsets, component types, buffer lengths, the extras' indices) and
-//!   re-packed with correct chunk headers, then words of the headers and of the BIN chunk set
+//!   re-packed with correct chunk headers (some cases start from the halo's tetrahedra
+//!   accessor cut to none, half or all but one), then words of the headers and of the BIN chunk set
 //!   to extremes (NaN, u32::MAX, ...), bits flipped, the file cut or lengthened;
 //! - `.vtk`: the same build's binary file and two ASCII renditions (file versions 3.0 and
 //!   5.1, with sections halo4d does not write): values in the binary blocks set to extremes,
 //!   the header lines' counts, types and keywords changed, lines deleted, duplicated, swapped
-//!   or inserted, numbers in the ASCII data changed, bytes flipped, the file cut.
+//!   or inserted, numbers in the ASCII data changed, bytes flipped, the file cut; also an
+//!   ASCII file without halo4d's FIELD data (another program's) and halos cut to half and
+//!   to no tetrahedra.
 //!
 //! Properties: no input panics a parser; every error message is non-empty and shorter than
 //! [`MAX_MESSAGE`] bytes (a scene's starts with the file's name); a scene that parses writes
 //! out and parses back equal; whatever a reader returns is finite, its indices in range and
-//! its counts consistent, and `read_glb` reads the same halos as `read_scene_glb`. A failing
+//! its counts consistent, and `read_glb` reads the same halos as `read_scene_glb`; a `.vtk`
+//! without the layout is read as plain tetrahedra and checked; a halo cut short (a strict
+//! prefix of its tetrahedra, the rest of the file as built) fails `halo4d check`. A failing
 //! case is reported as its mutations, and the input they make is written to the temporary
 //! directory.
 //!
 //! The default run (`cargo test --release`) tries [`SCENE_CASES`], [`GLB_CASES`] and
-//! [`VTK_CASES`] cases, in about 15 s on two cores. A longer run, on another seed
+//! [`VTK_CASES`] cases; with [`crate::fuzz_build`]'s, all the fuzzing takes about 30 s on
+//! two cores (`cargo test --release --test main fuzz`). A longer run, on another seed
 //! (`HALO4D_FUZZ_SEED=N` picks yet another):
 //!
 //! ```sh
 //! HALO4D_FUZZ_CASES=200000 cargo test --release --test main fuzz -- --ignored
 //! ```
 
-use crate::common::{fixture, fixture_scenes, pack_glb};
+use crate::common::{fixture, fixture_scenes, pack_glb, scenes_in};
 use halo4d::Scene;
 use halo4d::{
-    import::ImportedHalo, import::ImportedScene, import::read_glb, import::read_scene_glb,
-    import::read_vtk,
+    import::FileTetrahedra, import::ImportedHalo, import::ImportedScene, import::PlainTetrahedra,
+    import::read_glb, import::read_scene_glb, import::read_vtk, import::read_vtk_tetrahedra,
 };
 use proptest::collection::vec;
 use proptest::prelude::*;
@@ -51,7 +58,7 @@ use std::sync::OnceLock;
 
 /// Every error message must be shorter than this: one line a person can read, not an echo
 /// of the input (a malformed VTK once got a 66 KB line back).
-const MAX_MESSAGE: usize = 1000;
+pub(crate) const MAX_MESSAGE: usize = 1000;
 
 /// Scene cases of the default run.
 const SCENE_CASES: u32 = 20_000;
@@ -89,7 +96,7 @@ fn runner(target: &str, cases: u32, long: bool) -> TestRunner {
 
 /// Runs `cases` cases of `strategy` through `test`; on a failure writes the minimal input
 /// (`render`ed) to the temporary directory and panics with it and its mutations.
-fn fuzz<S: Strategy>(
+pub(crate) fn fuzz<S: Strategy>(
     target: &str,
     ext: &str,
     cases: u32,
@@ -126,7 +133,7 @@ fn fuzz<S: Strategy>(
 }
 
 /// The number of cases of the long run, from `HALO4D_FUZZ_CASES`.
-fn long_cases() -> u32 {
+pub(crate) fn long_cases() -> u32 {
     std::env::var("HALO4D_FUZZ_CASES")
         .ok()
         .map(|s| {
@@ -138,7 +145,7 @@ fn long_cases() -> u32 {
 }
 
 /// An error's message is one line of reasonable size.
-fn message_ok(what: &str, message: &str) -> Result<(), String> {
+pub(crate) fn message_ok(what: &str, message: &str) -> Result<(), String> {
     if message.trim().is_empty() {
         return Err(format!("{what}: empty error message"));
     }
@@ -154,10 +161,10 @@ fn message_ok(what: &str, message: &str) -> Result<(), String> {
 
 /// Counts what the cases came to, to check that the mutations reach every outcome.
 #[derive(Default)]
-struct Tally(RefCell<BTreeMap<&'static str, usize>>);
+pub(crate) struct Tally(RefCell<BTreeMap<&'static str, usize>>);
 
 impl Tally {
-    fn add(&self, what: &'static str) {
+    pub(crate) fn add(&self, what: &'static str) {
         *self.0.borrow_mut().entry(what).or_default() += 1;
     }
 
@@ -166,7 +173,7 @@ impl Tally {
     }
 
     /// At least `share` of the cases came to `what`.
-    fn assert_share(&self, what: &str, share: f64) {
+    pub(crate) fn assert_share(&self, what: &str, share: f64) {
         let (count, cases) = (self.get(what), self.get("cases"));
         eprintln!("{count} of {cases} cases {what}");
         assert!(
@@ -862,6 +869,7 @@ fn scene_seeds() -> &'static SceneSeeds {
     SEEDS.get_or_init(|| {
         let mut trees: Vec<Node> = fixture_scenes()
             .iter()
+            .chain(&scenes_in("animations"))
             .map(|p| {
                 let text = std::fs::read_to_string(p).unwrap();
                 Node::from_value(&serde_json::from_str(&text).unwrap())
@@ -1087,7 +1095,7 @@ fn set_word(bytes: &mut [u8], at: usize, width: usize, big: bool, value: u64) {
 
 /// A change to a file's bytes.
 #[derive(Clone, Debug)]
-enum ByteOp {
+pub(crate) enum ByteOp {
     /// A bit flipped.
     Flip { at: u32, bit: u8 },
     /// The file cut at a position.
@@ -1096,7 +1104,7 @@ enum ByteOp {
     Insert { at: u32, bytes: Vec<u8> },
 }
 
-fn byte_op_strategy() -> impl Strategy<Value = ByteOp> {
+pub(crate) fn byte_op_strategy() -> impl Strategy<Value = ByteOp> {
     prop_oneof![
         3 => (any::<u32>(), any::<u8>()).prop_map(|(at, bit)| ByteOp::Flip { at, bit }),
         1 => any::<u32>().prop_map(ByteOp::Cut),
@@ -1105,7 +1113,7 @@ fn byte_op_strategy() -> impl Strategy<Value = ByteOp> {
     ]
 }
 
-fn apply_bytes(bytes: &mut Vec<u8>, op: &ByteOp) {
+pub(crate) fn apply_bytes(bytes: &mut Vec<u8>, op: &ByteOp) {
     let pos = |at: u32, n: usize| at as usize % (n + 1);
     match op {
         ByteOp::Flip { at, bit } => {
@@ -1132,6 +1140,8 @@ struct GlbSeed {
     halo: ImportedHalo,
     scene: ImportedScene,
     json: Node,
+    /// `json` with the halo's tetrahedra accessor cut short.
+    cuts: Vec<Node>,
     bin_chunk: Vec<u8>,
     vocabulary: Vocabulary,
 }
@@ -1153,8 +1163,28 @@ fn glb_seed() -> &'static GlbSeed {
             read_scene_glb(glb).unwrap()
         );
         let vocabulary = Vocabulary::of(&[&json]);
+        let halo = read_glb(glb).unwrap().remove(0);
+        // The halo's tetrahedra accessor cut to none, half and all but one.
+        let tets = halo.mesh.tets.len() as u64;
+        let cuts = [0, tets / 2, tets - 1]
+            .map(|keep| {
+                let mut v = value.clone();
+                let mesh = v["meshes"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .find(|m| m["extras"].get("halo").is_some())
+                    .unwrap();
+                let k = mesh["extras"]["halo"]["tetrahedra"].as_u64().unwrap() as usize;
+                let count = &mut v["accessors"][k]["count"];
+                let per = count.as_u64().unwrap() / tets;
+                *count = (per * keep).into();
+                Node::from_value(&v)
+            })
+            .to_vec();
         GlbSeed {
-            halo: read_glb(glb).unwrap().remove(0),
+            halo,
+            cuts,
             scene: read_scene_glb(glb).unwrap(),
             json,
             bin_chunk,
@@ -1184,6 +1214,8 @@ enum GlbWord {
 
 #[derive(Clone, Debug)]
 struct GlbCase {
+    /// Start from the seed with its halo's tetrahedra cut short (`GlbSeed::cuts`).
+    cut: Option<u32>,
     tree: Vec<TreeOp>,
     json_text: Vec<TextOp>,
     words: Vec<(GlbWord, Word)>,
@@ -1197,12 +1229,14 @@ fn glb_strategy() -> impl Strategy<Value = GlbCase> {
         4 => any::<u32>().prop_map(GlbWord::Bin),
     ];
     (
+        prop_oneof![6 => Just(None), 1 => any::<u32>().prop_map(Some)],
         vec(tree_op_strategy(), 0..5),
         prop_oneof![8 => Just(Vec::new()), 1 => vec(text_op_strategy(), 1..3)],
         prop_oneof![2 => Just(Vec::new()), 1 => vec((place, word_strategy()), 1..4)],
         prop_oneof![4 => Just(Vec::new()), 1 => vec(byte_op_strategy(), 1..3)],
     )
-        .prop_map(|(tree, json_text, words, bytes)| GlbCase {
+        .prop_map(|(cut, tree, json_text, words, bytes)| GlbCase {
+            cut,
             tree,
             json_text,
             words,
@@ -1212,7 +1246,10 @@ fn glb_strategy() -> impl Strategy<Value = GlbCase> {
 
 fn render_glb(case: &GlbCase) -> Vec<u8> {
     let seed = glb_seed();
-    let mut tree = seed.json.clone();
+    let mut tree = match case.cut {
+        Some(k) => seed.cuts[k as usize % seed.cuts.len()].clone(),
+        None => seed.json.clone(),
+    };
     for op in &case.tree {
         seed.vocabulary.apply(&mut tree, op);
     }
@@ -1352,7 +1389,7 @@ fn check_glb(bytes: &[u8], tally: &Tally) -> Result<(), String> {
             }
             for h in halos {
                 halo_ok(h)?;
-                check_changed(h, &glb_seed().halo, tally);
+                check_changed(h, &glb_seed().halo, tally)?;
             }
         }
         Err(e) => {
@@ -1412,12 +1449,33 @@ fn check_glb(bytes: &[u8], tally: &Tally) -> Result<(), String> {
 }
 
 /// What `halo4d check FILE` does next, on every halo whose mesh differs from the seed's:
-/// the checker must not panic.
-fn check_changed(h: &ImportedHalo, seed: &ImportedHalo, tally: &Tally) {
-    if h.mesh != seed.mesh {
-        tally.add("checked a changed halo");
-        let _ = halo4d::check::check(&h.mesh);
+/// the checker must not panic, and a halo cut short (the seed's vertices and surface, a
+/// strict prefix of its tetrahedra, as a cut accessor or CELLS count leaves it, down to
+/// none) no longer covers its surface and must fail.
+fn check_changed(h: &ImportedHalo, seed: &ImportedHalo, tally: &Tally) -> Result<(), String> {
+    let (m, s) = (&h.mesh, &seed.mesh);
+    if m == s {
+        return Ok(());
     }
+    tally.add("checked a changed halo");
+    let stats = halo4d::check::check(m);
+    if m.positions == s.positions
+        && m.surface_vertices == s.surface_vertices
+        && m.surface_triangles == s.surface_triangles
+        && m.tets.len() < s.tets.len()
+        && s.tets.starts_with(&m.tets)
+    {
+        tally.add("checked a cut halo");
+        if stats.passes() {
+            return Err(format!(
+                "halo `{}` cut to {} of its {} tetrahedra passes the check",
+                h.name,
+                m.tets.len(),
+                s.tets.len()
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn fuzz_glb(cases: u32, long: bool) {
@@ -1437,6 +1495,7 @@ fn fuzz_glb(cases: u32, long: bool) {
     tally.assert_share("failed read_scene_glb", 0.2);
     tally.assert_share("checked a changed halo", 0.01);
     tally.assert_share("verified a changed scene", 0.01);
+    tally.assert_share("checked a cut halo", 0.02);
 }
 
 #[test]
@@ -1562,12 +1621,28 @@ fn vtk_seeds() -> &'static VtkSeeds {
     SEEDS.get_or_init(|| {
         let binary = built().vtk.clone();
         let halo = read_vtk(&binary).unwrap();
+        // Cut short: half the tetrahedra, and none (what `check` must fail).
+        let cut = |keep: usize| {
+            let mut h = halo.clone();
+            h.mesh.tets.truncate(keep);
+            ascii_vtk(&h, false).into_bytes()
+        };
+        // Another program's: no FIELD data, so no halo layout.
+        let text = ascii_vtk(&halo, false);
+        let (field, points) = (
+            text.find("FIELD FieldData").unwrap(),
+            text.find("POINTS").unwrap(),
+        );
+        let plain = format!("{}{}", &text[..field], &text[points..]).into_bytes();
         let files = vec![
             binary.clone(),
             ascii_vtk(&halo, false).into_bytes(),
             ascii_vtk(&halo, true).into_bytes(),
+            plain,
+            cut(halo.mesh.tets.len() / 2),
+            cut(0),
         ];
-        for f in &files[1..] {
+        for f in &files[1..3] {
             let again = read_vtk(f).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(again.mesh, halo.mesh);
             assert_eq!((&again.t, &again.d_orig), (&halo.t, &halo.d_orig));
@@ -1662,7 +1737,7 @@ const VTK_WORDS: &[&str] = &[
 ];
 
 /// Numbers for VTK text, some of them not numbers to every reader.
-const VTK_NUMBERS: &[&str] = &[
+pub(crate) const VTK_NUMBERS: &[&str] = &[
     "0",
     "-0",
     "1",
@@ -1939,18 +2014,52 @@ fn render_vtk(case: &VtkCase) -> Vec<u8> {
 
 fn check_vtk(bytes: &[u8], tally: &Tally) -> Result<(), String> {
     tally.add("cases");
+    let tetrahedra = read_vtk_tetrahedra(bytes);
     match read_vtk(bytes) {
         Ok(halo) => {
             tally.add("read");
             halo_ok(&halo)?;
-            check_changed(&halo, &vtk_seeds().halo, tally);
-            Ok(())
+            check_changed(&halo, &vtk_seeds().halo, tally)?;
+            // `halo4d check` reads the same halo.
+            match tetrahedra {
+                Ok(FileTetrahedra::Halos(h)) if h.len() == 1 && h[0] == halo => Ok(()),
+                other => Err(format!(
+                    "read_vtk read halo `{}`, read_vtk_tetrahedra {other:?}",
+                    halo.name
+                )),
+            }
         }
         Err(e) => {
             tally.add("failed");
-            message_ok("read_vtk", &e.to_string())
+            message_ok("read_vtk", &e.to_string())?;
+            match tetrahedra {
+                // Without halo4d's layout: tetrahedra alone, which the checks that need no
+                // layout take.
+                Ok(FileTetrahedra::Plain(plain)) => {
+                    tally.add("read as plain tetrahedra");
+                    plain_ok(&plain)?;
+                    let _ = halo4d::check::check_tetrahedra(&plain.positions, &plain.tets);
+                    Ok(())
+                }
+                Ok(FileTetrahedra::Halos(_)) => Err(format!(
+                    "read_vtk_tetrahedra read a halo where read_vtk failed: {e}"
+                )),
+                Err(e) => message_ok("read_vtk_tetrahedra", &e.to_string()),
+            }
         }
     }
+}
+
+/// Tetrahedra read without a halo layout are finite, their indices in range.
+fn plain_ok(m: &PlainTetrahedra) -> Result<(), String> {
+    let nv = m.positions.len();
+    if m.positions.iter().any(|p| !p.iter().all(|x| x.is_finite())) {
+        return Err(format!("mesh `{}` read with a non-finite position", m.name));
+    }
+    if m.tets.iter().any(|t| t.iter().any(|&i| i as usize >= nv)) {
+        return Err(format!("mesh `{}` read with an index out of range", m.name));
+    }
+    Ok(())
 }
 
 fn fuzz_vtk(cases: u32, long: bool) {
@@ -1967,6 +2076,8 @@ fn fuzz_vtk(cases: u32, long: bool) {
     tally.assert_share("read", 0.1);
     tally.assert_share("failed", 0.3);
     tally.assert_share("checked a changed halo", 0.01);
+    tally.assert_share("read as plain tetrahedra", 0.02);
+    tally.assert_share("checked a cut halo", 0.02);
 }
 
 #[test]

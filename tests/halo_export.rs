@@ -7,7 +7,7 @@ use glam::{DVec3, Vec3};
 use halo4d::Scene;
 use halo4d::SurfaceProduct;
 use halo4d::check::check;
-use halo4d::import::read as read_halos;
+use halo4d::import::FileTetrahedra;
 use halo4d::internals::file_order;
 use halo4d::{import::ImportError, import::ImportedHalo, import::read_glb, import::read_vtk};
 use serde_json::Value;
@@ -46,8 +46,19 @@ fn f32_bits(values: &[f64]) -> Vec<u64> {
         .collect()
 }
 
-/// An ASCII legacy VTK of `h`, field data right after DATASET (where VTK's own writer puts
-/// it, not where halo4d does), `extra_field` lines appended to it.
+/// The halos of a file halo4d wrote, read as `halo4d check` reads them.
+fn read_halos(path: &Path) -> Result<Vec<ImportedHalo>, ImportError> {
+    match halo4d::import::read(path)? {
+        FileTetrahedra::Halos(halos) => Ok(halos),
+        FileTetrahedra::Plain(mesh) => {
+            panic!("{}: not read as halos: {}", path.display(), mesh.why)
+        }
+    }
+}
+
+/// An ASCII legacy VTK of `h`; `with_layout`: with halo4d's FIELD data right after DATASET
+/// (where VTK's own writer puts it, not where halo4d does), else with none, as another
+/// program writes it.
 fn ascii_vtk(h: &ImportedHalo, with_layout: bool) -> String {
     let m = &h.mesh;
     let mut s = format!(
@@ -531,18 +542,12 @@ fn check_file_sees_every_prism_missing_from_a_halo() {
 #[test]
 fn unreadable_files_are_errors_of_the_cli_with_the_file_named() {
     let dir = tempfile::tempdir().unwrap();
-    let (glb, vtk, _) = patches(dir.path());
+    let (glb, _, _) = patches(dir.path());
     let bytes = std::fs::read(&glb).unwrap();
     std::fs::write(dir.path().join("cut.glb"), &bytes[..bytes.len() / 2]).unwrap();
-    let halo = read_vtk(&std::fs::read(&vtk).unwrap()).unwrap();
-    std::fs::write(dir.path().join("bare.vtk"), ascii_vtk(&halo, false)).unwrap();
     std::fs::write(dir.path().join("notes.txt"), "hello").unwrap();
     for (file, words) in [
         ("cut.glb", &["cut.glb", "truncated"][..]),
-        (
-            "bare.vtk",
-            &["bare.vtk", "lacks the halo layout", "surface_vertices"],
-        ),
         ("notes.txt", &["notes.txt", ".glb or a .vtk"]),
         ("absent.vtk", &["absent.vtk", "cannot read"]),
         // Not there, and no extension: not found, not "unknown file type".
@@ -554,6 +559,84 @@ fn unreadable_files_are_errors_of_the_cli_with_the_file_named() {
         let out = halo4d(&["check", file], dir.path());
         assert_unreadable(&out, file, words);
     }
+}
+
+#[test]
+fn tetrahedra_without_the_halo_layout_get_the_checks_that_need_none() {
+    // Another program's .vtk (no FIELD data) or an earlier halo4d's (no `layers`): checked
+    // as tetrahedra (orientation, repeats, faces, volume), saying what cannot be checked;
+    // the exit status is that verdict.
+    let dir = tempfile::tempdir().unwrap();
+    let (_, vtk, _) = patches(dir.path());
+    let mut halo = read_vtk(&std::fs::read(&vtk).unwrap()).unwrap();
+    let bare = ascii_vtk(&halo, false);
+    let earlier = ascii_vtk(&halo, true).replace("layers 1 1 int\n2\n", "nothing 1 1 int\n2\n");
+    let tets = halo.mesh.tets.clone();
+    // Half the tetrahedra are still a valid tetrahedral mesh: only the layout could tell
+    // that a halo is missing prisms.
+    halo.mesh.tets.truncate(tets.len() / 2);
+    let half = ascii_vtk(&halo, false);
+    halo.mesh.tets = tets.clone();
+    halo.mesh.tets[7].swap(0, 1);
+    let inverted = ascii_vtk(&halo, false);
+    halo.mesh.tets = tets.clone();
+    halo.mesh.tets.push(tets[3]);
+    let repeated = ascii_vtk(&halo, false);
+    halo.mesh.tets = tets.clone();
+    halo.mesh.tets.remove(11);
+    let hole = ascii_vtk(&halo, false);
+    let passes = ["ok: no inverted, flat or repeated tetrahedron"];
+    for (file, text, code, words) in [
+        ("bare.vtk", &bare, 0, &["another program wrote it"][..]),
+        (
+            "earlier.vtk",
+            &earlier,
+            0,
+            &["an earlier halo4d wrote it"][..],
+        ),
+        ("half.vtk", &half, 0, &passes[..]),
+        ("inverted.vtk", &inverted, 1, &["FAILED", "1 inverted"][..]),
+        (
+            "repeated.vtk",
+            &repeated,
+            1,
+            &["FAILED", "1 duplicate_tets"][..],
+        ),
+        // A tetrahedron taken out leaves a hole whose faces are boundary faces: the boundary
+        // encloses what is left, so the volumes still add up.
+        ("hole.vtk", &hole, 0, &passes[..]),
+    ] {
+        std::fs::write(dir.path().join(file), text).unwrap();
+        let out = halo4d(&["check", file], dir.path());
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(out.status.code(), Some(code), "{file}: {stdout}");
+        assert!(stdout.starts_with("not a halo: "), "{file}: {stdout}");
+        assert!(
+            stdout.contains("not checked: the halo's offset faces"),
+            "{file}: {stdout}"
+        );
+        assert!(stdout.contains("\nmesh "), "{file}: {stdout}");
+        assert!(!stdout.contains("quad_mismatches"), "{file}: {stdout}");
+        for w in words {
+            assert!(stdout.contains(w), "{file}: `{w}` not in {stdout}");
+        }
+    }
+    // Two unit corner tetrahedra, one on each side of the z = 0 plane: 1/6 each.
+    let two = halo4d::check_file(&fixture("meshes/two-tetrahedra.vtk")).unwrap();
+    assert!(
+        two.failures().is_empty() && two.plain.is_some(),
+        "{}",
+        two.text()
+    );
+    let s = two.halos[0].1;
+    assert_eq!((s.tets, s.boundary_faces, s.interior_faces), (2, 6, 1));
+    assert_eq!((s.volume, s.boundary_volume), (1.0 / 3.0, 1.0 / 3.0));
+    assert_eq!((s.min_volume, s.max_volume), (1.0 / 6.0, 1.0 / 6.0));
+    let checked = halo4d::check_file(&dir.path().join("half.vtk")).unwrap();
+    let (_, stats) = &checked.halos[0];
+    assert_eq!(stats.tets, tets.len() / 2);
+    assert_eq!(stats.inverted + stats.flat + stats.overshared_faces, 0);
+    assert!(stats.volume_defect < 1e-9, "{stats:?}");
 }
 
 /// `read_glb` fails with an error containing `words`.

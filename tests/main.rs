@@ -8,6 +8,7 @@ mod common;
 mod curves_export;
 mod export;
 mod fuzz;
+mod fuzz_build;
 mod gallery;
 mod halo;
 mod halo_export;

@@ -21,7 +21,7 @@ mod vtk;
 
 pub use glb::{read_glb, read_scene_glb};
 pub use mesh::{MeshFileError, MeshFileLocation, MeshFormat, parse_mesh4, read_mesh4};
-pub use vtk::read_vtk;
+pub use vtk::{read_vtk, read_vtk_tetrahedra};
 
 use crate::check::{LAYERS, TetMesh};
 use crate::intersect::Curves;
@@ -208,10 +208,19 @@ pub enum ImportError {
         /// What is wrong.
         message: String,
     },
+    /// Tetrahedra without a halo layout break what the checker takes for granted.
+    #[error("mesh `{}`: {}", shorten(.name), shorten(.message))]
+    BadTetrahedra {
+        /// The mesh's name (the title).
+        name: String,
+        /// What is wrong.
+        message: String,
+    },
 }
 
-/// Reads the halos of a `.glb` or `.vtk` file, chosen by its extension.
-pub fn read(path: &Path) -> Result<Vec<ImportedHalo>, ImportError> {
+/// Reads the tetrahedra of a `.glb` or `.vtk` file, chosen by its extension: its halos, or
+/// a `.vtk`'s tetrahedra without halo4d's layout.
+pub fn read(path: &Path) -> Result<FileTetrahedra, ImportError> {
     // A path that is not there is that, whatever its extension says.
     std::fs::metadata(path)?;
     let ext = path
@@ -219,13 +228,65 @@ pub fn read(path: &Path) -> Result<Vec<ImportedHalo>, ImportError> {
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     match ext.as_str() {
-        "glb" => read_glb(&std::fs::read(path)?),
-        "vtk" => Ok(vec![read_vtk(&std::fs::read(path)?)?]),
+        "glb" => read_glb(&std::fs::read(path)?).map(FileTetrahedra::Halos),
+        "vtk" => read_vtk_tetrahedra(&std::fs::read(path)?),
         _ => Err(ImportError::UnknownType(if ext.is_empty() {
             "(no extension)".into()
         } else {
             format!(".{ext}")
         })),
+    }
+}
+
+/// The tetrahedra of a file, as `halo4d check` reads them ([`read`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum FileTetrahedra {
+    /// Halos in halo4d's layout (every halo of a `.glb`; a `.vtk` that gives the layout).
+    Halos(Vec<ImportedHalo>),
+    /// A `.vtk` of tetrahedra without halo4d's layout.
+    Plain(PlainTetrahedra),
+}
+
+/// Tetrahedra without halo4d's halo layout (another program's `.vtk`, or an earlier
+/// halo4d's): what [`crate::check::check_tetrahedra`] checks.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PlainTetrahedra {
+    /// The title up to its first `: `.
+    pub name: String,
+    /// Vertex positions, all finite.
+    pub positions: Vec<[f64; 3]>,
+    /// Four vertex indices each, all in range, positively oriented in halo4d's convention.
+    pub tets: Vec<[u32; 4]>,
+    /// Why the file is not read as a halo: what says that halo4d's layout is missing.
+    pub why: String,
+}
+
+impl PlainTetrahedra {
+    /// Checks what the checker takes for granted: finite positions, indices in range.
+    fn validate(self) -> Result<Self, ImportError> {
+        let bad = |message: String| ImportError::BadTetrahedra {
+            name: self.name.clone(),
+            message,
+        };
+        if let Some(i) = self
+            .positions
+            .iter()
+            .position(|p| !p.iter().all(|x| x.is_finite()))
+        {
+            let [x, y, z] = self.positions[i];
+            return Err(bad(format!(
+                "vertex {i} has a non-finite coordinate ({x}, {y}, {z})"
+            )));
+        }
+        let nv = self.positions.len();
+        for (k, tet) in self.tets.iter().enumerate() {
+            if let Some(&i) = tet.iter().find(|&&i| i as usize >= nv) {
+                return Err(bad(format!(
+                    "tetrahedron {k} names vertex {i}, but there are only {nv} vertices"
+                )));
+            }
+        }
+        Ok(self)
     }
 }
 

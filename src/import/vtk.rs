@@ -3,9 +3,10 @@
 //! cell's ids) and of 5.1 (OFFSETS and CONNECTIVITY arrays). `surface_vertices`, `rho`,
 //! `delta_d` and `delta_t` come from the dataset's FIELD data, `t` and `d_orig` from the
 //! point data (SCALARS or FIELD arrays). Sections a halo does not need (other point or cell
-//! attributes, lookup tables, METADATA) are read past.
+//! attributes, lookup tables, METADATA) are read past. A file without halo4d's layout is
+//! read as tetrahedra alone for `halo4d check` ([`read_vtk_tetrahedra`]).
 
-use super::{FileParams, ImportError, ImportedHalo};
+use super::{FileParams, FileTetrahedra, ImportError, ImportedHalo, PlainTetrahedra};
 use crate::check::TetMesh;
 use crate::convention::file_order;
 use crate::limits::shorten;
@@ -23,12 +24,47 @@ const VTK_TETRA: f64 = 10.0;
 /// Reads the halo of a legacy VTK file (see [`crate::export::write_vtk`]).
 pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
     let (mut r, title) = header(bytes)?;
+    halo(r.grid()?, &title)
+}
+
+/// Reads a legacy `.vtk` of tetrahedra as `halo4d check` takes it: a halo where the file
+/// gives halo4d's layout ([`read_vtk`]); otherwise (another program's file, or an earlier
+/// halo4d's without `layers`) its tetrahedra alone, with why the halo's own checks cannot
+/// be made. A file that gives the layout wrongly is an error, as with [`read_vtk`].
+pub fn read_vtk_tetrahedra(bytes: &[u8]) -> Result<FileTetrahedra> {
+    let (mut r, title) = header(bytes)?;
     let grid = r.grid()?;
+    let has = |key: &str| grid.field.contains_key(key);
+    let why = match (has("surface_vertices"), has("layers")) {
+        (true, true) => return Ok(FileTetrahedra::Halos(vec![halo(grid, &title)?])),
+        (false, _) => {
+            "its FIELD data does not give halo4d's halo layout (`surface_vertices`, `layers`): another program wrote it"
+        }
+        (true, false) => {
+            "its FIELD data has `surface_vertices` but not `layers`: an earlier halo4d wrote it, with one layer of prisms and no surface vertices among the halo's"
+        }
+    };
+    PlainTetrahedra {
+        name: name(&title),
+        positions: grid.points,
+        tets: grid.tets,
+        why: why.to_string(),
+    }
+    .validate()
+    .map(FileTetrahedra::Plain)
+}
+
+/// The name of a halo or mesh: the title up to its first `: `, or `halo`.
+fn name(title: &str) -> String {
     let name = title
         .split_once(": ")
-        .map_or(title.as_str(), |(head, _)| head)
+        .map_or(title, |(head, _)| head)
         .trim();
-    let name = if name.is_empty() { "halo" } else { name }.to_string();
+    if name.is_empty() { "halo" } else { name }.to_string()
+}
+
+/// The halo of a grid whose FIELD data gives halo4d's layout.
+fn halo(grid: Grid, title: &str) -> Result<ImportedHalo> {
     let field = |key: &str| grid.field.get(key).and_then(|v| v.first().copied());
     let n = surface_vertices(&grid.field)?;
     for key in ["rho", "delta_d", "delta_t"] {
@@ -40,7 +76,7 @@ pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
     }
     let surface_triangles = surface_triangles(&grid.field, n)?;
     ImportedHalo {
-        name,
+        name: name(title),
         mesh: TetMesh {
             positions: grid.points,
             surface_vertices: n as usize,
