@@ -32,6 +32,10 @@
 //!   (`missing_surface_faces`): what puts every surface point inside its own halo with
 //!   t = 1/2;
 //! - the tetrahedra's volumes add up to the volume the boundary encloses (`volume_defect`).
+//!
+//! Tetrahedra without the layout (another program's mesh) get the checks that need none
+//! ([`check_tetrahedra`]): orientation, degenerate and repeated tetrahedra, overshared
+//! faces, and the volume.
 
 use crate::limits::VOLUME_DEFECT;
 use rayon::prelude::*;
