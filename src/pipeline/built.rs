@@ -196,10 +196,12 @@ pub(super) fn in_view(
     let mut timings = samples.timings;
     let projections = project(scene, samples.surfaces, &mut timings, bar)?;
     let scale = Scale::of(scene, &projections, stages)?;
-    let mut crowding = CrowdingReport {
-        triangles: work::surface_crowding(scene, &projections)?,
-        halos: Vec::new(),
-    };
+    // Measured for the stages that query the triangles; a build of the report alone (an
+    // adaptive mesh of millions of triangles, say) skips it.
+    let mut crowding = CrowdingReport::default();
+    if stages.curves || stages.halos {
+        crowding.triangles = work::surface_crowding(scene, &projections)?;
+    }
     let Scale {
         diagonal,
         pixel,

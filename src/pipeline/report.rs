@@ -28,9 +28,10 @@ pub struct MemoryReport {
 }
 
 /// `report.json`'s `crowding`: per surface, on average over points spread over it by area,
-/// how many triangles' boxes hold the point (`triangles`) and how many halo tetrahedra's
-/// boxes, of all the halos (`halos`, empty without halos): what a query of the curves, the
-/// verification and the picture costs there. A build is refused beyond
+/// how many triangles' boxes hold the point (`triangles`, empty when the build makes
+/// neither curves nor halos) and how many halo tetrahedra's boxes, of all the halos
+/// (`halos`, empty without halos): what a query of the curves, the verification and the
+/// picture costs there. A build is refused beyond
 /// [`SURFACE_CROWDING`](crate::limits::SURFACE_CROWDING) and
 /// [`HALO_CROWDING`](crate::limits::HALO_CROWDING).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
