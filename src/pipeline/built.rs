@@ -199,8 +199,13 @@ pub(super) fn in_view(
     // Measured for the stages that query the triangles; a build of the report alone (an
     // adaptive mesh of millions of triangles, say) skips it.
     let mut crowding = CrowdingReport::default();
-    if stages.curves || stages.halos {
-        crowding.triangles = work::surface_crowding(scene, &projections)?;
+    let probes = if stages.curves || stages.halos {
+        work::probes(&projections)
+    } else {
+        Vec::new()
+    };
+    if !probes.is_empty() {
+        crowding.triangles = work::surface_crowding(scene, &projections, &probes)?;
     }
     let Scale {
         diagonal,
@@ -213,7 +218,7 @@ pub(super) fn in_view(
         products.push(surface_product(scene, view, stages, rho, &mut timings, bar));
     }
     if stages.halos {
-        crowding.halos = work::halo_crowding(scene, &products, diagonal)?;
+        crowding.halos = work::halo_crowding(scene, &products, &probes, diagonal)?;
     }
     let mut curves = Curves::default();
     if stages.curves {
