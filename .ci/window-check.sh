@@ -9,7 +9,9 @@ scene=$2
 if ! command -v Xvfb >/dev/null || ! command -v xdotool >/dev/null; then
   apt-get update -qq && apt-get install -y -qq xvfb xdotool
 fi
-Xvfb :97 -screen 0 1280x1024x24 >/dev/null 2>&1 &
+# A key held 1.5 s repeats twice (after 300 ms, then every second), so the check below can tell
+# one step from a step per repeat whatever the machine's load.
+Xvfb :97 -screen 0 1280x1024x24 -ardelay 300 -arinterval 1000 >/dev/null 2>&1 &
 xvfb=$!
 trap 'kill "$xvfb" 2>/dev/null || true' EXIT
 export DISPLAY=:97
@@ -53,7 +55,9 @@ expect_not() {
 viewer=$!
 find_window "$viewer"
 expect "grid 64 slices | 1 spp | halos on | curves on | silhouettes on | opaque | colour by w | azimuth 35"
-xdotool key s; expect "grid 128 slices"
+# S held down takes one step (64 to 128 slices), not one per auto-repeat (256 or 512).
+xdotool keydown s; sleep 1.5; xdotool keyup s; expect "grid 128 slices"
+sleep 0.5; expect "grid 128 slices"
 xdotool key m; expect "view 128 slices"
 xdotool key h; expect "halos off"
 xdotool key c; expect "curves off"
@@ -94,6 +98,9 @@ expect "settled"
 # The view search runs in the background and turns the view to what it found.
 xdotool key a; expect "searching the view"
 expect "view search:"
+xdotool key v; expect "4D xy 0 xz 0 xw 0 yz 0 yw 30 zw 0 orthographic"
+# A held turn key repeats its step: 3 held 1.5 s turns xw by 15 degrees, then 15 more per repeat.
+xdotool keydown 3; sleep 1.5; xdotool keyup 3; expect_not "4D xy 0 xz 0 xw 0 "; expect_not " xw 15 "
 xdotool key v; expect "4D xy 0 xz 0 xw 0 yz 0 yw 30 zw 0 orthographic"
 xdotool key f; expect "saved exports/views/"
 xdotool key q

@@ -701,7 +701,11 @@ impl ApplicationHandler for App {
                 }
             }
             WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
-                redraw = self.key(&event.logical_key, event.physical_key, event_loop);
+                // A held key repeats only the steps (a 4D turn, a move along w); a toggle or a
+                // cycle taken twice from one press (an auto-repeat under load) would skip a state.
+                if !event.repeat || is_step(&event.logical_key, event.physical_key) {
+                    redraw = self.key(&event.logical_key, event.physical_key, event_loop);
+                }
             }
             _ => {}
         }
@@ -709,4 +713,19 @@ impl ApplicationHandler for App {
             state.window.request_redraw();
         }
     }
+}
+
+/// Whether a key is a step that holding it repeats: a 4D turn (1 to 6) or a move along w ([ ]).
+fn is_step(key: &Key, physical: PhysicalKey) -> bool {
+    matches!(
+        physical,
+        PhysicalKey::Code(
+            KeyCode::Digit1
+                | KeyCode::Digit2
+                | KeyCode::Digit3
+                | KeyCode::Digit4
+                | KeyCode::Digit5
+                | KeyCode::Digit6
+        )
+    ) || matches!(key, Key::Character(c) if c.as_str() == "[" || c.as_str() == "]")
 }
