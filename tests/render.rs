@@ -75,6 +75,75 @@ fn renders_are_deterministic_and_stereo_is_two_views() {
     );
 }
 
+#[test]
+fn adaptive_sampling_stays_within_its_tolerance_of_every_sample() {
+    // Every fixture at 240 x 240 with 4 samples: the adaptive picture (the centre sample
+    // alone where no neighbour's differs) against every sample of every pixel. The stated
+    // tolerance: no more than 0.1% of the pixels differ by more than 2 levels of 255 (a
+    // detail thinner than the spacing of the centre samples, which they miss), and the
+    // pixels the centre samples decide alike are most of the picture.
+    for path in fixture_scenes() {
+        let mut scene = Scene::load(&path).unwrap();
+        (
+            scene.render.width,
+            scene.render.height,
+            scene.render.samples,
+        ) = (240, 240, 4);
+        let built = crate::common::built(&scene).unwrap();
+        let picture = |adaptive: bool| {
+            built
+                .render(
+                    &scene.halo,
+                    &RenderSettings {
+                        adaptive,
+                        ..scene.render
+                    },
+                    &scene.camera,
+                )
+                .unwrap()
+        };
+        let (adaptive, every) = (picture(true), picture(false));
+        let pixels = adaptive.rgb.len() / 3;
+        let diff: Vec<u8> = adaptive
+            .rgb
+            .chunks(3)
+            .zip(every.rgb.chunks(3))
+            .map(|(a, b)| (0..3).map(|k| a[k].abs_diff(b[k])).max().unwrap())
+            .collect();
+        let off = diff.iter().filter(|&&d| d > 2).count();
+        let same = diff.iter().filter(|&&d| d == 0).count();
+        assert!(
+            off * 1000 <= pixels,
+            "{}: {off} of {pixels} pixels more than 2 levels off",
+            path.display()
+        );
+        assert!(
+            same * 2 > pixels,
+            "{}: only {same} of {pixels} pixels the same",
+            path.display()
+        );
+    }
+}
+
+#[test]
+fn a_picture_is_the_same_on_any_number_of_threads() {
+    let scene = Scene::default_scene();
+    let mut settings = scene.render;
+    (settings.width, settings.height) = (256, 256);
+    let built = crate::common::built(&scene).unwrap();
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| built.render(&scene.halo, &settings, &scene.camera).unwrap())
+    };
+    let one = on(1);
+    for threads in [2, 3, 8] {
+        assert!(on(threads).rgb == one.rgb, "{threads} threads");
+    }
+}
+
 /// The flat torus fixture, built, with what probing its picture needs.
 struct Torus {
     scene: Scene,

@@ -88,7 +88,7 @@ impl<'a> HaloIndex<'a> {
 
     /// Whether tetrahedron `g` may hide a point at depth `w`: its halo depth can be below
     /// `w` somewhere ([`floor`]).
-    fn may_hide(&self, g: u32, w: f64) -> bool {
+    pub(crate) fn may_hide(&self, g: u32, w: f64) -> bool {
         self.floor[g as usize] < w
     }
 
@@ -149,6 +149,18 @@ impl<'a> HaloIndex<'a> {
             bvh.primitive_indices[first..first + node.prim_count as usize]
                 .iter()
                 .all(|&g| f(g))
+        });
+    }
+
+    /// Calls `f` with each tetrahedron whose box meets `aabb`.
+    pub(crate) fn visit_box(&self, aabb: Aabb, mut f: impl FnMut(u32)) {
+        self.bvh.aabb_traverse(aabb, |bvh, node| {
+            let node = &bvh.nodes[node as usize];
+            let first = node.first_index as usize;
+            for &g in &bvh.primitive_indices[first..first + node.prim_count as usize] {
+                f(g);
+            }
+            true
         });
     }
 

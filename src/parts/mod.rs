@@ -11,9 +11,11 @@
 //! with every per-vertex value its readers need.
 
 mod index;
+mod near;
 
 pub use index::HaloIndex;
 pub(crate) use index::{inserted_sets, tet_box};
+pub(crate) use near::TriangleHiders;
 
 use crate::intersect::{Curves, Sheet};
 use crate::stipple::Stipples;

@@ -33,7 +33,7 @@ use crate::limits::{
 pub use clip::{Clip, ClipPlane};
 pub use compare::Comparison;
 
-use crate::parts::{HaloIndex, Parts};
+use crate::parts::{HaloIndex, Parts, TriangleHiders};
 use camera::Camera;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -211,6 +211,11 @@ pub struct RenderSettings {
     pub slices: u32,
     /// Samples per pixel on a square grid: 1, 4, 9 or 16.
     pub samples: u32,
+    /// In `exact` mode, every sample only in the pixels where the picture changes (an edge,
+    /// a gap, a crossing, a change of shade: where a pixel's centre sample differs from a
+    /// neighbour's), the centre sample alone elsewhere; `false` takes every sample of every
+    /// pixel (the reference).
+    pub adaptive: bool,
     /// Whether halos hide anything.
     pub halos: bool,
     /// Surface opacity at the near end of w (1 is opaque).
@@ -280,6 +285,7 @@ impl Default for RenderSettings {
             mode: RenderMode::Exact,
             slices: 256,
             samples: 4,
+            adaptive: true,
             halos: true,
             opacity: 1.0,
             opacity_far: None,
@@ -880,7 +886,8 @@ struct Scene<'a> {
     input: &'a Parts<'a>,
     settings: &'a RenderSettings,
     tracer: Tracer<'a>,
-    halos: Option<HaloIndex<'a>>,
+    /// The halos' tetrahedra, asked per triangle hit.
+    halos: Option<TriangleHiders<'a>>,
     /// Per surface and vertex, the tangent plane in 4D ([`shade::vertex_tangent_projectors`])
     /// when the lighting is 4D; empty otherwise.
     planes: Vec<Vec<glam::DMat4>>,
@@ -911,7 +918,9 @@ impl<'a> Scene<'a> {
             input,
             settings,
             tracer: Tracer::new(trace, (hi - lo).length()),
-            halos: settings.halos.then(|| HaloIndex::new(&input.halos)),
+            halos: settings
+                .halos
+                .then(|| TriangleHiders::new(HaloIndex::new(&input.halos), &input.surfaces)),
             planes: match settings.lighting {
                 Lighting::ThreeD => Vec::new(),
                 Lighting::FourD => input
@@ -972,20 +981,26 @@ impl<'a> Scene<'a> {
         Ok(())
     }
 
-    /// The sample points of pixel (x, y) in [-1, 1]^2 (y up), and which is its centre's.
-    fn samples(&self, x: usize, y: usize) -> impl Iterator<Item = (f64, f64, bool)> + '_ {
-        let n = (self.settings.samples as f64).sqrt().round() as usize;
+    /// The side of the square grid of samples in a pixel.
+    fn grid_side(&self) -> usize {
+        (self.settings.samples as f64).sqrt().round() as usize
+    }
+
+    /// Sample `k` of pixel (x, y) in [-1, 1]^2 (y up): row `k / n`, column `k % n` of the
+    /// pixel's n x n grid.
+    fn sample_point(&self, x: usize, y: usize, k: usize) -> (f64, f64) {
+        let n = self.grid_side();
         let (w, h) = (self.settings.width as f64, self.settings.height as f64);
-        (0..n * n).map(move |k| {
-            let (i, j) = (k % n, k / n);
-            let px = x as f64 + (i as f64 + 0.5) / n as f64;
-            let py = y as f64 + (j as f64 + 0.5) / n as f64;
-            (
-                2.0 * px / w - 1.0,
-                1.0 - 2.0 * py / h,
-                i == n / 2 && j == n / 2,
-            )
-        })
+        let (i, j) = (k % n, k / n);
+        let px = x as f64 + (i as f64 + 0.5) / n as f64;
+        let py = y as f64 + (j as f64 + 0.5) / n as f64;
+        (2.0 * px / w - 1.0, 1.0 - 2.0 * py / h)
+    }
+
+    /// The sample points of pixel (x, y) in [-1, 1]^2 (y up), in order.
+    fn samples(&self, x: usize, y: usize) -> impl Iterator<Item = (f64, f64)> + '_ {
+        let n = self.grid_side();
+        (0..n * n).map(move |k| self.sample_point(x, y, k))
     }
 
     /// Where `hit` of the ray (`origin`, `dir`) is, its w and its triangle's vertices.
@@ -998,23 +1013,27 @@ impl<'a> Scene<'a> {
 
     /// Whether the halos hide `hit` of the ray (`origin`, `dir`), asking the tetrahedra.
     fn hidden_hit(&self, origin: DVec3, dir: DVec3, hit: &Hit) -> bool {
-        let (x, w, tri) = self.at_hit(origin, dir, hit);
+        let (x, w, _) = self.at_hit(origin, dir, hit);
+        self.hidden_at(hit, x, w)
+    }
+
+    /// Whether the halos hide the point `x` at depth `w` of `hit`'s triangle.
+    fn hidden_at(&self, hit: &Hit, x: DVec3, w: f64) -> bool {
         self.halos
             .as_ref()
-            .is_some_and(|index| index.hidden(x, w, hit.surface, tri))
+            .is_some_and(|h| h.hidden(x, w, hit.surface, hit.triangle))
     }
 
     /// One eye's image.
     fn view(&self, cam: &Camera) -> View {
         match (self.settings.mode, &self.halos) {
-            (RenderMode::Slices, Some(index)) => self.view_slices(cam, index),
-            _ => self.view_with(cam, self.opaque_and_uncut(), |_, _, hit, x, w| {
-                let tri =
-                    self.input.surfaces[hit.surface as usize].triangles[hit.triangle as usize];
-                self.halos
-                    .as_ref()
-                    .is_some_and(|index| index.hidden(x, w, hit.surface, tri))
-            }),
+            (RenderMode::Slices, Some(h)) => self.view_slices(cam, h.index()),
+            _ => self.view_with(
+                cam,
+                self.opaque_and_uncut(),
+                self.settings.adaptive,
+                |_, _, hit, x, w| self.hidden_at(hit, x, w),
+            ),
         }
     }
 
@@ -1022,14 +1041,53 @@ impl<'a> Scene<'a> {
     /// which hits the halos hide; rows shared between the cores. With `nearest_first`
     /// (for a `hidden` that does not number the hits), each ray first finds its nearest
     /// surface, with the hits as near ([`Tracer::nearest_hits`]); where the first of them
-    /// is hidden, it traces every hit, so the picture is the same either way.
+    /// is hidden, it traces every hit, so the picture is the same either way. With
+    /// `adaptive` (also for a `hidden` that does not number the hits), every pixel's centre
+    /// sample is traced first and only the pixels where it differs from a neighbour's
+    /// ([`Scene::differs`]: an edge, a gap, a crossing, a change of shade) take their other
+    /// samples; the rest are their centre sample.
     fn view_with(
         &self,
         cam: &Camera,
         nearest_first: bool,
+        adaptive: bool,
         hidden: impl Fn(usize, usize, &Hit, DVec3, f64) -> bool + Sync,
     ) -> View {
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
+        let n = self.grid_side();
+        let centre = (n / 2) * n + n / 2;
+        // Sample `k` of `pixel`, its hits numbered from `numbered` on (which it advances).
+        let sample = |hits: &mut Vec<Hit>, pixel: usize, k: usize, numbered: &mut usize| {
+            let (sx, sy) = self.sample_point(pixel % w, pixel / w, k);
+            let (origin, dir) = cam.ray(sx, sy);
+            // Opaque and uncut: where the nearest surface is visible it is all the ray
+            // shows, and only the hits that near are traced.
+            if nearest_first {
+                let slack = 2.0 * self.tracer.same();
+                self.tracer.nearest_hits(origin, dir, 0.0, slack, hits);
+                let shown = self.shade(cam, origin, dir, hits, |j, hit, x, wd| {
+                    hidden(pixel, j, hit, x, wd)
+                });
+                if !shown.first_hidden {
+                    return shown;
+                }
+            }
+            self.trace(origin, dir, hits);
+            let base = *numbered;
+            *numbered += hits.len();
+            self.shade(cam, origin, dir, hits, |j, hit, x, wd| {
+                hidden(pixel, base + j, hit, x, wd)
+            })
+        };
+        // The centre samples first, where the pixels are sampled adaptively.
+        let probes: Vec<Shown> = if adaptive && n > 1 {
+            (0..w * h)
+                .into_par_iter()
+                .map_init(Vec::new, |hits, pixel| sample(hits, pixel, centre, &mut 0))
+                .collect()
+        } else {
+            Vec::new()
+        };
         let mut rgb = vec![DVec3::ZERO; w * h];
         let mut front = vec![f64::INFINITY; w * h];
         let mut gap = vec![false; w * h];
@@ -1046,46 +1104,54 @@ impl<'a> Scene<'a> {
                     .enumerate()
                 {
                     let pixel = y * w + x;
+                    let probe = probes.get(pixel);
+                    if let Some(p) = probe
+                        && !self.changes_around(&probes, (x, y), (w, h))
+                    {
+                        (*c, *f, *g) = (p.colour, p.first, p.first_hidden);
+                        continue;
+                    }
                     let mut sum = DVec3::ZERO;
-                    let mut count = 0;
                     let mut numbered = 0;
-                    for (sx, sy, centre) in self.samples(x, y) {
-                        let (origin, dir) = cam.ray(sx, sy);
-                        // Opaque and uncut: where the nearest surface is visible it is all
-                        // the ray shows, and only the hits that near are traced.
-                        if nearest_first {
-                            let slack = 2.0 * self.tracer.same();
-                            self.tracer.nearest_hits(origin, dir, 0.0, slack, hits);
-                            let shown = self.shade(cam, origin, dir, hits, |k, hit, x, wd| {
-                                hidden(pixel, k, hit, x, wd)
-                            });
-                            if !shown.2 {
-                                sum += shown.0;
-                                count += 1;
-                                if centre {
-                                    *f = shown.1;
-                                }
-                                continue;
-                            }
-                        }
-                        self.trace(origin, dir, hits);
-                        let base = numbered;
-                        numbered += hits.len();
-                        let (colour, first, first_hidden) =
-                            self.shade(cam, origin, dir, hits, |k, hit, x, wd| {
-                                hidden(pixel, base + k, hit, x, wd)
-                            });
-                        sum += colour;
-                        count += 1;
-                        if centre {
-                            *f = first;
-                            *g = first_hidden;
+                    for k in 0..n * n {
+                        let shown = match probe {
+                            Some(&p) if k == centre => p,
+                            _ => sample(hits, pixel, k, &mut numbered),
+                        };
+                        sum += shown.colour;
+                        if k == centre {
+                            (*f, *g) = (shown.first, shown.first_hidden);
                         }
                     }
-                    *c = sum / count as f64;
+                    *c = sum / (n * n) as f64;
                 }
             });
         View { rgb, front, gap }
+    }
+
+    /// Whether the centre sample of pixel `(x, y)` differs from that of a pixel around it
+    /// ([`Scene::differs`]), in an image of `(w, h)` pixels.
+    fn changes_around(
+        &self,
+        probes: &[Shown],
+        (x, y): (usize, usize),
+        (w, h): (usize, usize),
+    ) -> bool {
+        let p = &probes[y * w + x];
+        (y.saturating_sub(1)..(y + 2).min(h)).any(|j| {
+            (x.saturating_sub(1)..(x + 2).min(w)).any(|i| self.differs(p, &probes[j * w + i]))
+        })
+    }
+
+    /// Whether what two neighbouring rays show differs enough that the pixels between them
+    /// need all their samples: another surface or none, a gap on one and not the other, a
+    /// jump in distance (one sheet behind another), or a change of colour above
+    /// [`ADAPTIVE_COLOUR_STEP`].
+    fn differs(&self, a: &Shown, b: &Shown) -> bool {
+        a.surface != b.surface
+            || a.first_hidden != b.first_hidden
+            || (a.first - b.first).abs() > ADAPTIVE_DEPTH_JUMP * self.radius
+            || (a.colour - b.colour).abs().max_element() > ADAPTIVE_COLOUR_STEP
     }
 
     /// Whether every surface is opaque and nothing cuts hits away (hither, clip, ribbons):
@@ -1136,7 +1202,7 @@ impl<'a> Scene<'a> {
                 let mut probes = Vec::new();
                 for pixel in y * w..(y + 1) * w {
                     let before = probes.len();
-                    for (sx, sy, _) in self.samples(pixel % w, y) {
+                    for (sx, sy) in self.samples(pixel % w, y) {
                         let (origin, dir) = cam.ray(sx, sy);
                         self.trace(origin, dir, hits);
                         for hit in hits.iter() {
@@ -1176,14 +1242,13 @@ impl<'a> Scene<'a> {
             &probes,
         );
         drop(probes);
-        self.view_with(cam, false, |pixel, k, _, _, _| {
+        self.view_with(cam, false, false, |pixel, k, _, _, _| {
             hidden[starts[pixel] as usize + k]
         })
     }
 
     /// Composites the hits of one ray front to back, leaving out those `hidden(k, hit, x,
-    /// w)` says the halos hide: the colour, the distance of the first visible hit, and
-    /// whether the first hit is hidden.
+    /// w)` says the halos hide.
     fn shade(
         &self,
         cam: &Camera,
@@ -1191,13 +1256,14 @@ impl<'a> Scene<'a> {
         dir: DVec3,
         hits: &[Hit],
         hidden: impl Fn(usize, &Hit, DVec3, f64) -> bool,
-    ) -> (DVec3, f64, bool) {
+    ) -> Shown {
         let s = self.settings;
         let (w0, w1) = self.w_range;
         let span = if w1 > w0 { w1 - w0 } else { 1.0 };
         let mut colour = DVec3::ZERO;
         let mut alpha = 0.0;
         let mut first = f64::INFINITY;
+        let mut surface = u32::MAX;
         let mut first_hidden = false;
         for (k, hit) in hits.iter().enumerate() {
             let surf = &self.input.surfaces[hit.surface as usize];
@@ -1213,7 +1279,7 @@ impl<'a> Scene<'a> {
                 continue;
             }
             if first.is_infinite() {
-                first = hit.t;
+                (first, surface) = (hit.t, hit.surface);
             }
             let n = shade::shading_normal(
                 tri.map(|v| surf.positions[v as usize]),
@@ -1239,13 +1305,36 @@ impl<'a> Scene<'a> {
                 break;
             }
         }
-        (
-            colour + self.background * (1.0 - alpha),
+        Shown {
+            colour: colour + self.background * (1.0 - alpha),
             first,
+            surface,
             first_hidden,
-        )
+        }
     }
 }
+
+/// What one ray shows ([`Scene::shade`]).
+#[derive(Clone, Copy, Debug)]
+struct Shown {
+    /// The hits composited over the background.
+    colour: DVec3,
+    /// The distance of the first hit the halos leave visible (infinite where none).
+    first: f64,
+    /// Its surface (`u32::MAX` where none).
+    surface: u32,
+    /// Whether the halos hide the ray's first hit.
+    first_hidden: bool,
+}
+
+/// Where two neighbouring centre samples are farther apart along their rays than this (in
+/// units of half the scene's diagonal), the pixels around take all their samples: one sheet
+/// seen past the edge of another.
+const ADAPTIVE_DEPTH_JUMP: f64 = 0.01;
+
+/// Where two neighbouring centre samples differ by more than this in any linear colour
+/// channel, the pixels around take all their samples.
+const ADAPTIVE_COLOUR_STEP: f64 = 0.04;
 
 /// The tangent projectors of a triangle's corners interpolated at barycentric `b`.
 fn mix_planes(p: [glam::DMat4; 3], b: [f64; 3]) -> glam::DMat4 {
@@ -1277,16 +1366,11 @@ mod tests {
             let (placement, prepared) = prepare(&parts, &scene.render, &scene.camera).unwrap();
             assert!(prepared.opaque_and_uncut());
             let cam = Camera::new(&scene.camera, &placement, 200, 200, 0.0).unwrap();
-            let hidden = |_: usize, _: usize, hit: &Hit, x: DVec3, w: f64| {
-                let tri = parts.surfaces[hit.surface as usize].triangles[hit.triangle as usize];
-                prepared
-                    .halos
-                    .as_ref()
-                    .is_some_and(|index| index.hidden(x, w, hit.surface, tri))
-            };
+            let hidden =
+                |_: usize, _: usize, hit: &Hit, x: DVec3, w: f64| prepared.hidden_at(hit, x, w);
             let (fast, full) = (
-                prepared.view_with(&cam, true, hidden),
-                prepared.view_with(&cam, false, hidden),
+                prepared.view_with(&cam, true, false, hidden),
+                prepared.view_with(&cam, false, false, hidden),
             );
             assert_eq!(fast.rgb, full.rgb, "{}", scene.name);
             assert_eq!(fast.front, full.front, "{}", scene.name);

@@ -167,14 +167,16 @@ impl Scene<'_> {
 
     /// Whether each candidate is the first sheet the halos leave visible along its eye ray.
     fn stipples_visible(&self, cam: &Camera, candidates: &[Drawn]) -> Vec<bool> {
-        let triangle = |d: &Drawn| {
-            let surf = &self.input.surfaces[d.surface as usize];
-            let set = surf
+        let triangle_index = |d: &Drawn| {
+            let set = self.input.surfaces[d.surface as usize]
                 .stipples
                 .expect("candidates come from surfaces with stipples");
-            surf.triangles[set.triangle[d.rank as usize] as usize]
+            set.triangle[d.rank as usize]
         };
-        let Some(index) = &self.halos else {
+        let triangle = |d: &Drawn| {
+            self.input.surfaces[d.surface as usize].triangles[triangle_index(d) as usize]
+        };
+        let Some(hiders) = &self.halos else {
             return candidates
                 .par_iter()
                 .map_init(Vec::new, |hits, d| {
@@ -187,7 +189,7 @@ impl Scene<'_> {
             RenderMode::Exact => candidates
                 .par_iter()
                 .map_init(Vec::new, |hits, d| {
-                    !index.hidden(d.position, d.w, d.surface, triangle(d))
+                    !hiders.hidden(d.position, d.w, d.surface, triangle_index(d))
                         && !self.occluded(cam, d.position, hits)
                 })
                 .collect(),
@@ -235,7 +237,7 @@ impl Scene<'_> {
                 let probes: Vec<slices::Probe> = per.iter().flatten().copied().collect();
                 let depth = (self.centre - cam.eye).dot(cam.forward);
                 let hidden = slices::hidden(
-                    index,
+                    hiders.index(),
                     cam,
                     (w, h),
                     self.settings.slices,

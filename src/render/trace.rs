@@ -30,8 +30,10 @@ pub struct Hit {
 /// The triangles of all surfaces in one BVH.
 pub struct Tracer<'a> {
     surfaces: Vec<TraceSurface<'a>>,
-    /// Global triangle -> (surface, triangle).
+    /// Per BVH slot, its triangle's (surface, triangle) and corners: read in the order the
+    /// traversal meets them, with no lookup through the surfaces.
     tris: Vec<(u32, u32)>,
+    corners: Vec<[DVec3; 3]>,
     bvh: Bvh2,
     /// Hits closer than this along the ray are one hit on a shared edge or vertex.
     same: f64,
@@ -57,10 +59,24 @@ impl<'a> Tracer<'a> {
                 tris.push((s as u32, i as u32));
             }
         }
+        let bvh = broad::build(&boxes, 4);
+        let tris: Vec<(u32, u32)> = bvh
+            .primitive_indices
+            .iter()
+            .map(|&g| tris[g as usize])
+            .collect();
+        let corners = tris
+            .iter()
+            .map(|&(s, i)| {
+                let surf = &surfaces[s as usize];
+                surf.triangles[i as usize].map(|v| surf.positions[v as usize])
+            })
+            .collect();
         Tracer {
             surfaces,
             tris,
-            bvh: broad::build(&boxes, 4),
+            corners,
+            bvh,
             same: 1e-12 * scale,
         }
     }
@@ -70,9 +86,10 @@ impl<'a> Tracer<'a> {
     /// triangles of one surface hits it once.
     pub fn hits(&self, origin: DVec3, dir: DVec3, t_min: f64, hits: &mut Vec<Hit>) {
         hits.clear();
+        let shear = Shear::new(origin, dir);
         self.bvh
             .ray_traverse_anyhit(self.ray(origin, dir), |_, slot| {
-                if let Some(hit) = self.hit(origin, dir, slot)
+                if let Some(hit) = self.hit(&shear, slot)
                     && hit.t > t_min
                 {
                     hits.push(hit);
@@ -95,9 +112,10 @@ impl<'a> Tracer<'a> {
         hits.clear();
         let mut nearest = f64::INFINITY;
         let mut found = obvhs::ray::RayHit::none();
+        let shear = Shear::new(origin, dir);
         self.bvh
             .ray_traverse(self.ray(origin, dir), &mut found, |_, slot| {
-                match self.hit(origin, dir, slot) {
+                match self.hit(&shear, slot) {
                     Some(hit) if hit.t > t_min && hit.t <= nearest + slack => {
                         nearest = nearest.min(hit.t);
                         hits.push(hit);
@@ -128,12 +146,9 @@ impl<'a> Tracer<'a> {
     }
 
     /// Where the ray meets the triangle in BVH slot `slot`, if it does.
-    fn hit(&self, origin: DVec3, dir: DVec3, slot: usize) -> Option<Hit> {
-        let g = self.bvh.primitive_indices[slot];
-        let (s, i) = self.tris[g as usize];
-        let surf = &self.surfaces[s as usize];
-        let p = surf.triangles[i as usize].map(|v| surf.positions[v as usize]);
-        intersect(origin, dir, p).map(|(t, bary)| Hit {
+    fn hit(&self, shear: &Shear, slot: usize) -> Option<Hit> {
+        let (s, i) = self.tris[slot];
+        shear.intersect(&self.corners[slot]).map(|(t, bary)| Hit {
             t,
             surface: s,
             triangle: i,
@@ -171,44 +186,64 @@ impl<'a> Tracer<'a> {
     }
 }
 
-/// Watertight ray-triangle intersection (Woop, Benthin and Wald 2013) in f64, edges
-/// included: (t, barycentric coordinates). The triangle is sheared into the ray's frame and
-/// tested with 2D edge functions; a vertex shared by two triangles shears to the same point
-/// and a shared edge's function is exactly negated between them, so a ray through an edge
-/// hits both neighbours (one hit after [`Tracer::hits`] merges them), never neither.
-fn intersect(origin: DVec3, dir: DVec3, p: [DVec3; 3]) -> Option<(f64, [f64; 3])> {
-    let a = dir.abs();
-    let kz = if a.x >= a.y && a.x >= a.z {
-        0
-    } else if a.y >= a.z {
-        1
-    } else {
-        2
-    };
-    let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
-    if dir[kz] < 0.0 {
-        std::mem::swap(&mut kx, &mut ky);
+/// A ray set up for watertight ray-triangle intersection (Woop, Benthin and Wald 2013) in
+/// f64, edges included: the axis the ray runs most along and the shear that takes the ray to
+/// that axis, found once per ray. A triangle is sheared into the ray's frame and tested with
+/// 2D edge functions; a vertex shared by two triangles shears to the same point and a shared
+/// edge's function is exactly negated between them, so a ray through an edge hits both
+/// neighbours (one hit after [`Tracer::hits`] merges them), never neither.
+struct Shear {
+    origin: DVec3,
+    k: [usize; 3],
+    s: [f64; 3],
+}
+
+impl Shear {
+    fn new(origin: DVec3, dir: DVec3) -> Self {
+        let a = dir.abs();
+        let kz = if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        if dir[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        Shear {
+            origin,
+            k: [kx, ky, kz],
+            s: [dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]],
+        }
     }
-    let (sx, sy, sz) = (dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
-    let shear = |q: DVec3| {
-        let r = q - origin;
-        (r[kx] - sx * r[kz], r[ky] - sy * r[kz], sz * r[kz])
-    };
-    let (ax, ay, az) = shear(p[0]);
-    let (bx, by, bz) = shear(p[1]);
-    let (cx, cy, cz) = shear(p[2]);
-    let u = cx * by - cy * bx;
-    let v = ax * cy - ay * cx;
-    let w = bx * ay - by * ax;
-    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
-        return None;
+
+    /// (t, barycentric coordinates) where the ray meets triangle `p`, if it does.
+    #[inline]
+    fn intersect(&self, p: &[DVec3; 3]) -> Option<(f64, [f64; 3])> {
+        let [kx, ky, kz] = self.k;
+        let [sx, sy, sz] = self.s;
+        let shear = |q: DVec3| {
+            let r = q - self.origin;
+            (r[kx] - sx * r[kz], r[ky] - sy * r[kz], sz * r[kz])
+        };
+        let (ax, ay, az) = shear(p[0]);
+        let (bx, by, bz) = shear(p[1]);
+        let (cx, cy, cz) = shear(p[2]);
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return None;
+        }
+        let det = u + v + w;
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        let t = (u * az + v * bz + w * cz) / det;
+        Some((t, [u / det, v / det, w / det]))
     }
-    let det = u + v + w;
-    if det == 0.0 || !det.is_finite() {
-        return None;
-    }
-    let t = (u * az + v * bz + w * cz) / det;
-    Some((t, [u / det, v / det, w / det]))
 }
 
 #[cfg(test)]
