@@ -13,6 +13,7 @@ use super::{RenderError, Scene};
 use crate::intersect::Curve;
 use crate::limits::FieldError;
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 
 /// The colour of the silhouettes, and of the curves when they are drawn in one ink (linear
 /// RGB).
@@ -169,21 +170,28 @@ impl Scene<'_> {
             };
             mask.draw_polyline(&run.points).map_err(line_error)?;
         }
-        let mut broadener = Broadener::new();
-        let mut out = Vec::new();
-        for (class, entry) in masks.into_iter().enumerate() {
-            let Some((ink, mask)) = entry.filter(|(_, m)| !m.is_empty()) else {
-                continue;
-            };
-            let coverage = match (s.line_width_far, class) {
-                (_, BROKEN) => broadener.broaden(&mask, s.line_width * BROKEN_WIDTH),
-                (Some(_), _) => broadener.broaden_varying(&mask),
-                (None, _) => broadener.broaden(&mask, s.line_width),
-            }
-            .map_err(line_error)?;
-            out.push(Lines { ink, coverage });
-        }
-        Ok(out)
+        // The classes side by side on the cores, each thread with its own FFT plans.
+        let drawn: Vec<(usize, DVec3, Mask)> = masks
+            .into_iter()
+            .enumerate()
+            .filter_map(|(class, entry)| {
+                entry
+                    .filter(|(_, m)| !m.is_empty())
+                    .map(|(ink, mask)| (class, ink, mask))
+            })
+            .collect();
+        drawn
+            .into_par_iter()
+            .map_init(Broadener::new, |broadener, (class, ink, mask)| {
+                let coverage = match (s.line_width_far, class) {
+                    (_, BROKEN) => broadener.broaden(&mask, s.line_width * BROKEN_WIDTH),
+                    (Some(_), _) => broadener.broaden_varying(&mask),
+                    (None, _) => broadener.broaden(&mask, s.line_width),
+                }
+                .map_err(line_error)?;
+                Ok(Lines { ink, coverage })
+            })
+            .collect()
     }
 
     /// The visible runs of the scene's lines in the image of `cam`: the curves, silhouettes
