@@ -185,10 +185,10 @@ fn rank(
         }
         let r = radius(j);
         if j % LEVELS_PER_GRID == 0 {
-            grid = Grid::new(CELL * r);
-            for &i in &accepted {
-                grid.insert(points[i as usize]);
-            }
+            grid = Grid::of(
+                CELL * r,
+                accepted.iter().map(|&i| points[i as usize]).collect(),
+            );
         }
         // Candidates join when a level needs them: OVERSAMPLE times as many as a
         // Poisson-disc set of this radius holds, so that the early levels, which accept few,
@@ -227,7 +227,7 @@ fn rank(
 /// points in a row of memory, not scattered over the candidates).
 struct Grid {
     cell: f64,
-    cells: HashMap<[i64; 4], Vec<DVec4>, BuildHasherDefault<CellHasher>>,
+    cells: HashMap<Cell, Vec<DVec4>, BuildHasherDefault<CellHasher>>,
 }
 
 impl Grid {
@@ -238,20 +238,41 @@ impl Grid {
         }
     }
 
-    /// The cell of `p`, shifted by `corner`'s bits along the axes: its four integer
-    /// coordinates, whole (packed into fewer bits, cells far apart would share a key, and a
-    /// mesh reaching 1e29 along w would pile its stipples into one).
-    fn key(&self, p: DVec4, corner: u32) -> [i64; 4] {
-        std::array::from_fn(|axis| {
-            // Beyond 2^62 cells (a coordinate of 1e30 over a cell of 1e-12) the cells merge,
-            // which costs distance tests, never a wrong answer.
-            const FAR: f64 = (1u64 << 62) as f64;
-            (p[axis] / self.cell).floor().clamp(-FAR, FAR) as i64 + i64::from((corner >> axis) & 1)
-        })
+    /// The cell of `p`: its four integer coordinates, whole (packed into fewer bits, cells
+    /// far apart would share a key, and a mesh reaching 1e29 along w would pile its stipples
+    /// into one).
+    fn key(&self, p: DVec4) -> Cell {
+        Cell(std::array::from_fn(|axis| {
+            Self::whole((p[axis] / self.cell).floor())
+        }))
+    }
+
+    /// A cell coordinate as an integer. Beyond 2^62 cells (a coordinate of 1e30 over a cell
+    /// of 1e-12) the cells merge, which costs distance tests, never a wrong answer.
+    fn whole(c: f64) -> i64 {
+        const FAR: f64 = (1u64 << 62) as f64;
+        c.clamp(-FAR, FAR) as i64
+    }
+
+    /// The grid of cell `cell` over `points`, built at once: the points sorted by cell on
+    /// the cores, then each cell's run moved into the map (a cell's order does not matter:
+    /// a query takes the nearest of a cell's points).
+    fn of(cell: f64, points: Vec<DVec4>) -> Grid {
+        let mut grid = Grid::new(cell);
+        let mut keyed: Vec<(Cell, DVec4)> =
+            points.into_par_iter().map(|p| (grid.key(p), p)).collect();
+        keyed.par_sort_unstable_by_key(|&(key, _)| key.0);
+        let runs: Vec<&[(Cell, DVec4)]> = keyed.chunk_by(|a, b| a.0 == b.0).collect();
+        grid.cells.reserve(runs.len());
+        for run in runs {
+            grid.cells
+                .insert(run[0].0, run.iter().map(|&(_, p)| p).collect());
+        }
+        grid
     }
 
     fn insert(&mut self, p: DVec4) {
-        let key = self.key(p, 0);
+        let key = self.key(p);
         self.cells.entry(key).or_default().push(p);
     }
 
@@ -261,27 +282,34 @@ impl Grid {
     /// bound of the nearest distance (a rejected candidate only comes back sooner).
     fn near_within(&self, p: DVec4, r: f64) -> Option<f64> {
         // The ball of radius r meets at most two cells per axis: p's own, and the next one
-        // down or up where it reaches across a face.
-        let cell = |x: f64| (x / self.cell).floor();
-        let (mut down, mut up) = (0u32, 0u32);
+        // down or up where it reaches across a face (floor(y) < c exactly when y < c, for
+        // a whole c: one floor per axis).
+        let mut own = [0i64; 4];
+        let mut step = [0i64; 4];
+        let mut reach = 0u32;
         for axis in 0..4 {
-            let own = cell(p[axis]);
-            down |= u32::from(cell(p[axis] - r) < own) << axis;
-            up |= u32::from(cell(p[axis] + r) > own) << axis;
+            let c = (p[axis] / self.cell).floor();
+            own[axis] = Self::whole(c);
+            if (p[axis] - r) / self.cell < c {
+                (step[axis], reach) = (-1, reach | 1 << axis);
+            } else if (p[axis] + r) / self.cell >= c + 1.0 {
+                (step[axis], reach) = (1, reach | 1 << axis);
+            }
         }
-        let reach = down | up;
-        let base = p - DVec4::select(
-            glam::BVec4::new(down & 1 != 0, down & 2 != 0, down & 4 != 0, down & 8 != 0),
-            DVec4::splat(r),
-            DVec4::ZERO,
-        );
         // Every subset of the axes it reaches across, p's own cell first.
         let mut subset = 0u32;
         loop {
-            let corner = subset ^ down;
+            let key = Cell(std::array::from_fn(|axis| {
+                own[axis]
+                    + if subset >> axis & 1 != 0 {
+                        step[axis]
+                    } else {
+                        0
+                    }
+            }));
             let best = self
                 .cells
-                .get(&self.key(base, corner))
+                .get(&key)
                 .into_iter()
                 .flatten()
                 .map(|q| q.distance_squared(p))
@@ -295,6 +323,23 @@ impl Grid {
                 return None;
             }
         }
+    }
+}
+
+/// A cell of the grid: its integer coordinates, hashed as one word (four words through
+/// the hasher cost more than the distance tests).
+#[derive(Clone, Copy, PartialEq, Eq)]
+struct Cell([i64; 4]);
+
+impl std::hash::Hash for Cell {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        let [a, b, c, d] = self.0.map(|k| k as u64);
+        state.write_u64(
+            a.wrapping_mul(0x9E37_79B9_7F4A_7C15)
+                ^ b.wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
+                ^ c.wrapping_mul(0x1656_67B1_9E37_79F9)
+                ^ d.wrapping_mul(0x27D4_EB2F_1656_67C5),
+        );
     }
 }
 
