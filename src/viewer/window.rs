@@ -700,12 +700,13 @@ impl ApplicationHandler for App {
                     redraw = true;
                 }
             }
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
-                // A held key repeats only the steps (a 4D turn, a move along w); a toggle or a
-                // cycle taken twice from one press (an auto-repeat under load) would skip a state.
-                if !event.repeat || is_step(&event.logical_key, event.physical_key) {
-                    redraw = self.key(&event.logical_key, event.physical_key, event_loop);
-                }
+            // A held key repeats only the steps (a 4D turn, a move along w); a toggle or a
+            // cycle taken twice from one press (an auto-repeat under load) would skip a state.
+            WindowEvent::KeyboardInput { event, .. }
+                if event.state == ElementState::Pressed
+                    && (!event.repeat || is_step(&event.logical_key, event.physical_key)) =>
+            {
+                redraw = self.key(&event.logical_key, event.physical_key, event_loop);
             }
             _ => {}
         }
