@@ -142,25 +142,19 @@ impl<'a> HaloIndex<'a> {
     }
 
     /// Calls `f` with each tetrahedron whose box contains `x`, until it returns false.
-    fn visit(&self, x: DVec3, mut f: impl FnMut(u32) -> bool) {
-        self.bvh.aabb_traverse(broad::outward(x, x), |bvh, node| {
+    fn visit(&self, x: DVec3, f: impl FnMut(u32) -> bool) {
+        self.visit_box(broad::outward(x, x), f);
+    }
+
+    /// Calls `f` with each tetrahedron whose box meets `aabb` (and the others in the BVH's
+    /// leaves with one), until it returns false.
+    pub(crate) fn visit_box(&self, aabb: Aabb, mut f: impl FnMut(u32) -> bool) {
+        self.bvh.aabb_traverse(aabb, |bvh, node| {
             let node = &bvh.nodes[node as usize];
             let first = node.first_index as usize;
             bvh.primitive_indices[first..first + node.prim_count as usize]
                 .iter()
                 .all(|&g| f(g))
-        });
-    }
-
-    /// Calls `f` with each tetrahedron whose box meets `aabb`.
-    pub(crate) fn visit_box(&self, aabb: Aabb, mut f: impl FnMut(u32)) {
-        self.bvh.aabb_traverse(aabb, |bvh, node| {
-            let node = &bvh.nodes[node as usize];
-            let first = node.first_index as usize;
-            for &g in &bvh.primitive_indices[first..first + node.prim_count as usize] {
-                f(g);
-            }
-            true
         });
     }
 

@@ -2,7 +2,7 @@
 //! renderer's question (is this point of a sheet hidden?) asked millions of times, one BVH
 //! query per triangle instead of one per point.
 
-use super::{HaloIndex, SurfacePart};
+use super::{HaloIndex, Parts, SurfacePart};
 use crate::intersect::broad;
 use glam::DVec3;
 use std::sync::OnceLock;
@@ -15,17 +15,18 @@ struct Near {
     hi: DVec3,
 }
 
-/// Where a triangle's points lie: its box and the slab about its plane, both grown by
-/// `pad`, and the tetrahedra that meet both, less those of the triangle's own prisms
+/// Where a triangle's points lie: its box and the slab about its plane, both grown by a
+/// pad, and the tetrahedra that meet both, less those of the triangle's own prisms
 /// ([`HaloIndex::within`]), which never hide it.
 #[derive(Debug)]
 struct Hiders {
     lo: DVec3,
     hi: DVec3,
-    /// The plane's unit normal and offset (zero for a triangle of no area: no slab).
+    /// The plane's unit normal and offset (zero for a triangle of no area).
     normal: DVec3,
     offset: f64,
-    pad: f64,
+    /// The slab's half-width: the pad, infinite for a triangle of no area (no slab).
+    slab: f64,
     near: Box<[Near]>,
 }
 
@@ -34,32 +35,33 @@ impl Hiders {
     fn holds(&self, x: DVec3) -> bool {
         x.cmpge(self.lo).all()
             && x.cmple(self.hi).all()
-            && (self.normal.dot(x) - self.offset).abs() <= self.pad
+            && (self.normal.dot(x) - self.offset).abs() <= self.slab
     }
 }
 
 /// [`HaloIndex::hidden`] for points of the surfaces' triangles, with the same answers: each
 /// triangle's candidates are found by one box query the first time a point of it is asked
 /// about (from any thread), then every point of it is tested against them alone, most often
-/// none (a triangle far from the other sheets). A point outside its triangle's grown box (a
-/// ray's hit rounded off the triangle) asks the index directly.
+/// none (a triangle far from the other sheets). A point outside its triangle's grown box or
+/// slab (a ray's hit rounded far off the triangle) asks the index directly.
 pub(crate) struct TriangleHiders<'a> {
     index: HaloIndex<'a>,
-    surfaces: Vec<SurfacePart<'a>>,
+    surfaces: &'a [SurfacePart<'a>],
     /// Per surface and triangle, its candidates once found.
     found: Vec<Vec<OnceLock<Hiders>>>,
 }
 
 impl<'a> TriangleHiders<'a> {
-    /// The hiders of the triangles of `surfaces` in `index` (made of the same parts).
-    pub(crate) fn new(index: HaloIndex<'a>, surfaces: &[SurfacePart<'a>]) -> Self {
+    /// The halos of `parts` indexed, to be asked about points of its surfaces' triangles.
+    pub(crate) fn new(parts: &'a Parts<'a>) -> Self {
         TriangleHiders {
-            index,
-            found: surfaces
+            index: HaloIndex::new(&parts.halos),
+            found: parts
+                .surfaces
                 .iter()
                 .map(|s| (0..s.triangles.len()).map(|_| OnceLock::new()).collect())
                 .collect(),
-            surfaces: surfaces.to_vec(),
+            surfaces: &parts.surfaces,
         }
     }
 
@@ -87,11 +89,12 @@ impl<'a> TriangleHiders<'a> {
     }
 
     /// The candidates of one triangle. Its points, as a ray's hit computes them, lie within
-    /// rounding of the triangle: within a pad (a millionth of its diagonal and a billionth of
-    /// its coordinates, far above any rounding) of its box and of its plane
-    /// ([`Hiders::holds`] checks each point, and a point outside asks the index). A tetrahedron is a candidate where its box meets the grown
-    /// box and its corners do not all lie on one side of the grown slab, with a margin of
-    /// half the pad for the rounding of their distances.
+    /// rounding of the triangle: within a pad (a millionth of its diagonal and a billionth
+    /// of its coordinates, far above any rounding) of its box and of its plane
+    /// ([`Hiders::holds`] checks each point, and a point outside asks the index). A
+    /// tetrahedron is a candidate where its box meets the grown box and its corners do not
+    /// all lie on one side of the grown slab, with a margin of half the pad for the
+    /// rounding of their distances.
     fn find(&self, surface: u32, triangle: u32) -> Hiders {
         let s = &self.surfaces[surface as usize];
         let own = s.triangles[triangle as usize];
@@ -110,7 +113,7 @@ impl<'a> TriangleHiders<'a> {
         let mut near = Vec::new();
         self.index.visit_box(broad::outward(lo, hi), |g| {
             if self.index.within(g, surface, &own) {
-                return;
+                return true;
             }
             let (corners, ..) = self.index.tet(g);
             let [a, b, c, d] = corners;
@@ -125,13 +128,14 @@ impl<'a> TriangleHiders<'a> {
                     hi: g_hi,
                 });
             }
+            true
         });
         Hiders {
             lo,
             hi,
             normal,
             offset,
-            pad: slab,
+            slab,
             near: near.into_boxed_slice(),
         }
     }
@@ -161,7 +165,7 @@ mod tests {
                 .unwrap();
             let parts = built.parts(&scene.halo);
             let index = HaloIndex::new(&parts.halos);
-            let hiders = TriangleHiders::new(HaloIndex::new(&parts.halos), &parts.surfaces);
+            let hiders = TriangleHiders::new(&parts);
             let (mut asked, mut hidden) = (0, 0);
             for (s, surf) in parts.surfaces.iter().enumerate() {
                 let span = surf.w.iter().fold(0.0f64, |m, w| m.max(w.abs()));

@@ -950,9 +950,7 @@ impl<'a> Scene<'a> {
             input,
             settings,
             tracer: Tracer::new(trace, (hi - lo).length()),
-            halos: settings
-                .halos
-                .then(|| TriangleHiders::new(HaloIndex::new(&input.halos), &input.surfaces)),
+            halos: settings.halos.then(|| TriangleHiders::new(input)),
             planes: match settings.lighting {
                 Lighting::ThreeD => Vec::new(),
                 Lighting::FourD => input
