@@ -95,7 +95,7 @@ fn primary_rays(c: &mut Criterion) {
         curves: false,
         silhouettes: false,
         broken_edges: false,
-        ..scene.render.clone()
+        ..scene.render
     };
     let with_halos = picture(true);
     let cam = *Prober::new(&parts, &with_halos, &scene.camera)
