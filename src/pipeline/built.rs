@@ -274,19 +274,14 @@ fn surface_product(
 ) -> SurfaceProduct {
     let InView {
         entry,
-        sample:
-            Sample {
-                name,
-                mesh,
-                stats,
-                report,
-            },
+        sample,
         projected,
     } = view;
+    let name = &sample.name;
     let (halo, halo_report) = if stages.halos {
         bar.set_message(format!("halo of {name}"));
         let start = Instant::now();
-        let built = build_halo(&projected, &mesh.triangles, rho, &scene.halo);
+        let built = build_halo(&projected, &sample.mesh.triangles, rho, &scene.halo);
         timings.halo += ms(start);
         built
     } else {
@@ -297,10 +292,17 @@ fn surface_product(
         bar.set_message(format!("stipples of {name}"));
         let start = Instant::now();
         let st = &scene.render.stipple;
-        let set = Stipples::generate(&mesh.positions, &mesh.triangles, st.count, st.seed);
+        let set = sample.stipples(st.count, st.seed);
         timings.stipples += ms(start);
         set
     });
+    let Sample {
+        name,
+        mesh,
+        stats,
+        report,
+        ..
+    } = sample;
     SurfaceProduct {
         name,
         surface: entry.surface.clone(),

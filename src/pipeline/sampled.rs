@@ -7,8 +7,10 @@ use crate::error::Error;
 use crate::intersect::{self, Curves, Sheet};
 use crate::sample::{self, Audit, Mesh4, MeshStats, Source, audit};
 use crate::scene::Scene;
+use crate::stipple::Stipples;
 use glam::DVec3;
 use indicatif::ProgressBar;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 /// A scene's surfaces sampled (or read from their files) and audited: what a build makes
@@ -28,6 +30,27 @@ pub(super) struct Sample {
     pub(super) mesh: Mesh4,
     pub(super) stats: MeshStats,
     pub(super) report: SamplingReport,
+    /// The mesh's stipples for the count and seed first asked, ranked once and shared by
+    /// every clone of the samples: they depend on the 4D mesh alone, not on the view, so
+    /// the frames of an animation and the views built from one sampling rank them once.
+    pub(super) stipples: Arc<OnceLock<(StippleKey, Stipples)>>,
+}
+
+/// The stipples' count and seed.
+type StippleKey = (usize, u64);
+
+impl Sample {
+    /// The mesh's `count` stipples from `seed` ([`Stipples::generate`]): the shared set when
+    /// it was ranked for them, else ranked now (and shared when it is the first asked).
+    pub(super) fn stipples(&self, count: usize, seed: u64) -> Stipples {
+        let rank = || Stipples::generate(&self.mesh.positions, &self.mesh.triangles, count, seed);
+        let (key, set) = self.stipples.get_or_init(|| ((count, seed), rank()));
+        if *key == (count, seed) {
+            set.clone()
+        } else {
+            rank()
+        }
+    }
 }
 
 impl Sampled {
@@ -186,7 +209,59 @@ pub(super) fn sample_with(scene: &Scene, bar: &ProgressBar) -> Sampled {
             mesh,
             stats,
             report,
+            stipples: Arc::default(),
         });
     }
     Sampled { surfaces, timings }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn views_built_from_one_sampling_rank_their_stipples_once() {
+        // An animation's frames are views built from one sampling: a stipple picture's
+        // ranking (seconds at 600,000 stipples) is made for the first and shared by the rest.
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/fixtures/scenes/klein-bottle-stipples.json"
+        );
+        let mut scene = Scene::load(std::path::Path::new(path)).unwrap();
+        scene.render.stipple.count = 3000;
+        let samples = Sampled::of(&scene);
+        let stipples = |built: &Built| built.surfaces[0].stipples.clone().unwrap();
+        let first = stipples(&samples.build(&scene, Stages::of(&scene)).unwrap());
+        let mesh = &samples.surfaces[0].mesh;
+        // The first build ranked them into the samples' shared set.
+        let (key, shared) = samples.surfaces[0]
+            .stipples
+            .get()
+            .expect("the set is shared");
+        assert_eq!(*key, (3000, scene.render.stipple.seed));
+        assert_eq!(shared.bary, first.bary);
+        // Another view takes the shared set: the same points, ranked by the mesh alone.
+        let mut turned = scene.clone();
+        turned.view.rotation.xw += 30.0;
+        let second = stipples(&samples.build(&turned, Stages::of(&turned)).unwrap());
+        assert_eq!(
+            (&second.triangle, &second.bary),
+            (&first.triangle, &first.bary)
+        );
+        // Another count is ranked anew, the shared set kept.
+        let mut more = scene.clone();
+        more.render.stipple.count = 4000;
+        let other = stipples(&samples.build(&more, Stages::of(&more)).unwrap());
+        let fresh = Stipples::generate(
+            &mesh.positions,
+            &mesh.triangles,
+            4000,
+            more.render.stipple.seed,
+        );
+        assert_eq!(
+            (&other.triangle, &other.bary),
+            (&fresh.triangle, &fresh.bary)
+        );
+        assert_eq!(samples.surfaces[0].stipples.get().unwrap().0, *key);
+    }
 }
