@@ -38,7 +38,7 @@ use camera::Camera;
 use glam::DVec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use trace::{Hit, TraceSurface, Tracer};
+use trace::{Hit, Primary, TraceSurface, Tracer};
 
 /// Perspective or orthographic.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -1086,6 +1086,7 @@ impl<'a> Scene<'a> {
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
         let n = self.grid_side();
         let centre = (n / 2) * n + n / 2;
+        let primary = Primary::new(&self.tracer, cam, self.settings.width, self.settings.height);
         // Sample `k` of `pixel`, its hits numbered from `numbered` on (which it advances).
         let sample = |hits: &mut Vec<Hit>, pixel: usize, k: usize, numbered: &mut usize| {
             let (sx, sy) = self.sample_point(pixel % w, pixel / w, k);
@@ -1094,7 +1095,7 @@ impl<'a> Scene<'a> {
             // shows, and only the hits that near are traced.
             if nearest_first {
                 let slack = 2.0 * self.tracer.same();
-                self.tracer.nearest_hits(origin, dir, 0.0, slack, hits);
+                primary.nearest_hits([sx, sy], origin, dir, 0.0, slack, hits);
                 let shown = self.shade(cam, origin, dir, hits, |j, hit, x, wd| {
                     hidden(pixel, j, hit, x, wd)
                 });
@@ -1102,7 +1103,7 @@ impl<'a> Scene<'a> {
                     return shown;
                 }
             }
-            self.trace(origin, dir, hits);
+            self.trace_primary(&primary, [sx, sy], origin, dir, hits);
             let base = *numbered;
             *numbered += hits.len();
             self.shade(cam, origin, dir, hits, |j, hit, x, wd| {
@@ -1197,9 +1198,31 @@ impl<'a> Scene<'a> {
 
     /// Every hit of a ray that is not clipped away (hither, ribbons), in order.
     fn trace(&self, origin: DVec3, dir: DVec3, hits: &mut Vec<Hit>) {
+        self.tracer.hits(origin, dir, self.t_min(), hits);
+        self.cut(origin, dir, hits);
+    }
+
+    /// [`Scene::trace`] of the primary ray through image point `at`, through `primary`.
+    fn trace_primary(
+        &self,
+        primary: &Primary,
+        at: [f64; 2],
+        origin: DVec3,
+        dir: DVec3,
+        hits: &mut Vec<Hit>,
+    ) {
+        primary.hits(at, origin, dir, self.t_min(), hits);
+        self.cut(origin, dir, hits);
+    }
+
+    /// Where a ray's hits start: the hither distance, if any.
+    fn t_min(&self) -> f64 {
+        self.settings.hither.map_or(0.0, |h| h * self.radius)
+    }
+
+    /// Drops the hits that the clip and the ribbons cut away.
+    fn cut(&self, origin: DVec3, dir: DVec3, hits: &mut Vec<Hit>) {
         let s = self.settings;
-        let t_min = s.hither.map_or(0.0, |h| h * self.radius);
-        self.tracer.hits(origin, dir, t_min, hits);
         if let Some(c) = &s.clip {
             hits.retain(|hit| !c.removes(origin + dir * hit.t));
         }

@@ -15,7 +15,7 @@
 //! pixel.
 
 use super::camera::Camera;
-use super::trace::Hit;
+use super::trace::{Hit, Primary};
 use super::{RenderError, RenderMode, RibbonAxis, Scene, View, shade, slices};
 use crate::stipple::Stipples;
 use glam::DVec3;
@@ -312,12 +312,13 @@ impl Scene<'_> {
                 1.0 - 2.0 * (y as f64 + 0.5) / h as f64,
             )
         };
+        let primary = Primary::new(&self.tracer, cam, self.settings.width, self.settings.height);
         (0..w * h)
             .into_par_iter()
             .map_init(Vec::new, |hits: &mut Vec<Hit>, pixel| {
                 let (sx, sy) = sample(pixel % w, pixel / w);
                 let (origin, dir) = cam.ray(sx, sy);
-                self.trace(origin, dir, hits);
+                self.trace_primary(&primary, [sx, sy], origin, dir, hits);
                 hits.iter()
                     .find(|hit| !self.hidden_hit(origin, dir, hit))
                     .map_or(f64::INFINITY, |hit| hit.t)

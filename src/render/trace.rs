@@ -1,5 +1,8 @@
-//! Every intersection of a ray with the projected triangles, through an obvhs BVH.
+//! Every intersection of a ray with the projected triangles, through an obvhs BVH, or for a
+//! picture's primary rays through the tiles of the picture ([`Primary`]).
 
+use super::CameraProjection;
+use super::camera::Camera;
 use crate::intersect::broad;
 use glam::{DVec3, Vec3A};
 use obvhs::bvh2::Bvh2;
@@ -156,10 +159,15 @@ impl<'a> Tracer<'a> {
         })
     }
 
-    /// Sorts hits by t and drops the second of two at one t on neighbouring triangles of
-    /// one surface (a ray through their shared edge or vertex).
+    /// Sorts hits by t (then surface and triangle, so that the order the triangles were
+    /// met in does not matter) and drops the second of two at one t on neighbouring
+    /// triangles of one surface (a ray through their shared edge or vertex).
     fn order(&self, hits: &mut Vec<Hit>) {
-        hits.sort_by(|a, b| a.t.total_cmp(&b.t));
+        hits.sort_by(|a, b| {
+            a.t.total_cmp(&b.t)
+                .then(a.surface.cmp(&b.surface))
+                .then(a.triangle.cmp(&b.triangle))
+        });
         let mut kept = 0;
         for k in 0..hits.len() {
             let h = hits[k];
@@ -184,6 +192,253 @@ impl<'a> Tracer<'a> {
         }
         hits.truncate(kept);
     }
+}
+
+/// Pixels on a side of a tile of [`Primary`].
+const TILE: f64 = 8.0;
+
+/// How many tile entries, per triangle and per tile, binning may make before the BVH is
+/// the better way (long slivers across the picture).
+const MOST_ENTRIES: usize = 16;
+
+/// A triangle of one tile: its BVH slot and its projected box in image coordinates.
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    slot: u32,
+    lo: [f64; 2],
+    hi: [f64; 2],
+}
+
+impl Entry {
+    fn holds(&self, at: [f64; 2]) -> bool {
+        at[0] >= self.lo[0] && at[0] <= self.hi[0] && at[1] >= self.lo[1] && at[1] <= self.hi[1]
+    }
+}
+
+/// The triangles of a [`Tracer`] as one camera's picture sees them, for its primary rays
+/// (through image points (sx, sy) in [-1, 1]^2, y up, as [`Camera::ray`] takes them):
+/// each triangle listed in the square tiles of the picture its projected box meets (grown
+/// by far more than rounding), so that a ray tests the few triangles of its tile whose
+/// boxes hold its image point, with the tracer's exact test. A triangle whose projection is
+/// unbounded (it reaches the plane of a perspective eye) is in every tile. The hits are the
+/// tracer's own, ordered alike: a triangle a ray meets projects to a box that holds the
+/// ray's image point. Where binning would make too many entries (slivers across the
+/// picture) the rays go through the BVH.
+pub(crate) struct Primary<'t, 'a> {
+    tracer: &'t Tracer<'a>,
+    tiles: Option<Tiles>,
+}
+
+struct Tiles {
+    /// Tiles across and down; image units per tile along x and y.
+    cols: usize,
+    rows: usize,
+    step: [f64; 2],
+    /// Each tile's entries: `entries[starts[i]..starts[i + 1]]`, tiles row by row from
+    /// the bottom (sy = -1).
+    starts: Vec<usize>,
+    entries: Vec<Entry>,
+    /// Triangles in every tile.
+    everywhere: Vec<Entry>,
+}
+
+impl<'t, 'a> Primary<'t, 'a> {
+    /// The triangles of `tracer` binned for `cam`'s picture of `width` x `height` pixels.
+    pub(crate) fn new(tracer: &'t Tracer<'a>, cam: &Camera, width: u32, height: u32) -> Self {
+        Primary {
+            tracer,
+            tiles: Tiles::new(tracer, cam, width, height),
+        }
+    }
+
+    /// [`Tracer::hits`] of the primary ray through image point `at`.
+    pub(crate) fn hits(
+        &self,
+        at: [f64; 2],
+        origin: DVec3,
+        dir: DVec3,
+        t_min: f64,
+        hits: &mut Vec<Hit>,
+    ) {
+        let Some(tiles) = &self.tiles else {
+            return self.tracer.hits(origin, dir, t_min, hits);
+        };
+        tiles.collect(self.tracer, at, origin, dir, t_min, hits);
+        self.tracer.order(hits);
+    }
+
+    /// [`Tracer::nearest_hits`] of the primary ray through image point `at`.
+    pub(crate) fn nearest_hits(
+        &self,
+        at: [f64; 2],
+        origin: DVec3,
+        dir: DVec3,
+        t_min: f64,
+        slack: f64,
+        hits: &mut Vec<Hit>,
+    ) {
+        let Some(tiles) = &self.tiles else {
+            return self.tracer.nearest_hits(origin, dir, t_min, slack, hits);
+        };
+        tiles.collect(self.tracer, at, origin, dir, t_min, hits);
+        let nearest = hits.iter().map(|h| h.t).fold(f64::INFINITY, f64::min);
+        hits.retain(|h| h.t <= nearest + slack);
+        self.tracer.order(hits);
+    }
+}
+
+impl Tiles {
+    fn new(tracer: &Tracer, cam: &Camera, width: u32, height: u32) -> Option<Tiles> {
+        let cols = (f64::from(width) / TILE).ceil() as usize;
+        let rows = (f64::from(height) / TILE).ceil() as usize;
+        // Image units per tile: the picture spans 2 along each axis.
+        let step = [
+            2.0 * TILE / f64::from(width),
+            2.0 * TILE / f64::from(height),
+        ];
+        let boxes: Vec<Option<([f64; 2], [f64; 2])>> = tracer
+            .corners
+            .iter()
+            .map(|c| projected_box(cam, c))
+            .collect();
+        let tile_of = |x: f64, axis: usize, count: usize| {
+            (((x + 1.0) / step[axis]).floor().max(0.0) as usize).min(count - 1)
+        };
+        let span = |(lo, hi): ([f64; 2], [f64; 2])| {
+            (
+                tile_of(lo[0], 0, cols)..=tile_of(hi[0], 0, cols),
+                tile_of(lo[1], 1, rows)..=tile_of(hi[1], 1, rows),
+            )
+        };
+        let mut counts = vec![0usize; cols * rows + 1];
+        let mut everywhere = Vec::new();
+        let mut total = 0usize;
+        for (slot, b) in boxes.iter().enumerate() {
+            let Some(b) = *b else {
+                everywhere.push(Entry {
+                    slot: slot as u32,
+                    lo: [f64::NEG_INFINITY; 2],
+                    hi: [f64::INFINITY; 2],
+                });
+                continue;
+            };
+            if b.1[0] < -1.0 || b.0[0] > 1.0 || b.1[1] < -1.0 || b.0[1] > 1.0 {
+                continue; // outside the picture: no primary ray meets it
+            }
+            let (xs, ys) = span(b);
+            for j in ys {
+                for i in xs.clone() {
+                    counts[j * cols + i + 1] += 1;
+                    total += 1;
+                }
+            }
+            if total > MOST_ENTRIES * (boxes.len() + cols * rows) {
+                return None;
+            }
+        }
+        let mut starts = counts;
+        for i in 0..cols * rows {
+            starts[i + 1] += starts[i];
+        }
+        let mut fill = starts.clone();
+        let mut entries = vec![
+            Entry {
+                slot: 0,
+                lo: [0.0; 2],
+                hi: [0.0; 2],
+            };
+            total
+        ];
+        for (slot, b) in boxes.iter().enumerate() {
+            let Some((lo, hi)) = *b else { continue };
+            if hi[0] < -1.0 || lo[0] > 1.0 || hi[1] < -1.0 || lo[1] > 1.0 {
+                continue;
+            }
+            let (xs, ys) = span((lo, hi));
+            for j in ys {
+                for i in xs.clone() {
+                    let k = &mut fill[j * cols + i];
+                    entries[*k] = Entry {
+                        slot: slot as u32,
+                        lo,
+                        hi,
+                    };
+                    *k += 1;
+                }
+            }
+        }
+        Some(Tiles {
+            cols,
+            rows,
+            step,
+            starts,
+            entries,
+            everywhere,
+        })
+    }
+
+    /// Every hit beyond `t_min` of the ray through image point `at` on the triangles of its
+    /// tile whose boxes hold the point, unordered, into `hits` (cleared first).
+    fn collect(
+        &self,
+        tracer: &Tracer,
+        at: [f64; 2],
+        origin: DVec3,
+        dir: DVec3,
+        t_min: f64,
+        hits: &mut Vec<Hit>,
+    ) {
+        hits.clear();
+        let i = (((at[0] + 1.0) / self.step[0]).floor().max(0.0) as usize).min(self.cols - 1);
+        let j = (((at[1] + 1.0) / self.step[1]).floor().max(0.0) as usize).min(self.rows - 1);
+        let tile = j * self.cols + i;
+        let shear = Shear::new(origin, dir);
+        let entries = &self.entries[self.starts[tile]..self.starts[tile + 1]];
+        for e in entries.iter().chain(&self.everywhere) {
+            if e.holds(at)
+                && let Some(hit) = tracer.hit(&shear, e.slot as usize)
+                && hit.t > t_min
+            {
+                hits.push(hit);
+            }
+        }
+    }
+}
+
+/// The box in image coordinates of triangle `p`'s projection by `cam`, grown by far more
+/// than the rounding of a hit's image point (a millionth of the box's size, and a
+/// billionth of the picture); `None` where a perspective eye's plane comes near the
+/// triangle (its projection is unbounded).
+fn projected_box(cam: &Camera, p: &[DVec3; 3]) -> Option<([f64; 2], [f64; 2])> {
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    let (hw, hh) = (cam.half_height * cam.aspect, cam.half_height);
+    for &q in p {
+        let d = q - cam.eye;
+        let (x, y, z) = (d.dot(cam.right), d.dot(cam.up), d.dot(cam.forward));
+        let image = match cam.projection {
+            CameraProjection::Perspective => {
+                // Far enough in front of the eye that the division is well conditioned.
+                if !(z > 1e-9 * d.length()) {
+                    return None;
+                }
+                [x / (z * hw), y / (z * hh)]
+            }
+            CameraProjection::Orthographic => [x / hw, y / hh],
+        };
+        for k in 0..2 {
+            lo[k] = lo[k].min(image[k]);
+            hi[k] = hi[k].max(image[k]);
+        }
+    }
+    if !(lo[0].is_finite() && lo[1].is_finite() && hi[0].is_finite() && hi[1].is_finite()) {
+        return None;
+    }
+    let pad = |k: usize| 1e-6 * (hi[k] - lo[k]) + 1e-9;
+    Some((
+        [lo[0] - pad(0), lo[1] - pad(1)],
+        [hi[0] + pad(0), hi[1] + pad(1)],
+    ))
 }
 
 /// A ray set up for watertight ray-triangle intersection (Woop, Benthin and Wald 2013) in
@@ -279,5 +534,92 @@ mod tests {
         assert!((hits[0].t - 4.0).abs() < 1e-12 && (hits[1].t - 5.0).abs() < 1e-12);
         tracer.hits(DVec3::new(2.0, 0.5, 5.0), -DVec3::Z, 0.0, &mut hits);
         assert!(hits.is_empty());
+    }
+}
+
+#[cfg(test)]
+mod primary_tests {
+    use super::*;
+    use crate::render::{Prober, RenderSettings};
+
+    #[test]
+    fn the_tiles_find_the_hits_the_bvh_finds() {
+        // The default scene through the rays of a 96 x 80 picture (pixel centres and
+        // points between them), from its own perspective camera, an orthographic camera
+        // along the same axis, and a perspective eye inside the scene (triangles reach its
+        // plane and are in every tile; others project across the picture): every ray's
+        // hits, from the start and past a distance, and its nearest hits, are the
+        // tracer's own.
+        let scene = crate::Scene::default_scene();
+        let built = crate::Sampled::of(&scene)
+            .into_built(&scene, crate::Stages::of(&scene))
+            .unwrap();
+        let parts = built.parts(&scene.halo);
+        let (width, height) = (96, 80);
+        let settings = RenderSettings {
+            width,
+            height,
+            ..scene.render
+        };
+        let cam = *Prober::new(&parts, &settings, &scene.camera)
+            .unwrap()
+            .camera();
+        let surfaces: Vec<TraceSurface> = parts
+            .surfaces
+            .iter()
+            .map(|s| TraceSurface {
+                positions: s.positions,
+                triangles: s.triangles,
+            })
+            .collect();
+        let (lo, hi) = surfaces
+            .iter()
+            .flat_map(|s| s.positions)
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| {
+                (lo.min(p), hi.max(p))
+            });
+        let size = (hi - lo).length();
+        let tracer = Tracer::new(surfaces, size);
+        let centre = (lo + hi) / 2.0;
+        let orthographic = Camera {
+            projection: CameraProjection::Orthographic,
+            half_height: 0.3 * size,
+            ..cam
+        };
+        let inside = Camera {
+            eye: centre - cam.forward * (0.05 * size),
+            ..cam
+        };
+        let slack = 2.0 * tracer.same();
+        let (mut expected, mut got) = (Vec::new(), Vec::new());
+        for (name, cam) in [
+            ("perspective", cam),
+            ("orthographic", orthographic),
+            ("inside", inside),
+        ] {
+            let primary = Primary::new(&tracer, &cam, width, height);
+            let (mut rays, mut hit) = (0, 0);
+            for j in 0..2 * height {
+                for i in 0..2 * width {
+                    let at = [
+                        (f64::from(i) + 0.5) / f64::from(width) - 1.0,
+                        1.0 - (f64::from(j) + 0.5) / f64::from(height),
+                    ];
+                    let (origin, dir) = cam.ray(at[0], at[1]);
+                    for t_min in [0.0, 0.3 * size] {
+                        tracer.hits(origin, dir, t_min, &mut expected);
+                        primary.hits(at, origin, dir, t_min, &mut got);
+                        assert_eq!(got, expected, "{name}: hits at {at:?} past {t_min}");
+                    }
+                    tracer.nearest_hits(origin, dir, 0.0, slack, &mut expected);
+                    primary.nearest_hits(at, origin, dir, 0.0, slack, &mut got);
+                    assert_eq!(got, expected, "{name}: nearest hits at {at:?}");
+                    hit += usize::from(!expected.is_empty());
+                    rays += 1;
+                }
+            }
+            // Most rays of each camera meet the scene: the comparison is not of misses.
+            assert!(hit * 3 > rays, "{name}: {hit} of {rays} rays hit");
+        }
     }
 }
