@@ -418,8 +418,9 @@ fn projected_box(cam: &Camera, p: &[DVec3; 3]) -> Option<([f64; 2], [f64; 2])> {
         let (x, y, z) = (d.dot(cam.right), d.dot(cam.up), d.dot(cam.forward));
         let image = match cam.projection {
             CameraProjection::Perspective => {
-                // Far enough in front of the eye that the division is well conditioned.
-                if !(z > 1e-9 * d.length()) {
+                // Far enough in front of the eye that the division is well conditioned (a
+                // NaN compares false and is refused too).
+                if z.partial_cmp(&(1e-9 * d.length())) != Some(std::cmp::Ordering::Greater) {
                     return None;
                 }
                 [x / (z * hw), y / (z * hh)]
