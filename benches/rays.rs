@@ -2,9 +2,10 @@
 //! 1024 x 1024 picture, one through each pixel's centre.
 //!
 //! Criterion times, on every core, with the rays per second as its throughput:
-//! - `nearest`: the tracer alone ([`Tracer::nearest_hits`], the renderer's first pass: the
-//!   nearest hit, with the hits within the tracer's same-hit distance of it), what Embree's
-//!   closest-hit query does;
+//! - `nearest`: the tracer alone ([`Tracer::nearest_hits`]: the nearest hit, with the hits
+//!   within the tracer's same-hit distance of it), what Embree's closest-hit query does,
+//!   through the BVH; `nearest_tiles`, the same hits through the picture's tiles
+//!   ([`Primary`], what the renderer's primary rays use);
 //! - `picture_surfaces` and `picture_halos`: the exact picture at one sample a pixel (no
 //!   lines), without and with the halos' exact hiding test: each ray traced, decided and
 //!   shaded, the colours turned into bytes.
@@ -18,7 +19,7 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
-use halo4d::internals::{Camera, TraceSurface, Tracer};
+use halo4d::internals::{Camera, Primary, TraceSurface, Tracer};
 use halo4d::render::{Prober, RenderMode, RenderSettings};
 use rayon::prelude::*;
 use std::hint::black_box;
@@ -127,7 +128,25 @@ fn primary_rays(c: &mut Criterion) {
             })
             .collect()
     };
+    let primary = Primary::new(&tracer, &cam, SIDE, SIDE);
+    let side = f64::from(SIDE);
+    let trace_tiles = || -> Vec<f64> {
+        (0..rays.len())
+            .into_par_iter()
+            .map_init(Vec::new, |hits, i| {
+                let (x, y) = (
+                    f64::from(i as u32 % SIDE) + 0.5,
+                    f64::from(i as u32 / SIDE) + 0.5,
+                );
+                let at = [2.0 * x / side - 1.0, 1.0 - 2.0 * y / side];
+                let (origin, dir) = rays[i];
+                primary.nearest_hits(at, origin, dir, 0.0, slack, hits);
+                hits.first().map_or(f64::INFINITY, |h| h.t)
+            })
+            .collect()
+    };
     let nearest = trace_all();
+    assert_eq!(trace_tiles(), nearest, "the tiles find the BVH's hits");
     let hit = nearest.iter().filter(|t| t.is_finite()).count();
     let file = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("exports/rays/default-scene.bin");
     write_rays(&surfaces, &rays, &nearest, &file).expect("the rays file is written");
@@ -142,6 +161,7 @@ fn primary_rays(c: &mut Criterion) {
     group.sample_size(20);
     group.throughput(Throughput::Elements(rays.len() as u64));
     group.bench_function("nearest", |b| b.iter(|| black_box(trace_all())));
+    group.bench_function("nearest_tiles", |b| b.iter(|| black_box(trace_tiles())));
     let without_halos = picture(false);
     for (name, settings) in [
         ("picture_surfaces", &without_halos),

@@ -105,7 +105,7 @@ pub mod internals {
     pub use crate::render::compare::verdict_differs;
     pub use crate::render::overlay::{INK, OVER_BANDS, OVER_SHADE, curve_ink};
     pub use crate::render::stipple::{Drawn, tone};
-    pub use crate::render::trace::{Hit, TraceSurface, Tracer};
+    pub use crate::render::trace::{Hit, Primary, TraceSurface, Tracer};
     pub use crate::render::visible::curve_visibility;
 
     /// One-pixel lines broadened to an exact width.

@@ -224,7 +224,7 @@ impl Entry {
 /// tracer's own, ordered alike: a triangle a ray meets projects to a box that holds the
 /// ray's image point. Where binning would make too many entries (slivers across the
 /// picture) the rays go through the BVH.
-pub(crate) struct Primary<'t, 'a> {
+pub struct Primary<'t, 'a> {
     tracer: &'t Tracer<'a>,
     tiles: Option<Tiles>,
 }
@@ -244,7 +244,7 @@ struct Tiles {
 
 impl<'t, 'a> Primary<'t, 'a> {
     /// The triangles of `tracer` binned for `cam`'s picture of `width` x `height` pixels.
-    pub(crate) fn new(tracer: &'t Tracer<'a>, cam: &Camera, width: u32, height: u32) -> Self {
+    pub fn new(tracer: &'t Tracer<'a>, cam: &Camera, width: u32, height: u32) -> Self {
         Primary {
             tracer,
             tiles: Tiles::new(tracer, cam, width, height),
@@ -252,14 +252,7 @@ impl<'t, 'a> Primary<'t, 'a> {
     }
 
     /// [`Tracer::hits`] of the primary ray through image point `at`.
-    pub(crate) fn hits(
-        &self,
-        at: [f64; 2],
-        origin: DVec3,
-        dir: DVec3,
-        t_min: f64,
-        hits: &mut Vec<Hit>,
-    ) {
+    pub fn hits(&self, at: [f64; 2], origin: DVec3, dir: DVec3, t_min: f64, hits: &mut Vec<Hit>) {
         let Some(tiles) = &self.tiles else {
             return self.tracer.hits(origin, dir, t_min, hits);
         };
@@ -268,7 +261,7 @@ impl<'t, 'a> Primary<'t, 'a> {
     }
 
     /// [`Tracer::nearest_hits`] of the primary ray through image point `at`.
-    pub(crate) fn nearest_hits(
+    pub fn nearest_hits(
         &self,
         at: [f64; 2],
         origin: DVec3,
