@@ -65,6 +65,7 @@ mod inspect;
 pub mod intersect;
 pub mod limits;
 mod memory;
+pub mod motion;
 mod parts;
 mod pipeline;
 pub mod render;

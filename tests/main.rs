@@ -14,6 +14,7 @@ mod halo;
 mod halo_export;
 mod intersect;
 mod lines;
+mod motion;
 mod own;
 mod readme;
 mod refine;

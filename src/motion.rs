@@ -1,0 +1,360 @@
+//! Motion pictures: a surface cut by the hyperplanes ⟨n, x⟩ = c of a height function
+//! h = ⟨n, X⟩. What this module gives so far is where the slices change: the critical
+//! points of h on the surface (births, saddles, deaths), found on the 4D mesh and refined on
+//! the exact surface, and the Morse check of their count.
+//!
+//! **On the mesh** (Banchoff's critical points of a piecewise-linear height): a vertex's
+//! link is the cycle of its neighbours; the number of sign changes of h(neighbour) - h(v)
+//! around it is 0 at a minimum or maximum, 2 at a regular vertex and 2k at a saddle of
+//! multiplicity k - 1. Ties of h are broken by vertex index (simulation of simplicity), so
+//! every vertex is one of these. Summed over a closed mesh, 1 - changes / 2 is its Euler
+//! characteristic, whatever n is.
+//!
+//! **On the surface**: from each critical vertex, Newton's method on ∇h = (⟨n, X_u⟩,
+//! ⟨n, X_v⟩) = 0 with the exact second derivatives (steps past a glued side continue on the
+//! side it is glued to), until the gradient on the surface is at rounding. The index comes
+//! from the Hessian of h in (u, v) at the point (its signature is the surface Hessian's):
+//! 0 a minimum (a birth as c rises), 1 a saddle, 2 a maximum (a death); a Hessian singular
+//! to 1e-8 of its size is *degenerate* (a critical circle, as for the flat torus with n = w,
+//! or a point where h is not a Morse function). Points reached from two vertices are one.
+//!
+//! A coarse mesh can have a pair of critical vertices where the surface has none (a saddle
+//! and an extremum side by side, which cancel in the count): Newton's method finds no
+//! critical point from them, and they are kept apart ([`Critical::not_converged`]).
+//!
+//! **The check**: on a closed surface whose critical points are none degenerate,
+//! #minima - #saddles + #maxima = χ, the surface's Euler characteristic
+//! ([`Critical::morse`]).
+
+use crate::limits::FieldError;
+use crate::sample::Mesh4;
+use crate::surfaces::Surface;
+use glam::DVec4;
+use serde::Serialize;
+
+/// Newton steps from a critical vertex before it counts as not converged.
+const NEWTON_STEPS: usize = 60;
+
+/// A refined critical point whose surface gradient (dimensionless: n is a unit vector) is
+/// above this is not converged.
+pub const CRITICAL_RESIDUAL: f64 = 1e-10;
+
+/// The Hessian's determinant below this share of its squared size is degenerate.
+const DEGENERATE: f64 = 1e-8;
+
+/// What happens to the slices at a critical point as the level rises.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Event {
+    /// A minimum: a component is born.
+    Birth,
+    /// A saddle: two components join, one splits, or (on a non-orientable surface) one
+    /// passes through itself.
+    Saddle,
+    /// A maximum: a component dies.
+    Death,
+    /// The Hessian is singular: no Morse index (a critical circle, a degenerate point).
+    Degenerate,
+}
+
+impl Event {
+    /// The Morse index: 0, 1 or 2; `None` when degenerate.
+    pub fn index(self) -> Option<u32> {
+        match self {
+            Event::Birth => Some(0),
+            Event::Saddle => Some(1),
+            Event::Death => Some(2),
+            Event::Degenerate => None,
+        }
+    }
+}
+
+/// A critical point of h on the surface.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct CriticalPoint {
+    /// Its event.
+    pub event: Event,
+    /// Its level c = h.
+    pub level: f64,
+    /// Its patch and parameters (of the mesh vertex, where it could not be refined).
+    pub patch: usize,
+    /// Parameters (u, v).
+    pub uv: [f64; 2],
+    /// The surface point in 4D.
+    pub point: DVec4,
+    /// The norm of h's gradient on the surface there (0 for a vertex of a mesh without
+    /// parameters, where h is piecewise linear).
+    pub residual: f64,
+    /// The mesh vertex it was found from.
+    pub vertex: u32,
+    /// Whether Newton's method refined it onto the exact surface (false for a mesh read
+    /// from a file, which keeps the mesh's vertex, and where Newton did not converge).
+    pub refined: bool,
+}
+
+/// The discrete critical vertices of the mesh, counted.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct DiscreteCounts {
+    /// Vertices whose neighbours are all higher.
+    pub minima: usize,
+    /// Saddles, each counted with its multiplicity.
+    pub saddles: usize,
+    /// Vertices whose neighbours are all lower.
+    pub maxima: usize,
+    /// Vertices on the mesh's boundary, not classified.
+    pub boundary: usize,
+}
+
+/// The critical points of h = ⟨n, X⟩ on one surface.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Critical {
+    /// The unit direction n.
+    pub direction: DVec4,
+    /// The critical points, by level: refined onto the surface (or the mesh's vertices,
+    /// for a mesh without parameters).
+    pub points: Vec<CriticalPoint>,
+    /// The mesh's critical vertices.
+    pub discrete: DiscreteCounts,
+    /// Critical vertices from which Newton's method found no critical point (`refined`
+    /// false), by level: pairs that the mesh's coarseness makes, or points the refinement
+    /// cannot reach (then the count fails).
+    pub not_converged: Vec<CriticalPoint>,
+}
+
+impl Critical {
+    /// (minima, saddles, maxima, degenerate) among the points.
+    pub fn counts(&self) -> [usize; 4] {
+        let mut c = [0; 4];
+        for p in &self.points {
+            c[p.event.index().map_or(3, |i| i as usize)] += 1;
+        }
+        c
+    }
+
+    /// The Morse check on a closed surface of Euler characteristic `euler`: no point
+    /// degenerate, and #minima - #saddles + #maxima = χ; else what fails.
+    pub fn morse(&self, euler: i64) -> Result<(), String> {
+        let [min, saddle, max, degenerate] = self.counts();
+        if degenerate > 0 {
+            return Err(format!(
+                "{degenerate} degenerate critical point(s): the height is not a Morse \
+                 function in this direction; tilt the direction a little"
+            ));
+        }
+        let sum = min as i64 - saddle as i64 + max as i64;
+        if sum != euler {
+            let unrefined = match self.not_converged.len() {
+                0 => String::new(),
+                k => format!(" ({k} critical vertices of the mesh not refined)"),
+            };
+            return Err(format!(
+                "{min} minima - {saddle} saddles + {max} maxima = {sum}, not the Euler \
+                 characteristic {euler}{unrefined}"
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The critical points of h = ⟨n, X⟩ (n normalized here) on `mesh`, refined on `surface`
+/// where the mesh has parameters on it (a catalogue or formula surface); a mesh read from a
+/// file (`surface` `None`) keeps its vertices. An error names a direction that is zero or
+/// not finite.
+pub fn critical_points(
+    mesh: &Mesh4,
+    surface: Option<&Surface>,
+    n: DVec4,
+) -> Result<Critical, FieldError> {
+    let length = n.length();
+    if !(length.is_finite() && length > 0.0) {
+        return Err(FieldError::new(
+            "direction",
+            format!("must be a nonzero, finite 4D vector, got {n}"),
+        ));
+    }
+    let n = n / length;
+    let h: Vec<f64> = mesh.positions.iter().map(|p| p.dot(n)).collect();
+    let (found, discrete) = critical_vertices(mesh, &h);
+    let diagonal = mesh
+        .bounds()
+        .map_or(1.0, |(lo, hi)| (hi - lo).length().max(f64::MIN_POSITIVE));
+    let mut points: Vec<CriticalPoint> = Vec::new();
+    let mut not_converged = Vec::new();
+    for (vertex, event) in found {
+        let v = vertex as usize;
+        let start = CriticalPoint {
+            event,
+            level: h[v],
+            patch: mesh.patch[v] as usize,
+            uv: mesh.uv[v],
+            point: mesh.positions[v],
+            residual: 0.0,
+            vertex,
+            refined: false,
+        };
+        let point = match surface {
+            None => start,
+            Some(s) => match newton(s, n, start) {
+                Some(p) => p,
+                None => {
+                    not_converged.push(start);
+                    continue;
+                }
+            },
+        };
+        // Reached from another vertex already: one point.
+        let same = points.iter().any(|q| {
+            q.refined && point.refined && q.point.distance(point.point) <= 1e-9 * diagonal
+        });
+        if !same {
+            points.push(point);
+        }
+    }
+    let by_level = |a: &CriticalPoint, b: &CriticalPoint| {
+        a.level.total_cmp(&b.level).then(a.vertex.cmp(&b.vertex))
+    };
+    points.sort_by(by_level);
+    not_converged.sort_by(by_level);
+    Ok(Critical {
+        direction: n,
+        points,
+        discrete,
+        not_converged,
+    })
+}
+
+/// The mesh's critical vertices with their events (a saddle of multiplicity k once), and
+/// their counts. A vertex is above another where its height is, ties broken by index.
+fn critical_vertices(mesh: &Mesh4, h: &[f64]) -> (Vec<(u32, Event)>, DiscreteCounts) {
+    let nv = mesh.positions.len();
+    let above = |a: u32, b: u32| (h[a as usize], a) > (h[b as usize], b);
+    let mut changes = vec![0u32; nv];
+    let mut higher = vec![false; nv];
+    let mut lower = vec![false; nv];
+    let mut used = vec![false; nv];
+    // Each triangle (v, a, b) is one edge of v's link; the sign changes around the link
+    // are its edges whose ends lie on opposite sides of h(v).
+    let mut edges: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            let (v, a, b) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+            let (sa, sb) = (above(a, v), above(b, v));
+            changes[v as usize] += u32::from(sa != sb);
+            higher[v as usize] |= sa || sb;
+            lower[v as usize] |= !sa || !sb;
+            used[v as usize] = true;
+            *edges.entry((v.min(a), v.max(a))).or_default() += 1;
+        }
+    }
+    let mut boundary = vec![false; nv];
+    for (&(a, b), &count) in &edges {
+        if count != 2 {
+            boundary[a as usize] = true;
+            boundary[b as usize] = true;
+        }
+    }
+    let mut counts = DiscreteCounts::default();
+    let mut found = Vec::new();
+    for v in 0..nv {
+        if !used[v] {
+            continue;
+        }
+        if boundary[v] {
+            counts.boundary += 1;
+            continue;
+        }
+        let event = match changes[v] {
+            0 if !lower[v] => {
+                counts.minima += 1;
+                Event::Birth
+            }
+            0 => {
+                counts.maxima += 1;
+                Event::Death
+            }
+            2 => continue,
+            c => {
+                counts.saddles += (c / 2 - 1) as usize;
+                Event::Saddle
+            }
+        };
+        found.push((v as u32, event));
+    }
+    (found, counts)
+}
+
+/// Newton's method on ∇h = 0 from `start`'s parameters; the refined point with its event
+/// from the Hessian, or `None` when it leaves the surface's domain, meets a singular step
+/// or does not converge.
+fn newton(surface: &Surface, n: DVec4, start: CriticalPoint) -> Option<CriticalPoint> {
+    let (mut patch, [mut u, mut v]) = (start.patch, start.uv);
+    // Once converged, a few more steps take the residual down to rounding; the best point
+    // is kept.
+    let (mut best, mut polish): (Option<CriticalPoint>, usize) = (None, 0);
+    for _ in 0..NEWTON_STEPS {
+        let e = surface.eval(patch, u, v);
+        let g = [n.dot(e.du), n.dot(e.dv)];
+        let hess = [n.dot(e.duu), n.dot(e.duv), n.dot(e.dvv)];
+        let residual = surface_gradient(e.du, e.dv, g);
+        if residual <= CRITICAL_RESIDUAL && best.is_none_or(|b| residual < b.residual) {
+            best = Some(CriticalPoint {
+                event: event_of(hess),
+                level: n.dot(e.p),
+                patch,
+                uv: [u, v],
+                point: e.p,
+                residual,
+                refined: true,
+                ..start
+            });
+        }
+        if best.is_some() {
+            polish += 1;
+            if polish > 3 || residual == 0.0 {
+                break;
+            }
+        }
+        let det = hess[0] * hess[2] - hess[1] * hess[1];
+        if det == 0.0 || !det.is_finite() {
+            break;
+        }
+        let du = -(hess[2] * g[0] - hess[1] * g[1]) / det;
+        let dv = -(hess[0] * g[1] - hess[1] * g[0]) / det;
+        let (p, nu, nv, inside) = surface.chart(patch, u + du, v + dv);
+        if !(inside && nu.is_finite() && nv.is_finite()) {
+            break;
+        }
+        (patch, u, v) = (p, nu, nv);
+    }
+    best
+}
+
+/// The norm of h's gradient on the surface from its coordinate gradient `g` (with the
+/// metric of the tangents: g^T G^-1 g); the coordinate gradient's norm where the tangents
+/// are degenerate.
+fn surface_gradient(du: DVec4, dv: DVec4, g: [f64; 2]) -> f64 {
+    let (a, b, c) = (du.dot(du), du.dot(dv), dv.dot(dv));
+    let det = a * c - b * b;
+    if det > 0.0 && det.is_finite() {
+        ((c * g[0] * g[0] - 2.0 * b * g[0] * g[1] + a * g[1] * g[1]) / det)
+            .max(0.0)
+            .sqrt()
+    } else {
+        g[0].hypot(g[1])
+    }
+}
+
+/// The event of a critical point from h's Hessian `[h_uu, h_uv, h_vv]`.
+fn event_of(hess: [f64; 3]) -> Event {
+    let det = hess[0] * hess[2] - hess[1] * hess[1];
+    let size = hess[0] * hess[0] + 2.0 * hess[1] * hess[1] + hess[2] * hess[2];
+    if det.abs() <= DEGENERATE * size || !det.is_finite() {
+        Event::Degenerate
+    } else if det < 0.0 {
+        Event::Saddle
+    } else if hess[0] + hess[2] > 0.0 {
+        Event::Birth
+    } else {
+        Event::Death
+    }
+}

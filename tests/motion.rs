@@ -1,0 +1,146 @@
+//! Critical points of a height function on the surfaces: exact levels on the flat torus,
+//! the Morse count on every closed catalogue surface, degenerate directions named.
+
+use glam::DVec4;
+use halo4d::motion::{Event, critical_points};
+use halo4d::sample::{bounding_diagonal, sample_adaptive, sample_uniform};
+use halo4d::surfaces::{
+    FlatTorus, KleinBottle, ProjectivePlane, SpunTrefoil, Surface, TwistSpunTrefoil,
+};
+
+/// A direction in no special position with respect to any catalogue surface.
+fn generic() -> DVec4 {
+    DVec4::new(1.0, 0.3, 0.7, 0.2)
+}
+
+#[test]
+fn the_flat_torus_has_its_four_critical_points_at_their_exact_levels() {
+    // h = a cos u + b sin u + c cos v + d sin v (unit radii): critical where both
+    // circles' parts are, at ±|(a, b)| ± |(c, d)|: one minimum, two saddles, one maximum.
+    let surface = Surface::FlatTorus(FlatTorus::default());
+    let mesh = sample_uniform(&surface, 48, 48);
+    let found = critical_points(&mesh, Some(&surface), generic()).unwrap();
+    let n = generic().normalize();
+    let (a, c) = (n.x.hypot(n.y), n.z.hypot(n.w));
+    let expected = [
+        (Event::Birth, -a - c),
+        (Event::Saddle, -a + c),
+        (Event::Saddle, a - c),
+        (Event::Death, a + c),
+    ];
+    let got: Vec<(Event, f64)> = found.points.iter().map(|p| (p.event, p.level)).collect();
+    assert_eq!(got.len(), 4, "{got:?}");
+    let mut expected = expected.to_vec();
+    expected.sort_by(|x, y| x.1.total_cmp(&y.1));
+    for ((e, level), (want, want_level)) in got.iter().zip(&expected) {
+        assert_eq!(e, want, "{got:?}");
+        assert!(
+            (level - want_level).abs() <= 1e-12,
+            "{level} against {want_level}"
+        );
+    }
+    assert!(
+        found
+            .points
+            .iter()
+            .all(|p| p.refined && p.residual <= 1e-10)
+    );
+    assert_eq!(found.counts(), [1, 2, 1, 0]);
+    assert_eq!(found.morse(0), Ok(()));
+    // The count the check takes is the surface's: a wrong characteristic fails.
+    assert!(
+        found
+            .morse(2)
+            .unwrap_err()
+            .contains("not the Euler characteristic 2")
+    );
+    // The mesh's own critical vertices add up to its Euler characteristic, 0.
+    let d = found.discrete;
+    assert_eq!(d.minima as i64 - d.saddles as i64 + d.maxima as i64, 0);
+}
+
+#[test]
+fn a_direction_with_critical_circles_is_named_degenerate() {
+    // h = sin v along w: its maxima and minima are whole circles v = ±π/2.
+    let surface = Surface::FlatTorus(FlatTorus::default());
+    let mesh = sample_uniform(&surface, 32, 32);
+    let found = critical_points(&mesh, Some(&surface), DVec4::W).unwrap();
+    assert!(found.counts()[3] > 0, "{:?}", found.counts());
+    let err = found.morse(0).unwrap_err();
+    assert!(err.contains("degenerate") && err.contains("tilt"), "{err}");
+}
+
+#[test]
+fn every_closed_catalogue_surface_passes_the_morse_count() {
+    let surfaces = [
+        (Surface::SpunTrefoil(SpunTrefoil::default()), 2),
+        (Surface::TwistSpunTrefoil(TwistSpunTrefoil::default()), 2),
+        (Surface::KleinBottle(KleinBottle::default()), 0),
+        (Surface::ProjectivePlane(ProjectivePlane::default()), 1),
+        (Surface::FlatTorus(FlatTorus::default()), 0),
+    ];
+    for (surface, euler) in surfaces {
+        let d = bounding_diagonal(&surface);
+        let mesh = sample_adaptive(&surface, 1e-3 * d, 2_000_000).mesh;
+        for n in [generic(), DVec4::new(-0.2, 0.9, 0.1, -0.4)] {
+            let found = critical_points(&mesh, Some(&surface), n).unwrap();
+            let what = format!("{} along {n}: {:?}", surface.type_name(), found.points);
+            assert_eq!(found.morse(euler), Ok(()), "{what}");
+            // A saddle missed is seen.
+            let mut missing = found.clone();
+            let saddle = missing.points.iter().position(|p| p.event == Event::Saddle);
+            missing.points.remove(saddle.expect("a saddle"));
+            assert!(missing.morse(euler).is_err(), "{what}");
+            assert!(found.points.iter().all(|p| p.residual <= 1e-10), "{what}");
+            // Each point is where h is: its level is h at its 4D point.
+            for p in &found.points {
+                assert!(
+                    (p.level - p.point.dot(found.direction)).abs() <= 1e-12,
+                    "{what}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn a_mesh_without_parameters_keeps_its_critical_vertices() {
+    // A tetrahedron's boundary in 4D: the highest and lowest vertices are the maximum and
+    // minimum, the other two regular; nothing is refined.
+    let mesh = halo4d::sample::mesh_from_data(halo4d::sample::MeshData4 {
+        positions: vec![
+            DVec4::new(0.0, 0.0, 0.0, 0.0),
+            DVec4::new(1.0, 0.0, 0.0, 0.1),
+            DVec4::new(0.0, 1.0, 0.0, 0.2),
+            DVec4::new(0.0, 0.0, 1.0, 0.3),
+        ],
+        triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    });
+    let found = critical_points(&mesh, None, DVec4::W).unwrap();
+    assert_eq!(found.counts(), [1, 0, 1, 0]);
+    assert_eq!(
+        found.points.iter().map(|p| p.vertex).collect::<Vec<_>>(),
+        [0, 3]
+    );
+    assert!(found.points.iter().all(|p| !p.refined));
+    assert_eq!(found.morse(2), Ok(()));
+}
+
+#[test]
+fn a_direction_that_is_zero_or_not_finite_is_refused() {
+    let surface = Surface::FlatTorus(FlatTorus::default());
+    let mesh = sample_uniform(&surface, 8, 8);
+    for n in [
+        DVec4::ZERO,
+        DVec4::new(f64::NAN, 0.0, 0.0, 1.0),
+        DVec4::splat(1e300),
+    ] {
+        let err = critical_points(&mesh, Some(&surface), n).unwrap_err();
+        assert_eq!(err.field, "direction");
+        assert!(
+            err.message.contains("nonzero, finite 4D vector"),
+            "{}",
+            err.message
+        );
+    }
+}
