@@ -1,7 +1,8 @@
 //! Motion pictures: a surface cut by the hyperplanes ⟨n, x⟩ = c of a height function
-//! h = ⟨n, X⟩. What this module gives so far is where the slices change: the critical
-//! points of h on the surface (births, saddles, deaths), found on the 4D mesh and refined on
-//! the exact surface, and the Morse check of their count.
+//! h = ⟨n, X⟩. What this module gives so far: where the slices change, the critical points
+//! of h on the surface (births, saddles, deaths), found on the 4D mesh and refined on the
+//! exact surface, with the Morse check of their count; and the slice of the mesh at a level
+//! ([`slice`]), whose components change at the mesh's critical vertices as their events say.
 //!
 //! **On the mesh** (Banchoff's critical points of a piecewise-linear height): a vertex's
 //! link is the cycle of its neighbours; the number of sign changes of h(neighbour) - h(v)
@@ -357,4 +358,86 @@ fn event_of(hess: [f64; 3]) -> Event {
     } else {
         Event::Death
     }
+}
+
+/// A curve of a slice: its points in 4D, on the hyperplane, in order.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SliceCurve {
+    /// The points, one where each mesh edge crosses the level.
+    pub points: Vec<DVec4>,
+    /// Whether the curve closes on itself (else it ends on the mesh's boundary).
+    pub closed: bool,
+}
+
+/// The slice of `mesh` by the hyperplane ⟨n, x⟩ = `c` (n a unit vector): the curves where
+/// its triangles cross the level, each point where a mesh edge does (linear along the
+/// edge). A vertex exactly at the level counts as above it, so every triangle crosses it
+/// in one segment or not at all and the curves are simple. A closed mesh's curves are all
+/// closed; their number is the slice's number of components.
+pub fn slice(mesh: &Mesh4, n: DVec4, c: f64) -> Vec<SliceCurve> {
+    let h: Vec<f64> = mesh.positions.iter().map(|p| p.dot(n)).collect();
+    let above = |v: u32| h[v as usize] >= c;
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    // Each crossing triangle is one segment between its two crossing edges; an edge is
+    // in at most two segments (one per triangle on it).
+    let mut at_edge: std::collections::HashMap<(u32, u32), Vec<usize>> =
+        std::collections::HashMap::new();
+    let mut segments: Vec<[(u32, u32); 2]> = Vec::new();
+    for t in &mesh.triangles {
+        let crossing: Vec<(u32, u32)> = (0..3)
+            .map(|k| (t[k], t[(k + 1) % 3]))
+            .filter(|&(a, b)| above(a) != above(b))
+            .map(|(a, b)| key(a, b))
+            .collect();
+        if let [e, f] = crossing[..] {
+            for edge in [e, f] {
+                at_edge.entry(edge).or_default().push(segments.len());
+            }
+            segments.push([e, f]);
+        }
+    }
+    let point = |(a, b): (u32, u32)| {
+        let (ha, hb) = (h[a as usize], h[b as usize]);
+        let t = (c - ha) / (hb - ha);
+        mesh.positions[a as usize].lerp(mesh.positions[b as usize], t)
+    };
+    let mut used = vec![false; segments.len()];
+    let mut curves = Vec::new();
+    // Open curves first, from edges in one segment (on the boundary), then the loops.
+    let mut starts: Vec<(u32, u32)> = at_edge
+        .iter()
+        .filter(|(_, s)| s.len() == 1)
+        .map(|(&e, _)| e)
+        .collect();
+    starts.sort_unstable();
+    let loops: Vec<(u32, u32)> = segments.iter().map(|s| s[0]).collect();
+    for (start, open) in starts
+        .into_iter()
+        .map(|e| (e, true))
+        .chain(loops.into_iter().map(|e| (e, false)))
+    {
+        let Some(&first) = at_edge[&start].iter().find(|&&s| !used[s]) else {
+            continue;
+        };
+        let mut points = vec![point(start)];
+        let (mut edge, mut seg) = (start, first);
+        loop {
+            used[seg] = true;
+            let [e, f] = segments[seg];
+            edge = if e == edge { f } else { e };
+            if edge == start {
+                break;
+            }
+            points.push(point(edge));
+            match at_edge[&edge].iter().find(|&&s| !used[s]) {
+                Some(&next) => seg = next,
+                None => break,
+            }
+        }
+        curves.push(SliceCurve {
+            points,
+            closed: !open && edge == start,
+        });
+    }
+    curves
 }

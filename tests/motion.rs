@@ -2,7 +2,7 @@
 //! the Morse count on every closed catalogue surface, degenerate directions named.
 
 use glam::DVec4;
-use halo4d::motion::{Event, critical_points};
+use halo4d::motion::{Event, critical_points, slice};
 use halo4d::sample::{bounding_diagonal, sample_adaptive, sample_uniform};
 use halo4d::surfaces::{
     FlatTorus, KleinBottle, ProjectivePlane, SpunTrefoil, Surface, TwistSpunTrefoil,
@@ -141,6 +141,90 @@ fn a_direction_that_is_zero_or_not_finite_is_refused() {
             err.message.contains("nonzero, finite 4D vector"),
             "{}",
             err.message
+        );
+    }
+}
+
+#[test]
+fn the_flat_torus_slices_have_the_components_its_critical_points_say() {
+    // Between the minimum and the first saddle the slice is one circle, between the saddles
+    // two, then one again, and nothing outside; at every level a closed mesh's slice is
+    // closed curves, each point on the hyperplane.
+    let surface = Surface::FlatTorus(FlatTorus::default());
+    let mesh = sample_uniform(&surface, 64, 64);
+    let found = critical_points(&mesh, Some(&surface), generic()).unwrap();
+    let n = found.direction;
+    let levels: Vec<f64> = found.points.iter().map(|p| p.level).collect();
+    let components = |c: f64| {
+        let curves = slice(&mesh, n, c);
+        for curve in &curves {
+            assert!(curve.closed);
+            assert!(curve.points.iter().all(|p| (p.dot(n) - c).abs() <= 1e-12));
+        }
+        curves.len()
+    };
+    assert_eq!(components(levels[0] - 0.1), 0);
+    assert_eq!(components(levels[3] + 0.1), 0);
+    for (k, want) in [1, 2, 1].into_iter().enumerate() {
+        let (lo, hi) = (levels[k], levels[k + 1]);
+        for share in [0.25, 0.5, 0.75] {
+            assert_eq!(
+                components(lo + (hi - lo) * share),
+                want,
+                "between {lo} and {hi}"
+            );
+        }
+    }
+}
+
+#[test]
+fn across_each_critical_level_the_components_change_as_its_event_says() {
+    // A birth adds a component, a death removes one, a saddle joins two or splits one
+    // (or, on a non-orientable surface, may keep the count), on the knotted spheres and
+    // the Klein bottle.
+    for (surface, orientable) in [
+        (Surface::SpunTrefoil(SpunTrefoil::default()), true),
+        (Surface::TwistSpunTrefoil(TwistSpunTrefoil::default()), true),
+        (Surface::KleinBottle(KleinBottle::default()), false),
+    ] {
+        let d = bounding_diagonal(&surface);
+        let mesh = sample_adaptive(&surface, 1e-4 * d, 2_000_000).mesh;
+        let found = critical_points(&mesh, Some(&surface), generic()).unwrap();
+        assert!(found.not_converged.is_empty(), "{}", surface.type_name());
+        let n = found.direction;
+        // The mesh's slice changes where its critical vertices are (the refined levels lie
+        // near them, not at them): the intervals are taken between the vertices' levels.
+        let mut points: Vec<(f64, Event)> = found
+            .points
+            .iter()
+            .map(|p| (mesh.positions[p.vertex as usize].dot(n), p.event))
+            .collect();
+        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut below = 0;
+        for (k, &(level, event)) in points.iter().enumerate() {
+            let above_level = points
+                .get(k + 1)
+                .map_or(level + 1.0, |&(next, _)| (level + next) / 2.0);
+            let above = slice(&mesh, n, above_level).len() as i64;
+            let change = above - below;
+            let what = format!(
+                "{} at {level} ({event:?}): {below} then {above}",
+                surface.type_name()
+            );
+            match event {
+                Event::Birth => assert_eq!(change, 1, "{what}"),
+                Event::Death => assert_eq!(change, -1, "{what}"),
+                Event::Saddle if orientable => assert_eq!(change.abs(), 1, "{what}"),
+                Event::Saddle => assert!(change.abs() <= 1, "{what}"),
+                Event::Degenerate => panic!("{what}"),
+            }
+            below = above;
+        }
+        assert_eq!(
+            below,
+            0,
+            "{}: nothing above the highest point",
+            surface.type_name()
         );
     }
 }
