@@ -2,7 +2,7 @@
 //! h = ⟨n, X⟩. What this module gives so far: where the slices change, the critical points
 //! of h on the surface (births, saddles, deaths), found on the 4D mesh and refined on the
 //! exact surface, with the Morse check of their count; and the slice of the mesh at a level
-//! ([`slice`]), whose components change at the mesh's critical vertices as their events say.
+//! ([`slice()`]), whose components change at the mesh's critical vertices as their events say.
 //!
 //! **On the mesh** (Banchoff's critical points of a piecewise-linear height): a vertex's
 //! link is the cycle of its neighbours; the number of sign changes of h(neighbour) - h(v)
@@ -363,27 +363,48 @@ fn event_of(hess: [f64; 3]) -> Event {
 /// A curve of a slice: its points in 4D, on the hyperplane, in order.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SliceCurve {
-    /// The points, one where each mesh edge crosses the level.
+    /// The points, one where each mesh edge crosses the level, moved onto the surface
+    /// where it has parameters.
     pub points: Vec<DVec4>,
     /// Whether the curve closes on itself (else it ends on the mesh's boundary).
     pub closed: bool,
 }
 
+/// The slice of a surface by a hyperplane.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Slice {
+    /// The level c.
+    pub level: f64,
+    /// The curves: on a closed surface all closed, as many as the slice has components.
+    pub curves: Vec<SliceCurve>,
+    /// The largest |⟨n, x⟩ - c| of the points moved onto the surface (0 where none was).
+    pub max_residual: f64,
+    /// Points Newton's method could not move onto the surface (they keep the mesh's).
+    pub not_converged: usize,
+}
+
+/// Newton steps moving a slice point onto the surface.
+const SLICE_STEPS: usize = 60;
+
 /// The slice of `mesh` by the hyperplane ⟨n, x⟩ = `c` (n a unit vector): the curves where
-/// its triangles cross the level, each point where a mesh edge does (linear along the
-/// edge). A vertex exactly at the level counts as above it, so every triangle crosses it
-/// in one segment or not at all and the curves are simple. A closed mesh's curves are all
-/// closed; their number is the slice's number of components.
-pub fn slice(mesh: &Mesh4, n: DVec4, c: f64) -> Vec<SliceCurve> {
+/// its triangles cross the level, each point where a mesh edge does, then moved onto
+/// `surface` where the mesh has parameters on it (Newton's method on h = c from the point's
+/// parameters along its edge, each step the smallest in (u, v)). A vertex exactly at the
+/// level counts as above it, so every triangle crosses the level in one segment or not at
+/// all and the curves are simple: their topology is the mesh's, which changes at the mesh's
+/// critical vertices. Near a critical level the mesh's slice can hold a small loop that the
+/// surface's has not yet (or no longer): points Newton's method cannot move keep the mesh's
+/// place and are counted ([`Slice::not_converged`]).
+pub fn slice(mesh: &Mesh4, surface: Option<&Surface>, n: DVec4, c: f64) -> Slice {
     let h: Vec<f64> = mesh.positions.iter().map(|p| p.dot(n)).collect();
     let above = |v: u32| h[v as usize] >= c;
     let key = |a: u32, b: u32| (a.min(b), a.max(b));
-    // Each crossing triangle is one segment between its two crossing edges; an edge is
-    // in at most two segments (one per triangle on it).
+    // Each crossing triangle is one segment between its two crossing edges; an edge is in
+    // at most two segments (one per triangle on it).
     let mut at_edge: std::collections::HashMap<(u32, u32), Vec<usize>> =
         std::collections::HashMap::new();
-    let mut segments: Vec<[(u32, u32); 2]> = Vec::new();
-    for t in &mesh.triangles {
+    let mut segments: Vec<([(u32, u32); 2], usize)> = Vec::new();
+    for (ti, t) in mesh.triangles.iter().enumerate() {
         let crossing: Vec<(u32, u32)> = (0..3)
             .map(|k| (t[k], t[(k + 1) % 3]))
             .filter(|&(a, b)| above(a) != above(b))
@@ -393,16 +414,41 @@ pub fn slice(mesh: &Mesh4, n: DVec4, c: f64) -> Vec<SliceCurve> {
             for edge in [e, f] {
                 at_edge.entry(edge).or_default().push(segments.len());
             }
-            segments.push([e, f]);
+            segments.push(([e, f], ti));
         }
     }
-    let point = |(a, b): (u32, u32)| {
+    let mut out = Slice {
+        level: c,
+        curves: Vec::new(),
+        max_residual: 0.0,
+        not_converged: 0,
+    };
+    // Where edge (a, b) of triangle `ti` crosses the level, on the surface where it can be.
+    let mut point = |(a, b): (u32, u32), ti: usize| {
         let (ha, hb) = (h[a as usize], h[b as usize]);
         let t = (c - ha) / (hb - ha);
-        mesh.positions[a as usize].lerp(mesh.positions[b as usize], t)
+        let on_mesh = mesh.positions[a as usize].lerp(mesh.positions[b as usize], t);
+        let Some(surface) = surface else {
+            return on_mesh;
+        };
+        let corner = |v: u32| {
+            let k = mesh.triangles[ti].iter().position(|&x| x == v).unwrap_or(0);
+            mesh.triangle_uv[ti][k]
+        };
+        let (ua, ub) = (corner(a), corner(b));
+        let uv = [ua[0] + (ub[0] - ua[0]) * t, ua[1] + (ub[1] - ua[1]) * t];
+        match onto_level(surface, mesh.triangle_patch[ti] as usize, uv, n, c) {
+            Some((p, residual)) => {
+                out.max_residual = out.max_residual.max(residual);
+                p
+            }
+            None => {
+                out.not_converged += 1;
+                on_mesh
+            }
+        }
     };
     let mut used = vec![false; segments.len()];
-    let mut curves = Vec::new();
     // Open curves first, from edges in one segment (on the boundary), then the loops.
     let mut starts: Vec<(u32, u32)> = at_edge
         .iter()
@@ -410,7 +456,7 @@ pub fn slice(mesh: &Mesh4, n: DVec4, c: f64) -> Vec<SliceCurve> {
         .map(|(&e, _)| e)
         .collect();
     starts.sort_unstable();
-    let loops: Vec<(u32, u32)> = segments.iter().map(|s| s[0]).collect();
+    let loops: Vec<(u32, u32)> = segments.iter().map(|s| s.0[0]).collect();
     for (start, open) in starts
         .into_iter()
         .map(|e| (e, true))
@@ -419,25 +465,76 @@ pub fn slice(mesh: &Mesh4, n: DVec4, c: f64) -> Vec<SliceCurve> {
         let Some(&first) = at_edge[&start].iter().find(|&&s| !used[s]) else {
             continue;
         };
-        let mut points = vec![point(start)];
+        let mut points = vec![point(start, segments[first].1)];
         let (mut edge, mut seg) = (start, first);
         loop {
             used[seg] = true;
-            let [e, f] = segments[seg];
+            let ([e, f], ti) = segments[seg];
             edge = if e == edge { f } else { e };
             if edge == start {
                 break;
             }
-            points.push(point(edge));
+            points.push(point(edge, ti));
             match at_edge[&edge].iter().find(|&&s| !used[s]) {
                 Some(&next) => seg = next,
                 None => break,
             }
         }
-        curves.push(SliceCurve {
+        out.curves.push(SliceCurve {
             points,
             closed: !open && edge == start,
         });
     }
-    curves
+    out
+}
+
+/// The point of `surface` at level `c` of h = ⟨n, X⟩ that Newton's method reaches from
+/// `uv` on `patch` (each step the smallest in (u, v) that zeroes the linearized h - c),
+/// with its |h - c|; `None` when the residual does not come under 1e-12 of the surface's
+/// size (a step that cannot stay on the surface, a vanishing gradient).
+fn onto_level(
+    surface: &Surface,
+    mut patch: usize,
+    [mut u, mut v]: [f64; 2],
+    n: DVec4,
+    c: f64,
+) -> Option<(DVec4, f64)> {
+    // The surface's own rounding (about 1e-15 of its size where its formula is long) can
+    // keep the residual above f64's: once under 1e-12 of the size, a few more steps keep
+    // the best point.
+    let (mut best, mut polish): (Option<(DVec4, f64)>, usize) = (None, 0);
+    for _ in 0..SLICE_STEPS {
+        let e = surface.eval(patch, u, v);
+        let r = c - n.dot(e.p);
+        let size = c.abs() + e.p.length();
+        if r.abs() <= 1e-12 * size && best.is_none_or(|b| r.abs() < b.1) {
+            best = Some((e.p, r.abs()));
+        }
+        if best.is_some() {
+            polish += 1;
+            if polish > 3 || r.abs() <= 2.0 * f64::EPSILON * size {
+                break;
+            }
+        }
+        let g = [n.dot(e.du), n.dot(e.dv)];
+        let g2 = g[0] * g[0] + g[1] * g[1];
+        if g2 == 0.0 || !g2.is_finite() {
+            break;
+        }
+        // A step past a pole or an open side, or one that does not bring h nearer to c
+        // (near a critical point, where h bends away), is halved until it does.
+        let mut step = [g[0] * r / g2, g[1] * r / g2];
+        let moved = (0..16).find_map(|_| {
+            let (p, nu, nv, inside) = surface.chart(patch, u + step[0], v + step[1]);
+            step = [step[0] / 2.0, step[1] / 2.0];
+            (inside
+                && nu.is_finite()
+                && nv.is_finite()
+                && (c - n.dot(surface.point(p, nu, nv))).abs() < r.abs())
+            .then_some((p, nu, nv))
+        });
+        let Some(next) = moved else { break };
+        (patch, u, v) = next;
+    }
+    best
 }
