@@ -19,7 +19,8 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
-use halo4d::internals::{Camera, Primary, TraceSurface, Tracer};
+use halo4d::SurfacePart;
+use halo4d::internals::{Camera, Primary, Tracer};
 use halo4d::render::{Prober, RenderMode, RenderSettings};
 use rayon::prelude::*;
 use std::hint::black_box;
@@ -44,7 +45,7 @@ fn rays(cam: &Camera) -> Vec<(DVec3, DVec3)> {
 /// origin and direction) and the nearest distance of each (infinity for a miss), little
 /// endian after the magic `H4DRAYS1` and the three counts.
 fn write_rays(
-    surfaces: &[TraceSurface],
+    surfaces: &[SurfacePart],
     rays: &[(DVec3, DVec3)],
     nearest: &[f64],
     path: &PathBuf,
@@ -103,22 +104,8 @@ fn primary_rays(c: &mut Criterion) {
         .expect("the default scene's camera")
         .camera();
     let rays = rays(&cam);
-    let surfaces: Vec<TraceSurface> = parts
-        .surfaces
-        .iter()
-        .map(|s| TraceSurface {
-            positions: s.positions,
-            triangles: s.triangles,
-        })
-        .collect();
-    let (lo, hi) = surfaces
-        .iter()
-        .flat_map(|s| s.positions)
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| {
-            (lo.min(p), hi.max(p))
-        });
-    // The renderer's scale and slack: the box of the scene, and twice the same-hit distance.
-    let tracer = Tracer::new(surfaces.clone(), (hi - lo).length());
+    // The renderer's tracer and slack (twice the same-hit distance).
+    let tracer = Tracer::of_parts(&parts);
     let slack = 2.0 * tracer.same();
     let trace_all = || -> Vec<f64> {
         rays.par_iter()
@@ -149,8 +136,8 @@ fn primary_rays(c: &mut Criterion) {
     assert_eq!(trace_tiles(), nearest, "the tiles find the BVH's hits");
     let hit = nearest.iter().filter(|t| t.is_finite()).count();
     let file = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("exports/rays/default-scene.bin");
-    write_rays(&surfaces, &rays, &nearest, &file).expect("the rays file is written");
-    let triangles: usize = surfaces.iter().map(|s| s.triangles.len()).sum();
+    write_rays(&parts.surfaces, &rays, &nearest, &file).expect("the rays file is written");
+    let triangles: usize = parts.surfaces.iter().map(|s| s.triangles.len()).sum();
     println!(
         "{} rays, {hit} hitting {triangles} triangles; wrote {}",
         rays.len(),

@@ -38,7 +38,7 @@ use camera::Camera;
 use glam::DVec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use trace::{Hit, Primary, TraceSurface, Tracer};
+use trace::{Hit, Primary, Tracer};
 
 /// Perspective or orthographic.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -931,14 +931,6 @@ struct Scene<'a> {
 
 impl<'a> Scene<'a> {
     fn new(input: &'a Parts<'a>, settings: &'a RenderSettings, (lo, hi): (DVec3, DVec3)) -> Self {
-        let trace = input
-            .surfaces
-            .iter()
-            .map(|s| TraceSurface {
-                positions: s.positions,
-                triangles: s.triangles,
-            })
-            .collect();
         let w_range = input
             .surfaces
             .iter()
@@ -949,7 +941,7 @@ impl<'a> Scene<'a> {
         Scene {
             input,
             settings,
-            tracer: Tracer::new(trace, (hi - lo).length()),
+            tracer: Tracer::of_parts(input),
             halos: settings.halos.then(|| TriangleHiders::new(input)),
             planes: match settings.lighting {
                 Lighting::ThreeD => Vec::new(),

@@ -4,6 +4,7 @@
 use super::CameraProjection;
 use super::camera::Camera;
 use crate::intersect::broad;
+use crate::parts::Parts;
 use glam::{DVec3, Vec3A};
 use obvhs::bvh2::Bvh2;
 use obvhs::ray::Ray;
@@ -82,6 +83,22 @@ impl<'a> Tracer<'a> {
             bvh,
             same: 1e-12 * scale,
         }
+    }
+
+    /// The tracer of the surfaces of `parts`, as the renderer makes it: their triangles,
+    /// with the box of the triangles' corners as the scene's size.
+    pub fn of_parts(parts: &'a Parts<'a>) -> Self {
+        let surfaces: Vec<TraceSurface> = parts
+            .surfaces
+            .iter()
+            .map(|s| TraceSurface {
+                positions: s.positions,
+                triangles: s.triangles,
+            })
+            .collect();
+        let size = super::triangle_bounds(surfaces.iter().map(|s| (s.positions, s.triangles)))
+            .map_or(1.0, |(lo, hi)| (hi - lo).length());
+        Tracer::new(surfaces, size)
     }
 
     /// Every hit along the ray from `origin` in unit direction `dir` with t > `t_min`, in
@@ -558,22 +575,12 @@ mod primary_tests {
         let cam = *Prober::new(&parts, &settings, &scene.camera)
             .unwrap()
             .camera();
-        let surfaces: Vec<TraceSurface> = parts
-            .surfaces
-            .iter()
-            .map(|s| TraceSurface {
-                positions: s.positions,
-                triangles: s.triangles,
-            })
-            .collect();
-        let (lo, hi) = surfaces
-            .iter()
-            .flat_map(|s| s.positions)
-            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| {
-                (lo.min(p), hi.max(p))
-            });
+        let tracer = Tracer::of_parts(&parts);
+        let (lo, hi) = crate::render::triangle_bounds(
+            parts.surfaces.iter().map(|s| (s.positions, s.triangles)),
+        )
+        .unwrap();
         let size = (hi - lo).length();
-        let tracer = Tracer::new(surfaces, size);
         let centre = (lo + hi) / 2.0;
         let orthographic = Camera {
             projection: CameraProjection::Orthographic,
