@@ -29,14 +29,19 @@ use std::path::PathBuf;
 /// The picture's side in pixels.
 const SIDE: u32 = 1024;
 
+/// A primary ray: its image point, origin and unit direction.
+type PrimaryRay = ([f64; 2], DVec3, DVec3);
+
 /// The ray through the centre of each pixel, row by row from the top, as the renderer
 /// makes it.
-fn rays(cam: &Camera) -> Vec<(DVec3, DVec3)> {
+fn rays(cam: &Camera) -> Vec<PrimaryRay> {
     let side = f64::from(SIDE);
     (0..SIDE * SIDE)
         .map(|i| {
             let (x, y) = (f64::from(i % SIDE) + 0.5, f64::from(i / SIDE) + 0.5);
-            cam.ray(2.0 * x / side - 1.0, 1.0 - 2.0 * y / side)
+            let at = [2.0 * x / side - 1.0, 1.0 - 2.0 * y / side];
+            let (origin, dir) = cam.ray(at[0], at[1]);
+            (at, origin, dir)
         })
         .collect()
 }
@@ -46,7 +51,7 @@ fn rays(cam: &Camera) -> Vec<(DVec3, DVec3)> {
 /// endian after the magic `H4DRAYS1` and the three counts.
 fn write_rays(
     surfaces: &[SurfacePart],
-    rays: &[(DVec3, DVec3)],
+    rays: &[PrimaryRay],
     nearest: &[f64],
     path: &PathBuf,
 ) -> std::io::Result<()> {
@@ -71,7 +76,7 @@ fn write_rays(
         }
         base += s.positions.len() as u32;
     }
-    for &(origin, dir) in rays {
+    for &(_, origin, dir) in rays {
         f32s(&mut out, origin);
         f32s(&mut out, dir);
     }
@@ -109,24 +114,16 @@ fn primary_rays(c: &mut Criterion) {
     let slack = 2.0 * tracer.same();
     let trace_all = || -> Vec<f64> {
         rays.par_iter()
-            .map_init(Vec::new, |hits, &(origin, dir)| {
+            .map_init(Vec::new, |hits, &(_, origin, dir)| {
                 tracer.nearest_hits(origin, dir, 0.0, slack, hits);
                 hits.first().map_or(f64::INFINITY, |h| h.t)
             })
             .collect()
     };
     let primary = Primary::new(&tracer, &cam, SIDE, SIDE);
-    let side = f64::from(SIDE);
     let trace_tiles = || -> Vec<f64> {
-        (0..rays.len())
-            .into_par_iter()
-            .map_init(Vec::new, |hits, i| {
-                let (x, y) = (
-                    f64::from(i as u32 % SIDE) + 0.5,
-                    f64::from(i as u32 / SIDE) + 0.5,
-                );
-                let at = [2.0 * x / side - 1.0, 1.0 - 2.0 * y / side];
-                let (origin, dir) = rays[i];
+        rays.par_iter()
+            .map_init(Vec::new, |hits, &(at, origin, dir)| {
                 primary.nearest_hits(at, origin, dir, 0.0, slack, hits);
                 hits.first().map_or(f64::INFINITY, |h| h.t)
             })

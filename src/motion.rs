@@ -203,10 +203,11 @@ pub fn critical_points(
                 }
             },
         };
-        // Reached from another vertex already: one point.
-        let same = points.iter().any(|q| {
-            q.refined && point.refined && q.point.distance(point.point) <= 1e-9 * diagonal
-        });
+        // Refined onto a point reached from another vertex already: one point.
+        let same = point.refined
+            && points
+                .iter()
+                .any(|q| q.point.distance(point.point) <= 1e-9 * diagonal);
         if !same {
             points.push(point);
         }
@@ -230,7 +231,6 @@ fn critical_vertices(mesh: &Mesh4, h: &[f64]) -> (Vec<(u32, Event)>, DiscreteCou
     let nv = mesh.positions.len();
     let above = |a: u32, b: u32| (h[a as usize], a) > (h[b as usize], b);
     let mut changes = vec![0u32; nv];
-    let mut higher = vec![false; nv];
     let mut lower = vec![false; nv];
     let mut used = vec![false; nv];
     // Each triangle (v, a, b) is one edge of v's link; the sign changes around the link
@@ -241,7 +241,6 @@ fn critical_vertices(mesh: &Mesh4, h: &[f64]) -> (Vec<(u32, Event)>, DiscreteCou
             let (v, a, b) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
             let (sa, sb) = (above(a, v), above(b, v));
             changes[v as usize] += u32::from(sa != sb);
-            higher[v as usize] |= sa || sb;
             lower[v as usize] |= !sa || !sb;
             used[v as usize] = true;
             *edges.entry((v.min(a), v.max(a))).or_default() += 1;

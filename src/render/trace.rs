@@ -219,7 +219,7 @@ const TILE: f64 = 8.0;
 const MOST_ENTRIES: usize = 16;
 
 /// A triangle of one tile: its BVH slot and its projected box in image coordinates.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 struct Entry {
     slot: u32,
     lo: [f64; 2],
@@ -297,6 +297,12 @@ impl<'t, 'a> Primary<'t, 'a> {
     }
 }
 
+/// The tile along one axis that image coordinate `x` falls in, for tiles of `step` image
+/// units and `count` tiles (a coordinate outside the picture goes to the nearest).
+fn tile_index(x: f64, step: f64, count: usize) -> usize {
+    (((x + 1.0) / step).floor().max(0.0) as usize).min(count - 1)
+}
+
 impl Tiles {
     fn new(tracer: &Tracer, cam: &Camera, width: u32, height: u32) -> Option<Tiles> {
         let cols = (f64::from(width) / TILE).ceil() as usize;
@@ -306,43 +312,40 @@ impl Tiles {
             2.0 * TILE / f64::from(width),
             2.0 * TILE / f64::from(height),
         ];
-        let boxes: Vec<Option<([f64; 2], [f64; 2])>> = tracer
-            .corners
-            .iter()
-            .map(|c| projected_box(cam, c))
-            .collect();
-        let tile_of = |x: f64, axis: usize, count: usize| {
-            (((x + 1.0) / step[axis]).floor().max(0.0) as usize).min(count - 1)
-        };
-        let span = |(lo, hi): ([f64; 2], [f64; 2])| {
-            (
-                tile_of(lo[0], 0, cols)..=tile_of(hi[0], 0, cols),
-                tile_of(lo[1], 1, rows)..=tile_of(hi[1], 1, rows),
-            )
-        };
-        let mut counts = vec![0usize; cols * rows + 1];
+        // Each triangle in the picture with its box and the tiles it meets (columns, then
+        // rows, inclusive); those that reach the eye's plane in every tile.
+        let mut placed = Vec::new();
         let mut everywhere = Vec::new();
+        let mut counts = vec![0usize; cols * rows + 1];
         let mut total = 0usize;
-        for (slot, b) in boxes.iter().enumerate() {
-            let Some(b) = *b else {
+        for (slot, corners) in tracer.corners.iter().enumerate() {
+            let slot = slot as u32;
+            let Some((lo, hi)) = projected_box(cam, corners) else {
                 everywhere.push(Entry {
-                    slot: slot as u32,
+                    slot,
                     lo: [f64::NEG_INFINITY; 2],
                     hi: [f64::INFINITY; 2],
                 });
                 continue;
             };
-            if b.1[0] < -1.0 || b.0[0] > 1.0 || b.1[1] < -1.0 || b.0[1] > 1.0 {
+            if hi[0] < -1.0 || lo[0] > 1.0 || hi[1] < -1.0 || lo[1] > 1.0 {
                 continue; // outside the picture: no primary ray meets it
             }
-            let (xs, ys) = span(b);
-            for j in ys {
-                for i in xs.clone() {
+            let span = [0, 1].map(|k| {
+                let count = [cols, rows][k];
+                [
+                    tile_index(lo[k], step[k], count),
+                    tile_index(hi[k], step[k], count),
+                ]
+            });
+            for j in span[1][0]..=span[1][1] {
+                for i in span[0][0]..=span[0][1] {
                     counts[j * cols + i + 1] += 1;
                     total += 1;
                 }
             }
-            if total > MOST_ENTRIES * (boxes.len() + cols * rows) {
+            placed.push((Entry { slot, lo, hi }, span));
+            if total > MOST_ENTRIES * (tracer.corners.len() + cols * rows) {
                 return None;
             }
         }
@@ -351,28 +354,12 @@ impl Tiles {
             starts[i + 1] += starts[i];
         }
         let mut fill = starts.clone();
-        let mut entries = vec![
-            Entry {
-                slot: 0,
-                lo: [0.0; 2],
-                hi: [0.0; 2],
-            };
-            total
-        ];
-        for (slot, b) in boxes.iter().enumerate() {
-            let Some((lo, hi)) = *b else { continue };
-            if hi[0] < -1.0 || lo[0] > 1.0 || hi[1] < -1.0 || lo[1] > 1.0 {
-                continue;
-            }
-            let (xs, ys) = span((lo, hi));
-            for j in ys {
-                for i in xs.clone() {
+        let mut entries = vec![Entry::default(); total];
+        for (entry, span) in placed {
+            for j in span[1][0]..=span[1][1] {
+                for i in span[0][0]..=span[0][1] {
                     let k = &mut fill[j * cols + i];
-                    entries[*k] = Entry {
-                        slot: slot as u32,
-                        lo,
-                        hi,
-                    };
+                    entries[*k] = entry;
                     *k += 1;
                 }
             }
@@ -399,8 +386,8 @@ impl Tiles {
         hits: &mut Vec<Hit>,
     ) {
         hits.clear();
-        let i = (((at[0] + 1.0) / self.step[0]).floor().max(0.0) as usize).min(self.cols - 1);
-        let j = (((at[1] + 1.0) / self.step[1]).floor().max(0.0) as usize).min(self.rows - 1);
+        let i = tile_index(at[0], self.step[0], self.cols);
+        let j = tile_index(at[1], self.step[1], self.rows);
         let tile = j * self.cols + i;
         let shear = Shear::new(origin, dir);
         let entries = &self.entries[self.starts[tile]..self.starts[tile + 1]];
@@ -621,6 +608,54 @@ mod primary_tests {
             }
             // Most rays of each camera meet the scene: the comparison is not of misses.
             assert!(hit * 3 > rays, "{name}: {hit} of {rays} rays hit");
+        }
+    }
+}
+
+#[cfg(test)]
+mod fallback_tests {
+    use super::*;
+
+    #[test]
+    fn triangles_across_the_whole_picture_go_through_the_bvh_with_the_same_hits() {
+        // 64 sheets facing the eye, each covering the picture: listing each in all 16,384
+        // tiles would be past the limit, so the rays go through the BVH.
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        for k in 0..64u32 {
+            let z = 1.0 + f64::from(k) * 0.01;
+            positions.extend([
+                DVec3::new(-10.0, -10.0, z),
+                DVec3::new(10.0, -10.0, z),
+                DVec3::new(0.0, 10.0, z),
+            ]);
+            triangles.push([3 * k, 3 * k + 1, 3 * k + 2]);
+        }
+        let tracer = Tracer::new(
+            vec![TraceSurface {
+                positions: &positions,
+                triangles: &triangles,
+            }],
+            30.0,
+        );
+        let cam = Camera {
+            eye: DVec3::new(0.0, 0.0, -1.0),
+            forward: DVec3::Z,
+            right: DVec3::X,
+            up: DVec3::Y,
+            projection: CameraProjection::Perspective,
+            half_height: 0.5,
+            aspect: 1.0,
+        };
+        let primary = Primary::new(&tracer, &cam, 1024, 1024);
+        assert!(primary.tiles.is_none());
+        let (mut expected, mut got) = (Vec::new(), Vec::new());
+        for at in [[0.0, 0.0], [-0.9, 0.7], [0.5, -0.95]] {
+            let (origin, dir) = cam.ray(at[0], at[1]);
+            tracer.hits(origin, dir, 0.0, &mut expected);
+            primary.hits(at, origin, dir, 0.0, &mut got);
+            assert_eq!(expected.len(), 64);
+            assert_eq!(got, expected);
         }
     }
 }
