@@ -179,6 +179,10 @@ fn rank(
     let mut accepted: Vec<u32> = Vec::with_capacity(count);
     let mut grid = Grid::new(CELL * radius(0));
     let mut active = 0usize;
+    // The distance each candidate was last found from an earlier level's point (an upper
+    // bound of its nearest), infinite where none was within the radius.
+    let mut near = vec![f64::INFINITY; points.len()];
+    let mut level = Grid::new(CELL * radius(0));
     for j in 0..levels {
         if accepted.len() >= count {
             break;
@@ -200,10 +204,34 @@ fn rank(
             queue.push(i);
             active += 1;
         }
+        // First each candidate against the points of the earlier levels, on the cores (the
+        // grid does not change while they read it; the candidates in index order, which is
+        // the mesh's triangle order, so that neighbours query neighbouring cells one after
+        // another), then, in the queue's order, those that pass against the points accepted
+        // at this level.
+        let mut sorted = queue.clone();
+        sorted.par_sort_unstable();
+        let found: Vec<f64> = sorted
+            .par_iter()
+            .map(|&i| {
+                grid.near_within(points[i as usize], r)
+                    .unwrap_or(f64::INFINITY)
+            })
+            .collect();
+        for (&i, d) in sorted.iter().zip(found) {
+            near[i as usize] = d;
+        }
+        level.clear(CELL * r);
+        let start = accepted.len();
         for i in queue {
-            match grid.near_within(points[i as usize], r) {
+            let p = points[i as usize];
+            let d = near[i as usize];
+            match (d.is_finite())
+                .then_some(d)
+                .or_else(|| level.near_within(p, r))
+            {
                 None => {
-                    grid.insert(points[i as usize]);
+                    level.insert(p);
                     accepted.push(i);
                     if accepted.len() >= count {
                         break;
@@ -218,6 +246,9 @@ fn rank(
                     }
                 }
             }
+        }
+        for &i in &accepted[start..] {
+            grid.insert(points[i as usize]);
         }
     }
     accepted
@@ -269,6 +300,12 @@ impl Grid {
                 .insert(run[0].0, run.iter().map(|&(_, p)| p).collect());
         }
         grid
+    }
+
+    /// Empties the grid and sets its cell, keeping its memory.
+    fn clear(&mut self, cell: f64) {
+        self.cell = cell;
+        self.cells.clear();
     }
 
     fn insert(&mut self, p: DVec4) {
@@ -442,6 +479,21 @@ mod tests {
         let a = Stipples::generate(&p, &t, 500, 1);
         assert_eq!(a, Stipples::generate(&p, &t, 500, 1));
         assert_ne!(a.bary, Stipples::generate(&p, &t, 500, 2).bary);
+    }
+
+    #[test]
+    fn the_ranking_does_not_depend_on_the_number_of_threads() {
+        let (p, t) = square(12);
+        let on = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| Stipples::generate(&p, &t, 3000, 5))
+        };
+        let one = on(1);
+        assert_eq!(one.len(), 3000);
+        assert_eq!(one, on(3));
     }
 
     #[test]
