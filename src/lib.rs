@@ -71,6 +71,7 @@ mod pipeline;
 pub mod render;
 pub mod sample;
 mod scene;
+pub mod slicing;
 pub mod stipple;
 pub mod surfaces;
 pub mod sweep;

@@ -405,6 +405,12 @@ pub const FPS: Bound<u32> = Bound::closed(1, 240, "frames per second");
 /// I/N`).
 pub const SHARDS: Bound<u32> = Bound::at_least(1, "");
 
+/// Evenly spaced stills a motion picture adds to one per interval between critical levels.
+pub const MOTION_LEVELS: Bound<usize> = Bound::closed(0, 64, "stills");
+
+/// The tilt of a motion picture's direction that makes its height a Morse function.
+pub const PERTURB: Bound<f64> = Bound::closed(0.0, 10.0, "degrees");
+
 /// Slices of the halo depth in the viewer, whose slice textures live on the GPU.
 pub const VIEWER_SLICES: Bound<u32> = Bound::closed(2, 1024, "slices");
 
@@ -790,6 +796,8 @@ fn settings() -> Vec<Limit> {
         limit!(KEYFRAME_TIME, "`animation.keyframes[i].time`"),
         limit!(FPS, "`animation.fps`"),
         limit!(SHARDS, "N of `halo4d animate --shard I/N`"),
+        limit!(MOTION_LEVELS, "`halo4d slice --levels`"),
+        limit!(PERTURB, "`halo4d slice --perturb`"),
         limit!(VIEWER_SLICES, "the viewer's slices"),
         limit!(BENCH_FRAMES, "`halo4d-view --bench --frames`"),
         limit!(MAX_MEMORY, "`HALO4D_MAX_MEMORY`"),

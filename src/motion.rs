@@ -30,7 +30,7 @@
 use crate::limits::FieldError;
 use crate::sample::Mesh4;
 use crate::surfaces::Surface;
-use glam::DVec4;
+use glam::{DMat4, DVec4};
 use serde::Serialize;
 
 /// Newton steps from a critical vertex before it counts as not converged.
@@ -66,6 +66,16 @@ impl Event {
             Event::Saddle => Some(1),
             Event::Death => Some(2),
             Event::Degenerate => None,
+        }
+    }
+
+    /// Its name: birth, saddle, death or degenerate.
+    pub fn name(self) -> &'static str {
+        match self {
+            Event::Birth => "birth",
+            Event::Saddle => "saddle",
+            Event::Death => "death",
+            Event::Degenerate => "degenerate point",
         }
     }
 }
@@ -536,4 +546,251 @@ fn onto_level(
         (patch, u, v) = next;
     }
     best
+}
+
+/// The direction a view turns onto w, in the surface's own coordinates: Rᵀ e_w for the
+/// view's rotation R (the default direction of a motion picture, so that its slices are
+/// the view's levels of w).
+pub fn view_direction(rotation: DMat4) -> DVec4 {
+    rotation.transpose() * DVec4::W
+}
+
+/// An orthonormal frame of the hyperplanes ⟨n, x⟩ = c (n a unit vector): the view's x, y
+/// and z axes (Rᵀ e_x, Rᵀ e_y, Rᵀ e_z) turned by the smallest rotation that takes the
+/// view's w axis onto n (for n opposite to it, the half turn in the view's zw plane). For
+/// n the view's own w axis this is the view's x, y, z, so a slice is seen as the build's
+/// picture sees that level of w. A point x of the slice at level c has coordinates
+/// (⟨e_1, x⟩, ⟨e_2, x⟩, ⟨e_3, x⟩), its origin the point c n.
+pub fn hyperplane_frame(rotation: DMat4, n: DVec4) -> [DVec4; 3] {
+    let rt = rotation.transpose();
+    let axis = |k: usize| rt * DVec4::AXES[k];
+    let a = axis(3);
+    let cos = a.dot(n).clamp(-1.0, 1.0);
+    // The unit vector of the turn's plane perpendicular to a, towards n.
+    let across = n - a * cos;
+    let u = if across.length() > 1e-12 {
+        across.normalize()
+    } else {
+        axis(2)
+    };
+    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+    let (cos, sin) = if across.length() > 1e-12 || cos > 0.0 {
+        (cos, sin)
+    } else {
+        (-1.0, 0.0)
+    };
+    let turn = |x: DVec4| {
+        let (xa, xu) = (x.dot(a), x.dot(u));
+        x + (a * xa + u * xu) * (cos - 1.0) + (u * xa - a * xu) * sin
+    };
+    [0, 1, 2].map(|k| {
+        let e = turn(axis(k));
+        // Rounding of the turn taken off: exactly perpendicular to n.
+        (e - n * e.dot(n)).normalize()
+    })
+}
+
+/// `n` tilted by `degrees` towards the diagonal (e_1 + e_2 + e_3) / √3 of its hyperplane's
+/// `frame` (`--perturb`): a direction near n in no special position, the same on every run.
+pub fn tilt(n: DVec4, frame: &[DVec4; 3], degrees: f64) -> DVec4 {
+    let toward = (frame[0] + frame[1] + frame[2]).normalize();
+    let angle = degrees.to_radians();
+    (n * angle.cos() + toward * angle.sin()).normalize()
+}
+
+/// What is known of a surface's topology for the motion picture's checks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shape {
+    /// The Euler characteristic of a closed surface; `None` for a surface with boundary,
+    /// whose counts are not checked.
+    pub euler: Option<i64>,
+    /// Whether it is orientable (a saddle of a non-orientable surface may keep the slice's
+    /// number of components).
+    pub orientable: bool,
+}
+
+/// One still of a motion picture: the slice at a regular level.
+#[derive(Clone, Debug, Serialize)]
+pub struct Still {
+    /// The slice, its curves in 4D.
+    pub slice: Slice,
+    /// The interval of critical levels it lies in: 0 below the lowest critical point, k
+    /// between the k-th and the (k + 1)-th.
+    pub interval: usize,
+    /// Whether it is the interval's own still (else one of the evenly spaced ones asked).
+    pub between: bool,
+}
+
+/// A motion picture: the critical points of h = ⟨n, X⟩ and a still in every interval
+/// between them, with the checks of Morse theory.
+#[derive(Clone, Debug, Serialize)]
+pub struct MotionPicture {
+    /// The critical points, by level.
+    pub critical: Critical,
+    /// The frame of the hyperplanes, in which the stills' 3D coordinates are taken.
+    pub frame: [DVec4; 3],
+    /// The stills, by level.
+    pub stills: Vec<Still>,
+    /// The number of slice components in each interval (one more than the critical points).
+    pub components: Vec<usize>,
+    /// Each check that failed, saying what it found.
+    pub failures: Vec<String>,
+}
+
+impl Still {
+    /// The still's curves in the frame's 3D coordinates, each with whether it is closed.
+    pub fn in_frame(&self, frame: &[DVec4; 3]) -> Vec<(Vec<glam::DVec3>, bool)> {
+        self.slice
+            .curves
+            .iter()
+            .map(|c| {
+                let points = c
+                    .points
+                    .iter()
+                    .map(|p| glam::DVec3::new(p.dot(frame[0]), p.dot(frame[1]), p.dot(frame[2])))
+                    .collect();
+                (points, c.closed)
+            })
+            .collect()
+    }
+}
+
+/// The motion picture of `mesh` (its `surface` where it has one) along `n`, its
+/// hyperplanes' coordinates in `frame`: the critical points ([`critical_points`]), one
+/// still in each interval between consecutive critical levels and `extra` more at evenly
+/// spaced levels between the lowest and the highest, and the checks:
+///
+/// - on a closed surface, #minima - #saddles + #maxima = χ ([`Critical::morse`]);
+/// - across each critical level the slice's number of components changes as the event
+///   says: a birth adds one, a death removes one, a saddle adds or removes one (or, on a
+///   non-orientable surface, keeps the count);
+/// - each evenly spaced still has its interval's number of components.
+///
+/// The mesh's slice changes where its critical vertices are, and the refined levels lie
+/// near them: a still's level keeps clear of both (the middle of the gap between one
+/// critical point's higher and the next one's lower level), and an evenly spaced level
+/// that falls between a critical point's two levels is not checked. A surface with
+/// boundary (its shape's `euler` `None`) gets the stills without the checks.
+pub fn motion_picture(
+    mesh: &Mesh4,
+    surface: Option<&Surface>,
+    n: DVec4,
+    frame: [DVec4; 3],
+    shape: Shape,
+    extra: usize,
+) -> Result<MotionPicture, FieldError> {
+    let critical = critical_points(mesh, surface, n)?;
+    let n = critical.direction;
+    // Each critical point's band, from the lower to the higher of its refined level and
+    // its mesh vertex's, in the order of the vertices' levels: the mesh's slice changes
+    // where its critical vertices are.
+    struct Band {
+        lo: f64,
+        hi: f64,
+        vertex: f64,
+        point: CriticalPoint,
+    }
+    let mut bands: Vec<Band> = critical
+        .points
+        .iter()
+        .map(|&point| {
+            let vertex = mesh.positions[point.vertex as usize].dot(n);
+            Band {
+                lo: point.level.min(vertex),
+                hi: point.level.max(vertex),
+                vertex,
+                point,
+            }
+        })
+        .collect();
+    bands.sort_by(|a, b| a.vertex.total_cmp(&b.vertex));
+    let cut = |c: f64| slice(mesh, surface, n, c);
+    let mut stills = Vec::new();
+    let mut components = Vec::with_capacity(bands.len() + 1);
+    let mut failures = Vec::new();
+    for k in 0..=bands.len() {
+        // Below the lowest critical point and above the highest lie the mesh's lowest and
+        // highest vertices: nothing of the surface is there.
+        let count = if k == 0 || k == bands.len() {
+            0
+        } else {
+            let (lo, hi) = (bands[k - 1].hi, bands[k].lo);
+            let level = if lo < hi {
+                0.5 * (lo + hi)
+            } else {
+                0.5 * (bands[k - 1].vertex + bands[k].vertex)
+            };
+            let slice = cut(level);
+            let count = slice.curves.len();
+            stills.push(Still {
+                slice,
+                interval: k,
+                between: true,
+            });
+            count
+        };
+        components.push(count);
+    }
+    if extra > 0 && bands.len() >= 2 {
+        let (lo, hi) = (bands[0].lo, bands[bands.len() - 1].hi);
+        for i in 0..extra {
+            let level = lo + (hi - lo) * (i as f64 + 0.5) / extra as f64;
+            // One still at a level is enough.
+            if stills
+                .iter()
+                .any(|s: &Still| (s.slice.level - level).abs() <= 1e-9 * (hi - lo))
+            {
+                continue;
+            }
+            let interval = bands.iter().filter(|b| b.vertex < level).count();
+            let clear = bands.iter().all(|b| level < b.lo || level > b.hi);
+            let slice = cut(level);
+            if shape.euler.is_some() && clear && slice.curves.len() != components[interval] {
+                failures.push(format!(
+                    "the slice at {level} has {} components, its interval {interval} {}",
+                    slice.curves.len(),
+                    components[interval]
+                ));
+            }
+            stills.push(Still {
+                slice,
+                interval,
+                between: false,
+            });
+        }
+        stills.sort_by(|a, b| a.slice.level.total_cmp(&b.slice.level));
+    }
+    if let Some(euler) = shape.euler {
+        if let Err(e) = critical.morse(euler) {
+            failures.push(e);
+        }
+        for (k, band) in bands.iter().enumerate() {
+            let (below, above) = (components[k] as i64, components[k + 1] as i64);
+            let change = above - below;
+            let event = band.point.event;
+            let ok = match event {
+                Event::Birth => change == 1,
+                Event::Death => change == -1,
+                Event::Saddle if shape.orientable => change.abs() == 1,
+                Event::Saddle => change.abs() <= 1,
+                Event::Degenerate => true,
+            };
+            if !ok {
+                failures.push(format!(
+                    "across the {} at level {} (its mesh vertex at {}): {below} component(s) \
+                     below, {above} above",
+                    event.name(),
+                    band.point.level,
+                    band.vertex
+                ));
+            }
+        }
+    }
+    Ok(MotionPicture {
+        critical,
+        frame,
+        stills,
+        components,
+        failures,
+    })
 }

@@ -721,3 +721,118 @@ fn render_writes_beside_the_build_s_picture_and_refuses_an_out_that_is_not_a_png
     }
     assert!(!dir.path().join("x.jpg").exists());
 }
+
+#[test]
+fn slice_draws_the_spun_trefoils_square_knot_and_checks_its_critical_levels() {
+    // Along the spinning plane's w the spun trefoil's middle slice is the arc and its
+    // mirror image: the square knot, one curve with six crossings; either side of it two
+    // curves, and one curve nearest the extremes.
+    let dir = tempfile::tempdir().unwrap();
+    let out = halo4d(
+        &[
+            "slice",
+            "--direction",
+            "0,0,0,1",
+            "--levels",
+            "1",
+            "--out",
+            "m",
+            "-q",
+        ],
+        dir.path(),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("2 births, 2 saddles, 2 deaths (χ = 2)"),
+        "{err}"
+    );
+    let m = dir.path().join("m");
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(m.join("motion.json")).unwrap()).unwrap();
+    let surface = &json["surfaces"][0];
+    assert_eq!(json["verified"], true);
+    assert_eq!(
+        surface["components"],
+        serde_json::json!([0, 1, 2, 1, 2, 1, 0])
+    );
+    let stills: Vec<(u64, u64)> = surface["stills"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| {
+            (
+                s["curves"].as_u64().unwrap(),
+                s["crossings"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(stills, [(1, 0), (2, 4), (1, 6), (2, 4), (1, 0)]);
+    for f in [
+        "spun_trefoil-motion.png",
+        "spun_trefoil-motion.svg",
+        "spun_trefoil-still-02.ply",
+    ] {
+        assert!(m.join(f).is_file(), "{f}");
+    }
+    let svg = std::fs::read_to_string(m.join("spun_trefoil-motion.svg")).unwrap();
+    assert!(svg.contains("1 curve, 6 crossings") && svg.ends_with("</svg>\n"));
+}
+
+#[test]
+fn slice_fails_a_degenerate_direction_until_it_is_tilted_and_refuses_bad_flags() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = fixture("scenes/flat-torus.json");
+    let scene = scene.to_str().unwrap();
+    // Along w the flat torus's height has critical circles: exit 3, saying what to do.
+    let out = halo4d(
+        &["slice", scene, "--direction", "0,0,0,1", "--out", "a", "-q"],
+        dir.path(),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(
+        err.contains("FAILED") && err.contains("degenerate"),
+        "{err}"
+    );
+    let out = halo4d(
+        &[
+            "slice",
+            scene,
+            "--direction",
+            "0,0,0,1",
+            "--perturb",
+            "2",
+            "--out",
+            "b",
+            "-q",
+        ],
+        dir.path(),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("1 births, 2 saddles, 1 deaths (χ = 0)"),
+        "{err}"
+    );
+    for (flags, expected) in [
+        (
+            &["--direction", "0,0,0,0"][..],
+            "--direction: must be a nonzero",
+        ),
+        (&["--direction", "1,2"][..], "2 numbers; give four"),
+        (&["--direction", "1,x,0,0"][..], "`x` is not a number"),
+        (&["--perturb", "45"][..], "--perturb"),
+        (&["--levels", "100"][..], "--levels"),
+    ] {
+        let mut args = vec!["slice", scene, "--out", "c", "-q"];
+        args.extend_from_slice(flags);
+        let out = halo4d(&args, dir.path());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && err.contains(expected),
+            "{flags:?}: {err}"
+        );
+        assert!(!dir.path().join("c").exists(), "{flags:?} wrote files");
+    }
+}

@@ -1,8 +1,10 @@
 //! Critical points of a height function on the surfaces: exact levels on the flat torus,
 //! the Morse count on every closed catalogue surface, degenerate directions named.
 
-use glam::DVec4;
-use halo4d::motion::{Event, critical_points, slice};
+use glam::{DMat4, DVec4};
+use halo4d::motion::{
+    Event, Shape, critical_points, hyperplane_frame, motion_picture, slice, tilt, view_direction,
+};
 use halo4d::sample::{bounding_diagonal, sample_adaptive, sample_uniform};
 use halo4d::surfaces::{
     FlatTorus, KleinBottle, ProjectivePlane, SpunTrefoil, Surface, TwistSpunTrefoil,
@@ -245,4 +247,121 @@ fn across_each_critical_level_the_components_change_as_its_event_says() {
             surface.type_name()
         );
     }
+}
+
+/// Two directions from a seed, in no special position (SplitMix64 numbers in [-1, 1)).
+fn seeded(seed: u64) -> [DVec4; 2] {
+    let mut state = seed;
+    let mut next = || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        2.0 * ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64 - 1.0
+    };
+    [0, 1].map(|_| DVec4::new(next(), next(), next(), next()))
+}
+
+#[test]
+fn every_closed_catalogue_surface_has_a_motion_picture_that_passes_its_checks() {
+    // In two seeded directions each: the Morse count is χ, and across every critical level
+    // the components change as its event says; a wrong χ is caught.
+    for (k, (surface, euler, orientable)) in [
+        (Surface::SpunTrefoil(SpunTrefoil::default()), 2, true),
+        (
+            Surface::TwistSpunTrefoil(TwistSpunTrefoil::default()),
+            2,
+            true,
+        ),
+        (Surface::KleinBottle(KleinBottle::default()), 0, false),
+        (
+            Surface::ProjectivePlane(ProjectivePlane::default()),
+            1,
+            false,
+        ),
+        (Surface::FlatTorus(FlatTorus::default()), 0, true),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let d = bounding_diagonal(&surface);
+        let mesh = sample_adaptive(&surface, 2.5e-4 * d, 4_000_000).mesh;
+        for n in seeded(k as u64 + 40) {
+            let n = n.normalize();
+            let frame = hyperplane_frame(DMat4::IDENTITY, n);
+            let shape = Shape {
+                euler: Some(euler),
+                orientable,
+            };
+            let what = format!("{} along {n}", surface.type_name());
+            let picture = motion_picture(&mesh, Some(&surface), n, frame, shape, 3).unwrap();
+            assert_eq!(picture.failures, Vec::<String>::new(), "{what}");
+            let points = picture.critical.points.len();
+            assert_eq!(picture.components.len(), points + 1, "{what}");
+            assert!(picture.stills.len() >= points - 1, "{what}");
+            for still in &picture.stills {
+                assert!(still.slice.max_residual <= 1e-12, "{what}");
+                assert!(still.slice.curves.iter().all(|c| c.closed), "{what}");
+                // A still between critical levels has its interval's components.
+                if still.between {
+                    assert_eq!(
+                        still.slice.curves.len(),
+                        picture.components[still.interval],
+                        "{what}"
+                    );
+                }
+            }
+            let wrong = Shape {
+                euler: Some(euler + 2),
+                orientable,
+            };
+            let picture = motion_picture(&mesh, Some(&surface), n, frame, wrong, 0).unwrap();
+            assert!(
+                picture
+                    .failures
+                    .iter()
+                    .any(|f| f.contains("Euler characteristic")),
+                "{what}: {:?}",
+                picture.failures
+            );
+        }
+    }
+}
+
+#[test]
+fn the_hyperplane_frame_is_the_views_axes_turned_onto_the_direction() {
+    let rotation = halo4d::view::Rotation4 {
+        xy: 20.0,
+        xz: -35.0,
+        xw: 70.0,
+        yz: 10.0,
+        yw: -50.0,
+        zw: 125.0,
+    }
+    .matrix();
+    let w = view_direction(rotation);
+    // Along the view's own w: the view's x, y and z.
+    let frame = hyperplane_frame(rotation, w);
+    for (k, e) in frame.iter().enumerate() {
+        let axis = rotation.transpose() * DVec4::AXES[k];
+        assert!(e.distance(axis) <= 1e-14, "{e} against {axis}");
+    }
+    // Any direction, the opposite one included: orthonormal, perpendicular to n, and with
+    // n a frame of R^4 turned as the view's (determinant +1).
+    for n in seeded(7).into_iter().chain([-w, w + DVec4::X * 1e-13]) {
+        let n = n.normalize();
+        let [a, b, c] = hyperplane_frame(rotation, n);
+        for (i, e) in [a, b, c].iter().enumerate() {
+            assert!((e.length() - 1.0).abs() <= 1e-14);
+            assert!(e.dot(n).abs() <= 1e-14);
+            for f in &[a, b, c][i + 1..] {
+                assert!(e.dot(*f).abs() <= 1e-14);
+            }
+        }
+        let det = DMat4::from_cols(a, b, c, n).determinant();
+        assert!((det - 1.0).abs() <= 1e-12, "{det}");
+    }
+    // A tilt turns n by its angle, within the hyperplane's frame.
+    let tilted = tilt(w, &frame, 3.0);
+    assert!((tilted.dot(w).acos().to_degrees() - 3.0).abs() <= 1e-9);
 }

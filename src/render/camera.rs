@@ -272,7 +272,7 @@ fn towards_eye(settings: &CameraSettings, azimuth_offset: f64) -> DVec3 {
 }
 
 /// The view direction, right and up of `settings` turned by `azimuth_offset` degrees.
-fn basis(settings: &CameraSettings, azimuth_offset: f64) -> (DVec3, DVec3, DVec3) {
+pub(crate) fn basis(settings: &CameraSettings, azimuth_offset: f64) -> (DVec3, DVec3, DVec3) {
     let forward = -towards_eye(settings, azimuth_offset);
     let right = forward.cross(DVec3::Z).try_normalize().unwrap_or(DVec3::Y);
     let up = right.cross(forward);

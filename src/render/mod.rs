@@ -15,6 +15,7 @@ pub(crate) mod camera;
 pub(crate) mod clip;
 pub(crate) mod compare;
 mod contour;
+pub mod diagram;
 pub(crate) mod lines;
 pub(crate) mod overlay;
 pub(crate) mod shade;

@@ -127,6 +127,27 @@ impl Label {
     }
 }
 
+/// Draws `text` at `size` pixels in `ink` into the `width` x `height` image `rgb` (linear
+/// RGB, row-major), centred on `(x, y)` both ways (its pixels' box), clipped to the image.
+pub(super) fn draw_centred(
+    rgb: &mut [DVec3],
+    (width, _height): (usize, usize),
+    text: &str,
+    size: f64,
+    (x, y): (f64, f64),
+    ink: DVec3,
+) -> Result<(), String> {
+    let Some(label) = Label::new(text, size)? else {
+        return Ok(());
+    };
+    let dx = x.round() as i32 - (label.lo.0 + label.hi.0) / 2;
+    let dy = y.round() as i32 - (label.lo.1 + label.hi.1) / 2;
+    for &(px, py, c) in &label.pixels {
+        blend(rgb, width, (px + dx, py + dy), ink, c);
+    }
+    Ok(())
+}
+
 /// Labels the colour bar whose top row is `bar_top` and which spans columns `x0..x1` of the
 /// `width` x `height` image `rgb` (linear RGB, row-major) with the w of its left end, its
 /// middle and its right end, `w`: text in `ink` with a thin outline in `outline`, on one

@@ -73,6 +73,20 @@ pub enum Command {
     /// hidden sample (a build's own verdict), 1 when something failed (a `FAILED` line says
     /// what), 2 when the folder or its .glb cannot be read.
     Check(CheckArgs),
+    /// A motion picture of each surface of a scene: the surface cut by the hyperplanes
+    /// <n, x> = c of the surface's own 4D coordinates, its critical levels (births, saddles,
+    /// deaths) found on the mesh and refined by Newton's method on the exact surface, one
+    /// still between each pair of consecutive critical levels drawn as a link diagram (seen
+    /// from the scene's camera, every under-strand broken), checked by Morse theory: on a
+    /// closed surface #births - #saddles + #deaths = χ, and across each critical level the
+    /// slice's components change as its event says. Writes <name>-motion.png and .svg (the
+    /// stills in one strip), <name>-still-NN.ply (each still's curves in the hyperplane's
+    /// frame) and motion.json.
+    ///
+    /// Exit status 0 when every check passes, 3 when one fails (a FAILED line says which;
+    /// a degenerate direction, such as one with critical circles, is one: tilt it with
+    /// --perturb), 1 on an error.
+    Slice(SliceArgs),
 }
 
 /// The arguments of `halo4d build`.
@@ -224,4 +238,43 @@ pub struct CheckArgs {
     /// field data) file, or a folder with one scene .glb, as `halo4d build` writes them.
     #[arg(value_name = "FILE|DIR")]
     pub file: PathBuf,
+}
+
+/// The arguments of `halo4d slice`.
+#[derive(Args)]
+pub struct SliceArgs {
+    /// Scene file (JSON) [default: the built-in default scene].
+    pub scene: Option<PathBuf>,
+    /// The direction n as x,y,z,w in the surfaces' own coordinates, any nonzero length
+    /// [default: the direction the scene's view turns onto w].
+    #[arg(long, value_name = "X,Y,Z,W", allow_hyphen_values = true, value_parser = direction)]
+    pub direction: Option<[f64; 4]>,
+    /// Evenly spaced stills to add, between the lowest and the highest critical level.
+    #[arg(long, default_value_t = 0)]
+    pub levels: usize,
+    /// Tilt the direction by this many degrees (towards the diagonal of its hyperplane's
+    /// frame), to make the height a Morse function.
+    #[arg(long, default_value_t = 0.0, value_name = "DEGREES")]
+    pub perturb: f64,
+    /// Output folder [default: exports/<scene name>/motion/].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// No progress messages.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// Four comma-separated numbers.
+fn direction(s: &str) -> Result<[f64; 4], String> {
+    let numbers: Vec<f64> = s
+        .split(',')
+        .map(|x| {
+            x.trim()
+                .parse::<f64>()
+                .map_err(|_| format!("`{}` is not a number; give four numbers x,y,z,w", x.trim()))
+        })
+        .collect::<Result<_, _>>()?;
+    numbers
+        .try_into()
+        .map_err(|v: Vec<f64>| format!("{} numbers; give four: x,y,z,w", v.len()))
 }

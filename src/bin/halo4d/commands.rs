@@ -1,7 +1,9 @@
 //! What each command of `halo4d` does: one function per command, each giving the exit
 //! status.
 
-use crate::cli::{AnimateArgs, BuildArgs, CheckArgs, GalleryArgs, RenderArgs, SweepArgs, ViewArgs};
+use crate::cli::{
+    AnimateArgs, BuildArgs, CheckArgs, GalleryArgs, RenderArgs, SliceArgs, SweepArgs, ViewArgs,
+};
 use clap::ValueEnum;
 use halo4d::limits::{FieldError, shorten};
 use halo4d::{Scene, animate::Shard, render::Comparison, sweep};
@@ -417,4 +419,35 @@ fn flag_names(e: sweep::SweepError) -> sweep::SweepError {
         }),
         other => other,
     }
+}
+
+/// `halo4d slice`.
+pub fn slice(args: SliceArgs) -> Outcome {
+    let SliceArgs {
+        scene,
+        direction,
+        levels,
+        perturb,
+        out,
+        quiet,
+    } = args;
+    let scene = load(scene, quiet)?;
+    let out = out.unwrap_or_else(|| PathBuf::from("exports").join(&scene.name).join("motion"));
+    let slicing = halo4d::slicing::Slicing {
+        direction,
+        levels,
+        perturb,
+    };
+    let motion = halo4d::slicing::slice_scene(&scene, slicing, &out)?;
+    eprint!("{}", motion.summary());
+    for f in &motion.files {
+        println!("{}", out.join(f).display());
+    }
+    if motion.verified {
+        return Ok(ExitCode::SUCCESS);
+    }
+    eprintln!(
+        "the motion picture fails its checks: its files are written, motion.json lists the failures; exit status 3"
+    );
+    Ok(ExitCode::from(UNVERIFIED))
 }

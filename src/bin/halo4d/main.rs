@@ -18,6 +18,7 @@ fn main() -> ExitCode {
         Command::Gallery(args) => commands::gallery(args),
         Command::View(args) => commands::view(args),
         Command::Check(args) => commands::check(args),
+        Command::Slice(args) => commands::slice(args),
     };
     outcome.unwrap_or_else(|e| {
         eprintln!("error: {e}");

@@ -1,0 +1,422 @@
+//! A scene's motion pictures (`halo4d slice`): each surface cut by the hyperplanes
+//! ⟨n, x⟩ = c, its critical levels found and checked by Morse theory ([`crate::motion`]),
+//! one still between each pair of consecutive critical levels drawn as a link diagram, and
+//! the files: `<name>-motion.png` and `.svg` (the stills in one strip), `<name>-still-NN.ply`
+//! (each still's curves in the hyperplane's frame) and `motion.json` (the critical points,
+//! the components per interval, the stills and the verdict).
+
+use crate::error::Error;
+use crate::export::{Staged, StagedError};
+use crate::limits::{self, FieldError};
+use crate::motion::{self, MotionPicture, Shape};
+use crate::pipeline::Sampled;
+use crate::render::diagram;
+use crate::render::text::compact;
+use crate::sample::Source;
+use crate::scene::Scene;
+use glam::DVec4;
+use serde::Serialize;
+use std::path::Path;
+
+/// The stills' panels: pixels on a side, line width in pixels, panels per row.
+const PANEL: u32 = 360;
+const LINE: f64 = 2.5;
+const COLUMNS: usize = 5;
+
+/// Relative tolerances (of the surface's 4D diagonal) at which a catalogue or formula
+/// surface is sampled again, in turn, while its motion picture fails a check that a finer
+/// mesh can pass: a coarse mesh has pairs of critical vertices where the surface has none,
+/// and critical vertices in another order than the surface's critical levels.
+const FINER: [f64; 3] = [2.5e-4, 6.25e-5, 1.5625e-5];
+
+/// The most triangles of a surface sampled again.
+const FINER_TRIANGLES: usize = 4_000_000;
+
+/// What to slice along, and how many stills more.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Slicing {
+    /// The direction n in the surfaces' own 4D coordinates, any nonzero length; `None`:
+    /// the direction the scene's view turns onto w ([`motion::view_direction`]).
+    pub direction: Option<[f64; 4]>,
+    /// Evenly spaced stills besides one per interval.
+    pub levels: usize,
+    /// Degrees to tilt the direction by ([`motion::tilt`]), 0 for none.
+    pub perturb: f64,
+}
+
+/// Why a motion picture could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum SliceError {
+    /// A setting (a flag) is out of range.
+    #[error("{0}")]
+    Setting(FieldError),
+    /// Sampling, drawing or writing failed.
+    #[error(transparent)]
+    Build(#[from] Error),
+}
+
+/// One surface's motion picture as `motion.json` records it.
+#[derive(Clone, Debug, Serialize)]
+pub struct SurfaceMotion {
+    /// The surface's name.
+    pub name: String,
+    /// The unit direction n.
+    pub direction: DVec4,
+    /// The hyperplanes' frame: the stills' x, y and z axes in 4D.
+    pub frame: [DVec4; 3],
+    /// The Euler characteristic checked against (`None`: the surface has a boundary and
+    /// nothing is checked).
+    pub euler: Option<i64>,
+    /// (minima, saddles, maxima, degenerate).
+    pub counts: [usize; 4],
+    /// The critical points, by level.
+    pub critical_points: Vec<motion::CriticalPoint>,
+    /// Critical vertices of the mesh that Newton's method found no critical point from.
+    pub not_refined: usize,
+    /// The slice's components in each interval between critical levels.
+    pub components: Vec<usize>,
+    /// The stills.
+    pub stills: Vec<StillRecord>,
+    /// Each check that failed.
+    pub failures: Vec<String>,
+    /// The finer mesh the motion picture was made on, where the scene's failed a check
+    /// (`None`: the scene's own mesh).
+    pub resampled: Option<Resampled>,
+}
+
+/// A surface sampled again, finer, for its motion picture.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Resampled {
+    /// The adaptive sampler's tolerance, relative to the surface's 4D diagonal.
+    pub relative_tolerance: f64,
+    /// Its triangles.
+    pub triangles: usize,
+}
+
+/// A still as `motion.json` records it.
+#[derive(Clone, Debug, Serialize)]
+pub struct StillRecord {
+    /// Its level c.
+    pub level: f64,
+    /// Its interval (0 below the lowest critical level).
+    pub interval: usize,
+    /// Whether it is its interval's own still (else an evenly spaced one).
+    pub between: bool,
+    /// Its curves.
+    pub curves: usize,
+    /// Crossings of its link diagram.
+    pub crossings: usize,
+    /// The largest |h - c| of its points moved onto the surface.
+    pub max_residual: f64,
+    /// Points left on the mesh.
+    pub not_converged: usize,
+    /// Its PLY file.
+    pub file: String,
+}
+
+/// A scene's motion pictures.
+#[derive(Clone, Debug, Serialize)]
+pub struct Motion {
+    /// The scene's name.
+    pub scene: String,
+    /// The tilt applied, degrees.
+    pub perturb: f64,
+    /// Each surface's.
+    pub surfaces: Vec<SurfaceMotion>,
+    /// Whether every check passed.
+    pub verified: bool,
+    /// The files written.
+    pub files: Vec<String>,
+}
+
+impl Motion {
+    /// A few lines for the terminal: per surface its critical points, its stills and its
+    /// verdict.
+    pub fn summary(&self) -> String {
+        let mut out = String::new();
+        for s in &self.surfaces {
+            let [min, saddle, max, degenerate] = s.counts;
+            let euler = s
+                .euler
+                .map_or("a surface with boundary: not checked".to_string(), |e| {
+                    format!("χ = {e}")
+                });
+            if let Some(r) = s.resampled {
+                out += &format!(
+                    "{}: sampled again at {:e} of its diagonal ({} triangles) for the checks\n",
+                    s.name, r.relative_tolerance, r.triangles
+                );
+            }
+            out += &format!(
+                "{}: {min} births, {saddle} saddles, {max} deaths{} ({euler}); components per interval {:?}\n",
+                s.name,
+                if degenerate > 0 {
+                    format!(", {degenerate} degenerate")
+                } else {
+                    String::new()
+                },
+                s.components
+            );
+            for still in &s.stills {
+                out += &format!(
+                    "  c = {:+.6}: {} curve(s), {} crossing(s)\n",
+                    still.level, still.curves, still.crossings
+                );
+            }
+            for f in &s.failures {
+                out += &format!("  FAILED {f}\n");
+            }
+        }
+        out
+    }
+}
+
+/// Makes the motion pictures of every surface of `scene` along `slicing` into `out`
+/// (files written under temporary names and moved into place together).
+pub fn slice_scene(scene: &Scene, slicing: Slicing, out: &Path) -> Result<Motion, SliceError> {
+    limits::MOTION_LEVELS
+        .check("--levels", slicing.levels)
+        .map_err(SliceError::Setting)?;
+    limits::PERTURB
+        .check("--perturb", slicing.perturb)
+        .map_err(SliceError::Setting)?;
+    let rotation = scene.view.rotation.matrix();
+    let n = match slicing.direction {
+        Some(d) => DVec4::from_array(d),
+        None => motion::view_direction(rotation),
+    };
+    let length = n.length();
+    if !(length.is_finite() && length > 0.0) {
+        return Err(SliceError::Setting(FieldError::new(
+            "--direction",
+            format!("must be a nonzero, finite 4D vector x,y,z,w; got {n}"),
+        )));
+    }
+    let mut n = n / length;
+    if slicing.perturb > 0.0 {
+        n = motion::tilt(n, &motion::hyperplane_frame(rotation, n), slicing.perturb);
+    }
+    let frame = motion::hyperplane_frame(rotation, n);
+    let sampled = Sampled::of(scene);
+    let staged = Staged::new(out).map_err(staged_error)?;
+    let mut surfaces = Vec::new();
+    let mut files = Vec::new();
+    for ((name, mesh), entry) in sampled.meshes().zip(&scene.surfaces) {
+        let (surface, shape) = match &entry.surface {
+            Source::Parametric(s) => {
+                let t = s.topology();
+                let euler = if t.closed {
+                    t.euler_characteristic
+                } else {
+                    None
+                };
+                (
+                    Some(s),
+                    Shape {
+                        euler,
+                        orientable: t.orientable,
+                    },
+                )
+            }
+            Source::Mesh(_) => {
+                let stats = mesh.validate();
+                let closed = stats.boundary_edges == 0 && stats.is_manifold();
+                (
+                    None,
+                    Shape {
+                        euler: closed.then_some(stats.euler_characteristic),
+                        orientable: stats.orientation_conflicts == 0,
+                    },
+                )
+            }
+        };
+        let cut = |mesh: &crate::sample::Mesh4| {
+            motion::motion_picture(mesh, surface, n, frame, shape, slicing.levels)
+                .map_err(SliceError::Setting)
+        };
+        let mut picture = cut(mesh)?;
+        let mut resampled = None;
+        if let Some(s) = surface {
+            let diagonal = crate::sample::bounding_diagonal(s);
+            for relative in FINER {
+                // A degenerate direction stays degenerate on any mesh.
+                if picture.failures.is_empty() || picture.critical.counts()[3] > 0 {
+                    break;
+                }
+                let finer = crate::sample::sample_adaptive(s, relative * diagonal, FINER_TRIANGLES);
+                picture = cut(&finer.mesh)?;
+                resampled = Some((relative, finer.mesh.triangles.len()));
+            }
+        }
+        let (mut record, written) = write_surface(scene, name, &picture, shape, &staged)?;
+        record.resampled = resampled.map(|(relative_tolerance, triangles)| Resampled {
+            relative_tolerance,
+            triangles,
+        });
+        files.extend(written);
+        surfaces.push(record);
+    }
+    files.push("motion.json".into());
+    let motion = Motion {
+        scene: scene.name.clone(),
+        perturb: slicing.perturb,
+        verified: surfaces.iter().all(|s| s.failures.is_empty()),
+        surfaces,
+        files,
+    };
+    let json = serde_json::to_vec_pretty(&motion).map_err(|e| Error::Internal {
+        stage: "motion",
+        message: e.to_string(),
+    })?;
+    staged
+        .write("motion.json".into(), &json)
+        .map_err(staged_error)?;
+    staged.commit().map_err(staged_error)?;
+    Ok(motion)
+}
+
+/// One surface's strip, stills and record, its files staged.
+fn write_surface(
+    scene: &Scene,
+    name: &str,
+    picture: &MotionPicture,
+    shape: Shape,
+    staged: &Staged,
+) -> Result<(SurfaceMotion, Vec<String>), SliceError> {
+    let critical = &picture.critical;
+    let step = critical
+        .points
+        .windows(2)
+        .map(|w| w[1].level - w[0].level)
+        .fold(f64::INFINITY, f64::min);
+    let step = if step.is_finite() { step } else { 1.0 };
+    let curves: Vec<_> = picture
+        .stills
+        .iter()
+        .map(|still| still.in_frame(&picture.frame))
+        .collect();
+    let pages = diagram::pages(&curves, &scene.camera, PANEL);
+    let labels: Vec<(String, String)> = picture
+        .stills
+        .iter()
+        .zip(&pages)
+        .map(|(still, page)| {
+            let after = critical
+                .points
+                .iter()
+                .rev()
+                .find(|p| p.level < still.slice.level)
+                .map(|p| format!(" · after a {}", p.event.name()))
+                .unwrap_or_default();
+            let (curves, crossings) = (still.slice.curves.len(), page.under.len());
+            (
+                format!("c = {}{after}", compact(still.slice.level, step)),
+                format!(
+                    "{curves} curve{}, {crossings} crossing{}",
+                    if curves == 1 { "" } else { "s" },
+                    if crossings == 1 { "" } else { "s" }
+                ),
+            )
+        })
+        .collect();
+    let (strip, svg) =
+        diagram::draw_strip(&pages, &labels, COLUMNS, PANEL, LINE).map_err(|e| Error::Render {
+            scene: scene.name.clone(),
+            source: e,
+        })?;
+    let mut files = Vec::new();
+    let mut write = |file: String, bytes: &[u8]| -> Result<String, SliceError> {
+        let file = staged.write(file, bytes).map_err(staged_error)?;
+        files.push(file.clone());
+        Ok(file)
+    };
+    write(format!("{name}-motion.png"), &strip.png())?;
+    write(format!("{name}-motion.svg"), svg.as_bytes())?;
+    let mut stills = Vec::new();
+    for (k, ((still, page), curves)) in picture.stills.iter().zip(&pages).zip(&curves).enumerate() {
+        let file = write(
+            format!("{name}-still-{k:02}.ply"),
+            &still_ply(curves, still.slice.level, name),
+        )?;
+        stills.push(StillRecord {
+            level: still.slice.level,
+            interval: still.interval,
+            between: still.between,
+            curves: still.slice.curves.len(),
+            crossings: page.under.len(),
+            max_residual: still.slice.max_residual,
+            not_converged: still.slice.not_converged,
+            file,
+        });
+    }
+    let record = SurfaceMotion {
+        name: name.to_string(),
+        direction: critical.direction,
+        frame: picture.frame,
+        euler: shape.euler,
+        counts: critical.counts(),
+        critical_points: critical.points.clone(),
+        not_refined: critical.not_converged.len(),
+        components: picture.components.clone(),
+        stills,
+        failures: picture.failures.clone(),
+        resampled: None,
+    };
+    Ok((record, files))
+}
+
+/// A still's curves as a binary little-endian PLY: per point x, y, z in the hyperplane's
+/// frame (double) and its curve's index (float); per segment an `edge` (a closed curve's
+/// last point back to its first).
+fn still_ply(curves: &[(Vec<glam::DVec3>, bool)], level: f64, name: &str) -> Vec<u8> {
+    let vertices: usize = curves.iter().map(|c| c.0.len()).sum();
+    let edges: usize = curves
+        .iter()
+        .map(|(p, closed)| {
+            if *closed {
+                p.len()
+            } else {
+                p.len().saturating_sub(1)
+            }
+        })
+        .sum();
+    let header = format!(
+        "ply\nformat binary_little_endian 1.0\n\
+         comment halo4d {}: surface {name}, slice at level {level:e}, in the hyperplane's frame\n\
+         element vertex {vertices}\n\
+         property double x\nproperty double y\nproperty double z\nproperty float curve\n\
+         element edge {edges}\n\
+         property int vertex1\nproperty int vertex2\n\
+         end_header\n",
+        env!("CARGO_PKG_VERSION"),
+    );
+    let mut out = header.into_bytes();
+    for (k, (points, _)) in curves.iter().enumerate() {
+        for p in points {
+            for x in p.to_array() {
+                out.extend_from_slice(&x.to_le_bytes());
+            }
+            out.extend_from_slice(&(k as f32).to_le_bytes());
+        }
+    }
+    let mut first = 0i32;
+    for (points, closed) in curves {
+        let n = points.len() as i32;
+        let count = if *closed { n } else { (n - 1).max(0) };
+        for i in 0..count {
+            for v in [first + i, first + (i + 1) % n] {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        first += n;
+    }
+    out
+}
+
+/// A staging failure as the build's error.
+fn staged_error(e: StagedError) -> SliceError {
+    SliceError::Build(match e {
+        StagedError::Io { path, source } => Error::Write { path, source },
+        busy => Error::Busy(busy),
+    })
+}
