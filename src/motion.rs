@@ -670,7 +670,7 @@ impl Still {
 /// near them: a still's level keeps clear of both (the middle of the gap between one
 /// critical point's higher and the next one's lower level), and an evenly spaced level
 /// that falls between a critical point's two levels is not checked. A surface with
-/// boundary (its shape's `euler` `None`) gets the stills without the checks.
+/// boundary (its shape's `euler` `None`) gets the stills, its end intervals' too, without the checks.
 pub fn motion_picture(
     mesh: &Mesh4,
     surface: Option<&Surface>,
@@ -705,17 +705,34 @@ pub fn motion_picture(
         .collect();
     bands.sort_by(|a, b| a.vertex.total_cmp(&b.vertex));
     let cut = |c: f64| slice(mesh, surface, n, c);
+    let closed = shape.euler.is_some();
+    let (lowest, highest) = mesh
+        .positions
+        .iter()
+        .map(|p| p.dot(n))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| {
+            (lo.min(h), hi.max(h))
+        });
     let mut stills = Vec::new();
     let mut components = Vec::with_capacity(bands.len() + 1);
     let mut failures = Vec::new();
     for k in 0..=bands.len() {
-        // Below the lowest critical point and above the highest lie the mesh's lowest and
-        // highest vertices: nothing of the surface is there.
-        let count = if k == 0 || k == bands.len() {
+        // On a closed surface the mesh's lowest and highest vertices are critical: nothing
+        // lies below the lowest critical point or above the highest. A surface with
+        // boundary reaches past them: its end intervals have stills too, between the
+        // critical levels and the mesh's extreme heights.
+        let (lo, hi) = (
+            if k == 0 { lowest } else { bands[k - 1].hi },
+            if k == bands.len() {
+                highest
+            } else {
+                bands[k].lo
+            },
+        );
+        let count = if closed && (k == 0 || k == bands.len()) {
             0
         } else {
-            let (lo, hi) = (bands[k - 1].hi, bands[k].lo);
-            let level = if lo < hi {
+            let level = if lo < hi || k == 0 || k == bands.len() {
                 0.5 * (lo + hi)
             } else {
                 0.5 * (bands[k - 1].vertex + bands[k].vertex)

@@ -104,6 +104,10 @@ pub struct StillRecord {
     pub between: bool,
     /// Its curves.
     pub curves: usize,
+    /// Its points (the PLY's vertices).
+    pub points: usize,
+    /// Its segments (the PLY's edges).
+    pub segments: usize,
     /// Crossings of its link diagram.
     pub crossings: usize,
     /// The largest |h - c| of its points moved onto the surface.
@@ -343,6 +347,8 @@ fn write_surface(
             interval: still.interval,
             between: still.between,
             curves: still.slice.curves.len(),
+            points: curves.iter().map(|c| c.0.len()).sum(),
+            segments: curves.iter().map(segments).sum(),
             crossings: page.under.len(),
             max_residual: still.slice.max_residual,
             not_converged: still.slice.not_converged,
@@ -400,10 +406,9 @@ fn still_ply(curves: &[(Vec<glam::DVec3>, bool)], level: f64, name: &str) -> Vec
         }
     }
     let mut first = 0i32;
-    for (points, closed) in curves {
-        let n = points.len() as i32;
-        let count = if *closed { n } else { (n - 1).max(0) };
-        for i in 0..count {
+    for curve in curves {
+        let n = curve.0.len() as i32;
+        for i in 0..segments(curve) as i32 {
             for v in [first + i, first + (i + 1) % n] {
                 out.extend_from_slice(&v.to_le_bytes());
             }
@@ -411,6 +416,15 @@ fn still_ply(curves: &[(Vec<glam::DVec3>, bool)], level: f64, name: &str) -> Vec
         first += n;
     }
     out
+}
+
+/// The segments of a curve: one per point when it closes, else one fewer.
+fn segments((points, closed): &(Vec<glam::DVec3>, bool)) -> usize {
+    if *closed {
+        points.len()
+    } else {
+        points.len().saturating_sub(1)
+    }
 }
 
 /// A staging failure as the build's error.

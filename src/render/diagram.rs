@@ -30,9 +30,12 @@ const PALETTE: [[f64; 3]; 6] = [
     [0.030, 0.350, 0.420],
 ];
 
-/// The page's colour (linear RGB) and the panels' frames'.
+/// The page's colour (linear RGB).
 const PAPER: DVec3 = DVec3::ONE;
-const FRAME: DVec3 = DVec3::splat(0.6);
+/// The panels' frames': a light blue, which no curve's colour and no shade of the labels'
+/// grey comes near.
+const FRAME: DVec3 = DVec3::new(0.35, 0.55, 0.95);
+/// The labels'.
 const INK: DVec3 = DVec3::splat(0.02);
 
 /// A panel's curves on the page: each point in pixels of the panel with its depth (larger
@@ -278,7 +281,7 @@ pub fn draw_strip(
         r#"<?xml version="1.0" encoding="UTF-8"?>
 <svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}">
 <rect width="{width}" height="{height}" fill="{}"/>"#,
-        hex(PAPER)
+        srgb(PAPER)
     );
     let mut broadener = Broadener::new();
     let empty = (String::new(), String::new());
@@ -294,7 +297,7 @@ pub fn draw_strip(
             r#"<rect x="{x0}.5" y="{y0}.5" width="{}" height="{}" fill="none" stroke="{}"/>"#,
             side - 1,
             side - 1,
-            hex(FRAME)
+            srgb(FRAME)
         );
         frame(&mut rgb, width as usize, (x0, y0), side);
         for (c, (points, closed)) in page.curves.iter().enumerate() {
@@ -314,7 +317,7 @@ pub fn draw_strip(
                 let _ = write!(
                     svg,
                     r#"<path fill="none" stroke="{}" stroke-width="{line:.2}" stroke-linecap="round" stroke-linejoin="round" d=""#,
-                    hex(colour)
+                    srgb(colour)
                 );
                 for (i, p) in run.iter().enumerate() {
                     let _ = write!(
@@ -356,7 +359,7 @@ pub fn draw_strip(
                 svg,
                 r#"<text x="{x:.1}" y="{:.1}" font-family="DejaVu Sans Mono, monospace" font-size="{text_size}" text-anchor="middle" dominant-baseline="central" fill="{}">{}</text>"#,
                 y,
-                hex(INK),
+                srgb(INK),
                 escape(label)
             );
         }
@@ -391,10 +394,10 @@ fn frame(rgb: &mut [DVec3], width: usize, (x0, y0): (u32, u32), side: u32) {
     }
 }
 
-/// A linear colour as SVG's sRGB hex.
-fn hex(c: DVec3) -> String {
+/// A linear colour as SVG's sRGB `rgb(r,g,b)`, as the picture's SVG writes it.
+fn srgb(c: DVec3) -> String {
     let [r, g, b] = c.to_array().map(super::to_srgb8);
-    format!("#{r:02x}{g:02x}{b:02x}")
+    format!("rgb({r},{g},{b})")
 }
 
 /// Text made safe for XML.
