@@ -27,11 +27,11 @@
 //! #minima - #saddles + #maxima = χ, the surface's Euler characteristic
 //! ([`Critical::morse`]).
 
-use crate::limits::FieldError;
+use crate::limits::{self, FieldError};
 use crate::sample::Mesh4;
 use crate::surfaces::Surface;
 use glam::{DMat4, DVec4};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Newton steps from a critical vertex before it counts as not converged.
 const NEWTON_STEPS: usize = 60;
@@ -596,6 +596,38 @@ pub fn tilt(n: DVec4, frame: &[DVec4; 3], degrees: f64) -> DVec4 {
     let toward = (frame[0] + frame[1] + frame[2]).normalize();
     let angle = degrees.to_radians();
     (n * angle.cos() + toward * angle.sin()).normalize()
+}
+
+/// A scene's `slicing`: what `halo4d slice` cuts its surfaces along (its flags override
+/// these).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Slicing {
+    /// The direction n in the surfaces' own 4D coordinates, any nonzero length; absent:
+    /// the direction the scene's view turns onto w ([`view_direction`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub direction: Option<[f64; 4]>,
+    /// Evenly spaced stills besides one per interval between critical levels.
+    pub levels: usize,
+    /// Degrees to tilt the direction by ([`tilt`]), 0 for none.
+    pub perturb: f64,
+}
+
+impl Slicing {
+    /// Checks every value; names the first bad field.
+    pub fn check(&self) -> Result<(), FieldError> {
+        if let Some(d) = self.direction {
+            let length = DVec4::from_array(d).length();
+            if !(length.is_finite() && length > 0.0) {
+                return Err(FieldError::new(
+                    "direction",
+                    format!("must be a nonzero, finite 4D vector [x, y, z, w]; got {d:?}"),
+                ));
+            }
+        }
+        limits::MOTION_LEVELS.check("levels", self.levels)?;
+        limits::PERTURB.check("perturb", self.perturb)
+    }
 }
 
 /// What is known of a surface's topology for the motion picture's checks.

@@ -6,6 +6,7 @@
 //! is allowed. No input makes the parser panic.
 
 use crate::animation::Animation;
+use crate::motion::Slicing;
 use crate::halo::HaloParams;
 use crate::intersect::CurveSettings;
 use crate::limits::shorten;
@@ -55,6 +56,10 @@ pub struct Scene {
     /// camera.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub animation: Option<Animation>,
+    /// What `halo4d slice` cuts the surfaces along: the direction, evenly spaced stills
+    /// and a tilt.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slicing: Option<Slicing>,
 }
 
 /// One surface of a scene.
@@ -379,6 +384,9 @@ impl Scene {
         if let Some(a) = &self.animation {
             a.check(&self.view, &self.camera)
                 .map_err(|e| e.within("animation"))?;
+        }
+        if let Some(slicing) = &self.slicing {
+            slicing.check().map_err(|e| e.within("slicing"))?;
         }
         Ok(())
     }

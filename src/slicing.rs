@@ -7,8 +7,8 @@
 
 use crate::error::Error;
 use crate::export::{Staged, StagedError};
-use crate::limits::{self, FieldError};
-use crate::motion::{self, MotionPicture, Shape};
+use crate::limits::FieldError;
+use crate::motion::{self, MotionPicture, Shape, Slicing};
 use crate::pipeline::Sampled;
 use crate::render::diagram;
 use crate::render::text::compact;
@@ -31,18 +31,6 @@ const FINER: [f64; 3] = [2.5e-4, 6.25e-5, 1.5625e-5];
 
 /// The most triangles of a surface sampled again.
 const FINER_TRIANGLES: usize = 4_000_000;
-
-/// What to slice along, and how many stills more.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Slicing {
-    /// The direction n in the surfaces' own 4D coordinates, any nonzero length; `None`:
-    /// the direction the scene's view turns onto w ([`motion::view_direction`]).
-    pub direction: Option<[f64; 4]>,
-    /// Evenly spaced stills besides one per interval.
-    pub levels: usize,
-    /// Degrees to tilt the direction by ([`motion::tilt`]), 0 for none.
-    pub perturb: f64,
-}
 
 /// Why a motion picture could not be made.
 #[derive(Debug, thiserror::Error)]
@@ -175,28 +163,19 @@ impl Motion {
     }
 }
 
-/// Makes the motion pictures of every surface of `scene` along `slicing` into `out`
+/// Makes the motion pictures of every surface of `scene` along `slicing` (the scene's
+/// `slicing`, or other settings) into `out`
 /// (files written under temporary names and moved into place together).
 pub fn slice_scene(scene: &Scene, slicing: Slicing, out: &Path) -> Result<Motion, SliceError> {
-    limits::MOTION_LEVELS
-        .check("--levels", slicing.levels)
-        .map_err(SliceError::Setting)?;
-    limits::PERTURB
-        .check("--perturb", slicing.perturb)
-        .map_err(SliceError::Setting)?;
+    slicing
+        .check()
+        .map_err(|e| SliceError::Setting(e.within("slicing")))?;
     let rotation = scene.view.rotation.matrix();
     let n = match slicing.direction {
         Some(d) => DVec4::from_array(d),
         None => motion::view_direction(rotation),
     };
-    let length = n.length();
-    if !(length.is_finite() && length > 0.0) {
-        return Err(SliceError::Setting(FieldError::new(
-            "--direction",
-            format!("must be a nonzero, finite 4D vector x,y,z,w; got {n}"),
-        )));
-    }
-    let mut n = n / length;
+    let mut n = n.normalize();
     if slicing.perturb > 0.0 {
         n = motion::tilt(n, &motion::hyperplane_frame(rotation, n), slicing.perturb);
     }

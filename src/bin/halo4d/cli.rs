@@ -246,16 +246,19 @@ pub struct SliceArgs {
     /// Scene file (JSON) [default: the built-in default scene].
     pub scene: Option<PathBuf>,
     /// The direction n as x,y,z,w in the surfaces' own coordinates, any nonzero length
-    /// [default: the direction the scene's view turns onto w].
+    /// [default: the scene's `slicing.direction`, else the direction the scene's view turns
+    /// onto w].
     #[arg(long, value_name = "X,Y,Z,W", allow_hyphen_values = true, value_parser = direction)]
     pub direction: Option<[f64; 4]>,
-    /// Evenly spaced stills to add, between the lowest and the highest critical level.
-    #[arg(long, default_value_t = 0)]
-    pub levels: usize,
+    /// Evenly spaced stills to add, between the lowest and the highest critical level
+    /// [default: the scene's `slicing.levels`, else 0].
+    #[arg(long)]
+    pub levels: Option<usize>,
     /// Tilt the direction by this many degrees (towards the diagonal of its hyperplane's
-    /// frame), to make the height a Morse function.
-    #[arg(long, default_value_t = 0.0, value_name = "DEGREES")]
-    pub perturb: f64,
+    /// frame), to make the height a Morse function [default: the scene's
+    /// `slicing.perturb`, else 0].
+    #[arg(long, value_name = "DEGREES")]
+    pub perturb: Option<f64>,
     /// Output folder [default: exports/<scene name>/motion/].
     #[arg(long)]
     pub out: Option<PathBuf>,

@@ -431,12 +431,23 @@ pub fn slice(args: SliceArgs) -> Outcome {
         out,
         quiet,
     } = args;
+    // The flags first, named as flags: a bad one stops the command before the sampling.
+    let flags = halo4d::motion::Slicing {
+        direction,
+        levels: levels.unwrap_or(0),
+        perturb: perturb.unwrap_or(0.0),
+    };
+    flags.check().map_err(|e| FieldError {
+        field: format!("--{}", e.field),
+        ..e
+    })?;
     let scene = load(scene, quiet)?;
     let out = out.unwrap_or_else(|| PathBuf::from("exports").join(&scene.name).join("motion"));
-    let slicing = halo4d::slicing::Slicing {
-        direction,
-        levels,
-        perturb,
+    let from_scene = scene.slicing.unwrap_or_default();
+    let slicing = halo4d::motion::Slicing {
+        direction: direction.or(from_scene.direction),
+        levels: levels.unwrap_or(from_scene.levels),
+        perturb: perturb.unwrap_or(from_scene.perturb),
     };
     let motion = halo4d::slicing::slice_scene(&scene, slicing, &out)?;
     eprint!("{}", motion.summary());
