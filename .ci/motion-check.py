@@ -3,24 +3,27 @@
 Usage: motion-check.py FOLDER [FOLDER...]   (each what `halo4d slice --out FOLDER` wrote)
 
 For every still of every surface in FOLDER/motion.json: MeshLab (pymeshlab) and VTK
-(vtkPLYReader) read its PLY with the points and segments motion.json counts,
-every point finite; the strip's PNG opens (Pillow) at the size of its panels and draws ink
+(vtkPLYReader) read its PLY with the points and segments motion.json counts, every point
+finite; Blender (bpy) imports the surface's -motion.glb with one object per still, at its
+level, and a mesh for each still with curves; the strip's PNG opens (Pillow) at the size of its panels and draws ink
 in every panel that has curves. Fails when motion.json says the checks failed.
 """
 
 import json
 import math
+import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
-import pymeshlab
-import vtk
-import vtk.util.numpy_support
 from PIL import Image
 
 
 def check_still(path, still):
+    import pymeshlab
+    import vtk
+    import vtk.util.numpy_support
+
     problems = []
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(str(path))
@@ -42,6 +45,42 @@ def check_still(path, still):
     return problems
 
 
+def check_glb(path, stills):
+    """Blender's import, in a process of its own: bpy and the other programs' libraries
+    (Embree among them) do not load into one process."""
+    p = subprocess.run(
+        [sys.executable, __file__, "--child-glb", str(path), json.dumps(stills)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    if p.returncode != 0:
+        return [f"Blender: exit status {p.returncode}: {(p.stdout + p.stderr).strip()[-500:]}"]
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def child_glb(path, stills):
+    import bpy
+
+    stills = json.loads(stills)
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.import_scene.gltf(filepath=str(path))
+    objects = {o.name: o for o in bpy.data.objects if o.name.startswith("still-")}
+    problems = []
+    if len(objects) != len(stills):
+        problems.append(f"Blender imports {len(objects)} stills, motion.json has {len(stills)}")
+    for k, still in enumerate(stills):
+        o = objects.get(f"still-{k:02}")
+        if o is None:
+            continue
+        if abs(o.get("level", math.nan) - still["level"]) > 1e-12 * max(1.0, abs(still["level"])):
+            problems.append(f"still-{k:02}: level {o.get('level')} in Blender, {still['level']} in motion.json")
+        if still["curves"] > 0 and (o.type != "MESH" or len(o.data.polygons) == 0):
+            problems.append(f"still-{k:02}: {still['curves']} curves but no tubes in Blender")
+    print(json.dumps(problems))
+
+
 def check_folder(folder):
     folder = Path(folder)
     motion = json.loads((folder / "motion.json").read_text())
@@ -53,6 +92,7 @@ def check_folder(folder):
         problems += [f"{name}: {f}" for f in surface["failures"]]
         for still in surface["stills"]:
             problems += [f"{still['file']}: {p}" for p in check_still(folder / still["file"], still)]
+        problems += [f"{name}-motion.glb: {p}" for p in check_glb(folder / f"{name}-motion.glb", surface["stills"])]
         picture = np.asarray(Image.open(folder / f"{name}-motion.png").convert("L"))
         panels = len(surface["stills"])
         columns = min(panels, 5)
@@ -68,12 +108,15 @@ def check_folder(folder):
                 problems.append(f"{name}: panel {k} ({still['curves']} curves) draws {inked} pixels")
         print(
             f"  {folder.name}/{name}: {panels} stills, {sum(s['points'] for s in surface['stills'])} points, "
-            f"{sum(s['crossings'] for s in surface['stills'])} crossings; MeshLab and VTK read every still"
+            f"{sum(s['crossings'] for s in surface['stills'])} crossings; MeshLab and VTK read every still, Blender its .glb"
         )
     return problems
 
 
 def main():
+    if sys.argv[1:2] == ["--child-glb"]:
+        child_glb(*sys.argv[2:])
+        return
     if len(sys.argv) < 2:
         print(__doc__)
         sys.exit(2)

@@ -6,11 +6,11 @@
 //! is allowed. No input makes the parser panic.
 
 use crate::animation::Animation;
-use crate::motion::Slicing;
 use crate::halo::HaloParams;
 use crate::intersect::CurveSettings;
 use crate::limits::shorten;
 use crate::limits::{FieldError, NAME_LENGTH, SURFACES, TRIANGLES, TUBE_RADIUS};
+use crate::motion::Slicing;
 use crate::render::{CameraSettings, RenderSettings};
 use crate::sample::{Sampling, Source};
 use crate::view::View;

@@ -1,8 +1,9 @@
 //! A scene's motion pictures (`halo4d slice`): each surface cut by the hyperplanes
 //! ⟨n, x⟩ = c, its critical levels found and checked by Morse theory ([`crate::motion`]),
 //! one still between each pair of consecutive critical levels drawn as a link diagram, and
-//! the files: `<name>-motion.png` and `.svg` (the stills in one strip), `<name>-still-NN.ply`
-//! (each still's curves in the hyperplane's frame) and `motion.json` (the critical points,
+//! the files: `<name>-motion.png` and `.svg` (the stills in one strip), `<name>-motion.glb`
+//! (their curves as tubes, side by side), `<name>-still-NN.ply` (each still's curves in the
+//! hyperplane's frame) and `motion.json` (the critical points,
 //! the components per interval, the stills and the verdict).
 
 use crate::error::Error;
@@ -314,12 +315,16 @@ fn write_surface(
         Ok(file)
     };
     write(format!("{name}-motion.png"), &strip.png())?;
+    write(
+        format!("{name}-motion.glb"),
+        &stills_glb(scene, name, picture, &curves)?,
+    )?;
     write(format!("{name}-motion.svg"), svg.as_bytes())?;
     let mut stills = Vec::new();
     for (k, ((still, page), curves)) in picture.stills.iter().zip(&pages).zip(&curves).enumerate() {
         let file = write(
             format!("{name}-still-{k:02}.ply"),
-            &still_ply(curves, still.slice.level, name),
+            &crate::export::to_still_ply(curves, still.slice.level, name),
         )?;
         stills.push(StillRecord {
             level: still.slice.level,
@@ -327,7 +332,7 @@ fn write_surface(
             between: still.between,
             curves: still.slice.curves.len(),
             points: curves.iter().map(|c| c.0.len()).sum(),
-            segments: curves.iter().map(segments).sum(),
+            segments: curves.iter().map(crate::export::segments).sum(),
             crossings: page.under.len(),
             max_residual: still.slice.max_residual,
             not_converged: still.slice.not_converged,
@@ -350,60 +355,62 @@ fn write_surface(
     Ok((record, files))
 }
 
-/// A still's curves as a binary little-endian PLY: per point x, y, z in the hyperplane's
-/// frame (double) and its curve's index (float); per segment an `edge` (a closed curve's
-/// last point back to its first).
-fn still_ply(curves: &[(Vec<glam::DVec3>, bool)], level: f64, name: &str) -> Vec<u8> {
-    let vertices: usize = curves.iter().map(|c| c.0.len()).sum();
-    let edges: usize = curves
-        .iter()
-        .map(|(p, closed)| {
-            if *closed {
-                p.len()
-            } else {
-                p.len().saturating_sub(1)
-            }
-        })
-        .sum();
-    let header = format!(
-        "ply\nformat binary_little_endian 1.0\n\
-         comment halo4d {}: surface {name}, slice at level {level:e}, in the hyperplane's frame\n\
-         element vertex {vertices}\n\
-         property double x\nproperty double y\nproperty double z\nproperty float curve\n\
-         element edge {edges}\n\
-         property int vertex1\nproperty int vertex2\n\
-         end_header\n",
-        env!("CARGO_PKG_VERSION"),
+/// The stills as tubes in a `.glb`, side by side in rows of [`COLUMNS`] as in the strip,
+/// each still's tubes `outputs.curve_radius` of the stills' diagonal thick.
+fn stills_glb(
+    scene: &Scene,
+    name: &str,
+    picture: &MotionPicture,
+    curves: &[Vec<(Vec<glam::DVec3>, bool)>],
+) -> Result<Vec<u8>, SliceError> {
+    let (lo, hi) = curves.iter().flatten().flat_map(|c| &c.0).fold(
+        (glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
     );
-    let mut out = header.into_bytes();
-    for (k, (points, _)) in curves.iter().enumerate() {
-        for p in points {
-            for x in p.to_array() {
-                out.extend_from_slice(&x.to_le_bytes());
-            }
-            out.extend_from_slice(&(k as f32).to_le_bytes());
-        }
-    }
-    let mut first = 0i32;
-    for curve in curves {
-        let n = curve.0.len() as i32;
-        for i in 0..segments(curve) as i32 {
-            for v in [first + i, first + (i + 1) % n] {
-                out.extend_from_slice(&v.to_le_bytes());
-            }
-        }
-        first += n;
-    }
-    out
-}
-
-/// The segments of a curve: one per point when it closes, else one fewer.
-fn segments((points, closed): &(Vec<glam::DVec3>, bool)) -> usize {
-    if *closed {
-        points.len()
+    let (centre, size) = if lo.x <= hi.x {
+        (
+            crate::convention::to_gltf((lo + hi) * 0.5),
+            (hi - lo).max_element(),
+        )
     } else {
-        points.len().saturating_sub(1)
-    }
+        (glam::DVec3::ZERO, 1.0)
+    };
+    let diagonal = if lo.x <= hi.x {
+        (hi - lo).length()
+    } else {
+        1.0
+    };
+    let spacing = 1.25 * size.max(f64::MIN_POSITIVE);
+    let offset = |k: usize| {
+        glam::DVec3::new(
+            (k % COLUMNS) as f64 * spacing,
+            -((k / COLUMNS) as f64) * spacing,
+            0.0,
+        ) - centre
+    };
+    let stills: Vec<(f64, Vec<(Vec<glam::DVec3>, bool)>)> = picture
+        .stills
+        .iter()
+        .zip(curves)
+        .map(|(s, c)| (s.slice.level, c.clone()))
+        .collect();
+    let asset = serde_json::json!({
+        "surface": name,
+        "direction": picture.critical.direction.to_array(),
+        "frame": picture.frame.map(|e| e.to_array()),
+    });
+    crate::export::stills_glb(
+        &stills,
+        scene.outputs.curve_radius * diagonal,
+        offset,
+        &asset,
+    )
+    .map_err(|message| {
+        SliceError::Build(Error::Internal {
+            stage: "motion",
+            message,
+        })
+    })
 }
 
 /// A staging failure as the build's error.

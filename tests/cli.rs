@@ -780,12 +780,24 @@ fn slice_draws_the_spun_trefoils_square_knot_and_checks_its_critical_levels() {
     // The flags override the scene's: along the view's w (the direction without either),
     // another motion picture, with its own count of critical points, still χ = 2.
     let out = halo4d(
-        &["slice", "--direction", "0.1,0.2,0.3,0.9", "--levels", "0", "--out", "n", "-q"],
+        &[
+            "slice",
+            "--direction",
+            "0.1,0.2,0.3,0.9",
+            "--levels",
+            "0",
+            "--out",
+            "n",
+            "-q",
+        ],
         dir.path(),
     );
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
-    assert!(!err.contains("2 births, 2 saddles, 2 deaths") && err.contains("(χ = 2)"), "{err}");
+    assert!(
+        !err.contains("2 births, 2 saddles, 2 deaths") && err.contains("(χ = 2)"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -850,7 +862,10 @@ fn slice_fails_a_degenerate_direction_until_it_is_tilted_and_refuses_bad_flags()
     let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
     json["slicing"] = serde_json::json!({ "perturb": 20 });
     std::fs::write(&bad, json.to_string()).unwrap();
-    let out = halo4d(&["slice", bad.to_str().unwrap(), "--out", "c", "-q"], dir.path());
+    let out = halo4d(
+        &["slice", bad.to_str().unwrap(), "--out", "c", "-q"],
+        dir.path(),
+    );
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("slicing.perturb: must be 0 to 10"), "{err}");

@@ -35,11 +35,12 @@
 //! "failures"}}`.
 
 use super::SurfaceData;
-use super::tubes::tubes;
+use super::tubes::{tubes, tubes_of};
 use crate::check::LAYERS;
 use crate::convention::{MESH_4D, file_order, to_gltf};
 use crate::halo::Halo;
 use crate::intersect::{CurvePoint, Curves};
+use crate::render::diagram::PALETTE as STILLS;
 use crate::render::stipple::Drawn;
 use crate::view::area_normal_sums;
 use glam::{DVec3, Vec3};
@@ -339,6 +340,121 @@ pub fn glb_chunks(
     });
     let text = b.root.to_vec().map_err(|e| e.to_string())?;
     Ok((text, b.bin))
+}
+
+/// A motion picture's stills as a `.glb`: one node per still, named `still-NN` with its
+/// level in its extras, each curve of it a tube of `radius` (its own material, in the
+/// colours of the stills' pictures, [`STILLS`]); the vertices in the hyperplane's frame (as glTF's y up), each
+/// node moved by `offset(k)` (glTF's frame) so that the stills lie side by side. A still
+/// without curves gets an empty node.
+pub fn stills_glb(
+    stills: &[(f64, Vec<(Vec<DVec3>, bool)>)],
+    radius: f64,
+    offset: impl Fn(usize) -> DVec3,
+    asset: &serde_json::Value,
+) -> Result<Vec<u8>, String> {
+    let mut b = Builder {
+        root: json::Root {
+            asset: json::Asset {
+                generator: Some(format!("halo4d {}", env!("CARGO_PKG_VERSION"))),
+                extras: raw_extras(serde_json::json!({ "halo4d": asset }))?,
+                ..Default::default()
+            },
+            ..Default::default()
+        },
+        bin: Vec::new(),
+    };
+    // Each colour's material, made when a curve first takes it (the validator counts an
+    // unused one).
+    let mut materials: Vec<Option<json::Index<json::Material>>> = vec![None; STILLS.len()];
+    let mut nodes = Vec::new();
+    for (k, (level, curves)) in stills.iter().enumerate() {
+        let mut primitives = Vec::new();
+        for (c, curve) in curves.iter().enumerate() {
+            let tube = tubes_of(std::slice::from_ref(curve), radius);
+            if tube.triangles.is_empty() {
+                continue;
+            }
+            let positions = b.positions(&tube.positions);
+            let normals = b.normals(&tube.normals);
+            let triangles: Vec<u32> = tube.triangles.iter().flatten().copied().collect();
+            let indices = b.indices(
+                &triangles,
+                Some(json::buffer::Target::ElementArrayBuffer),
+                None,
+            );
+            primitives.push(json::mesh::Primitive {
+                attributes: [
+                    (Valid(json::mesh::Semantic::Positions), positions),
+                    (Valid(json::mesh::Semantic::Normals), normals),
+                ]
+                .into_iter()
+                .collect(),
+                extensions: None,
+                extras: None,
+                indices: Some(indices),
+                material: Some(material(&mut b, &mut materials, c % STILLS.len())),
+                mode: Valid(json::mesh::Mode::Triangles),
+                targets: None,
+            });
+        }
+        let mesh = (!primitives.is_empty()).then(|| {
+            b.root.push(json::Mesh {
+                extensions: None,
+                extras: None,
+                name: Some(format!("still-{k:02}")),
+                primitives,
+                weights: None,
+            })
+        });
+        let translation = offset(k).as_vec3().to_array();
+        nodes.push(b.root.push(json::Node {
+            mesh,
+            name: Some(format!("still-{k:02}")),
+            translation: Some(translation),
+            extras: raw_extras(serde_json::json!({ "level": level, "curves": curves.len() }))?,
+            ..Default::default()
+        }));
+    }
+    let scene = b.root.push(json::Scene {
+        extensions: None,
+        extras: None,
+        name: Some("motion picture".into()),
+        nodes,
+    });
+    b.root.scene = Some(scene);
+    b.root.push(json::Buffer {
+        byte_length: USize64::from(b.bin.len()),
+        name: None,
+        uri: None,
+        extensions: None,
+        extras: None,
+    });
+    let text = b.root.to_vec().map_err(|e| e.to_string())?;
+    Ok(glb_container(text, b.bin))
+}
+
+/// The material of palette colour `k` for [`stills_glb`], made on first use.
+fn material(
+    b: &mut Builder,
+    made: &mut [Option<json::Index<json::Material>>],
+    k: usize,
+) -> json::Index<json::Material> {
+    *made[k].get_or_insert_with(|| {
+        b.root.push(json::Material {
+            name: Some(format!("curve {k}")),
+            pbr_metallic_roughness: json::material::PbrMetallicRoughness {
+                base_color_factor: json::material::PbrBaseColorFactor({
+                    let [r, g, b] = STILLS[k].map(|c| c as f32);
+                    [r, g, b, 1.0]
+                }),
+                metallic_factor: json::material::StrengthFactor(0.0),
+                roughness_factor: json::material::StrengthFactor(0.8),
+                ..Default::default()
+            },
+            ..Default::default()
+        })
+    })
 }
 
 /// Appends the mesh of surface `s`: its projected positions and normals, W, U, V and PATCH,

@@ -19,10 +19,10 @@ mod ply;
 mod tubes;
 mod vtk;
 
-pub use gltf::{glb_chunks, glb_container, to_glb, write_glb_container};
+pub use gltf::{glb_chunks, glb_container, stills_glb, to_glb, write_glb_container};
 pub use obj::to_obj;
 pub use off4::to_4off;
-pub use ply::{to_curves_ply, to_ply, to_stipples_ply};
+pub use ply::{segments, to_curves_ply, to_ply, to_still_ply, to_stipples_ply};
 pub use vtk::write_vtk;
 
 mod staged;

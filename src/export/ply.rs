@@ -3,6 +3,7 @@
 use super::SurfaceData;
 use crate::intersect::Curves;
 use crate::render::stipple::Drawn;
+use glam::DVec3;
 
 /// Builds a binary little-endian PLY with all surfaces in one mesh: per vertex x, y, z,
 /// nx, ny, nz, `quality` (the w-depth, which MeshLab keeps as its per-vertex scalar), u, v,
@@ -137,4 +138,60 @@ pub fn to_curves_ply(curves: &Curves, scene_name: &str) -> Vec<u8> {
         }
     }
     out
+}
+
+/// A still's curves as a binary little-endian PLY: per point x, y, z in the hyperplane's
+/// frame (double) and its curve's index (float); per segment an `edge` (a closed curve's
+/// last point back to its first).
+pub fn to_still_ply(curves: &[(Vec<DVec3>, bool)], level: f64, name: &str) -> Vec<u8> {
+    let vertices: usize = curves.iter().map(|c| c.0.len()).sum();
+    let edges: usize = curves
+        .iter()
+        .map(|(p, closed)| {
+            if *closed {
+                p.len()
+            } else {
+                p.len().saturating_sub(1)
+            }
+        })
+        .sum();
+    let header = format!(
+        "ply\nformat binary_little_endian 1.0\n\
+         comment halo4d {}: surface {name}, slice at level {level:e}, in the hyperplane's frame\n\
+         element vertex {vertices}\n\
+         property double x\nproperty double y\nproperty double z\nproperty float curve\n\
+         element edge {edges}\n\
+         property int vertex1\nproperty int vertex2\n\
+         end_header\n",
+        env!("CARGO_PKG_VERSION"),
+    );
+    let mut out = header.into_bytes();
+    for (k, (points, _)) in curves.iter().enumerate() {
+        for p in points {
+            for x in p.to_array() {
+                out.extend_from_slice(&x.to_le_bytes());
+            }
+            out.extend_from_slice(&(k as f32).to_le_bytes());
+        }
+    }
+    let mut first = 0i32;
+    for curve in curves {
+        let n = curve.0.len() as i32;
+        for i in 0..segments(curve) as i32 {
+            for v in [first + i, first + (i + 1) % n] {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        first += n;
+    }
+    out
+}
+
+/// The segments of a curve: one per point when it closes, else one fewer.
+pub fn segments((points, closed): &(Vec<DVec3>, bool)) -> usize {
+    if *closed {
+        points.len()
+    } else {
+        points.len().saturating_sub(1)
+    }
 }

@@ -43,7 +43,7 @@ pub fn tubes(curves: &Curves, radius: f64) -> Tubes {
 }
 
 /// [`tubes`] of polylines given as their points and whether they close.
-fn tubes_of(polylines: &[(Vec<DVec3>, bool)], radius: f64) -> Tubes {
+pub(crate) fn tubes_of(polylines: &[(Vec<DVec3>, bool)], radius: f64) -> Tubes {
     let mut out = Tubes::default();
     let mut first_point = 0u32;
     for (points, closed) in polylines {

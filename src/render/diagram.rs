@@ -20,8 +20,9 @@ use std::fmt::Write;
 /// The gap cut into an under-strand on each side of a crossing, in line widths.
 pub const GAP: f64 = 2.5;
 
-/// Component colours (linear RGB), in turn.
-const PALETTE: [[f64; 3]; 6] = [
+/// Component colours (linear RGB), in turn: the curves of a still, in the pictures and
+/// the stills' `.glb`.
+pub const PALETTE: [[f64; 3]; 6] = [
     [0.018, 0.162, 0.440],
     [0.730, 0.080, 0.030],
     [0.020, 0.360, 0.080],

@@ -80,8 +80,8 @@ pub enum Command {
     /// from the scene's camera, every under-strand broken), checked by Morse theory: on a
     /// closed surface #births - #saddles + #deaths = χ, and across each critical level the
     /// slice's components change as its event says. Writes <name>-motion.png and .svg (the
-    /// stills in one strip), <name>-still-NN.ply (each still's curves in the hyperplane's
-    /// frame) and motion.json.
+    /// stills in one strip), <name>-motion.glb (their curves as tubes), <name>-still-NN.ply
+    /// (each still's curves in the hyperplane's frame) and motion.json.
     ///
     /// Exit status 0 when every check passes, 3 when one fails (a FAILED line says which;
     /// a degenerate direction, such as one with critical circles, is one: tilt it with
