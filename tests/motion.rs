@@ -365,3 +365,55 @@ fn the_hyperplane_frame_is_the_views_axes_turned_onto_the_direction() {
     let tilted = tilt(w, &frame, 3.0);
     assert!((tilted.dot(w).acos().to_degrees() - 3.0).abs() <= 1e-9);
 }
+
+#[test]
+fn slice_points_lie_on_the_surface_and_within_the_meshs_error_of_the_meshs_slice() {
+    // The spun trefoil at 1e-3 of its diagonal, cut between critical levels: every point
+    // of the refined slice is on the hyperplane to 1e-12, on the surface (it is a surface
+    // point), and near the mesh's own slice (brute force: its distance to every segment of
+    // the mesh's slice curves) within a few times the sampling tolerance.
+    let surface = Surface::SpunTrefoil(SpunTrefoil::default());
+    let tolerance = 1e-3 * bounding_diagonal(&surface);
+    let mesh = sample_adaptive(&surface, tolerance, 2_000_000).mesh;
+    let n = generic().normalize();
+    let frame = hyperplane_frame(DMat4::IDENTITY, n);
+    let shape = Shape {
+        euler: Some(2),
+        orientable: true,
+    };
+    let picture = motion_picture(&mesh, Some(&surface), n, frame, shape, 0).unwrap();
+    let mut checked = 0;
+    for still in &picture.stills {
+        let c = still.slice.level;
+        let on_mesh = slice(&mesh, None, n, c);
+        let segments: Vec<(DVec4, DVec4)> = on_mesh
+            .curves
+            .iter()
+            .flat_map(|curve| {
+                let p = &curve.points;
+                (0..p.len()).map(move |k| (p[k], p[(k + 1) % p.len()]))
+            })
+            .collect();
+        let distance = |x: DVec4| {
+            segments
+                .iter()
+                .map(|&(a, b)| {
+                    let t = ((x - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+                    x.distance(a + (b - a) * t)
+                })
+                .fold(f64::INFINITY, f64::min)
+        };
+        for curve in &still.slice.curves {
+            for &p in &curve.points {
+                assert!((p.dot(n) - c).abs() <= 1e-12);
+                let d = distance(p);
+                assert!(
+                    d <= 4.0 * tolerance,
+                    "at level {c}: {d} from the mesh's slice, tolerance {tolerance}"
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 1000, "{checked}");
+}
