@@ -630,6 +630,9 @@ impl Slicing {
     }
 }
 
+/// A curve in 3D: its points, and whether it closes (its last point joined to its first).
+pub type Polyline = (Vec<glam::DVec3>, bool);
+
 /// What is known of a surface's topology for the motion picture's checks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Shape {
@@ -671,7 +674,7 @@ pub struct MotionPicture {
 
 impl Still {
     /// The still's curves in the frame's 3D coordinates, each with whether it is closed.
-    pub fn in_frame(&self, frame: &[DVec4; 3]) -> Vec<(Vec<glam::DVec3>, bool)> {
+    pub fn in_frame(&self, frame: &[DVec4; 3]) -> Vec<Polyline> {
         self.slice
             .curves
             .iter()

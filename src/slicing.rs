@@ -9,7 +9,7 @@
 use crate::error::Error;
 use crate::export::{Staged, StagedError};
 use crate::limits::FieldError;
-use crate::motion::{self, MotionPicture, Shape, Slicing};
+use crate::motion::{self, MotionPicture, Polyline, Shape, Slicing};
 use crate::pipeline::Sampled;
 use crate::render::diagram;
 use crate::render::text::compact;
@@ -361,7 +361,7 @@ fn stills_glb(
     scene: &Scene,
     name: &str,
     picture: &MotionPicture,
-    curves: &[Vec<(Vec<glam::DVec3>, bool)>],
+    curves: &[Vec<Polyline>],
 ) -> Result<Vec<u8>, SliceError> {
     let (lo, hi) = curves.iter().flatten().flat_map(|c| &c.0).fold(
         (glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY),
@@ -388,7 +388,7 @@ fn stills_glb(
             0.0,
         ) - centre
     };
-    let stills: Vec<(f64, Vec<(Vec<glam::DVec3>, bool)>)> = picture
+    let stills: Vec<(f64, Vec<Polyline>)> = picture
         .stills
         .iter()
         .zip(curves)

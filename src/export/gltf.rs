@@ -40,6 +40,7 @@ use crate::check::LAYERS;
 use crate::convention::{MESH_4D, file_order, to_gltf};
 use crate::halo::Halo;
 use crate::intersect::{CurvePoint, Curves};
+use crate::motion::Polyline;
 use crate::render::diagram::PALETTE as STILLS;
 use crate::render::stipple::Drawn;
 use crate::view::area_normal_sums;
@@ -348,7 +349,7 @@ pub fn glb_chunks(
 /// node moved by `offset(k)` (glTF's frame) so that the stills lie side by side. A still
 /// without curves gets an empty node.
 pub fn stills_glb(
-    stills: &[(f64, Vec<(Vec<DVec3>, bool)>)],
+    stills: &[(f64, Vec<Polyline>)],
     radius: f64,
     offset: impl Fn(usize) -> DVec3,
     asset: &serde_json::Value,

@@ -2,8 +2,8 @@
 
 use super::SurfaceData;
 use crate::intersect::Curves;
+use crate::motion::Polyline;
 use crate::render::stipple::Drawn;
-use glam::DVec3;
 
 /// Builds a binary little-endian PLY with all surfaces in one mesh: per vertex x, y, z,
 /// nx, ny, nz, `quality` (the w-depth, which MeshLab keeps as its per-vertex scalar), u, v,
@@ -143,7 +143,7 @@ pub fn to_curves_ply(curves: &Curves, scene_name: &str) -> Vec<u8> {
 /// A still's curves as a binary little-endian PLY: per point x, y, z in the hyperplane's
 /// frame (double) and its curve's index (float); per segment an `edge` (a closed curve's
 /// last point back to its first).
-pub fn to_still_ply(curves: &[(Vec<DVec3>, bool)], level: f64, name: &str) -> Vec<u8> {
+pub fn to_still_ply(curves: &[Polyline], level: f64, name: &str) -> Vec<u8> {
     let vertices: usize = curves.iter().map(|c| c.0.len()).sum();
     let edges: usize = curves
         .iter()
@@ -188,7 +188,7 @@ pub fn to_still_ply(curves: &[(Vec<DVec3>, bool)], level: f64, name: &str) -> Ve
 }
 
 /// The segments of a curve: one per point when it closes, else one fewer.
-pub fn segments((points, closed): &(Vec<DVec3>, bool)) -> usize {
+pub fn segments((points, closed): &Polyline) -> usize {
     if *closed {
         points.len()
     } else {

@@ -12,6 +12,7 @@
 //! gets no tube.
 
 use crate::intersect::Curves;
+use crate::motion::Polyline;
 use glam::DVec3;
 use std::f64::consts::TAU;
 
@@ -34,7 +35,7 @@ pub struct Tubes {
 /// Tubes of `radius` (absolute) around every curve of `curves` with two or more distinct
 /// points.
 pub fn tubes(curves: &Curves, radius: f64) -> Tubes {
-    let polylines: Vec<(Vec<DVec3>, bool)> = curves
+    let polylines: Vec<Polyline> = curves
         .curves
         .iter()
         .map(|c| (c.points.iter().map(|p| p.position).collect(), c.closed))
@@ -43,7 +44,7 @@ pub fn tubes(curves: &Curves, radius: f64) -> Tubes {
 }
 
 /// [`tubes`] of polylines given as their points and whether they close.
-pub(crate) fn tubes_of(polylines: &[(Vec<DVec3>, bool)], radius: f64) -> Tubes {
+pub(crate) fn tubes_of(polylines: &[Polyline], radius: f64) -> Tubes {
     let mut out = Tubes::default();
     let mut first_point = 0u32;
     for (points, closed) in polylines {

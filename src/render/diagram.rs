@@ -14,6 +14,7 @@ use super::camera::basis;
 use super::lines::{Broadener, Mask};
 use super::text;
 use super::{Picture, RenderError};
+use crate::motion::Polyline;
 use glam::{DVec2, DVec3};
 use std::fmt::Write;
 
@@ -218,7 +219,7 @@ pub fn runs(points: &[DVec2], closed: bool, cuts: &[f64], gap: f64) -> Vec<Vec<D
 /// pixels, projected along the view direction of `camera` (its azimuth and elevation;
 /// orthographic), all at one scale and centred alike so that a place in 3D is the same
 /// place in every panel, with their crossings.
-pub fn pages(panels: &[Vec<(Vec<DVec3>, bool)>], camera: &CameraSettings, side: u32) -> Vec<Page> {
+pub fn pages(panels: &[Vec<Polyline>], camera: &CameraSettings, side: u32) -> Vec<Page> {
     let (forward, right, up) = basis(camera, 0.0);
     let page = |p: DVec3| (DVec2::new(p.dot(right), -p.dot(up)), p.dot(forward));
     let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
