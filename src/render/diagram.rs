@@ -6,8 +6,8 @@
 //! A crossing is where two segments' projections cross properly, decided by the exact
 //! `orient2d` on their page coordinates; the strand farther from the eye there is the
 //! under-strand, cut by a gap of [`GAP`] line widths on each side. Lines are drawn at an
-//! exact width by the renderer's line broadening (`render::lines`), one mask per colour; each component of a panel has its
-//! own colour.
+//! exact width by the renderer's line broadening (`render::lines`), one mask per colour;
+//! each curve of a panel has its own colour.
 
 use super::CameraSettings;
 use super::camera::basis;
