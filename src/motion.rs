@@ -666,6 +666,10 @@ pub struct MotionPicture {
     pub frame: [DVec4; 3],
     /// The stills, by level.
     pub stills: Vec<Still>,
+    /// The critical points in the order the mesh's slices meet them (by their vertices'
+    /// levels, which can differ from the refined levels' order where two lie close):
+    /// interval k lies between the (k - 1)-th and the k-th.
+    pub sequence: Vec<CriticalPoint>,
     /// The number of slice components in each interval (one more than the critical points).
     pub components: Vec<usize>,
     /// Each check that failed, saying what it found.
@@ -842,6 +846,7 @@ pub fn motion_picture(
         critical,
         frame,
         stills,
+        sequence: bands.iter().map(|b| b.point).collect(),
         components,
         failures,
     })

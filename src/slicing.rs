@@ -228,8 +228,13 @@ pub fn slice_scene(scene: &Scene, slicing: Slicing, out: &Path) -> Result<Motion
                     break;
                 }
                 let finer = crate::sample::sample_adaptive(s, relative * diagonal, FINER_TRIANGLES);
+                let triangles = finer.mesh.triangles.len();
+                // A scene sampled finer already keeps its mesh.
+                if triangles <= resampled.map_or(mesh.triangles.len(), |r: (f64, usize)| r.1) {
+                    continue;
+                }
                 picture = cut(&finer.mesh)?;
-                resampled = Some((relative, finer.mesh.triangles.len()));
+                resampled = Some((relative, triangles));
             }
         }
         let (mut record, written) = write_surface(scene, name, &picture, shape, &staged)?;
@@ -285,12 +290,10 @@ fn write_surface(
         .iter()
         .zip(&pages)
         .map(|(still, page)| {
-            let after = critical
-                .points
-                .iter()
-                .rev()
-                .find(|p| p.level < still.slice.level)
-                .map(|p| format!(" · after a {}", p.event.name()))
+            let after = still
+                .interval
+                .checked_sub(1)
+                .map(|k| format!(" · after a {}", picture.sequence[k].event.name()))
                 .unwrap_or_default();
             let (curves, crossings) = (still.slice.curves.len(), page.under.len());
             (
