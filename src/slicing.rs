@@ -418,8 +418,5 @@ fn stills_glb(
 
 /// A staging failure as the build's error.
 fn staged_error(e: StagedError) -> SliceError {
-    SliceError::Build(match e {
-        StagedError::Io { path, source } => Error::Write { path, source },
-        busy => Error::Busy(busy),
-    })
+    SliceError::Build(crate::pipeline::staged_error(e))
 }

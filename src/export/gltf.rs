@@ -72,6 +72,47 @@ struct Builder {
 }
 
 impl Builder {
+    /// An empty document whose asset names halo4d and carries `asset` in its extras as
+    /// `halo4d`.
+    fn new(asset: &serde_json::Value) -> Result<Builder, String> {
+        Ok(Builder {
+            root: json::Root {
+                asset: json::Asset {
+                    generator: Some(format!("halo4d {}", env!("CARGO_PKG_VERSION"))),
+                    extras: raw_extras(serde_json::json!({ "halo4d": asset }))?,
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+            bin: Vec::new(),
+        })
+    }
+
+    /// The document with its scene `name` of `nodes` and its one buffer: the JSON and the
+    /// binary chunk.
+    fn finish(
+        mut self,
+        name: &str,
+        nodes: Vec<json::Index<json::Node>>,
+    ) -> Result<(Vec<u8>, Vec<u8>), String> {
+        let scene = self.root.push(json::Scene {
+            extensions: None,
+            extras: None,
+            name: Some(name.into()),
+            nodes,
+        });
+        self.root.scene = Some(scene);
+        self.root.push(json::Buffer {
+            byte_length: USize64::from(self.bin.len()),
+            name: None,
+            uri: None,
+            extensions: None,
+            extras: None,
+        });
+        let text = self.root.to_vec().map_err(|e| e.to_string())?;
+        Ok((text, self.bin))
+    }
+
     /// Appends a buffer view of 4-byte `words` (little-endian), written straight into the
     /// binary chunk; `target` is `None` for data that no primitive reads (the tetrahedra).
     fn view(
@@ -282,17 +323,7 @@ pub fn glb_chunks(
     stipples: &[Drawn],
     asset: &serde_json::Value,
 ) -> Result<(Vec<u8>, Vec<u8>), String> {
-    let mut b = Builder {
-        root: json::Root {
-            asset: json::Asset {
-                generator: Some(format!("halo4d {}", env!("CARGO_PKG_VERSION"))),
-                extras: raw_extras(serde_json::json!({ "halo4d": asset }))?,
-                ..Default::default()
-            },
-            ..Default::default()
-        },
-        bin: Vec::new(),
-    };
+    let mut b = Builder::new(asset)?;
     let mut nodes = Vec::new();
     for (k, s) in surfaces.iter().enumerate() {
         let mesh = surface_mesh(&mut b, s, PALETTE[k % PALETTE.len()])?;
@@ -325,22 +356,7 @@ pub fn glb_chunks(
             ..Default::default()
         }));
     }
-    let scene = b.root.push(json::Scene {
-        extensions: None,
-        extras: None,
-        name: Some("halo4d".into()),
-        nodes,
-    });
-    b.root.scene = Some(scene);
-    b.root.push(json::Buffer {
-        byte_length: USize64::from(b.bin.len()),
-        name: None,
-        uri: None,
-        extensions: None,
-        extras: None,
-    });
-    let text = b.root.to_vec().map_err(|e| e.to_string())?;
-    Ok((text, b.bin))
+    b.finish("halo4d", nodes)
 }
 
 /// A motion picture's stills as a `.glb`: one node per still, named `still-NN` with its
@@ -354,17 +370,7 @@ pub fn stills_glb(
     offset: impl Fn(usize) -> DVec3,
     asset: &serde_json::Value,
 ) -> Result<Vec<u8>, String> {
-    let mut b = Builder {
-        root: json::Root {
-            asset: json::Asset {
-                generator: Some(format!("halo4d {}", env!("CARGO_PKG_VERSION"))),
-                extras: raw_extras(serde_json::json!({ "halo4d": asset }))?,
-                ..Default::default()
-            },
-            ..Default::default()
-        },
-        bin: Vec::new(),
-    };
+    let mut b = Builder::new(asset)?;
     // Each colour's material, made when a curve first takes it (the validator counts an
     // unused one).
     let mut materials: Vec<Option<json::Index<json::Material>>> = vec![None; STILLS.len()];
@@ -417,22 +423,8 @@ pub fn stills_glb(
             ..Default::default()
         }));
     }
-    let scene = b.root.push(json::Scene {
-        extensions: None,
-        extras: None,
-        name: Some("motion picture".into()),
-        nodes,
-    });
-    b.root.scene = Some(scene);
-    b.root.push(json::Buffer {
-        byte_length: USize64::from(b.bin.len()),
-        name: None,
-        uri: None,
-        extensions: None,
-        extras: None,
-    });
-    let text = b.root.to_vec().map_err(|e| e.to_string())?;
-    Ok(glb_container(text, b.bin))
+    let (text, bin) = b.finish("motion picture", nodes)?;
+    Ok(glb_container(text, bin))
 }
 
 /// The material of palette colour `k` for [`stills_glb`], made on first use.

@@ -15,6 +15,7 @@ mod write;
 pub use built::{Built, SurfaceProduct};
 pub use report::{Report, Timings};
 pub use sampled::{Sampled, shown_curves};
+pub(crate) use write::staged_error;
 pub use write::{glb_bytes, write};
 
 use crate::error::Error;

@@ -302,7 +302,7 @@ pub fn glb_bytes(scene: &Scene, built: &Built) -> Result<Vec<u8>, Error> {
 }
 
 /// A [`export::StagedError`] as the pipeline's error.
-fn staged_error(e: export::StagedError) -> Error {
+pub(crate) fn staged_error(e: export::StagedError) -> Error {
     match e {
         export::StagedError::Io { path, source } => Error::Write { path, source },
         busy => Error::Busy(busy),

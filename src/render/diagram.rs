@@ -12,6 +12,7 @@
 use super::CameraSettings;
 use super::camera::basis;
 use super::lines::{Broadener, Mask};
+use super::svg::rgb as svg_colour;
 use super::text;
 use super::{Picture, RenderError};
 use crate::motion::Polyline;
@@ -277,14 +278,7 @@ pub fn draw_strip(
     let (width, height) = (cell_w * columns as u32, cell_h * rows as u32);
     let lines = |e: super::lines::LinesError| RenderError::Internal(e.to_string());
     let mut rgb = vec![PAPER; width as usize * height as usize];
-    let mut svg = String::new();
-    let _ = writeln!(
-        svg,
-        r#"<?xml version="1.0" encoding="UTF-8"?>
-<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}">
-<rect width="{width}" height="{height}" fill="{}"/>"#,
-        srgb(PAPER)
-    );
+    let mut svg = super::svg::header(width, height, PAPER);
     let mut broadener = Broadener::new();
     let empty = (String::new(), String::new());
     for (k, page) in pages.iter().enumerate() {
@@ -299,7 +293,7 @@ pub fn draw_strip(
             r#"<rect x="{x0}.5" y="{y0}.5" width="{}" height="{}" fill="none" stroke="{}"/>"#,
             side - 1,
             side - 1,
-            srgb(FRAME)
+            svg_colour(FRAME)
         );
         frame(&mut rgb, width as usize, (x0, y0), side);
         for (c, (points, closed)) in page.curves.iter().enumerate() {
@@ -319,7 +313,7 @@ pub fn draw_strip(
                 let _ = write!(
                     svg,
                     r#"<path fill="none" stroke="{}" stroke-width="{line:.2}" stroke-linecap="round" stroke-linejoin="round" d=""#,
-                    srgb(colour)
+                    svg_colour(colour)
                 );
                 for (i, p) in run.iter().enumerate() {
                     let _ = write!(
@@ -361,7 +355,7 @@ pub fn draw_strip(
                 svg,
                 r#"<text x="{x:.1}" y="{:.1}" font-family="DejaVu Sans Mono, monospace" font-size="{text_size}" text-anchor="middle" dominant-baseline="central" fill="{}">{}</text>"#,
                 y,
-                srgb(INK),
+                svg_colour(INK),
                 escape(label)
             );
         }
@@ -394,12 +388,6 @@ fn frame(rgb: &mut [DVec3], width: usize, (x0, y0): (u32, u32), side: u32) {
             rgb[y * width + x] = FRAME;
         }
     }
-}
-
-/// A linear colour as SVG's sRGB `rgb(r,g,b)`, as the picture's SVG writes it.
-fn srgb(c: DVec3) -> String {
-    let [r, g, b] = c.to_array().map(super::to_srgb8);
-    format!("rgb({r},{g},{b})")
 }
 
 /// Text made safe for XML.

@@ -21,7 +21,7 @@ pub(crate) mod overlay;
 pub(crate) mod shade;
 pub(crate) mod slices;
 pub(crate) mod stipple;
-mod svg;
+pub(crate) mod svg;
 pub(crate) mod text;
 pub(crate) mod trace;
 pub(crate) mod visible;

@@ -14,14 +14,7 @@ use std::fmt::Write;
 /// An SVG document of `width` x `height` pixels with `runs` stroked over `background`
 /// (linear RGB).
 pub(crate) fn document(width: u32, height: u32, background: DVec3, runs: &[Run]) -> String {
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        r#"<?xml version="1.0" encoding="UTF-8"?>
-<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}">
-<rect width="{width}" height="{height}" fill="{}"/>"#,
-        rgb(background)
-    );
+    let mut out = header(width, height, background);
     // In the order the PNG lays its inks over each other.
     let mut ordered: Vec<&Run> = runs.iter().collect();
     ordered.sort_by_key(|r| r.class);
@@ -51,7 +44,20 @@ pub(crate) fn document(width: u32, height: u32, background: DVec3, runs: &[Run])
 }
 
 /// `rgb(r,g,b)` of a linear colour, in sRGB bytes.
-fn rgb(c: DVec3) -> String {
+/// The start of an SVG document of `width` x `height` pixels filled with `background`
+/// (linear RGB); the caller closes it with `</svg>`.
+pub(super) fn header(width: u32, height: u32, background: DVec3) -> String {
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}">
+<rect width="{width}" height="{height}" fill="{}"/>
+"#,
+        rgb(background)
+    )
+}
+
+/// A linear colour as SVG's sRGB `rgb(r,g,b)`.
+pub(super) fn rgb(c: DVec3) -> String {
     let [r, g, b] = [c.x, c.y, c.z].map(super::to_srgb8);
     format!("rgb({r},{g},{b})")
 }
