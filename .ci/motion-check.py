@@ -6,7 +6,8 @@ For every still of every surface in FOLDER/motion.json: MeshLab (pymeshlab) and 
 (vtkPLYReader) read its PLY with the points and segments motion.json counts, every point
 finite; Blender (bpy) imports the surface's -motion.glb with one object per still, at its
 level, and a mesh for each still with curves; the strip's PNG opens (Pillow) at the size of its panels and draws ink
-in every panel that has curves. Fails when motion.json says the checks failed.
+in every panel that has curves; a film (an animated PNG) has the frames motion.json lists,
+each with curves drawn. Fails when motion.json says the checks failed.
 """
 
 import json
@@ -106,6 +107,15 @@ def check_folder(folder):
             inked = int((inside < 200).sum())
             if still["curves"] > 0 and inked < 20:
                 problems.append(f"{name}: panel {k} ({still['curves']} curves) draws {inked} pixels")
+        if surface.get("film"):
+            film = Image.open(folder / f"{name}-film.png")
+            frames = getattr(film, "n_frames", 1)
+            if frames != len(surface["film"]):
+                problems.append(f"{name}-film.png: Pillow reads {frames} frames, motion.json has {len(surface['film'])}")
+            for k in range(frames):
+                film.seek(k)
+                if int((np.asarray(film.convert("L")) < 200).sum()) < 20 and surface["film"][k]["curves"] > 0:
+                    problems.append(f"{name}-film.png: frame {k} draws nothing")
         print(
             f"  {folder.name}/{name}: {panels} stills, {sum(s['points'] for s in surface['stills'])} points, "
             f"{sum(s['crossings'] for s in surface['stills'])} crossings; MeshLab and VTK read every still, Blender its .glb"

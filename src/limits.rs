@@ -408,6 +408,9 @@ pub const SHARDS: Bound<u32> = Bound::at_least(1, "");
 /// Evenly spaced stills a motion picture adds to one per interval between critical levels.
 pub const MOTION_LEVELS: Bound<usize> = Bound::closed(0, 64, "stills");
 
+/// Frames of a motion picture's film through the levels (0: no film).
+pub const FILM_FRAMES: Bound<u32> = Bound::closed(0, 2400, "frames");
+
 /// The tilt of a motion picture's direction that makes its height a Morse function.
 pub const PERTURB: Bound<f64> = Bound::closed(0.0, 10.0, "degrees");
 
@@ -798,6 +801,7 @@ fn settings() -> Vec<Limit> {
         limit!(SHARDS, "N of `halo4d animate --shard I/N`"),
         limit!(MOTION_LEVELS, "`halo4d slice --levels`"),
         limit!(PERTURB, "`halo4d slice --perturb`"),
+        limit!(FILM_FRAMES, "`halo4d slice --film`"),
         limit!(VIEWER_SLICES, "the viewer's slices"),
         limit!(BENCH_FRAMES, "`halo4d-view --bench --frames`"),
         limit!(MAX_MEMORY, "`HALO4D_MAX_MEMORY`"),

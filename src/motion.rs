@@ -611,6 +611,9 @@ pub struct Slicing {
     pub levels: usize,
     /// Degrees to tilt the direction by ([`tilt`]), 0 for none.
     pub perturb: f64,
+    /// Frames of a film through the levels, from the surface's lowest point to its
+    /// highest, 0 for none.
+    pub film: u32,
 }
 
 impl Slicing {
@@ -626,7 +629,8 @@ impl Slicing {
             }
         }
         limits::MOTION_LEVELS.check("levels", self.levels)?;
-        limits::PERTURB.check("perturb", self.perturb)
+        limits::PERTURB.check("perturb", self.perturb)?;
+        limits::FILM_FRAMES.check("film", self.film)
     }
 }
 
@@ -634,7 +638,7 @@ impl Slicing {
 pub type Polyline = (Vec<glam::DVec3>, bool);
 
 /// What is known of a surface's topology for the motion picture's checks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub struct Shape {
     /// The Euler characteristic of a closed surface; `None` for a surface with boundary,
     /// whose counts are not checked.
@@ -674,6 +678,8 @@ pub struct MotionPicture {
     pub components: Vec<usize>,
     /// Each check that failed, saying what it found.
     pub failures: Vec<String>,
+    /// The surface's topology the checks took.
+    pub shape: Shape,
 }
 
 impl Still {
@@ -787,35 +793,6 @@ pub fn motion_picture(
         };
         components.push(count);
     }
-    if extra > 0 && bands.len() >= 2 {
-        let (lo, hi) = (bands[0].lo, bands[bands.len() - 1].hi);
-        for i in 0..extra {
-            let level = lo + (hi - lo) * (i as f64 + 0.5) / extra as f64;
-            // One still at a level is enough.
-            if stills
-                .iter()
-                .any(|s: &Still| (s.slice.level - level).abs() <= 1e-9 * (hi - lo))
-            {
-                continue;
-            }
-            let interval = bands.iter().filter(|b| b.vertex < level).count();
-            let clear = bands.iter().all(|b| level < b.lo || level > b.hi);
-            let slice = cut(level);
-            if shape.euler.is_some() && clear && slice.curves.len() != components[interval] {
-                failures.push(format!(
-                    "the slice at {level} has {} components, its interval {interval} {}",
-                    slice.curves.len(),
-                    components[interval]
-                ));
-            }
-            stills.push(Still {
-                slice,
-                interval,
-                between: false,
-            });
-        }
-        stills.sort_by(|a, b| a.slice.level.total_cmp(&b.slice.level));
-    }
     if let Some(euler) = shape.euler {
         if let Err(e) = critical.morse(euler) {
             failures.push(e);
@@ -842,12 +819,72 @@ pub fn motion_picture(
             }
         }
     }
-    Ok(MotionPicture {
+    let mut picture = MotionPicture {
+        sequence: bands.iter().map(|b| b.point).collect(),
         critical,
         frame,
         stills,
-        sequence: bands.iter().map(|b| b.point).collect(),
         components,
         failures,
-    })
+        shape,
+    };
+    if extra > 0 && bands.len() >= 2 {
+        let (lo, hi) = (bands[0].lo, bands[bands.len() - 1].hi);
+        for i in 0..extra {
+            let level = lo + (hi - lo) * (i as f64 + 0.5) / extra as f64;
+            // One still at a level is enough.
+            if picture
+                .stills
+                .iter()
+                .any(|s| (s.slice.level - level).abs() <= 1e-9 * (hi - lo))
+            {
+                continue;
+            }
+            let (still, agrees) = picture.still_at(mesh, surface, level);
+            if agrees == Some(false) {
+                picture.failures.push(format!(
+                    "the slice at {level} has {} components, its interval {} {}",
+                    still.slice.curves.len(),
+                    still.interval,
+                    picture.components[still.interval]
+                ));
+            }
+            picture.stills.push(still);
+        }
+        picture
+            .stills
+            .sort_by(|a, b| a.slice.level.total_cmp(&b.slice.level));
+    }
+    Ok(picture)
+}
+
+impl MotionPicture {
+    /// The slice of `mesh` (the one the picture was made of, with its `surface`) at
+    /// `level`, as a still of this picture: its interval (by the levels of the critical
+    /// points' mesh vertices), and whether it has its interval's number of components:
+    /// `None` where that is not checked (a surface with boundary, or a level between a
+    /// critical point's refined level and its vertex's).
+    pub fn still_at(
+        &self,
+        mesh: &Mesh4,
+        surface: Option<&Surface>,
+        level: f64,
+    ) -> (Still, Option<bool>) {
+        let n = self.critical.direction;
+        let vertex = |p: &CriticalPoint| mesh.positions[p.vertex as usize].dot(n);
+        let interval = self.sequence.iter().filter(|p| vertex(p) < level).count();
+        let clear = self.sequence.iter().all(|p| {
+            let v = vertex(p);
+            level < p.level.min(v) || level > p.level.max(v)
+        });
+        let slice = slice(mesh, surface, n, level);
+        let agrees = (self.shape.euler.is_some() && clear)
+            .then(|| slice.curves.len() == self.components[interval]);
+        let still = Still {
+            slice,
+            interval,
+            between: false,
+        };
+        (still, agrees)
+    }
 }

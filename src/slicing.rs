@@ -23,6 +23,10 @@ use std::path::Path;
 const PANEL: u32 = 360;
 const LINE: f64 = 2.5;
 const COLUMNS: usize = 5;
+/// The film's frames: pixels on a side, line width, frames per second.
+const FILM_SIDE: u32 = 720;
+const FILM_LINE: f64 = 3.0;
+const FILM_FPS: u32 = 24;
 
 /// Relative tolerances (of the surface's 4D diagonal) at which a catalogue or formula
 /// surface is sampled again, in turn, while its motion picture fails a check that a finer
@@ -68,9 +72,25 @@ pub struct SurfaceMotion {
     pub stills: Vec<StillRecord>,
     /// Each check that failed.
     pub failures: Vec<String>,
+    /// The film's frames, when one was asked for.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub film: Vec<FilmFrame>,
     /// The finer mesh the motion picture was made on, where the scene's failed a check
     /// (`None`: the scene's own mesh).
     pub resampled: Option<Resampled>,
+}
+
+/// A frame of the film as `motion.json` records it.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct FilmFrame {
+    /// Its level c.
+    pub level: f64,
+    /// Its interval between critical levels.
+    pub interval: usize,
+    /// Its curves.
+    pub curves: usize,
+    /// Crossings of its link diagram.
+    pub crossings: usize,
 }
 
 /// A surface sampled again, finer, for its motion picture.
@@ -220,6 +240,7 @@ pub fn slice_scene(scene: &Scene, slicing: Slicing, out: &Path) -> Result<Motion
         };
         let mut picture = cut(mesh)?;
         let mut resampled = None;
+        let mut finest = None;
         if let Some(s) = surface {
             let diagonal = crate::sample::bounding_diagonal(s);
             for relative in FINER {
@@ -235,9 +256,18 @@ pub fn slice_scene(scene: &Scene, slicing: Slicing, out: &Path) -> Result<Motion
                 }
                 picture = cut(&finer.mesh)?;
                 resampled = Some((relative, triangles));
+                finest = Some(finer.mesh);
             }
         }
+        let mesh = finest.as_ref().unwrap_or(mesh);
         let (mut record, written) = write_surface(scene, name, &picture, shape, &staged)?;
+        if slicing.film > 0 {
+            let (frames, failures, file) =
+                write_film(scene, name, &picture, mesh, surface, slicing.film, &staged)?;
+            record.film = frames;
+            record.failures.extend(failures);
+            files.push(file);
+        }
         record.resampled = resampled.map(|(relative_tolerance, triangles)| Resampled {
             relative_tolerance,
             triangles,
@@ -284,7 +314,7 @@ fn write_surface(
         .iter()
         .map(|still| still.in_frame(&picture.frame))
         .collect();
-    let pages = diagram::pages(&curves, &scene.camera, PANEL);
+    let pages = diagram::pages(&curves, &scene.camera, PANEL, &[]);
     let labels: Vec<(String, String)> = picture
         .stills
         .iter()
@@ -295,14 +325,9 @@ fn write_surface(
                 .checked_sub(1)
                 .map(|k| format!(" · after a {}", picture.sequence[k].event.name()))
                 .unwrap_or_default();
-            let (curves, crossings) = (still.slice.curves.len(), page.under.len());
             (
                 format!("c = {}{after}", compact(still.slice.level, step)),
-                format!(
-                    "{curves} curve{}, {crossings} crossing{}",
-                    if curves == 1 { "" } else { "s" },
-                    if crossings == 1 { "" } else { "s" }
-                ),
+                caption(still.slice.curves.len(), page.under.len()),
             )
         })
         .collect();
@@ -353,9 +378,105 @@ fn write_surface(
         components: picture.components.clone(),
         stills,
         failures: picture.failures.clone(),
+        film: Vec::new(),
         resampled: None,
     };
     Ok((record, files))
+}
+
+/// A still's caption: its curves and crossings.
+fn caption(curves: usize, crossings: usize) -> String {
+    let s = |k: usize| if k == 1 { "" } else { "s" };
+    format!(
+        "{curves} curve{}, {crossings} crossing{}",
+        s(curves),
+        s(crossings)
+    )
+}
+
+/// The film of `picture` (made of `mesh` and its `surface`): `frames` slices at levels
+/// spread evenly from the mesh's lowest point to its highest, each drawn as a link diagram
+/// at one scale (the whole surface's), written as `<name>-film.png`, an animated PNG; each
+/// frame checked against its interval's number of components. Gives the frames' records,
+/// the failures and the file.
+fn write_film(
+    scene: &Scene,
+    name: &str,
+    picture: &MotionPicture,
+    mesh: &crate::sample::Mesh4,
+    surface: Option<&crate::surfaces::Surface>,
+    frames: u32,
+    staged: &Staged,
+) -> Result<(Vec<FilmFrame>, Vec<String>, String), SliceError> {
+    use rayon::prelude::*;
+    let n = picture.critical.direction;
+    let (lowest, highest) = mesh
+        .positions
+        .iter()
+        .map(|p| p.dot(n))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| {
+            (lo.min(h), hi.max(h))
+        });
+    let stills: Vec<(motion::Still, Option<bool>)> = (0..frames)
+        .into_par_iter()
+        .map(|k| {
+            let level = lowest + (highest - lowest) * (f64::from(k) + 0.5) / f64::from(frames);
+            picture.still_at(mesh, surface, level)
+        })
+        .collect();
+    let curves: Vec<Vec<Polyline>> = stills
+        .iter()
+        .map(|(still, _)| still.in_frame(&picture.frame))
+        .collect();
+    let f = &picture.frame;
+    let outline: Vec<glam::DVec3> = mesh
+        .positions
+        .iter()
+        .map(|p| glam::DVec3::new(p.dot(f[0]), p.dot(f[1]), p.dot(f[2])))
+        .collect();
+    let pages = diagram::pages(&curves, &scene.camera, FILM_SIDE, &outline);
+    let step = (highest - lowest) / f64::from(frames);
+    let mut failures = Vec::new();
+    let mut records = Vec::new();
+    for (k, ((still, agrees), page)) in stills.iter().zip(&pages).enumerate() {
+        let (level, count) = (still.slice.level, still.slice.curves.len());
+        if *agrees == Some(false) {
+            failures.push(format!(
+                "film frame {k} at level {level}: {count} component(s), its interval {} {}",
+                still.interval, picture.components[still.interval]
+            ));
+        }
+        records.push(FilmFrame {
+            level,
+            interval: still.interval,
+            curves: count,
+            crossings: page.under.len(),
+        });
+    }
+    let draw = |k: usize| -> std::io::Result<Vec<u8>> {
+        let r = &records[k];
+        let label = (
+            format!("c = {}", compact(r.level, step)),
+            caption(r.curves, r.crossings),
+        );
+        diagram::draw_strip(&pages[k..=k], &[label], 1, FILM_SIDE, FILM_LINE)
+            .map(|(picture, _)| picture.rgb)
+            .map_err(std::io::Error::other)
+    };
+    let size = diagram::strip_size(1, FILM_SIDE, 1);
+    let mut bytes = Vec::new();
+    crate::export::write_apng(&mut bytes, size, FILM_FPS, frames, |k| draw(k as usize)).map_err(
+        |e| {
+            SliceError::Build(Error::Internal {
+                stage: "motion",
+                message: e.to_string(),
+            })
+        },
+    )?;
+    let file = staged
+        .write(format!("{name}-film.png"), &bytes)
+        .map_err(staged_error)?;
+    Ok((records, failures, file))
 }
 
 /// The stills as tubes in a `.glb`, side by side in rows of [`COLUMNS`] as in the strip,

@@ -724,23 +724,11 @@ fn render_writes_beside_the_build_s_picture_and_refuses_an_out_that_is_not_a_png
 
 #[test]
 fn slice_draws_the_spun_trefoils_square_knot_and_checks_its_critical_levels() {
-    // Along the spinning plane's w the spun trefoil's middle slice is the arc and its
-    // mirror image: the square knot, one curve with six crossings; either side of it two
-    // curves, and one curve nearest the extremes.
+    // Along the spinning plane's w (the default scene's `slicing`) the spun trefoil's
+    // middle slice is the arc and its mirror image: the square knot, one curve with six
+    // crossings; either side of it two curves, and one curve nearest the extremes.
     let dir = tempfile::tempdir().unwrap();
-    let out = halo4d(
-        &[
-            "slice",
-            "--direction",
-            "0,0,0,1",
-            "--levels",
-            "1",
-            "--out",
-            "m",
-            "-q",
-        ],
-        dir.path(),
-    );
+    let out = halo4d(&["slice", "--film", "12", "--out", "m", "-q"], dir.path());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
     assert!(
@@ -775,6 +763,20 @@ fn slice_draws_the_spun_trefoils_square_knot_and_checks_its_critical_levels() {
     ] {
         assert!(m.join(f).is_file(), "{f}");
     }
+    // The film: 12 frames through the levels, each recorded, an animated PNG of 12 frames.
+    let film = surface["film"].as_array().unwrap();
+    assert_eq!(film.len(), 12);
+    let decoder = png::Decoder::new(std::io::BufReader::new(
+        std::fs::File::open(m.join("spun_trefoil-film.png")).unwrap(),
+    ));
+    let reader = decoder.read_info().unwrap();
+    assert_eq!(
+        reader.info().animation_control.map(|a| a.num_frames),
+        Some(12)
+    );
+    let counts: Vec<u64> = film.iter().map(|f| f["curves"].as_u64().unwrap()).collect();
+    assert_eq!(counts.first(), Some(&1));
+    assert!(counts.contains(&2), "{counts:?}");
     let svg = std::fs::read_to_string(m.join("spun_trefoil-motion.svg")).unwrap();
     assert!(svg.contains("1 curve, 6 crossings") && svg.ends_with("</svg>\n"));
     // The flags override the scene's: along the view's w (the direction without either),
@@ -845,6 +847,7 @@ fn slice_fails_a_degenerate_direction_until_it_is_tilted_and_refuses_bad_flags()
         (&["--direction", "1,x,0,0"][..], "`x` is not a number"),
         (&["--perturb", "45"][..], "--perturb"),
         (&["--levels", "100"][..], "--levels"),
+        (&["--film", "5000"][..], "--film"),
     ] {
         let mut args = vec!["slice", scene, "--out", "c", "-q"];
         args.extend_from_slice(flags);

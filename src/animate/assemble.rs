@@ -175,19 +175,8 @@ pub fn assemble(dir: &Path) -> Result<Assembled, AnimateError> {
     gather(dir, status.frames)?;
     let path = dir.join(ANIMATION);
     let (width, height) = status.size;
-    let fps = u16::try_from(status.fps).unwrap_or(u16::MAX);
     export::write_atomic_shared(&path, |w| {
-        let mut encoder = png::Encoder::new(w, width, height);
-        encoder.set_color(png::ColorType::Rgb);
-        encoder.set_depth(png::BitDepth::Eight);
-        encoder
-            .set_animated(status.frames, 0)
-            .map_err(std::io::Error::other)?;
-        encoder
-            .set_frame_delay(1, fps)
-            .map_err(std::io::Error::other)?;
-        let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
-        for k in 0..status.frames {
+        export::write_apng(w, (width, height), status.fps, status.frames, |k| {
             let file = frame_file(k, "png");
             let frame = image::open(dir.join(&file))
                 .map_err(|e| std::io::Error::other(format!("{file}: {e}")))?
@@ -199,11 +188,8 @@ pub fn assemble(dir: &Path) -> Result<Assembled, AnimateError> {
                     frame.height()
                 )));
             }
-            writer
-                .write_image_data(frame.as_raw())
-                .map_err(std::io::Error::other)?;
-        }
-        writer.finish().map_err(std::io::Error::other)
+            Ok(frame.into_raw())
+        })
     })
     .map_err(io(&path))?;
     let bytes = std::fs::metadata(&path).map_err(io(&path))?.len();

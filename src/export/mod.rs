@@ -109,3 +109,31 @@ fn write_partial_as(
         })?;
     Ok(tmp)
 }
+
+/// Writes an animated PNG of `frames` pictures of `width` x `height` (8-bit RGB, each
+/// given by `frame(k)` as it is written, so that no more than one is held), shown at `fps`
+/// frames per second, looping.
+pub fn write_apng(
+    w: &mut dyn Write,
+    (width, height): (u32, u32),
+    fps: u32,
+    frames: u32,
+    mut frame: impl FnMut(u32) -> std::io::Result<Vec<u8>>,
+) -> std::io::Result<()> {
+    let mut encoder = png::Encoder::new(w, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder
+        .set_animated(frames, 0)
+        .map_err(std::io::Error::other)?;
+    encoder
+        .set_frame_delay(1, u16::try_from(fps).unwrap_or(u16::MAX))
+        .map_err(std::io::Error::other)?;
+    let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
+    for k in 0..frames {
+        writer
+            .write_image_data(&frame(k)?)
+            .map_err(std::io::Error::other)?;
+    }
+    writer.finish().map_err(std::io::Error::other)
+}

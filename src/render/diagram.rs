@@ -219,16 +219,21 @@ pub fn runs(points: &[DVec2], closed: bool, cuts: &[f64], gap: f64) -> Vec<Vec<D
 /// The panels of curves in 3D (each curve with whether it closes) on pages of `side`
 /// pixels, projected along the view direction of `camera` (its azimuth and elevation;
 /// orthographic), all at one scale and centred alike so that a place in 3D is the same
-/// place in every panel, with their crossings.
-pub fn pages(panels: &[Vec<Polyline>], camera: &CameraSettings, side: u32) -> Vec<Page> {
+/// place in every panel (the scale fits every panel's points and the points `also`, such
+/// as a surface whose slices a film shows), with their crossings.
+pub fn pages(
+    panels: &[Vec<Polyline>],
+    camera: &CameraSettings,
+    side: u32,
+    also: &[DVec3],
+) -> Vec<Page> {
     let (forward, right, up) = basis(camera, 0.0);
     let page = |p: DVec3| (DVec2::new(p.dot(right), -p.dot(up)), p.dot(forward));
     let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
-    for (points, _) in panels.iter().flatten() {
-        for &p in points {
-            let q = page(p).0;
-            (lo, hi) = (lo.min(q), hi.max(q));
-        }
+    let points = panels.iter().flatten().flat_map(|c| &c.0).chain(also);
+    for &p in points {
+        let q = page(p).0;
+        (lo, hi) = (lo.min(q), hi.max(q));
     }
     let extent = (hi - lo).max_element();
     let margin = 0.08 * f64::from(side);
@@ -271,11 +276,10 @@ pub fn draw_strip(
     line: f64,
 ) -> Result<(Picture, String), RenderError> {
     let columns = columns.clamp(1, pages.len().max(1));
-    let rows = pages.len().div_ceil(columns).max(1);
-    let text_size = (f64::from(side) / 22.0).round().max(text::MIN_TEXT);
-    let band = (text_size * 1.8).round() as u32;
+    let (width, height) = strip_size(pages.len(), side, columns);
+    let band = label_band(side);
+    let text_size = text_size(side);
     let (cell_w, cell_h) = (side, side + 2 * band);
-    let (width, height) = (cell_w * columns as u32, cell_h * rows as u32);
     let lines = |e: super::lines::LinesError| RenderError::Internal(e.to_string());
     let mut rgb = vec![PAPER; width as usize * height as usize];
     let mut svg = super::svg::header(width, height, PAPER);
@@ -373,6 +377,26 @@ pub fn draw_strip(
         },
         svg,
     ))
+}
+
+/// The labels' size in pixels for panels of `side`.
+fn text_size(side: u32) -> f64 {
+    (f64::from(side) / 22.0).round().max(text::MIN_TEXT)
+}
+
+/// The height of the band above and below a panel of `side` that holds its labels.
+fn label_band(side: u32) -> u32 {
+    (text_size(side) * 1.8).round() as u32
+}
+
+/// The size of [`draw_strip`]'s picture of `panels` panels of `side` in rows of `columns`.
+pub fn strip_size(panels: usize, side: u32, columns: usize) -> (u32, u32) {
+    let columns = columns.clamp(1, panels.max(1));
+    let rows = panels.div_ceil(columns).max(1);
+    (
+        side * columns as u32,
+        (side + 2 * label_band(side)) * rows as u32,
+    )
 }
 
 /// A one-pixel frame round the panel of `side` at (x0, y0).

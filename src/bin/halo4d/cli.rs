@@ -259,6 +259,11 @@ pub struct SliceArgs {
     /// `slicing.perturb`, else 0].
     #[arg(long, value_name = "DEGREES")]
     pub perturb: Option<f64>,
+    /// A film of this many frames through the levels, from each surface's lowest point to
+    /// its highest (<name>-film.png, an animated PNG), each frame checked against its
+    /// interval [default: the scene's `slicing.film`, else none].
+    #[arg(long, value_name = "FRAMES")]
+    pub film: Option<u32>,
     /// Output folder [default: exports/<scene name>/motion/].
     #[arg(long)]
     pub out: Option<PathBuf>,

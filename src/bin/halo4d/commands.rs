@@ -428,6 +428,7 @@ pub fn slice(args: SliceArgs) -> Outcome {
         direction,
         levels,
         perturb,
+        film,
         out,
         quiet,
     } = args;
@@ -436,6 +437,7 @@ pub fn slice(args: SliceArgs) -> Outcome {
         direction,
         levels: levels.unwrap_or(0),
         perturb: perturb.unwrap_or(0.0),
+        film: film.unwrap_or(0),
     };
     flags.check().map_err(|e| FieldError {
         field: format!("--{}", e.field),
@@ -448,6 +450,7 @@ pub fn slice(args: SliceArgs) -> Outcome {
         direction: direction.or(from_scene.direction),
         levels: levels.unwrap_or(from_scene.levels),
         perturb: perturb.unwrap_or(from_scene.perturb),
+        film: film.unwrap_or(from_scene.film),
     };
     let motion = halo4d::slicing::slice_scene(&scene, slicing, &out)?;
     eprint!("{}", motion.summary());
