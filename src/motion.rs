@@ -1,8 +1,11 @@
 //! Motion pictures: a surface cut by the hyperplanes ⟨n, x⟩ = c of a height function
-//! h = ⟨n, X⟩. What this module gives so far: where the slices change, the critical points
-//! of h on the surface (births, saddles, deaths), found on the 4D mesh and refined on the
-//! exact surface, with the Morse check of their count; and the slice of the mesh at a level
-//! ([`slice()`]), whose components change at the mesh's critical vertices as their events say.
+//! h = ⟨n, X⟩. Where the slices change: the critical points of h on the surface (births,
+//! saddles, deaths), found on the 4D mesh and refined on the exact surface, with the Morse
+//! check of their count; the slice at a level ([`slice()`]), whose components change at the
+//! mesh's critical vertices as their events say; the hyperplanes' frame
+//! ([`hyperplane_frame`]); and the motion picture ([`motion_picture`]): a still in each
+//! interval between critical levels, with the checks that its components change as the
+//! events say (what `halo4d slice` draws, in `crate::slicing`).
 //!
 //! **On the mesh** (Banchoff's critical points of a piecewise-linear height): a vertex's
 //! link is the cycle of its neighbours; the number of sign changes of h(neighbour) - h(v)
