@@ -237,10 +237,16 @@ pub fn pages(
     }
     let extent = (hi - lo).max_element();
     let margin = 0.08 * f64::from(side);
-    let (scale, centre) = if extent > 0.0 && extent.is_finite() {
-        ((f64::from(side) - 2.0 * margin) / extent, (lo + hi) * 0.5)
+    // Centred on the box, also when it is a point (a slice shrunk to one, at a birth).
+    let centre = if lo.is_finite() && hi.is_finite() {
+        (lo + hi) * 0.5
     } else {
-        (1.0, DVec2::ZERO)
+        DVec2::ZERO
+    };
+    let scale = if extent > 0.0 && extent.is_finite() {
+        (f64::from(side) - 2.0 * margin) / extent
+    } else {
+        1.0
     };
     let to_px = |q: DVec2| (q - centre) * scale + DVec2::splat(0.5 * f64::from(side));
     panels
@@ -463,6 +469,22 @@ mod tests {
         assert_eq!(under.len(), 1);
         // The later diagonal (depth 1) is farther: cut at its middle, 2 + 2√2 + √2 along.
         assert!((under[0].at - (2.0 + 3.0 * 2f64.sqrt())).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_slice_shrunk_to_a_far_point_is_drawn_at_the_panels_centre() {
+        let p = DVec3::new(1e29, -3e28, 5e28);
+        let pages = pages(
+            &[vec![(vec![p; 3], true)]],
+            &CameraSettings::default(),
+            64,
+            &[],
+        );
+        let q = pages[0].curves[0].0[0].0;
+        assert!(q.distance(DVec2::splat(32.0)) < 1e-9, "{q}");
+        let (picture, svg) = draw_strip(&pages, &[], 1, 64, 2.0).unwrap();
+        assert_eq!((picture.width, picture.height), strip_size(1, 64, 1));
+        assert!(svg.ends_with("</svg>\n"));
     }
 
     #[test]
