@@ -601,6 +601,16 @@ pub fn tilt(n: DVec4, frame: &[DVec4; 3], degrees: f64) -> DVec4 {
     (n * angle.cos() + toward * angle.sin()).normalize()
 }
 
+/// The lowest and the highest of h = ⟨n, x⟩ over the mesh's vertices.
+pub fn heights(mesh: &Mesh4, n: DVec4) -> (f64, f64) {
+    mesh.positions
+        .iter()
+        .map(|p| p.dot(n))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| {
+            (lo.min(h), hi.max(h))
+        })
+}
+
 /// A scene's `slicing`: what `halo4d slice` cuts its surfaces along (its flags override
 /// these).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -754,13 +764,7 @@ pub fn motion_picture(
     bands.sort_by(|a, b| a.vertex.total_cmp(&b.vertex));
     let cut = |c: f64| slice(mesh, surface, n, c);
     let closed = shape.euler.is_some();
-    let (lowest, highest) = mesh
-        .positions
-        .iter()
-        .map(|p| p.dot(n))
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| {
-            (lo.min(h), hi.max(h))
-        });
+    let (lowest, highest) = heights(mesh, n);
     let mut stills = Vec::new();
     let mut components = Vec::with_capacity(bands.len() + 1);
     let mut failures = Vec::new();

@@ -410,13 +410,7 @@ fn write_film(
 ) -> Result<(Vec<FilmFrame>, Vec<String>, String), SliceError> {
     use rayon::prelude::*;
     let n = picture.critical.direction;
-    let (lowest, highest) = mesh
-        .positions
-        .iter()
-        .map(|p| p.dot(n))
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| {
-            (lo.min(h), hi.max(h))
-        });
+    let (lowest, highest) = motion::heights(mesh, n);
     let stills: Vec<(motion::Still, Option<bool>)> = (0..frames)
         .into_par_iter()
         .map(|k| {
