@@ -185,9 +185,15 @@ impl Motion {
 }
 
 /// Makes the motion pictures of every surface of `scene` along `slicing` (the scene's
-/// `slicing`, or other settings) into `out`
-/// (files written under temporary names and moved into place together).
-pub fn slice_scene(scene: &Scene, slicing: Slicing, out: &Path) -> Result<Motion, SliceError> {
+/// `slicing`, or other settings) into `out` (files written under temporary names and moved
+/// into place together); unless `quiet`, says on stderr when a surface is sampled again
+/// and why.
+pub fn slice_scene(
+    scene: &Scene,
+    slicing: Slicing,
+    out: &Path,
+    quiet: bool,
+) -> Result<Motion, SliceError> {
     slicing
         .check()
         .map_err(|e| SliceError::Setting(e.within("slicing")))?;
@@ -247,6 +253,12 @@ pub fn slice_scene(scene: &Scene, slicing: Slicing, out: &Path) -> Result<Motion
                 // A degenerate direction stays degenerate on any mesh.
                 if picture.failures.is_empty() || picture.critical.counts()[3] > 0 {
                     break;
+                }
+                if !quiet {
+                    eprintln!(
+                        "{name}: {}; sampling again at {relative:e} of its diagonal",
+                        picture.failures[0]
+                    );
                 }
                 let finer = crate::sample::sample_adaptive(s, relative * diagonal, FINER_TRIANGLES);
                 let triangles = finer.mesh.triangles.len();

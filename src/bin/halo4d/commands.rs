@@ -452,7 +452,7 @@ pub fn slice(args: SliceArgs) -> Outcome {
         perturb: perturb.unwrap_or(from_scene.perturb),
         film: film.unwrap_or(from_scene.film),
     };
-    let motion = halo4d::slicing::slice_scene(&scene, slicing, &out)?;
+    let motion = halo4d::slicing::slice_scene(&scene, slicing, &out, quiet)?;
     eprint!("{}", motion.summary());
     for f in &motion.files {
         println!("{}", out.join(f).display());
