@@ -569,19 +569,11 @@ pub fn hyperplane_frame(rotation: DMat4, n: DVec4) -> [DVec4; 3] {
     let axis = |k: usize| rt * DVec4::AXES[k];
     let a = axis(3);
     let cos = a.dot(n).clamp(-1.0, 1.0);
-    // The unit vector of the turn's plane perpendicular to a, towards n.
+    // The turn's plane: a and the unit vector u perpendicular to a towards n (the view's z
+    // where n is along ±a, for the half turn; any u serves the identity).
     let across = n - a * cos;
-    let u = if across.length() > 1e-12 {
-        across.normalize()
-    } else {
-        axis(2)
-    };
-    let sin = (1.0 - cos * cos).max(0.0).sqrt();
-    let (cos, sin) = if across.length() > 1e-12 || cos > 0.0 {
-        (cos, sin)
-    } else {
-        (-1.0, 0.0)
-    };
+    let sin = across.length();
+    let u = if sin > 1e-12 { across / sin } else { axis(2) };
     let turn = |x: DVec4| {
         let (xa, xu) = (x.dot(a), x.dot(u));
         x + (a * xa + u * xu) * (cos - 1.0) + (u * xa - a * xu) * sin
@@ -651,7 +643,7 @@ impl Slicing {
 pub type Polyline = (Vec<glam::DVec3>, bool);
 
 /// What is known of a surface's topology for the motion picture's checks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Shape {
     /// The Euler characteristic of a closed surface; `None` for a surface with boundary,
     /// whose counts are not checked.
@@ -662,7 +654,7 @@ pub struct Shape {
 }
 
 /// One still of a motion picture: the slice at a regular level.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
 pub struct Still {
     /// The slice, its curves in 4D.
     pub slice: Slice,
@@ -675,7 +667,7 @@ pub struct Still {
 
 /// A motion picture: the critical points of h = ⟨n, X⟩ and a still in every interval
 /// between them, with the checks of Morse theory.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
 pub struct MotionPicture {
     /// The critical points, by level.
     pub critical: Critical,
@@ -847,15 +839,8 @@ pub fn motion_picture(
             {
                 continue;
             }
-            let (still, agrees) = picture.still_at(mesh, surface, level);
-            if agrees == Some(false) {
-                picture.failures.push(format!(
-                    "the slice at {level} has {} components, its interval {} {}",
-                    still.slice.curves.len(),
-                    still.interval,
-                    picture.components[still.interval]
-                ));
-            }
+            let (still, failure) = picture.still_at(mesh, surface, level);
+            picture.failures.extend(failure);
             picture.stills.push(still);
         }
         picture
@@ -868,15 +853,15 @@ pub fn motion_picture(
 impl MotionPicture {
     /// The slice of `mesh` (the one the picture was made of, with its `surface`) at
     /// `level`, as a still of this picture: its interval (by the levels of the critical
-    /// points' mesh vertices), and whether it has its interval's number of components:
-    /// `None` where that is not checked (a surface with boundary, or a level between a
+    /// points' mesh vertices), and what fails when it does not have its interval's number
+    /// of components (not checked on a surface with boundary, nor at a level between a
     /// critical point's refined level and its vertex's).
     pub fn still_at(
         &self,
         mesh: &Mesh4,
         surface: Option<&Surface>,
         level: f64,
-    ) -> (Still, Option<bool>) {
+    ) -> (Still, Option<String>) {
         let n = self.critical.direction;
         let vertex = |p: &CriticalPoint| mesh.positions[p.vertex as usize].dot(n);
         let interval = self.sequence.iter().filter(|p| vertex(p) < level).count();
@@ -885,13 +870,18 @@ impl MotionPicture {
             level < p.level.min(v) || level > p.level.max(v)
         });
         let slice = slice(mesh, surface, n, level);
-        let agrees = (self.shape.euler.is_some() && clear)
-            .then(|| slice.curves.len() == self.components[interval]);
+        let (count, expected) = (slice.curves.len(), self.components[interval]);
+        let failure = (self.shape.euler.is_some() && clear && count != expected).then(|| {
+            format!(
+                "the slice at level {level} has {count} component(s), its interval {interval} \
+                 {expected}"
+            )
+        });
         let still = Still {
             slice,
             interval,
             between: false,
         };
-        (still, agrees)
+        (still, failure)
     }
 }

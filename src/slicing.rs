@@ -245,8 +245,8 @@ pub fn slice_scene(
                 .map_err(SliceError::Setting)
         };
         let mut picture = cut(mesh)?;
-        let mut resampled = None;
-        let mut finest = None;
+        // The finer mesh made, with its relative tolerance, once the scene's fails.
+        let mut finest: Option<(f64, crate::sample::Mesh4)> = None;
         if let Some(s) = surface {
             let diagonal = crate::sample::bounding_diagonal(s);
             for relative in FINER {
@@ -261,30 +261,29 @@ pub fn slice_scene(
                     );
                 }
                 let finer = crate::sample::sample_adaptive(s, relative * diagonal, FINER_TRIANGLES);
-                let triangles = finer.mesh.triangles.len();
+                let current = finest.as_ref().map_or(mesh, |f| &f.1);
                 // A scene sampled finer already keeps its mesh.
-                if triangles <= resampled.map_or(mesh.triangles.len(), |r: (f64, usize)| r.1) {
+                if finer.mesh.triangles.len() <= current.triangles.len() {
                     continue;
                 }
                 picture = cut(&finer.mesh)?;
-                resampled = Some((relative, triangles));
-                finest = Some(finer.mesh);
+                finest = Some((relative, finer.mesh));
             }
         }
-        let mesh = finest.as_ref().unwrap_or(mesh);
         let (mut record, written) = write_surface(scene, name, &picture, shape, &staged)?;
+        files.extend(written);
+        record.resampled = finest.as_ref().map(|(relative_tolerance, m)| Resampled {
+            relative_tolerance: *relative_tolerance,
+            triangles: m.triangles.len(),
+        });
         if slicing.film > 0 {
+            let mesh = finest.as_ref().map_or(mesh, |f| &f.1);
             let (frames, failures, file) =
                 write_film(scene, name, &picture, mesh, surface, slicing.film, &staged)?;
             record.film = frames;
             record.failures.extend(failures);
             files.push(file);
         }
-        record.resampled = resampled.map(|(relative_tolerance, triangles)| Resampled {
-            relative_tolerance,
-            triangles,
-        });
-        files.extend(written);
         surfaces.push(record);
     }
     files.push("motion.json".into());
@@ -423,7 +422,7 @@ fn write_film(
     use rayon::prelude::*;
     let n = picture.critical.direction;
     let (lowest, highest) = motion::heights(mesh, n);
-    let stills: Vec<(motion::Still, Option<bool>)> = (0..frames)
+    let stills: Vec<(motion::Still, Option<String>)> = (0..frames)
         .into_par_iter()
         .map(|k| {
             let level = lowest + (highest - lowest) * (f64::from(k) + 0.5) / f64::from(frames);
@@ -444,18 +443,12 @@ fn write_film(
     let step = (highest - lowest) / f64::from(frames);
     let mut failures = Vec::new();
     let mut records = Vec::new();
-    for (k, ((still, agrees), page)) in stills.iter().zip(&pages).enumerate() {
-        let (level, count) = (still.slice.level, still.slice.curves.len());
-        if *agrees == Some(false) {
-            failures.push(format!(
-                "film frame {k} at level {level}: {count} component(s), its interval {} {}",
-                still.interval, picture.components[still.interval]
-            ));
-        }
+    for (k, ((still, failure), page)) in stills.iter().zip(&pages).enumerate() {
+        failures.extend(failure.iter().map(|f| format!("film frame {k}: {f}")));
         records.push(FilmFrame {
-            level,
+            level: still.slice.level,
             interval: still.interval,
-            curves: count,
+            curves: still.slice.curves.len(),
             crossings: page.under.len(),
         });
     }
