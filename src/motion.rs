@@ -199,8 +199,9 @@ pub fn critical_points(
         let start = CriticalPoint {
             event,
             level: h[v],
-            patch: mesh.patch[v] as usize,
-            uv: mesh.uv[v],
+            // A mesh read back from a `.glb` keeps no parameters.
+            patch: mesh.patch.get(v).map_or(0, |&p| p as usize),
+            uv: mesh.uv.get(v).copied().unwrap_or_default(),
             point: mesh.positions[v],
             residual: 0.0,
             vertex,
@@ -636,6 +637,20 @@ impl Slicing {
         limits::MOTION_LEVELS.check("levels", self.levels)?;
         limits::PERTURB.check("perturb", self.perturb)?;
         limits::FILM_FRAMES.check("film", self.film)
+    }
+
+    /// The unit direction n it cuts along for a view of 4D rotation `rotation` (its
+    /// `direction`, else [`view_direction`], tilted by `perturb` degrees), with the frame of
+    /// its hyperplanes ([`hyperplane_frame`]). Takes a checked `Slicing`.
+    pub fn direction_and_frame(&self, rotation: DMat4) -> (DVec4, [DVec4; 3]) {
+        let mut n = self
+            .direction
+            .map_or_else(|| view_direction(rotation), DVec4::from_array)
+            .normalize();
+        if self.perturb > 0.0 {
+            n = tilt(n, &hyperplane_frame(rotation, n), self.perturb);
+        }
+        (n, hyperplane_frame(rotation, n))
     }
 }
 

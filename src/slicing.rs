@@ -197,16 +197,7 @@ pub fn slice_scene(
     slicing
         .check()
         .map_err(|e| SliceError::Setting(e.within("slicing")))?;
-    let rotation = scene.view.rotation.matrix();
-    let n = match slicing.direction {
-        Some(d) => DVec4::from_array(d),
-        None => motion::view_direction(rotation),
-    };
-    let mut n = n.normalize();
-    if slicing.perturb > 0.0 {
-        n = motion::tilt(n, &motion::hyperplane_frame(rotation, n), slicing.perturb);
-    }
-    let frame = motion::hyperplane_frame(rotation, n);
+    let (n, frame) = slicing.direction_and_frame(scene.view.rotation.matrix());
     let sampled = Sampled::of(scene);
     let staged = Staged::new(out).map_err(staged_error)?;
     let mut surfaces = Vec::new();

@@ -126,6 +126,17 @@ fn a_mesh_without_parameters_keeps_its_critical_vertices() {
     );
     assert!(found.points.iter().all(|p| !p.refined));
     assert_eq!(found.morse(2), Ok(()));
+    // As a `.glb` reads back: positions and triangles, no parameters at all.
+    let bare = halo4d::sample::Mesh4 {
+        positions: mesh.positions.clone(),
+        triangles: mesh.triangles.clone(),
+        ..Default::default()
+    };
+    assert_eq!(critical_points(&bare, None, DVec4::W).unwrap(), found);
+    assert_eq!(
+        halo4d::motion::slice(&bare, None, DVec4::W, 0.15),
+        halo4d::motion::slice(&mesh, None, DVec4::W, 0.15)
+    );
 }
 
 #[test]

@@ -246,6 +246,145 @@ fn the_explorer_draws_the_curves_a_build_shows() {
     }
 }
 
+#[test]
+fn the_explorer_shows_the_slices_halo4d_slice_makes_over_the_surfaces() {
+    let gpu = gpu();
+    let scene = Scene::load(&crate::common::fixture("scenes/default.json")).unwrap();
+    let model = Model::new(scene.clone()).unwrap();
+    let mut plane = model.hyperplane(None).unwrap();
+    // The hyperplane is `halo4d slice`'s: the same direction and critical levels, and at
+    // each still's level as many curves.
+    let dir = tempfile::tempdir().unwrap();
+    let motion =
+        halo4d::slicing::slice_scene(&scene, scene.slicing.unwrap(), dir.path(), true).unwrap();
+    let surface = &motion.surfaces[0];
+    assert!(surface.resampled.is_none(), "made on the scene's own mesh");
+    assert!((plane.direction - surface.direction).length() < 1e-15);
+    let levels = |points: &[halo4d::motion::CriticalPoint]| -> Vec<(String, f64)> {
+        points
+            .iter()
+            .map(|p| (p.event.name().to_string(), p.level))
+            .collect()
+    };
+    assert_eq!(levels(&plane.critical), levels(&surface.critical_points));
+    assert!(surface.stills.len() >= 5);
+    for still in &surface.stills {
+        plane.move_to(&model, still.level);
+        let curves: usize = plane.slices.iter().map(|s| s.curves.len()).sum();
+        assert_eq!(curves, still.curves, "at level {}", still.level);
+        assert!(plane.slices.iter().all(|s| s.max_residual <= 1e-12));
+    }
+    // It starts in the middle of the heights, here about c = 0, the square knot: one curve,
+    // and the title says between which events it lies; it stays within the heights.
+    let mut plane = model.hyperplane(None).unwrap();
+    let (lo, hi) = plane.range;
+    assert_eq!(plane.level, 0.5 * (lo + hi));
+    assert!(plane.level.abs() < 1e-3 * (hi - lo), "{}", plane.level);
+    let title = plane.describe();
+    assert!(
+        title.contains(": 1 curve |")
+            && title.contains("below: saddle at -0.2907")
+            && title.contains("above: saddle at 0.2907"),
+        "{title}"
+    );
+    let middle = plane.level;
+    plane.step(&model, 10.0);
+    assert_eq!(plane.level, plane.range.1);
+    assert!(
+        plane
+            .describe()
+            .contains("0 curves | below: death at 1.6542"),
+        "{}",
+        plane.describe()
+    );
+    assert!(plane.describe().ends_with("above: nothing"));
+    plane.move_to(&model, middle);
+    // Drawn: every pixel the slice changes lies on a projected slice curve, and there are
+    // many, in the slice's magenta.
+    let view = scene.view;
+    let base = ViewSettings {
+        render: RenderSettings {
+            curves: false,
+            silhouettes: false,
+            ..settings(&scene, HaloMode::Grid, 256).render
+        },
+        ..settings(&scene, HaloMode::Grid, 256)
+    };
+    let mut renderer =
+        viewer::Renderer::for_model(gpu, &model, &view, viewer::OFFSCREEN_FORMAT).unwrap();
+    let without = renderer.read_frame(gpu, &base).unwrap();
+    let polylines = plane.polylines(&view);
+    assert_eq!(polylines.len(), 1);
+    renderer.set_slice(gpu, &polylines).unwrap();
+    let with = renderer.read_frame(gpu, &base).unwrap();
+    let placement = renderer.asset().placement(&scene.camera, SIDE, SIDE);
+    let camera =
+        halo4d::internals::Camera::new(&scene.camera, &placement, SIDE, SIDE, 0.0).unwrap();
+    let mut segments = Vec::new();
+    for (points, closed) in &polylines {
+        let p: Vec<[f64; 2]> = points
+            .iter()
+            .filter_map(|&q| camera.project(q, SIDE, SIDE).map(|(xy, _)| xy))
+            .collect();
+        segments.extend(p.windows(2).map(|w| (w[0], w[1])));
+        if *closed {
+            segments.push((p[p.len() - 1], p[0]));
+        }
+    }
+    let (mut changed, mut magenta) = (0, 0);
+    for (i, (a, b)) in with
+        .picture
+        .rgb
+        .chunks(3)
+        .zip(without.picture.rgb.chunks(3))
+        .enumerate()
+    {
+        if a != b {
+            changed += 1;
+            magenta += usize::from(a[0] > 150 && a[2] > 120 && a[1] < 60);
+            let (x, y) = (
+                (i as u32 % SIDE) as f64 + 0.5,
+                (i as u32 / SIDE) as f64 + 0.5,
+            );
+            assert!(
+                segments
+                    .iter()
+                    .any(|&(a, b)| distance_to_segment([x, y], a, b) <= 2.25),
+                "pixel ({x}, {y}) changed away from the slice"
+            );
+        }
+    }
+    assert!(
+        magenta > 100,
+        "{magenta} of {changed} changed pixels magenta"
+    );
+    // A turn drops the slice until it is given for the new view.
+    let mut turned = view;
+    turned.rotation.xw += 20.0;
+    renderer.turn(gpu, &model, &turned).unwrap();
+    let bare = renderer.read_frame(gpu, &base).unwrap();
+    renderer.set_slice(gpu, &plane.polylines(&turned)).unwrap();
+    let again = renderer.read_frame(gpu, &base).unwrap();
+    assert_ne!(bare.picture.rgb, again.picture.rgb);
+    renderer.set_slice(gpu, &[]).unwrap();
+    assert_eq!(
+        renderer.read_frame(gpu, &base).unwrap().picture.rgb,
+        bare.picture.rgb
+    );
+}
+
+/// The distance from `p` to the segment from `a` to `b`.
+fn distance_to_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = dx * dx + dy * dy;
+    let s = if len2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a[0] + s * dx - p[0]).hypot(a[1] + s * dy - p[1])
+}
+
 /// Seeded 4D rotations: each of the six planes turned by up to 35 degrees either way.
 fn seeded_rotations(seed: u64, count: usize) -> Vec<Rotation4> {
     let mut rng = Rng(seed);
@@ -552,17 +691,9 @@ fn curves_colour_and_transparency_toggle_what_they_should() {
         }
     }
     let near_curve = |x: f64, y: f64| {
-        segments.iter().any(|&(a, b)| {
-            let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-            let len2 = dx * dx + dy * dy;
-            let s = if len2 > 0.0 {
-                (((x - a[0]) * dx + (y - a[1]) * dy) / len2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let (px, py) = (a[0] + s * dx - x, a[1] + s * dy - y);
-            px * px + py * py <= 2.25 * 2.25
-        })
+        segments
+            .iter()
+            .any(|&(a, b)| distance_to_segment([x, y], a, b) <= 2.25)
     };
     let mut changed = 0;
     for (i, (a, b)) in with
@@ -773,6 +904,25 @@ fn the_binary_writes_a_screenshot_and_refuses_bad_flags() {
     );
     let image = image::open(&png).unwrap();
     assert_eq!((image.width(), image.height()), (96, 64));
+    // The `.glb` carries its 4D mesh and scene: it can be sliced, and the slice shows.
+    let sliced = dir.path().join("sliced.png");
+    let out = run(&[
+        "--headless",
+        "--screenshot",
+        sliced.to_str().unwrap(),
+        "--size",
+        "96x64",
+        "--slices",
+        "64",
+        "--hyperplane",
+        "-0.5",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_ne!(image, image::open(&sliced).unwrap());
     for (args, words) in [
         (&["--headless"][..], &["--screenshot"][..]),
         (
@@ -786,6 +936,14 @@ fn the_binary_writes_a_screenshot_and_refuses_bad_flags() {
         (
             &["--headless", "--screenshot", "x.png", "--elevation", "95"],
             &["elevation"],
+        ),
+        (
+            &["--headless", "--screenshot", "x.png", "--hyperplane", "9"],
+            &["hyperplane", "level 9 is outside the surfaces' heights"],
+        ),
+        (
+            &["--bench", "--hyperplane", "0"],
+            &["--hyperplane", "not in --bench"],
         ),
     ] {
         let out = run(args);
@@ -988,8 +1146,9 @@ fn a_glb_turns_in_4d_as_its_scene_does_and_one_without_the_4d_mesh_in_3d() {
         },
         ..settings(&scene, HaloMode::Grid, 128)
     };
-    let frames = [&from_file, &from_scene]
-        .map(|source| distances(&viewer::screenshot_of(gpu, source, Some(&view), &s).unwrap()));
+    let frames = [&from_file, &from_scene].map(|source| {
+        distances(&viewer::screenshot_of(gpu, source, Some(&view), &s, None).unwrap())
+    });
     let differs = verdict_differs(&frames[0], &frames[1], SAME);
     assert!(
         differs < 0.001,
@@ -1151,6 +1310,7 @@ fn stipple_tile_difference(scene: &Scene, view: Option<&halo4d::view::View>) -> 
             },
             ..settings(&scene, HaloMode::Grid, 256)
         },
+        None,
     )
     .unwrap_or_else(|e| panic!("{}: {e}", scene.name));
     let (a, b) = (tile_ink(&cpu), tile_ink(&gpu_frame.picture));
@@ -1223,8 +1383,19 @@ fn the_stipple_style_is_refused_for_a_glb_without_its_4d_mesh() {
             },
             ..settings(&scene, HaloMode::Grid, 64)
         },
+        None,
     )
     .unwrap_err()
     .to_string();
     assert!(e.contains("stipple") && e.contains("4D mesh"), "{e}");
+    let e = viewer::screenshot_of(
+        gpu(),
+        &source,
+        None,
+        &settings(&scene, HaloMode::Grid, 64),
+        Some(0.0),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("hyperplane") && e.contains("no 4D mesh"), "{e}");
 }

@@ -93,6 +93,11 @@ struct Args {
     /// Frames per orbit for --bench.
     #[arg(long, default_value_t = 36)]
     frames: u32,
+    /// Show the slice by the hyperplane of the scene's `slicing` (the one `halo4d slice`
+    /// cuts along) at LEVEL, a height along its direction, over the surfaces (a scene only;
+    /// in the window, `L` shows it at the middle and `,` `.` move it).
+    #[arg(long, value_name = "LEVEL", allow_negative_numbers = true)]
+    hyperplane: Option<f64>,
     /// Render with the CPU renderer's exact mode too, and print for each mode and slice
     /// count the share of covered pixels where what is visible differs.
     #[arg(long)]
@@ -155,6 +160,12 @@ fn run(args: &Args) -> Result<(), ViewerError> {
         return Err(ViewerError::Setting(FieldError::new(
             "--headless",
             "needs --screenshot OUT.png (or --save-scene OUT.json, --bench or --compare)",
+        )));
+    }
+    if args.hyperplane.is_some() && (args.bench || args.compare) {
+        return Err(ViewerError::Setting(FieldError::new(
+            "--hyperplane",
+            "is drawn in a screenshot or the window, not in --bench or --compare",
         )));
     }
     let (source, notes) = Source::open(args.file.as_deref())?;
@@ -240,7 +251,8 @@ fn run(args: &Args) -> Result<(), ViewerError> {
     }
     if let Some(out) = &args.screenshot {
         let gpu = Gpu::headless()?;
-        let frame = viewer::screenshot_of(&gpu, &source, view.as_ref(), &settings)?;
+        let frame =
+            viewer::screenshot_of(&gpu, &source, view.as_ref(), &settings, args.hyperplane)?;
         halo4d::write_atomic(out, &frame.picture.png()).map_err(|e| ViewerError::Write {
             path: out.display().to_string(),
             message: e.to_string(),
@@ -269,7 +281,7 @@ fn run(args: &Args) -> Result<(), ViewerError> {
         return Ok(());
     }
     println!("{}", viewer::window::HELP);
-    viewer::window::run(source, view, settings)
+    viewer::window::run(source, view, settings, args.hyperplane)
 }
 
 fn bench(

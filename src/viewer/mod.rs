@@ -52,7 +52,7 @@ pub mod window;
 pub use gpu::Gpu;
 pub use renderer::{FrameTimes, OFFSCREEN_FORMAT, Renderer};
 pub use stipple::StippleSet;
-pub use turn::{Framing, Model};
+pub use turn::{Framing, Hyperplane, Model};
 
 use crate::import::{ImportError, ImportedScene};
 use crate::limits::{
@@ -793,6 +793,21 @@ impl Source {
         }
     }
 
+    /// The hyperplane of a model's scene at `level` ([`Model::hyperplane`]); refused for
+    /// an asset, which has no 4D mesh to slice.
+    pub fn hyperplane(&self, level: Option<f64>) -> Result<Hyperplane, ViewerError> {
+        match self {
+            Source::Model(m) => m.hyperplane(level),
+            Source::Asset(a) => Err(ViewerError::Setting(FieldError::new(
+                "hyperplane",
+                format!(
+                    "{} carries no 4D mesh to slice; open its scene file",
+                    a.1.name
+                ),
+            ))),
+        }
+    }
+
     /// The camera the scene records (the default where a `.glb` records none).
     pub fn camera(&self) -> CameraSettings {
         match self {
@@ -824,12 +839,14 @@ impl Source {
     }
 }
 
-/// Renders one frame of `source` offscreen (a model in `view`, with its curves).
+/// Renders one frame of `source` offscreen (a model in `view`, with its curves, and the
+/// slice by its scene's hyperplane at level `hyperplane` where one is given).
 pub fn screenshot_of(
     gpu: &Gpu,
     source: &Source,
     view: Option<&crate::view::View>,
     settings: &ViewSettings,
+    hyperplane: Option<f64>,
 ) -> Result<Frame, ViewerError> {
     settings.check()?;
     let mut renderer = source.renderer(
@@ -838,6 +855,12 @@ pub fn screenshot_of(
         settings.render.curves,
         renderer::OFFSCREEN_FORMAT,
     )?;
+    if let Some(level) = hyperplane {
+        let plane = source.hyperplane(Some(level))?;
+        if let Source::Model(m) = source {
+            renderer.set_slice(gpu, &plane.polylines(view.unwrap_or(&m.scene.view)))?;
+        }
+    }
     if settings.render.style == Style::Stipple {
         let st = settings.render.stipple;
         renderer.set_stipples(gpu, &source.stipples(st.count, st.seed)?)?;

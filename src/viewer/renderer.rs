@@ -8,6 +8,7 @@ use super::{
 };
 use crate::intersect::Curves;
 use crate::limits::FieldError;
+use crate::motion::Polyline;
 use crate::render::{Picture, Style, shade};
 use crate::view::View;
 use bytemuck::{Pod, Zeroable};
@@ -115,6 +116,7 @@ pub struct Renderer {
     composite: wgpu::RenderPipeline,
     curves: wgpu::RenderPipeline,
     silhouettes: wgpu::RenderPipeline,
+    slice_lines: wgpu::RenderPipeline,
     downsample: wgpu::RenderPipeline,
     cut: wgpu::RenderPipeline,
     voxelize: wgpu::ComputePipeline,
@@ -126,6 +128,8 @@ pub struct Renderer {
     stipple_pipeline: wgpu::RenderPipeline,
     /// The stipples, once given: (per stipple, per triangle's area ratio, how many).
     stipples: Option<(wgpu::Buffer, wgpu::Buffer, u32)>,
+    /// A hyperplane's slice, once given: (points, segments, how many segments).
+    slice: Option<(wgpu::Buffer, wgpu::Buffer, u32)>,
 }
 
 /// The asset's buffers on the GPU.
@@ -203,6 +207,7 @@ struct Pipelines {
     composite: wgpu::RenderPipeline,
     curves: wgpu::RenderPipeline,
     silhouettes: wgpu::RenderPipeline,
+    slice_lines: wgpu::RenderPipeline,
     downsample: wgpu::RenderPipeline,
     cut: wgpu::RenderPipeline,
     voxelize: wgpu::ComputePipeline,
@@ -317,6 +322,14 @@ impl Pipelines {
             &opaque_targets(false),
             None,
         );
+        let slice_lines = pipeline(
+            "slice",
+            "slice_vs",
+            "line_fs",
+            P::TriangleList,
+            &opaque_targets(false),
+            None,
+        );
         let stipple_pipeline = pipeline(
             "stipples",
             "stipple_vs",
@@ -342,6 +355,7 @@ impl Pipelines {
             composite,
             curves,
             silhouettes,
+            slice_lines,
             downsample,
             cut,
             voxelize,
@@ -382,6 +396,7 @@ impl Renderer {
             composite,
             curves,
             silhouettes,
+            slice_lines,
             downsample,
             cut,
             voxelize,
@@ -428,6 +443,7 @@ impl Renderer {
             composite,
             curves,
             silhouettes,
+            slice_lines,
             downsample,
             cut,
             voxelize,
@@ -437,6 +453,7 @@ impl Renderer {
             turner: None,
             stipple_pipeline,
             stipples: None,
+            slice: None,
         })
     }
 
@@ -484,8 +501,9 @@ impl Renderer {
 
     /// Rebuilds the surfaces and halos of `model` (the one this renderer was made for) in
     /// the 4D `view` on the GPU and reads them back (the view mode's slab lists and the
-    /// grid's voxelization read the positions); the curves are dropped until
-    /// [`Renderer::set_curves`] gives the view's. Milliseconds it took.
+    /// grid's voxelization read the positions); the curves and the slice are dropped until
+    /// [`Renderer::set_curves`] and [`Renderer::set_slice`] give the view's. Milliseconds
+    /// it took.
     pub fn turn(&mut self, gpu: &Gpu, model: &Model, view: &View) -> Result<f64, ViewerError> {
         let start = Instant::now();
         let turner = self
@@ -519,6 +537,7 @@ impl Renderer {
         self.asset.depth_range = framing.depth_range;
         self.asset.curve_points.clear();
         self.asset.curve_segments.clear();
+        self.slice = None;
         self.grid = None;
         Ok(start.elapsed().as_secs_f64() * 1e3)
     }
@@ -547,6 +566,46 @@ impl Renderer {
             bytemuck::cast_slice(&self.asset.curve_segments),
             wgpu::BufferUsages::STORAGE,
         )?;
+        Ok(())
+    }
+
+    /// Draws `polylines` (a hyperplane's slice, [`super::Hyperplane::polylines`], in the
+    /// view the renderer was last turned to) in the slice's colour, over the surfaces as
+    /// the curves are; none for an empty list.
+    pub fn set_slice(&mut self, gpu: &Gpu, polylines: &[Polyline]) -> Result<(), ViewerError> {
+        let centre = self.asset.centre();
+        let mut points: Vec<[f32; 4]> = Vec::new();
+        let mut segments: Vec<[u32; 2]> = Vec::new();
+        for (line, closed) in polylines {
+            let base = points.len() as u32;
+            let n = line.len() as u32;
+            points.extend(line.iter().map(|p| {
+                let [x, y, z] = (*p - centre).as_vec3().to_array();
+                [x, y, z, 0.0]
+            }));
+            segments.extend((1..n).map(|k| [base + k - 1, base + k]));
+            if *closed && n > 2 {
+                segments.push([base + n - 1, base]);
+            }
+        }
+        self.slice = if segments.is_empty() {
+            None
+        } else {
+            let count = segments.len() as u32;
+            Some((
+                gpu.buffer(
+                    "slice points",
+                    bytemuck::cast_slice(&points),
+                    wgpu::BufferUsages::STORAGE,
+                )?,
+                gpu.buffer(
+                    "slice segments",
+                    bytemuck::cast_slice(&segments),
+                    wgpu::BufferUsages::STORAGE,
+                )?,
+                count,
+            ))
+        };
         Ok(())
     }
 
@@ -804,7 +863,7 @@ impl Renderer {
         let composite = settings.transparent;
         let curves = settings.render.curves && !self.asset.curve_segments.is_empty();
         let silhouettes = settings.render.silhouettes && !self.asset.edges.is_empty();
-        if composite || curves || silhouettes {
+        if composite || curves || silhouettes || self.slice.is_some() {
             let mut pass = lines_pass(encoder, target, targets, composite);
             let depth = wgpu::BindingResource::TextureView(&targets.depth_view);
             if composite {
@@ -830,6 +889,19 @@ impl Renderer {
                         (14, depth.clone()),
                     ],
                     (0..6, 0..self.asset.curve_segments.len() as u32),
+                );
+            }
+            if let Some((points, segments, count)) = &self.slice {
+                self.draw(
+                    gpu,
+                    &mut pass,
+                    &self.slice_lines,
+                    &[
+                        (4, points.as_entire_binding()),
+                        (11, segments.as_entire_binding()),
+                        (14, depth.clone()),
+                    ],
+                    (0..6, 0..*count),
                 );
             }
             if silhouettes {

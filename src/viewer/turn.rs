@@ -28,7 +28,7 @@
 
 use super::{HaloVertex, SurfaceVertex, ViewerError};
 use crate::intersect::Curves;
-use crate::limits::{MAX_COORDINATE, MIN_EXTENT};
+use crate::limits::{FieldError, MAX_COORDINATE, MIN_EXTENT};
 use crate::sample::Mesh4;
 use crate::scene::Scene;
 use crate::tets::{self, Corners, Split};
@@ -290,6 +290,149 @@ impl Model {
             first_triangle += mesh.triangles.len() as u32;
         }
         out
+    }
+}
+
+/// The explorer's moving hyperplane ⟨n, x⟩ = level: the slices of a model's surfaces as
+/// `halo4d slice` makes them ([`crate::motion::slice`]: the points moved onto the surfaces
+/// where the mesh has their parameters), with the surfaces' critical levels, so that the
+/// title can say between which events the level lies.
+#[derive(Clone, Debug)]
+pub struct Hyperplane {
+    /// The unit direction n, in the surfaces' own coordinates: the scene's `slicing`'s
+    /// direction (the one `halo4d slice` cuts along), fixed while the view turns.
+    pub direction: DVec4,
+    /// The lowest and highest of h = ⟨n, x⟩ over the surfaces' vertices and critical
+    /// points: the levels the hyperplane moves between.
+    pub range: (f64, f64),
+    /// Every surface's critical points, merged by level.
+    pub critical: Vec<crate::motion::CriticalPoint>,
+    /// The level c.
+    pub level: f64,
+    /// Each surface's slice at the level.
+    pub slices: Vec<crate::motion::Slice>,
+}
+
+impl Model {
+    /// Each surface's 4D mesh with its analytic surface where the mesh has its parameters
+    /// (a scene's own sampling; a mesh read from a `.glb` has none).
+    fn with_surfaces(&self) -> impl Iterator<Item = (&Mesh4, Option<&crate::surfaces::Surface>)> {
+        self.surfaces
+            .iter()
+            .zip(&self.scene.surfaces)
+            .map(|((_, mesh), entry)| {
+                let surface = match &entry.surface {
+                    crate::sample::Source::Parametric(s)
+                        if mesh.triangle_uv.len() == mesh.triangles.len() =>
+                    {
+                        Some(s)
+                    }
+                    _ => None,
+                };
+                (mesh, surface)
+            })
+    }
+
+    /// The hyperplane of the scene's `slicing` (as `halo4d slice` takes it: its direction,
+    /// else the one the scene's view turns onto w, tilted by its `perturb`) at `level`, or
+    /// at the middle of the surfaces' heights; a level outside them is refused, with them.
+    pub fn hyperplane(&self, level: Option<f64>) -> Result<Hyperplane, ViewerError> {
+        let slicing = self.scene.slicing.unwrap_or_default();
+        let (direction, _) = slicing.direction_and_frame(self.scene.view.rotation.matrix());
+        let mut range = (f64::INFINITY, f64::NEG_INFINITY);
+        let mut critical = Vec::new();
+        for (mesh, surface) in self.with_surfaces() {
+            let (lo, hi) = crate::motion::heights(mesh, direction);
+            range = (range.0.min(lo), range.1.max(hi));
+            let found = crate::motion::critical_points(mesh, surface, direction)
+                .map_err(|e| ViewerError::Setting(e.within("slicing")))?;
+            critical.extend(found.points);
+        }
+        critical.sort_by(|a, b| a.level.total_cmp(&b.level));
+        // The surfaces' highest point can lie above the mesh's (a refined maximum).
+        if let (Some(first), Some(last)) = (critical.first(), critical.last()) {
+            range = (range.0.min(first.level), range.1.max(last.level));
+        }
+        let level = match level {
+            None => 0.5 * (range.0 + range.1),
+            Some(c) if c >= range.0 && c <= range.1 => c,
+            Some(c) => {
+                return Err(ViewerError::Setting(FieldError::new(
+                    "hyperplane",
+                    format!(
+                        "level {c} is outside the surfaces' heights along the slicing \
+                         direction, {:.6} to {:.6}",
+                        range.0, range.1
+                    ),
+                )));
+            }
+        };
+        let mut plane = Hyperplane {
+            direction,
+            range,
+            critical,
+            level,
+            slices: Vec::new(),
+        };
+        plane.move_to(self, plane.level);
+        Ok(plane)
+    }
+}
+
+impl Hyperplane {
+    /// Moves the level to `level` (kept within the surfaces' heights) and slices again.
+    pub fn move_to(&mut self, model: &Model, level: f64) {
+        self.level = level.clamp(self.range.0, self.range.1);
+        self.slices = model
+            .with_surfaces()
+            .map(|(mesh, surface)| crate::motion::slice(mesh, surface, self.direction, self.level))
+            .collect();
+    }
+
+    /// Moves the level by `share` of the surfaces' range of heights.
+    pub fn step(&mut self, model: &Model, share: f64) {
+        self.move_to(model, self.level + share * (self.range.1 - self.range.0));
+    }
+
+    /// The slices' curves in the 4D `view`, projected as the build projects the surfaces;
+    /// a curve is cut where it reaches the 4D eye.
+    pub fn polylines(&self, view: &View) -> Vec<crate::motion::Polyline> {
+        let map = |p: &DVec4| view.projection.apply(view.transform(*p)).map(|(q, _)| q);
+        let mut out = Vec::new();
+        for curve in self.slices.iter().flat_map(|s| &s.curves) {
+            let mapped: Vec<Option<DVec3>> = curve.points.iter().map(map).collect();
+            if mapped.iter().all(Option::is_some) {
+                out.push((mapped.into_iter().flatten().collect(), curve.closed));
+                continue;
+            }
+            out.extend(
+                mapped
+                    .split(Option::is_none)
+                    .filter(|run| run.len() > 1)
+                    .map(|run| (run.iter().flatten().copied().collect(), false)),
+            );
+        }
+        out
+    }
+
+    /// The level, its curves, and the critical levels either side with their events.
+    pub fn describe(&self) -> String {
+        let curves: usize = self.slices.iter().map(|s| s.curves.len()).sum();
+        let below = self.critical.iter().rev().find(|p| p.level <= self.level);
+        let above = self.critical.iter().find(|p| p.level > self.level);
+        let at = |p: Option<&crate::motion::CriticalPoint>, none: &str| {
+            p.map_or_else(
+                || none.to_string(),
+                |p| format!("{} at {:.4}", p.event.name(), p.level),
+            )
+        };
+        format!(
+            "slice h = {:.4}: {curves} curve{} | below: {} | above: {}",
+            self.level,
+            if curves == 1 { "" } else { "s" },
+            at(below, "nothing"),
+            at(above, "nothing"),
+        )
     }
 }
 

@@ -416,6 +416,18 @@ fn curve_vs(@builtin(vertex_index) vertex: u32, @builtin(instance_index) segment
     return out;
 }
 
+// A hyperplane's slice (the explorer's `L`): a curve on the surfaces, drawn as the curves
+// are, in magenta, which no colour scale of w has.
+const SLICE_INK: vec3<f32> = vec3<f32>(0.75, 0.0, 0.55);
+
+@vertex
+fn slice_vs(@builtin(vertex_index) vertex: u32, @builtin(instance_index) segment: u32) -> LineOut {
+    let ends = curve_segments[segment];
+    var out = band(curve_points[ends.x].xyz, curve_points[ends.y].xyz, vertex);
+    out.ink = SLICE_INK;
+    return out;
+}
+
 // Whether triangle `k`, whose vertex `p` is, faces the eye.
 fn facing(k: u32, p: vec3<f32>) -> bool {
     var towards = -view.forward.xyz;

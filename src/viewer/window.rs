@@ -13,10 +13,18 @@
 //! and zw by 15 degrees (with Shift, back); `[` and `]` move the surfaces along w; `P`
 //! switches the 4D projection between orthographic and perspective; `V` resets the 4D view;
 //! `F` writes the current view as a scene file (`exports/views/<name>-<k>.json`) and `B`
-//! builds it in the background (`exports/<name>-<k>/`), its verification in the title. The
-//! title shows the 4D view in the scene file's terms.
+//! builds it in the background (`exports/<name>-<k>/`), its verification in the title; `L`
+//! shows the slice by the hyperplane of the scene's `slicing` (as `halo4d slice` cuts: the
+//! curves where the surfaces cross a level of the height along that direction, drawn over
+//! them in magenta) and `,` and `.` move the level down and up by 1/64 of the surfaces'
+//! range of heights (with Shift, 1/640); the title names the level, its number of curves
+//! and the critical levels either side of it. The title shows the 4D view in the scene
+//! file's terms.
 
-use super::{Gpu, HaloMode, Renderer, SLICE_COUNTS, Source, StippleSet, ViewSettings, ViewerError};
+use super::{
+    Gpu, HaloMode, Hyperplane, Renderer, SLICE_COUNTS, Source, StippleSet, ViewSettings,
+    ViewerError,
+};
 use crate::intersect::Curves;
 use crate::render::Style;
 use crate::view::{Projection, View};
@@ -30,17 +38,27 @@ use winit::keyboard::{Key, KeyCode, ModifiersState, NamedKey, PhysicalKey};
 use winit::window::{Window, WindowId};
 
 /// The window's help, printed when it opens.
-pub const HELP: &str = "drag: turn | wheel: zoom | R: reset camera | S: slices | M: grid/view mode | H: halos | C: curves | O: silhouettes | T: transparency | W: colour by w | D: shaded/stipples | Q/Esc: quit\n4D (a scene file): Shift+drag: turn towards w | 1-6: turn xy xz xw yz yw zw by 15 degrees (Shift: back) | [ ]: move along w | P: 4D perspective/orthographic | V: reset the 4D view | F: save the view as a scene | B: build the saved view";
+pub const HELP: &str = "drag: turn | wheel: zoom | R: reset camera | S: slices | M: grid/view mode | H: halos | C: curves | O: silhouettes | T: transparency | W: colour by w | D: shaded/stipples | Q/Esc: quit\n4D (a scene file): Shift+drag: turn towards w | 1-6: turn xy xz xw yz yw zw by 15 degrees (Shift: back) | [ ]: move along w | P: 4D perspective/orthographic | V: reset the 4D view | F: save the view as a scene | B: build the saved view | L: slice by the hyperplane | , .: move it (Shift: finely)";
 
 /// Degrees a plane key turns.
 const STEP: f64 = 15.0;
 /// Degrees of a 4D or 3D turn per pixel dragged.
 const DRAG: f64 = 0.4;
+/// The share of the surfaces' range of heights a slice key moves the hyperplane (with
+/// Shift, a tenth of it).
+const SLICE_STEP: f64 = 1.0 / 64.0;
 
 /// Opens a window on `source` with `settings` (its size the window's first size), a model
-/// in the 4D `view` (its scene's when `None`), and runs until it is closed.
-pub fn run(source: Source, view: Option<View>, settings: ViewSettings) -> Result<(), ViewerError> {
+/// in the 4D `view` (its scene's when `None`) with the slice by its hyperplane at level
+/// `hyperplane` shown where one is given, and runs until it is closed.
+pub fn run(
+    source: Source,
+    view: Option<View>,
+    settings: ViewSettings,
+    hyperplane: Option<f64>,
+) -> Result<(), ViewerError> {
     settings.check()?;
+    let hyperplane = hyperplane.map(|c| source.hyperplane(Some(c))).transpose()?;
     let event_loop = EventLoop::new()
         .map_err(|e| ViewerError::NoAdapter(format!("no display to open a window on: {e}")))?;
     let view = match &source {
@@ -69,6 +87,8 @@ pub fn run(source: Source, view: Option<View>, settings: ViewSettings) -> Result
         search: None,
         note: String::new(),
         stipples: None,
+        hyperplane,
+        slice_drawn: false,
     };
     event_loop
         .run_app(&mut app)
@@ -123,6 +143,10 @@ struct App {
     note: String,
     /// The stipples being made in the background, until the renderer has them.
     stipples: Option<Receiver<Result<StippleSet, ViewerError>>>,
+    /// The hyperplane whose slice is shown (`L`).
+    hyperplane: Option<Hyperplane>,
+    /// Whether the renderer draws the hyperplane's slice as it is now.
+    slice_drawn: bool,
 }
 
 impl App {
@@ -167,6 +191,7 @@ impl App {
 
     fn redraw(&mut self) -> Result<(), ViewerError> {
         self.turn()?;
+        self.draw_slice()?;
         self.poll_curves()?;
         self.poll_jobs();
         self.poll_stipples()?;
@@ -228,6 +253,7 @@ impl App {
                 Ok(ms) => {
                     self.drawn_view = Some(view);
                     self.turn_ms = Some(ms);
+                    self.slice_drawn = false;
                 }
                 Err(e @ ViewerError::View(_)) => {
                     self.note = e.to_string();
@@ -235,6 +261,23 @@ impl App {
                 }
                 Err(e) => return Err(e),
             }
+        }
+        Ok(())
+    }
+
+    /// Gives the renderer the hyperplane's slice in the drawn view, or none, when what it
+    /// draws is not that.
+    fn draw_slice(&mut self) -> Result<(), ViewerError> {
+        let (Some(state), Some(view)) = (&mut self.state, self.drawn_view) else {
+            return Ok(());
+        };
+        if !self.slice_drawn {
+            let polylines = self
+                .hyperplane
+                .as_ref()
+                .map_or_else(Vec::new, |h| h.polylines(&view));
+            state.renderer.set_slice(&state.gpu, &polylines)?;
+            self.slice_drawn = true;
         }
         Ok(())
     }
@@ -358,10 +401,13 @@ impl App {
             None if self.note.is_empty() => String::new(),
             None => format!(" | {}", self.note),
             Some(v) => format!(
-                " | 4D {}{}{} | {}",
+                " | 4D {}{}{}{} | {}",
                 describe(&v),
                 self.turn_ms
                     .map_or_else(String::new, |ms| format!(" (halos rebuilt in {ms:.0} ms)")),
+                self.hyperplane
+                    .as_ref()
+                    .map_or_else(String::new, |h| format!(" | {}", h.describe())),
                 if self.note.is_empty() {
                     String::new()
                 } else {
@@ -469,11 +515,40 @@ impl App {
             self.note.clear();
             return true;
         }
+        let fine = if self.modifiers.shift_key() { 0.1 } else { 1.0 };
+        let step = match physical {
+            PhysicalKey::Code(KeyCode::Comma) => Some(-fine),
+            PhysicalKey::Code(KeyCode::Period) => Some(fine),
+            _ => None,
+        };
+        if let Some(step) = step {
+            if let Some(plane) = &mut self.hyperplane {
+                plane.step(model, step * SLICE_STEP);
+                self.slice_drawn = false;
+            } else {
+                self.note = "no slice shown: press L first".into();
+            }
+            return true;
+        }
         let Key::Character(c) = key else {
             return false;
         };
         let reach = model.radius_4d();
         match c.to_lowercase().as_str() {
+            "l" => {
+                self.hyperplane = match self.hyperplane.take() {
+                    Some(_) => None,
+                    None => match model.hyperplane(None) {
+                        Ok(plane) => Some(plane),
+                        Err(e) => {
+                            self.note = format!("no slice: {e}");
+                            None
+                        }
+                    },
+                };
+                self.slice_drawn = false;
+                return true;
+            }
             "[" => view.translation[3] -= 0.05 * reach,
             "]" => view.translation[3] += 0.05 * reach,
             "v" => *view = self.initial_view.expect("a model has a view"),
