@@ -16,7 +16,7 @@ pub use built::{Built, SurfaceProduct};
 pub use report::{Report, Timings};
 pub use sampled::{Sampled, shown_curves};
 pub(crate) use write::staged_error;
-pub use write::{glb_bytes, write};
+pub use write::{glb_bytes, report_of, write};
 
 use crate::error::Error;
 use crate::export;

@@ -51,6 +51,14 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     Ok(report)
 }
 
+/// The report of a build that was not written (what [`write`] reports, with no files and
+/// no picture), as the Python package gives it.
+pub fn report_of(scene: &Scene, built: &Built) -> Report {
+    let mut timings = built.timings;
+    timings.total = total(&timings);
+    assemble_report(scene, built, timings, None, built.failures(), Vec::new())
+}
+
 /// Writes the mesh files the scene asks for (`.glb`, `.ply`, stipples, `.obj`, `.4off`,
 /// `.vtk`), staged, from the surfaces' `data`, the `stipples` and the build's verdict
 /// (`failures`); gives their names in the report's order.

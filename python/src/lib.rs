@@ -1,0 +1,702 @@
+//! halo4d from Python (`import halo4d`): scenes read as the command line reads them, built
+//! once sampled for any number of views, and the results as NumPy arrays.
+//!
+//! Every array is one copy of the build's own buffer (`memcpy`, never a loop over elements
+//! in Python), made when it is asked for: `built.surfaces[0].positions` twice is two
+//! arrays with the same values. The work runs with the GIL released, on a thread of its
+//! own, while the calling thread waits in slices of 50 ms and checks for signals between
+//! them: Ctrl-C raises `KeyboardInterrupt` at once (the work itself finishes in the
+//! background and its result is dropped, since a build has no point at which it can stop
+//! part-way without leaving half a result).
+
+use halo4d::render::{RenderSettings, Style};
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::mpsc::{RecvTimeoutError, channel};
+use std::time::Duration;
+
+create_exception!(
+    halo4d,
+    SceneError,
+    PyValueError,
+    "A scene that is not valid: `field` is the path of the field at fault (`surfaces[0].surface.n`, `view.rotation.xw`), or None when the file could not be read; `file` names the scene's source; the message is the command line's."
+);
+
+create_exception!(
+    halo4d,
+    BuildError,
+    PyRuntimeError,
+    "A build, picture or write that failed: the message is the command line's."
+);
+
+/// `f` on a thread of its own with the GIL released, the calling thread checking for
+/// signals every 50 ms (Ctrl-C raises `KeyboardInterrupt` at once; the thread finishes in
+/// the background and its result is dropped).
+fn run<T: Send + 'static>(py: Python<'_>, f: impl FnOnce() -> T + Send + 'static) -> PyResult<T> {
+    let (tx, rx) = channel();
+    std::thread::Builder::new()
+        .name("halo4d".into())
+        .spawn(move || {
+            let _ = tx.send(f());
+        })
+        .map_err(|e| PyOSError::new_err(format!("cannot start a thread for halo4d: {e}")))?;
+    let mut rx = rx;
+    loop {
+        let (received, back) = py.detach(move || (rx.recv_timeout(Duration::from_millis(50)), rx));
+        rx = back;
+        match received {
+            Ok(value) => return Ok(value),
+            Err(RecvTimeoutError::Timeout) => py.check_signals()?,
+            Err(RecvTimeoutError::Disconnected) => {
+                return Err(BuildError::new_err(
+                    "halo4d's work stopped without a result (a panic: please report it)",
+                ));
+            }
+        }
+    }
+}
+
+/// A `SceneError` carrying the field and file of `e`.
+fn scene_error(py: Python<'_>, e: &halo4d::SceneError) -> PyErr {
+    let err = SceneError::new_err(e.to_string());
+    let (field, file) = match e {
+        halo4d::SceneError::Io { file, .. } => (None, file.clone()),
+        halo4d::SceneError::Syntax { field, file, .. }
+        | halo4d::SceneError::Invalid { field, file, .. } => (Some(field.clone()), file.clone()),
+    };
+    let value = err.value(py);
+    // Setting attributes on a fresh exception instance cannot fail.
+    let _ = value.setattr("field", field);
+    let _ = value.setattr("file", file);
+    err
+}
+
+/// A `BuildError` with the message of `e`.
+fn build_error(e: impl std::fmt::Display) -> PyErr {
+    BuildError::new_err(e.to_string())
+}
+
+/// Python's `json.dumps(value)`.
+fn dumps(value: &Bound<'_, PyAny>) -> PyResult<String> {
+    value
+        .py()
+        .import("json")?
+        .call_method1("dumps", (value,))?
+        .extract()
+}
+
+/// Python's `json.loads(text)`.
+fn loads<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
+    py.import("json")?.call_method1("loads", (text,))
+}
+
+/// A serializable value as Python objects (through JSON, as the files have it).
+fn to_python<'py>(py: Python<'py>, value: &impl serde::Serialize) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(value).map_err(build_error)?;
+    loads(py, &text)
+}
+
+/// `values` (f64 components, `width` per row) as an (n, width) array: one copy.
+fn matrix<'py, T: numpy::Element + Copy>(
+    py: Python<'py>,
+    values: &[T],
+    width: usize,
+) -> PyResult<Bound<'py, PyArray2<T>>> {
+    PyArray1::from_slice(py, values).reshape([values.len() / width, width])
+}
+
+/// A scene: its surfaces, 4D view, halos, camera, picture and outputs, validated as
+/// `halo4d build` validates a scene file.
+///
+/// `Scene()` is the default scene; `Scene(source)` takes a dict (the scene file's JSON as
+/// Python objects), a JSON string, or the path of a scene file (str or os.PathLike; mesh
+/// files it names are read relative to its folder). A scene that is not valid raises
+/// `SceneError`, whose `field` names the field at fault.
+#[pyclass(frozen, module = "halo4d")]
+struct Scene {
+    scene: Arc<halo4d::Scene>,
+}
+
+impl Scene {
+    fn parse(py: Python<'_>, text: &str, file: &str) -> PyResult<Scene> {
+        halo4d::Scene::parse(text, file)
+            .map(|scene| Scene {
+                scene: Arc::new(scene),
+            })
+            .map_err(|e| scene_error(py, &e))
+    }
+
+    /// This scene in the 4D `view` (a dict as a scene file's `view`), validated.
+    fn in_view(&self, py: Python<'_>, view: Option<&Bound<'_, PyAny>>) -> PyResult<Arc<halo4d::Scene>> {
+        let Some(view) = view.filter(|v| !v.is_none()) else {
+            return Ok(Arc::clone(&self.scene));
+        };
+        let mut json = serde_json::to_value(&*self.scene).map_err(build_error)?;
+        let view: serde_json::Value =
+            serde_json::from_str(&dumps(view)?).map_err(|e| SceneError::new_err(e.to_string()))?;
+        json["view"] = view;
+        Ok(Scene::parse(py, &json.to_string(), &format!("<{} with a view>", self.scene.name))?.scene)
+    }
+}
+
+#[pymethods]
+impl Scene {
+    #[new]
+    #[pyo3(signature = (source = None))]
+    fn new(py: Python<'_>, source: Option<&Bound<'_, PyAny>>) -> PyResult<Scene> {
+        let Some(source) = source.filter(|s| !s.is_none()) else {
+            return Ok(Scene {
+                scene: Arc::new(halo4d::Scene::default_scene()),
+            });
+        };
+        if source.is_instance_of::<PyDict>() {
+            return Scene::parse(py, &dumps(source)?, "<dict>");
+        }
+        if let Ok(text) = source.downcast::<PyString>() {
+            let text = text.to_cow()?;
+            if text.trim_start().starts_with('{') {
+                return Scene::parse(py, &text, "<json>");
+            }
+        }
+        let path: PathBuf = source.extract().map_err(|_| {
+            SceneError::new_err(format!(
+                "a scene is a dict, a JSON string or the path of a scene file, not {}",
+                source.get_type().name().map_or_else(|_| "this".into(), |n| n.to_string())
+            ))
+        })?;
+        let scene = run(py, move || halo4d::Scene::load(&path))?;
+        scene
+            .map(|scene| Scene {
+                scene: Arc::new(scene),
+            })
+            .map_err(|e| scene_error(py, &e))
+    }
+
+    /// The scene's name (its outputs' folder and file names).
+    #[getter]
+    fn name(&self) -> String {
+        self.scene.name.clone()
+    }
+
+    /// The scene as the JSON of a scene file.
+    fn to_json(&self) -> PyResult<String> {
+        serde_json::to_string_pretty(&*self.scene).map_err(build_error)
+    }
+
+    /// The scene as a dict (the JSON of a scene file, as Python objects).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &*self.scene)
+    }
+
+    /// Samples the scene's surfaces in 4D (adaptively, as its `sampling` says), once: the
+    /// result builds any number of 4D views without sampling again.
+    fn sample(&self, py: Python<'_>) -> PyResult<Sampled> {
+        let scene = Arc::clone(&self.scene);
+        let sampled = run(py, move || halo4d::Sampled::of(&scene))?;
+        Ok(Sampled {
+            scene: Arc::clone(&self.scene),
+            sampled: Arc::new(sampled),
+        })
+    }
+
+    /// Samples and builds the scene (in the 4D `view`, a dict as a scene file's `view`,
+    /// else the scene's): surfaces, halos, curves and their verification, as `halo4d
+    /// build` makes them, nothing written.
+    #[pyo3(signature = (view = None))]
+    fn build(&self, py: Python<'_>, view: Option<&Bound<'_, PyAny>>) -> PyResult<Built> {
+        self.sample(py)?.build(py, view)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "halo4d.Scene({:?}: {} surface(s))",
+            self.scene.name,
+            self.scene.surfaces.len()
+        )
+    }
+}
+
+/// A scene's surfaces sampled in 4D (`Scene.sample()`), to build in any number of views.
+#[pyclass(frozen, module = "halo4d")]
+struct Sampled {
+    scene: Arc<halo4d::Scene>,
+    sampled: Arc<halo4d::Sampled>,
+}
+
+#[pymethods]
+impl Sampled {
+    /// Builds the sampled surfaces in the 4D `view` (a dict as a scene file's `view`, else
+    /// the scene's): projected surfaces, halos, curves and their verification.
+    #[pyo3(signature = (view = None))]
+    fn build(&self, py: Python<'_>, view: Option<&Bound<'_, PyAny>>) -> PyResult<Built> {
+        let scene = Scene {
+            scene: Arc::clone(&self.scene),
+        }
+        .in_view(py, view)?;
+        let (sampled, in_view) = (Arc::clone(&self.sampled), Arc::clone(&scene));
+        let built = run(py, move || {
+            sampled.build(&in_view, halo4d::Stages::of(&in_view))
+        })?
+        .map_err(build_error)?;
+        Ok(Built {
+            scene,
+            built: Arc::new(built),
+        })
+    }
+
+    /// Triangles of all the surfaces.
+    #[getter]
+    fn triangles(&self) -> usize {
+        self.sampled.triangles()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "halo4d.Sampled({:?}: {} triangles)",
+            self.scene.name,
+            self.sampled.triangles()
+        )
+    }
+}
+
+/// A scene built in one 4D view: its surfaces, halos and curves as arrays, the verdict,
+/// the report; it writes the files and renders the picture.
+#[pyclass(frozen, module = "halo4d")]
+struct Built {
+    scene: Arc<halo4d::Scene>,
+    built: Arc<halo4d::Built>,
+}
+
+#[pymethods]
+impl Built {
+    /// The scene it was built from, in the view it was built in.
+    #[getter]
+    fn scene(&self) -> Scene {
+        Scene {
+            scene: Arc::clone(&self.scene),
+        }
+    }
+
+    /// Whether the build is verified: every halo passes the checker, every curve is
+    /// resolved, and the halos' verification against the curves found nothing wrong.
+    #[getter]
+    fn verified(&self) -> bool {
+        self.built.failures().is_empty()
+    }
+
+    /// What keeps the build from being verified (empty when it is).
+    #[getter]
+    fn failures(&self) -> Vec<String> {
+        self.built.failures()
+    }
+
+    /// Each surface: its 4D mesh, its projection and its halo.
+    #[getter]
+    fn surfaces(&self) -> Vec<Surface> {
+        (0..self.built.surfaces.len())
+            .map(|index| Surface {
+                built: Arc::clone(&self.built),
+                index,
+            })
+            .collect()
+    }
+
+    /// The self-intersection curves the files and the picture show (refined onto the
+    /// surfaces where the scene's `curves.refine` says).
+    #[getter]
+    fn curves(&self) -> Vec<Curve> {
+        (0..self.built.shown_curves().curves.len())
+            .map(|index| Curve {
+                built: Arc::clone(&self.built),
+                index,
+            })
+            .collect()
+    }
+
+    /// Where three sheets cross: an (n, 3) array of positions.
+    #[getter]
+    fn triple_points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let points: Vec<f64> = self
+            .built
+            .shown_curves()
+            .triple_points
+            .iter()
+            .flat_map(|t| t.position.to_array())
+            .collect();
+        matrix(py, &points, 3)
+    }
+
+    /// The build's report as a dict: what `report.json` holds, without the files (nothing
+    /// was written) and the picture (none was made).
+    #[getter]
+    fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &halo4d::report_of(&self.scene, &self.built))
+    }
+
+    /// Writes the files the scene's `outputs` ask for into `dir` (created if need be; every
+    /// file written whole or not at all), and gives the report (`report.json`) as a dict.
+    fn write<'py>(&self, py: Python<'py>, dir: PathBuf) -> PyResult<Bound<'py, PyAny>> {
+        let (scene, built) = (Arc::clone(&self.scene), Arc::clone(&self.built));
+        let report = run(py, move || halo4d::write(&scene, &built, &dir))?.map_err(build_error)?;
+        to_python(py, &report)
+    }
+
+    /// The picture, as `halo4d render` makes it with the scene's `render` and `camera`
+    /// (width, height, samples per pixel and style `"shaded"` or `"stipple"` override
+    /// them): an (height, width, 3) array of uint8 sRGB.
+    #[pyo3(signature = (width = None, height = None, style = None, samples = None))]
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        width: Option<u32>,
+        height: Option<u32>,
+        style: Option<&str>,
+        samples: Option<u32>,
+    ) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
+        let base = self.scene.render;
+        let style = match style {
+            None => base.style,
+            Some("shaded") => Style::Shaded,
+            Some("stipple") => Style::Stipple,
+            Some(other) => {
+                return Err(PyValueError::new_err(format!(
+                    "style `{other}`: use \"shaded\" or \"stipple\""
+                )));
+            }
+        };
+        let settings = RenderSettings {
+            width: width.unwrap_or(base.width),
+            height: height.unwrap_or(base.height),
+            samples: samples.unwrap_or(base.samples),
+            style,
+            ..base
+        };
+        settings
+            .check()
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        if style == Style::Stipple && !self.built.stages.stipples {
+            return Err(PyValueError::new_err(
+                "style \"stipple\": this scene was built without stipples; set its render.style to \"stipple\" and build again",
+            ));
+        }
+        let (scene, built) = (Arc::clone(&self.scene), Arc::clone(&self.built));
+        let picture = run(py, move || built.render(&scene.halo, &settings, &scene.camera))?
+            .map_err(build_error)?;
+        PyArray1::from_slice(py, &picture.rgb).reshape([
+            picture.height as usize,
+            picture.width as usize,
+            3,
+        ])
+    }
+
+    /// The scene's `.glb` (surfaces, halos, curves, the 4D mesh and the scene), as bytes.
+    fn glb<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyBytes>> {
+        let (scene, built) = (Arc::clone(&self.scene), Arc::clone(&self.built));
+        let bytes = run(py, move || halo4d::glb_bytes(&scene, &built))?.map_err(build_error)?;
+        Ok(pyo3::types::PyBytes::new(py, &bytes))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "halo4d.Built({:?}: {} surface(s), {} curve(s), {})",
+            self.scene.name,
+            self.built.surfaces.len(),
+            self.built.shown_curves().curves.len(),
+            if self.verified() {
+                "verified"
+            } else {
+                "NOT verified"
+            }
+        )
+    }
+}
+
+/// One surface of a build.
+#[pyclass(frozen, module = "halo4d")]
+struct Surface {
+    built: Arc<halo4d::Built>,
+    index: usize,
+}
+
+impl Surface {
+    fn product(&self) -> &halo4d::SurfaceProduct {
+        &self.built.surfaces[self.index]
+    }
+}
+
+#[pymethods]
+impl Surface {
+    /// The surface's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.product().name.clone()
+    }
+
+    /// The 4D mesh's vertices, (n, 4), in the surface's own coordinates.
+    #[getter]
+    fn vertices4d<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        matrix(py, bytemuck::cast_slice(&self.product().mesh.positions), 4)
+    }
+
+    /// The projected vertices, (n, 3): turned, moved and projected by the view, rounded to
+    /// f32 as the files store them (the `.ply`'s frame).
+    #[getter]
+    fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        matrix(py, bytemuck::cast_slice(&self.product().projected.positions), 3)
+    }
+
+    /// Each vertex's w after the view's turn (its depth in 4D; smaller is nearer), (n,).
+    #[getter]
+    fn w<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.product().projected.w)
+    }
+
+    /// The projected surface's unit vertex normals, (n, 3).
+    #[getter]
+    fn normals<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        matrix(py, bytemuck::cast_slice(&self.product().projected.normals), 3)
+    }
+
+    /// The triangles, (m, 3) vertex indices, wound as the files wind them.
+    #[getter]
+    fn triangles<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<u32>>> {
+        matrix(py, bytemuck::cast_slice(&self.product().mesh.triangles), 3)
+    }
+
+    /// The surface's halo, or None where it has none.
+    #[getter]
+    fn halo(&self) -> Option<Halo> {
+        (!self.product().halo.tets.is_empty()).then(|| Halo {
+            built: Arc::clone(&self.built),
+            index: self.index,
+        })
+    }
+
+    fn __repr__(&self) -> String {
+        let p = self.product();
+        format!(
+            "halo4d.Surface({:?}: {} vertices, {} triangles)",
+            p.name,
+            p.mesh.positions.len(),
+            p.mesh.triangles.len()
+        )
+    }
+}
+
+/// A surface's volumetric halo: conforming tetrahedra around the projected surface.
+#[pyclass(frozen, module = "halo4d")]
+struct Halo {
+    built: Arc<halo4d::Built>,
+    index: usize,
+}
+
+impl Halo {
+    fn halo(&self) -> &halo4d::halo::Halo {
+        &self.built.surfaces[self.index].halo
+    }
+}
+
+#[pymethods]
+impl Halo {
+    /// Its vertices, (k, 3): the offsets below and above the surface, the surface's own
+    /// vertices, then any inserted ones (the `.vtk`'s POINTS).
+    #[getter]
+    fn vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        matrix(py, bytemuck::cast_slice(&self.halo().positions), 3)
+    }
+
+    /// Its tetrahedra, (t, 4) vertex indices, positively oriented.
+    #[getter]
+    fn tetrahedra<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<u32>>> {
+        matrix(py, bytemuck::cast_slice(&self.halo().tets), 4)
+    }
+
+    /// Each vertex's offset parameter t in [-1, 1] (0 on the surface), (k,).
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.halo().t)
+    }
+
+    /// Each vertex's d_orig, the w of the surface point it was offset from, (k,).
+    #[getter]
+    fn d_orig<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.halo().d_orig)
+    }
+
+    /// How many of the vertices are the surface's own.
+    #[getter]
+    fn surface_vertices(&self) -> usize {
+        self.halo().surface_vertices
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "halo4d.Halo({} vertices, {} tetrahedra)",
+            self.halo().positions.len(),
+            self.halo().tets.len()
+        )
+    }
+}
+
+/// A self-intersection curve of the projected surfaces, with the two sheets that cross
+/// along it.
+#[pyclass(frozen, module = "halo4d")]
+struct Curve {
+    built: Arc<halo4d::Built>,
+    index: usize,
+}
+
+impl Curve {
+    fn curve(&self) -> &halo4d::intersect::Curve {
+        &self.built.shown_curves().curves[self.index]
+    }
+}
+
+#[pymethods]
+impl Curve {
+    /// Its points, (p, 3), in order.
+    #[getter]
+    fn points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let p: Vec<f64> = self
+            .curve()
+            .points
+            .iter()
+            .flat_map(|p| p.position.to_array())
+            .collect();
+        matrix(py, &p, 3)
+    }
+
+    /// The w of its two sheets at each point, (p, 2), labelled consistently along it.
+    #[getter]
+    fn w<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let w: Vec<f64> = self.curve().points.iter().flat_map(|p| p.w).collect();
+        matrix(py, &w, 2)
+    }
+
+    /// The surface (index into `Built.surfaces`) of each of its two sheets at each point,
+    /// (p, 2).
+    #[getter]
+    fn sheets<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<u32>>> {
+        let s: Vec<u32> = self
+            .curve()
+            .points
+            .iter()
+            .flat_map(|p| p.faces.map(|f| f.surface))
+            .collect();
+        matrix(py, &s, 2)
+    }
+
+    /// Which sheet (0 or 1) passes over the other at each point (nearer in w), (p,).
+    #[getter]
+    fn over<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u8>> {
+        let over: Vec<u8> = self.curve().points.iter().map(|p| p.near() as u8).collect();
+        PyArray1::from_slice(py, &over)
+    }
+
+    /// Whether it closes on itself.
+    #[getter]
+    fn closed(&self) -> bool {
+        self.curve().closed
+    }
+
+    /// How its two ends end: "closed", "boundary", "branch_point" (a cross-cap or a
+    /// singular point of the projection) or "branch" (unresolved).
+    #[getter]
+    fn ends(&self) -> [&'static str; 2] {
+        self.curve().ends.map(|e| match e {
+            halo4d::intersect::End::Closed => "closed",
+            halo4d::intersect::End::Boundary => "boundary",
+            halo4d::intersect::End::BranchPoint => "branch_point",
+            halo4d::intersect::End::Branch => "branch",
+        })
+    }
+
+    fn __len__(&self) -> usize {
+        self.curve().points.len()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "halo4d.Curve({} points, {})",
+            self.curve().points.len(),
+            if self.curve().closed { "closed" } else { "open" }
+        )
+    }
+}
+
+/// The catalogue of surfaces: per entry its `type` (as a scene file names it), a
+/// description, and its topology (`closed`, `orientable`, `euler_characteristic`).
+#[pyfunction]
+fn catalogue<'py>(py: Python<'py>) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    halo4d::surfaces::Surface::catalogue()
+        .iter()
+        .map(|s| {
+            let t = s.topology();
+            let entry = PyDict::new(py);
+            entry.set_item("type", s.type_name())?;
+            entry.set_item("description", s.description())?;
+            entry.set_item("closed", t.closed)?;
+            entry.set_item("orientable", t.orientable)?;
+            entry.set_item("euler_characteristic", t.euler_characteristic)?;
+            Ok(entry.into_any())
+        })
+        .collect()
+}
+
+/// `halo4d check` on a file (a `.glb` or `.vtk`) or a build's folder: a dict with
+/// `verified`, `failures`, `halos` (each halo's name and the checker's statistics), the
+/// `scene` the file records, `plain` (why a `.vtk` is not read as a halo, or None) and
+/// `text` (what the command prints). A file that cannot be read raises `OSError`.
+#[pyfunction]
+fn check<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
+    let target = path.clone();
+    let checked = run(py, move || {
+        if target.is_dir() {
+            halo4d::check_dir(&target)
+        } else {
+            halo4d::check_file(&target)
+        }
+    })?
+    .map_err(|e| PyOSError::new_err(e.to_string()))?;
+    let out = PyDict::new(py);
+    let failures = checked.failures();
+    out.set_item("verified", failures.is_empty())?;
+    out.set_item("failures", failures)?;
+    let halos = checked
+        .halos
+        .iter()
+        .map(|(name, stats)| {
+            let entry = to_python(py, stats)?;
+            entry.set_item("name", name)?;
+            Ok(entry)
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    out.set_item("halos", halos)?;
+    out.set_item("scene", checked.scene.clone())?;
+    out.set_item("plain", checked.plain.clone())?;
+    out.set_item("text", checked.text())?;
+    Ok(out.into_any())
+}
+
+/// halo4d's native module; `halo4d` re-exports it.
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("SceneError", py.get_type::<SceneError>())?;
+    m.add("BuildError", py.get_type::<BuildError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_class::<Scene>()?;
+    m.add_class::<Sampled>()?;
+    m.add_class::<Built>()?;
+    m.add_class::<Surface>()?;
+    m.add_class::<Halo>()?;
+    m.add_class::<Curve>()?;
+    m.add_function(wrap_pyfunction!(catalogue, m)?)?;
+    m.add_function(wrap_pyfunction!(check, m)?)?;
+    Ok(())
+}
