@@ -63,12 +63,17 @@ fn run<T: Send + 'static>(py: Python<'_>, f: impl FnOnce() -> T + Send + 'static
 
 /// A `SceneError` carrying the field and file of `e`.
 fn scene_error(py: Python<'_>, e: &halo4d::SceneError) -> PyErr {
-    let err = SceneError::new_err(e.to_string());
     let (field, file) = match e {
-        halo4d::SceneError::Io { file, .. } => (None, file.clone()),
+        halo4d::SceneError::Io { file, .. } => (None, file.as_str()),
         halo4d::SceneError::Syntax { field, file, .. }
-        | halo4d::SceneError::Invalid { field, file, .. } => (Some(field.clone()), file.clone()),
+        | halo4d::SceneError::Invalid { field, file, .. } => (Some(field.as_str()), file.as_str()),
     };
+    scene_error_at(py, e.to_string(), field, file)
+}
+
+/// A `SceneError` saying `message` about `field` (None: the source as a whole) of `file`.
+fn scene_error_at(py: Python<'_>, message: String, field: Option<&str>, file: &str) -> PyErr {
+    let err = SceneError::new_err(message);
     let value = err.value(py);
     // Setting attributes on a fresh exception instance cannot fail.
     let _ = value.setattr("field", field);
@@ -132,15 +137,26 @@ impl Scene {
     }
 
     /// This scene in the 4D `view` (a dict as a scene file's `view`), validated.
-    fn in_view(&self, py: Python<'_>, view: Option<&Bound<'_, PyAny>>) -> PyResult<Arc<halo4d::Scene>> {
+    fn in_view(
+        &self,
+        py: Python<'_>,
+        view: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Arc<halo4d::Scene>> {
         let Some(view) = view.filter(|v| !v.is_none()) else {
             return Ok(Arc::clone(&self.scene));
         };
         let mut json = serde_json::to_value(&*self.scene).map_err(build_error)?;
-        let view: serde_json::Value =
-            serde_json::from_str(&dumps(view)?).map_err(|e| SceneError::new_err(e.to_string()))?;
+        let file = format!("<{} with a view>", self.scene.name);
+        let view: serde_json::Value = serde_json::from_str(&dumps(view)?).map_err(|e| {
+            scene_error_at(
+                py,
+                format!("{file}: view: not a scene file's view ({e}; numbers must be finite)"),
+                Some("view"),
+                &file,
+            )
+        })?;
         json["view"] = view;
-        Ok(Scene::parse(py, &json.to_string(), &format!("<{} with a view>", self.scene.name))?.scene)
+        Ok(Scene::parse(py, &json.to_string(), &file)?.scene)
     }
 }
 
@@ -164,10 +180,18 @@ impl Scene {
             }
         }
         let path: PathBuf = source.extract().map_err(|_| {
-            SceneError::new_err(format!(
-                "a scene is a dict, a JSON string or the path of a scene file, not {}",
-                source.get_type().name().map_or_else(|_| "this".into(), |n| n.to_string())
-            ))
+            scene_error_at(
+                py,
+                format!(
+                    "a scene is a dict, a JSON string or the path of a scene file, not {}",
+                    source
+                        .get_type()
+                        .name()
+                        .map_or_else(|_| "this".into(), |n| n.to_string())
+                ),
+                None,
+                "<argument>",
+            )
         })?;
         let scene = run(py, move || halo4d::Scene::load(&path))?;
         scene
@@ -348,7 +372,9 @@ impl Built {
 
     /// The picture, as `halo4d render` makes it with the scene's `render` and `camera`
     /// (width, height, samples per pixel and style `"shaded"` or `"stipple"` override
-    /// them): an (height, width, 3) array of uint8 sRGB.
+    /// them): an (height, width, 3) array of uint8 sRGB. The halos are the build's: a
+    /// scene whose `halo.gap_px` sets their gap in pixels of its own picture shows that gap
+    /// at its own size, and scaled with the picture at another.
     #[pyo3(signature = (width = None, height = None, style = None, samples = None))]
     fn render<'py>(
         &self,
@@ -385,8 +411,10 @@ impl Built {
             ));
         }
         let (scene, built) = (Arc::clone(&self.scene), Arc::clone(&self.built));
-        let picture = run(py, move || built.render(&scene.halo, &settings, &scene.camera))?
-            .map_err(build_error)?;
+        let picture = run(py, move || {
+            built.render(&scene.halo, &settings, &scene.camera)
+        })?
+        .map_err(build_error)?;
         PyArray1::from_slice(py, &picture.rgb).reshape([
             picture.height as usize,
             picture.width as usize,
@@ -447,7 +475,11 @@ impl Surface {
     /// f32 as the files store them (the `.ply`'s frame).
     #[getter]
     fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        matrix(py, bytemuck::cast_slice(&self.product().projected.positions), 3)
+        matrix(
+            py,
+            bytemuck::cast_slice(&self.product().projected.positions),
+            3,
+        )
     }
 
     /// Each vertex's w after the view's turn (its depth in 4D; smaller is nearer), (n,).
@@ -459,7 +491,11 @@ impl Surface {
     /// The projected surface's unit vertex normals, (n, 3).
     #[getter]
     fn normals<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        matrix(py, bytemuck::cast_slice(&self.product().projected.normals), 3)
+        matrix(
+            py,
+            bytemuck::cast_slice(&self.product().projected.normals),
+            3,
+        )
     }
 
     /// The triangles, (m, 3) vertex indices, wound as the files wind them.
@@ -510,10 +546,18 @@ impl Halo {
         matrix(py, bytemuck::cast_slice(&self.halo().positions), 3)
     }
 
-    /// Its tetrahedra, (t, 4) vertex indices, positively oriented.
+    /// Its tetrahedra, (t, 4) vertex indices, in the files' order (the `.vtk`'s and
+    /// meshio's: seen from the fourth vertex the first three run counter-clockwise,
+    /// det[b - a, c - a, d - a] > 0).
     #[getter]
     fn tetrahedra<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<u32>>> {
-        matrix(py, bytemuck::cast_slice(&self.halo().tets), 4)
+        let tets: Vec<u32> = self
+            .halo()
+            .tets
+            .iter()
+            .flat_map(|&t| halo4d::internals::file_order(t))
+            .collect();
+        matrix(py, &tets, 4)
     }
 
     /// Each vertex's offset parameter t in [-1, 1] (0 on the surface), (k,).
@@ -624,7 +668,11 @@ impl Curve {
         format!(
             "halo4d.Curve({} points, {})",
             self.curve().points.len(),
-            if self.curve().closed { "closed" } else { "open" }
+            if self.curve().closed {
+                "closed"
+            } else {
+                "open"
+            }
         )
     }
 }

@@ -1,0 +1,277 @@
+"""The Python package against the command line: the same scene built by `halo4d build` and
+by `halo4d.Scene(...).build()` gives the same numbers, bit for bit where the files keep
+f64 (the 4OFF's 4D vertices, the VTK's halo points, t and d_orig) and to f32 where they
+keep f32 (the PLY); errors name their field; threads and Ctrl-C behave.
+
+Run with the package installed (`pip install ./python`) and the release binary built
+(`cargo build --release`; HALO4D_BIN names another): `python -m pytest python/tests`.
+"""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+
+import halo4d
+
+ROOT = Path(__file__).resolve().parents[2]
+BIN = Path(os.environ.get("HALO4D_BIN", ROOT / "target" / "release" / "halo4d"))
+DEFAULT = ROOT / "fixtures" / "scenes" / "default.json"
+
+
+def scene_dict(path=DEFAULT, **outputs):
+    """A fixture scene as a dict, with every mesh output on (and `outputs` over them)."""
+    d = json.loads(Path(path).read_text())
+    d["outputs"] = {"glb": True, "ply": True, "obj": False, "vtk": True, "off4": True,
+                    "report": True, "svg": False, "png": False, **outputs}
+    return d
+
+
+@pytest.fixture(scope="module")
+def cli_build(tmp_path_factory):
+    """The default scene with every mesh output, built by the command line and in Python."""
+    assert BIN.is_file(), f"{BIN} is missing: run `cargo build --release` first"
+    folder = tmp_path_factory.mktemp("cli")
+    scene_file = folder / "scene.json"
+    scene_file.write_text(json.dumps(scene_dict()))
+    out = folder / "out"
+    subprocess.run([str(BIN), "build", str(scene_file), "--out", str(out), "--quiet"],
+                   check=True)
+    built = halo4d.Scene(scene_file).build()
+    return out, built
+
+
+def untimed(value):
+    """`value` without the times it holds (keys `ms` and `*_ms`), which differ run to run."""
+    if isinstance(value, dict):
+        return {k: untimed(v) for k, v in value.items() if k != "ms" and not k.endswith("_ms")}
+    if isinstance(value, list):
+        return [untimed(v) for v in value]
+    return value
+
+
+def read_4off(path):
+    lines = [l for l in Path(path).read_text().splitlines() if l and not l.startswith("#")]
+    assert lines[0] == "4OFF"
+    n, m, _ = map(int, lines[1].split())
+    vertices = np.array([[float(x) for x in l.split()] for l in lines[2:2 + n]])
+    faces = np.array([[int(x) for x in l.split()[1:]] for l in lines[2 + n:2 + n + m]])
+    return vertices, faces
+
+
+def test_the_arrays_are_the_files_of_halo4d_build(cli_build):
+    out, built = cli_build
+    assert built.verified, built.failures
+    (surface,) = built.surfaces
+    name = built.scene.name
+    # The 4D mesh: the 4OFF keeps f64 (shortest round-trip digits), so bit for bit.
+    v4, faces = read_4off(out / f"{name}.4off")
+    assert surface.vertices4d.dtype == np.float64 and surface.vertices4d.shape == v4.shape
+    assert np.array_equal(surface.vertices4d, v4)
+    assert np.array_equal(surface.triangles, faces)
+    # The projected surface: the PLY keeps f32, and the positions are rounded to f32.
+    ply = meshio.read(out / f"{name}.ply")
+    assert np.array_equal(surface.positions, ply.points.astype(np.float64))
+    assert np.array_equal(surface.positions.astype(np.float32).astype(np.float64),
+                          surface.positions)
+    assert np.array_equal(surface.triangles, ply.cells_dict["triangle"])
+    assert np.array_equal(surface.w.astype(np.float32), ply.point_data["quality"])
+    # The halo: the VTK keeps f64.
+    halo = surface.halo
+    vtk = meshio.read(out / f"{name}-halo.vtk")
+    assert np.array_equal(halo.vertices, vtk.points)
+    assert np.array_equal(halo.tetrahedra, vtk.cells_dict["tetra"])
+    # In the files' orientation: every tetrahedron positive by VTK's rule.
+    a, b, c, d = (halo.vertices[halo.tetrahedra[:, k]] for k in range(4))
+    assert (np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a) > 0).all()
+    assert np.array_equal(halo.t, vtk.point_data["t"].ravel())
+    assert np.array_equal(halo.d_orig, vtk.point_data["d_orig"].ravel())
+    assert halo.surface_vertices == len(surface.vertices4d)
+    # The curves: as many, and as many points, as the report says.
+    report = json.loads((out / "report.json").read_text())
+    assert len(built.curves) == report["curves"]["count"] > 0
+    assert sum(len(c) for c in built.curves) == report["curves"]["points"]
+    for c in built.curves:
+        assert c.points.shape == (len(c), 3) and c.w.shape == (len(c), 2)
+        assert set(np.unique(c.over)) <= {0, 1}
+        assert np.array_equal(c.over, (c.w[:, 1] < c.w[:, 0]).astype(np.uint8))
+    # The report: the file's, but for what writing adds (the files) and the times.
+    mine = built.report
+    for key in ["surfaces", "curves", "halo_verification", "verified"]:
+        assert untimed(mine[key]) == untimed(report[key]), key
+    assert mine["verified"] is True
+
+
+def test_write_gives_the_files_and_the_report_of_halo4d_build(cli_build, tmp_path):
+    out, built = cli_build
+    report = built.write(tmp_path)
+    assert report["verified"] is True
+    for f in report["files"]:
+        assert (tmp_path / f).is_file(), f
+    # The same bytes as the command line's, but for the timings the report holds.
+    name = built.scene.name
+    for f in [f"{name}.4off", f"{name}-halo.vtk", f"{name}.ply"]:
+        assert (tmp_path / f).read_bytes() == (out / f).read_bytes(), f
+    checked = halo4d.check(tmp_path)
+    assert checked["verified"], checked["failures"]
+    assert checked["halos"][0]["tets"] == len(built.surfaces[0].halo.tetrahedra)
+    assert "passes" in checked["text"] or checked["verified"]
+
+
+def test_the_picture_is_the_command_lines(cli_build, tmp_path):
+    _, built = cli_build
+    small = built.render(160, 120, samples=1)
+    assert small.shape == (120, 160, 3) and small.dtype == np.uint8
+    assert len(np.unique(small.reshape(-1, 3), axis=0)) > 50, "the picture shows something"
+    # The halos' gap is set in pixels of the scene's own picture: built for that size, the
+    # picture is `halo4d render`'s, pixel for pixel.
+    scene = scene_dict(png=True)
+    scene["render"] = {**scene.get("render", {}), "width": 160, "height": 120, "samples": 1}
+    picture = halo4d.Scene(scene).build().render()
+    scene_file = tmp_path / "scene.json"
+    scene_file.write_text(json.dumps(scene))
+    png = tmp_path / "picture.png"
+    subprocess.run([str(BIN), "render", str(scene_file), "--out", str(png)], check=True,
+                   capture_output=True)
+    from PIL import Image
+    assert np.array_equal(np.asarray(Image.open(png).convert("RGB")), picture)
+    with pytest.raises(ValueError, match="style"):
+        built.render(style="pointillist")
+    with pytest.raises(ValueError, match="width"):
+        built.render(width=0)
+
+
+def test_a_scene_from_a_dict_json_or_file_is_the_same_scene():
+    d = json.loads(DEFAULT.read_text())
+    a = halo4d.Scene(d)
+    b = halo4d.Scene(json.dumps(d))
+    c = halo4d.Scene(DEFAULT)
+    d_ = halo4d.Scene(str(DEFAULT))
+    assert a.to_dict() == b.to_dict() == c.to_dict() == d_.to_dict()
+    assert halo4d.Scene().name == c.name == "spun-trefoil"
+    assert halo4d.Scene(a.to_json()).to_dict() == a.to_dict()
+
+
+@pytest.mark.parametrize(
+    "edit, field",
+    [
+        (lambda d: d["surfaces"][0]["surface"].update(n=3), "surfaces[0].surface.n"),
+        (lambda d: d.update(halo={"rho": -1.0}), "halo.rho"),
+        (lambda d: d["view"]["rotation"].update(xw="ten"), "view.rotation.xw"),
+        (lambda d: d.update(name=""), "name"),
+    ],
+)
+def test_a_bad_scene_raises_scene_error_naming_its_field(edit, field):
+    d = json.loads(DEFAULT.read_text())
+    d.setdefault("halo", {})
+    edit(d)
+    with pytest.raises(halo4d.SceneError) as caught:
+        halo4d.Scene(d)
+    assert caught.value.field == field, str(caught.value)
+    assert field in str(caught.value)
+    assert isinstance(caught.value, ValueError)
+
+
+def test_unreadable_and_foreign_sources_are_refused(tmp_path):
+    with pytest.raises(halo4d.SceneError) as caught:
+        halo4d.Scene(tmp_path / "missing.json")
+    assert caught.value.field is None and "cannot read" in str(caught.value)
+    with pytest.raises(halo4d.SceneError, match="dict, a JSON string or the path"):
+        halo4d.Scene(42)
+    with pytest.raises(halo4d.SceneError):
+        halo4d.Scene("{not json")
+    with pytest.raises(halo4d.SceneError) as caught:
+        halo4d.Scene().build(view={"rotation": {"xw": float("nan")}})
+    assert caught.value.field.startswith("view")
+    with pytest.raises(OSError, match="missing.glb"):
+        halo4d.check(tmp_path / "missing.glb")
+
+
+def test_sampling_once_builds_every_view_as_a_whole_build_of_that_view():
+    scene = halo4d.Scene(DEFAULT)
+    sampled = scene.sample()
+    assert sampled.triangles == len(scene.build().surfaces[0].triangles)
+    view = scene.to_dict()["view"]
+    for xw in [10.0, 35.0]:
+        turned = {**view, "rotation": {**view["rotation"], "xw": xw}}
+        once = sampled.build(view=turned)
+        d = scene.to_dict()
+        d["view"] = turned
+        whole = halo4d.Scene(d).build()
+        assert once.scene.to_dict()["view"]["rotation"]["xw"] == xw
+        a, b = once.surfaces[0], whole.surfaces[0]
+        assert np.array_equal(a.vertices4d, b.vertices4d)
+        assert np.array_equal(a.positions, b.positions)
+        assert np.array_equal(a.halo.vertices, b.halo.vertices)
+        assert [len(c) for c in once.curves] == [len(c) for c in whole.curves]
+        assert once.verified == whole.verified
+
+
+def test_two_threads_build_at_once_and_get_what_one_gets():
+    alone = halo4d.Scene(DEFAULT).build()
+    results = [None, None]
+    errors = []
+
+    def work(i):
+        try:
+            results[i] = halo4d.Scene(DEFAULT).build()
+        except Exception as e:  # reported below
+            errors.append(e)
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors, errors
+    for r in results:
+        assert r.verified
+        assert np.array_equal(r.surfaces[0].positions, alone.surfaces[0].positions)
+        assert np.array_equal(r.surfaces[0].halo.tetrahedra, alone.surfaces[0].halo.tetrahedra)
+        assert [c.points.tolist() for c in r.curves] == [c.points.tolist() for c in alone.curves]
+
+
+def test_the_catalogue_lists_every_surface_with_its_topology():
+    entries = halo4d.catalogue()
+    types = {e["type"] for e in entries}
+    assert {"spun_trefoil", "flat_torus", "klein_bottle"} <= types
+    by_type = {e["type"]: e for e in entries}
+    assert by_type["flat_torus"]["euler_characteristic"] == 0
+    assert by_type["klein_bottle"]["orientable"] is False
+    for e in entries:
+        # Every entry builds as a scene of its own type.
+        assert halo4d.Scene({"name": "x", "surfaces": [{"surface": {"type": e["type"]}}]})
+
+
+def test_ctrl_c_interrupts_a_long_build_at_once():
+    # A build far longer than the wait: SIGINT after the build started must raise
+    # KeyboardInterrupt in the calling thread well before the build could have finished.
+    code = f"""
+import json, sys, time, halo4d
+d = json.load(open({str(DEFAULT)!r}))
+d["surfaces"][0]["sampling"] = {{"method": "uniform", "u": 1500, "v": 1000}}
+scene = halo4d.Scene(d)
+print("ready", flush=True)
+start = time.monotonic()
+try:
+    scene.build()
+    print("finished", time.monotonic() - start, flush=True)
+except KeyboardInterrupt:
+    print("interrupted", time.monotonic() - start, flush=True)
+"""
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "ready"
+    import time
+    time.sleep(1.0)
+    p.send_signal(signal.SIGINT)
+    out, _ = p.communicate(timeout=120)
+    word, seconds = out.split()
+    assert word == "interrupted", out
+    assert float(seconds) < 5.0, out
