@@ -697,9 +697,10 @@ fn catalogue<'py>(py: Python<'py>) -> PyResult<Vec<Bound<'py, PyAny>>> {
 }
 
 /// `halo4d check` on a file (a `.glb` or `.vtk`) or a build's folder: a dict with
-/// `verified`, `failures`, `halos` (each halo's name and the checker's statistics), the
-/// `scene` the file records, `plain` (why a `.vtk` is not read as a halo, or None) and
-/// `text` (what the command prints). A file that cannot be read raises `OSError`.
+/// `verified`, `failures`, `halos` (each halo's name and the checker's statistics), for a
+/// folder the `curves` recomputed from its surfaces and the halos' `verification` against
+/// them, the `scene` the file records, `plain` (why a `.vtk` is not read as a halo, or None)
+/// and `text` (what the command prints). A file that cannot be read raises `OSError`.
 #[pyfunction]
 fn check<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
     let target = path.clone();
@@ -725,6 +726,10 @@ fn check<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
         })
         .collect::<PyResult<Vec<_>>>()?;
     out.set_item("halos", halos)?;
+    if let Some((curves, verification)) = &checked.verification {
+        out.set_item("curves", to_python(py, curves)?)?;
+        out.set_item("verification", to_python(py, verification)?)?;
+    }
     out.set_item("scene", checked.scene.clone())?;
     out.set_item("plain", checked.plain.clone())?;
     out.set_item("text", checked.text())?;

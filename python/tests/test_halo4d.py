@@ -122,7 +122,19 @@ def test_write_gives_the_files_and_the_report_of_halo4d_build(cli_build, tmp_pat
     checked = halo4d.check(tmp_path)
     assert checked["verified"], checked["failures"]
     assert checked["halos"][0]["tets"] == len(built.surfaces[0].halo.tetrahedra)
-    assert "passes" in checked["text"] or checked["verified"]
+    assert checked["verification"]["wrong"] == 0 < checked["verification"]["correct"]
+    assert checked["curves"]["count"] == len(built.curves)
+    assert checked["text"].startswith(f"scene {name}:")
+    # A planted fault: the halo as meshio writes it, one tetrahedron turned inside out.
+    halo = built.surfaces[0].halo
+    tets = halo.tetrahedra.copy()
+    tets[7, [2, 3]] = tets[7, [3, 2]]
+    flipped = tmp_path / "flipped.vtk"
+    meshio.write(flipped, meshio.Mesh(halo.vertices, [("tetra", tets.astype(np.int64))]))
+    checked = halo4d.check(flipped)
+    assert not checked["verified"]
+    assert checked["halos"][0]["inverted"] == 1, checked["halos"]
+    assert any("inverted" in f for f in checked["failures"]), checked["failures"]
 
 
 def test_the_picture_is_the_command_lines(cli_build, tmp_path):
