@@ -233,7 +233,8 @@ impl Scene {
         let mut de = serde_json::Deserializer::from_str(text);
         let mut scene: Scene = serde_path_to_error::deserialize(&mut de).map_err(|e| {
             let path = match e.path().to_string() {
-                p if p == "." => "(top level)".to_string(),
+                // `?`: where the text stopped being JSON, before any key.
+                p if p == "." || p == "?" => "(top level)".to_string(),
                 p => p,
             };
             syntax(&path, e.into_inner())

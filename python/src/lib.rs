@@ -125,6 +125,9 @@ fn matrix<'py, T: numpy::Element + Copy>(
 #[pyclass(frozen, module = "halo4d")]
 struct Scene {
     scene: Arc<halo4d::Scene>,
+    /// The folder mesh files' relative paths start from (the scene file's; else the
+    /// working directory).
+    folder: PathBuf,
 }
 
 impl Scene {
@@ -132,8 +135,37 @@ impl Scene {
         halo4d::Scene::parse(text, file)
             .map(|scene| Scene {
                 scene: Arc::new(scene),
+                folder: PathBuf::new(),
             })
             .map_err(|e| scene_error(py, &e))
+    }
+
+    /// A scene of the same folder.
+    fn sibling(&self, scene: Arc<halo4d::Scene>) -> Scene {
+        Scene {
+            scene,
+            folder: self.folder.clone(),
+        }
+    }
+
+    /// The scene's JSON with every mesh file's path taken from its folder, so that the JSON
+    /// reads back anywhere.
+    fn json(&self) -> PyResult<serde_json::Value> {
+        let mut json = serde_json::to_value(&*self.scene).map_err(build_error)?;
+        if let Some(surfaces) = json.get_mut("surfaces").and_then(|s| s.as_array_mut()) {
+            for entry in surfaces {
+                let surface = &mut entry["surface"];
+                if surface["type"] == "mesh"
+                    && let Some(path) = surface["path"].as_str()
+                    && std::path::Path::new(path).is_relative()
+                {
+                    let full = std::path::absolute(self.folder.join(path))
+                        .map_err(|e| PyOSError::new_err(e.to_string()))?;
+                    surface["path"] = full.display().to_string().into();
+                }
+            }
+        }
+        Ok(json)
     }
 
     /// This scene in the 4D `view` (a dict as a scene file's `view`), validated.
@@ -145,7 +177,7 @@ impl Scene {
         let Some(view) = view.filter(|v| !v.is_none()) else {
             return Ok(Arc::clone(&self.scene));
         };
-        let mut json = serde_json::to_value(&*self.scene).map_err(build_error)?;
+        let mut json = self.json()?;
         let file = format!("<{} with a view>", self.scene.name);
         let view: serde_json::Value = serde_json::from_str(&dumps(view)?).map_err(|e| {
             scene_error_at(
@@ -168,6 +200,7 @@ impl Scene {
         let Some(source) = source.filter(|s| !s.is_none()) else {
             return Ok(Scene {
                 scene: Arc::new(halo4d::Scene::default_scene()),
+                folder: PathBuf::new(),
             });
         };
         if source.is_instance_of::<PyDict>() {
@@ -193,10 +226,12 @@ impl Scene {
                 "<argument>",
             )
         })?;
+        let folder = path.parent().map(PathBuf::from).unwrap_or_default();
         let scene = run(py, move || halo4d::Scene::load(&path))?;
         scene
             .map(|scene| Scene {
                 scene: Arc::new(scene),
+                folder,
             })
             .map_err(|e| scene_error(py, &e))
     }
@@ -207,14 +242,16 @@ impl Scene {
         self.scene.name.clone()
     }
 
-    /// The scene as the JSON of a scene file.
+    /// The scene as the JSON of a scene file (mesh files' paths absolute, so that it
+    /// reads back from anywhere).
     fn to_json(&self) -> PyResult<String> {
-        serde_json::to_string_pretty(&*self.scene).map_err(build_error)
+        serde_json::to_string_pretty(&self.json()?).map_err(build_error)
     }
 
-    /// The scene as a dict (the JSON of a scene file, as Python objects).
+    /// The scene as a dict (the JSON of a scene file, as Python objects; mesh files' paths
+    /// absolute).
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        to_python(py, &*self.scene)
+        to_python(py, &self.json()?)
     }
 
     /// Samples the scene's surfaces in 4D (adaptively, as its `sampling` says), once: the
@@ -223,7 +260,7 @@ impl Scene {
         let scene = Arc::clone(&self.scene);
         let sampled = run(py, move || halo4d::Sampled::of(&scene))?;
         Ok(Sampled {
-            scene: Arc::clone(&self.scene),
+            scene: self.sibling(Arc::clone(&self.scene)),
             sampled: Arc::new(sampled),
         })
     }
@@ -248,27 +285,29 @@ impl Scene {
 /// A scene's surfaces sampled in 4D (`Scene.sample()`), to build in any number of views.
 #[pyclass(frozen, module = "halo4d")]
 struct Sampled {
-    scene: Arc<halo4d::Scene>,
+    scene: Scene,
     sampled: Arc<halo4d::Sampled>,
 }
 
 #[pymethods]
 impl Sampled {
     /// Builds the sampled surfaces in the 4D `view` (a dict as a scene file's `view`, else
-    /// the scene's): projected surfaces, halos, curves and their verification.
+    /// the scene's; a scene's `"view": "auto"` is searched first, as `halo4d build` does):
+    /// projected surfaces, halos, curves and their verification.
     #[pyo3(signature = (view = None))]
     fn build(&self, py: Python<'_>, view: Option<&Bound<'_, PyAny>>) -> PyResult<Built> {
-        let scene = Scene {
-            scene: Arc::clone(&self.scene),
-        }
-        .in_view(py, view)?;
-        let (sampled, in_view) = (Arc::clone(&self.sampled), Arc::clone(&scene));
-        let built = run(py, move || {
-            sampled.build(&in_view, halo4d::Stages::of(&in_view))
-        })?
-        .map_err(build_error)?;
+        let scene = self.scene.in_view(py, view)?;
+        let sampled = Arc::clone(&self.sampled);
+        let (scene, built) = run(py, move || {
+            let mut scene = (*scene).clone();
+            halo4d::resolve_view(&mut scene, true).map_err(build_error)?;
+            let built = sampled
+                .build(&scene, halo4d::Stages::of(&scene))
+                .map_err(build_error)?;
+            Ok::<_, PyErr>((scene, built))
+        })??;
         Ok(Built {
-            scene,
+            scene: self.scene.sibling(Arc::new(scene)),
             built: Arc::new(built),
         })
     }
@@ -282,7 +321,7 @@ impl Sampled {
     fn __repr__(&self) -> String {
         format!(
             "halo4d.Sampled({:?}: {} triangles)",
-            self.scene.name,
+            self.scene.scene.name,
             self.sampled.triangles()
         )
     }
@@ -292,7 +331,7 @@ impl Sampled {
 /// the report; it writes the files and renders the picture.
 #[pyclass(frozen, module = "halo4d")]
 struct Built {
-    scene: Arc<halo4d::Scene>,
+    scene: Scene,
     built: Arc<halo4d::Built>,
 }
 
@@ -301,9 +340,7 @@ impl Built {
     /// The scene it was built from, in the view it was built in.
     #[getter]
     fn scene(&self) -> Scene {
-        Scene {
-            scene: Arc::clone(&self.scene),
-        }
+        self.scene.sibling(Arc::clone(&self.scene.scene))
     }
 
     /// Whether the build is verified: every halo passes the checker, every curve is
@@ -359,13 +396,13 @@ impl Built {
     /// was written) and the picture (none was made).
     #[getter]
     fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        to_python(py, &halo4d::report_of(&self.scene, &self.built))
+        to_python(py, &halo4d::report_of(&self.scene.scene, &self.built))
     }
 
     /// Writes the files the scene's `outputs` ask for into `dir` (created if need be; every
     /// file written whole or not at all), and gives the report (`report.json`) as a dict.
     fn write<'py>(&self, py: Python<'py>, dir: PathBuf) -> PyResult<Bound<'py, PyAny>> {
-        let (scene, built) = (Arc::clone(&self.scene), Arc::clone(&self.built));
+        let (scene, built) = (Arc::clone(&self.scene.scene), Arc::clone(&self.built));
         let report = run(py, move || halo4d::write(&scene, &built, &dir))?.map_err(build_error)?;
         to_python(py, &report)
     }
@@ -384,7 +421,7 @@ impl Built {
         style: Option<&str>,
         samples: Option<u32>,
     ) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
-        let base = self.scene.render;
+        let base = self.scene.scene.render;
         let style = match style {
             None => base.style,
             Some("shaded") => Style::Shaded,
@@ -410,7 +447,7 @@ impl Built {
                 "style \"stipple\": this scene was built without stipples; set its render.style to \"stipple\" and build again",
             ));
         }
-        let (scene, built) = (Arc::clone(&self.scene), Arc::clone(&self.built));
+        let (scene, built) = (Arc::clone(&self.scene.scene), Arc::clone(&self.built));
         let picture = run(py, move || {
             built.render(&scene.halo, &settings, &scene.camera)
         })?
@@ -424,7 +461,7 @@ impl Built {
 
     /// The scene's `.glb` (surfaces, halos, curves, the 4D mesh and the scene), as bytes.
     fn glb<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyBytes>> {
-        let (scene, built) = (Arc::clone(&self.scene), Arc::clone(&self.built));
+        let (scene, built) = (Arc::clone(&self.scene.scene), Arc::clone(&self.built));
         let bytes = run(py, move || halo4d::glb_bytes(&scene, &built))?.map_err(build_error)?;
         Ok(pyo3::types::PyBytes::new(py, &bytes))
     }
@@ -432,7 +469,7 @@ impl Built {
     fn __repr__(&self) -> String {
         format!(
             "halo4d.Built({:?}: {} surface(s), {} curve(s), {})",
-            self.scene.name,
+            self.scene.scene.name,
             self.built.surfaces.len(),
             self.built.shown_curves().curves.len(),
             if self.verified() {
@@ -560,7 +597,8 @@ impl Halo {
         matrix(py, &tets, 4)
     }
 
-    /// Each vertex's offset parameter t in [-1, 1] (0 on the surface), (k,).
+    /// Each vertex's t, (k,): 0 on the negative offset, 1 on the positive, 0.5 on the
+    /// surface (an inserted vertex has the mean of its layer's corners).
     #[getter]
     fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_slice(py, &self.halo().t)

@@ -191,14 +191,32 @@ def test_a_bad_scene_raises_scene_error_naming_its_field(edit, field):
     assert isinstance(caught.value, ValueError)
 
 
+def test_a_scene_of_a_mesh_file_reads_back_from_anywhere(tmp_path, monkeypatch):
+    # The mesh's path is relative to the scene file; the dict and JSON give it absolute, so
+    # that they read back from another folder, and a view of it builds.
+    scene = halo4d.Scene(ROOT / "fixtures" / "scenes" / "mesh-clifford-torus.json")
+    monkeypatch.chdir(tmp_path)
+    again = halo4d.Scene(scene.to_dict())
+    assert Path(again.to_dict()["surfaces"][0]["surface"]["path"]).is_absolute()
+    view = scene.to_dict()["view"]
+    view["rotation"]["xw"] += 10.0
+    a, b = scene.sample().build(view=view), again.build(view=view)
+    assert np.array_equal(a.surfaces[0].positions, b.surfaces[0].positions)
+    assert a.verified and b.verified
+
+
 def test_unreadable_and_foreign_sources_are_refused(tmp_path):
     with pytest.raises(halo4d.SceneError) as caught:
         halo4d.Scene(tmp_path / "missing.json")
     assert caught.value.field is None and "cannot read" in str(caught.value)
     with pytest.raises(halo4d.SceneError, match="dict, a JSON string or the path"):
         halo4d.Scene(42)
-    with pytest.raises(halo4d.SceneError):
+    with pytest.raises(halo4d.SceneError) as caught:
         halo4d.Scene("{not json")
+    assert caught.value.file == "<json>" and caught.value.field == "(top level)", str(caught.value)
+    with pytest.raises(halo4d.SceneError) as caught:
+        halo4d.Scene(42)
+    assert caught.value.field is None and caught.value.file == "<argument>"
     with pytest.raises(halo4d.SceneError) as caught:
         halo4d.Scene().build(view={"rotation": {"xw": float("nan")}})
     assert caught.value.field.startswith("view")
