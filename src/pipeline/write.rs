@@ -51,7 +51,7 @@ pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Err
     Ok(report)
 }
 
-/// The report of a build that was not written (what [`write`] reports, with no files and
+/// The report of a build that was not written (what [`write()`] reports, with no files and
 /// no picture), as the Python package gives it.
 pub fn report_of(scene: &Scene, built: &Built) -> Report {
     let mut timings = built.timings;
