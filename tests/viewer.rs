@@ -317,42 +317,21 @@ fn the_explorer_shows_the_slices_halo4d_slice_makes_over_the_surfaces() {
     assert_eq!(polylines.len(), 1);
     renderer.set_slice(gpu, &polylines).unwrap();
     let with = renderer.read_frame(gpu, &base).unwrap();
-    let placement = renderer.asset().placement(&scene.camera, SIDE, SIDE);
-    let camera =
-        halo4d::internals::Camera::new(&scene.camera, &placement, SIDE, SIDE, 0.0).unwrap();
-    let mut segments = Vec::new();
-    for (points, closed) in &polylines {
-        let p: Vec<[f64; 2]> = points
+    let segments = pixel_segments(
+        &scene.camera,
+        renderer.asset(),
+        polylines
             .iter()
-            .filter_map(|&q| camera.project(q, SIDE, SIDE).map(|(xy, _)| xy))
-            .collect();
-        segments.extend(p.windows(2).map(|w| (w[0], w[1])));
-        if *closed {
-            segments.push((p[p.len() - 1], p[0]));
-        }
-    }
+            .map(|(points, closed)| (points.clone(), *closed)),
+    );
     let (mut changed, mut magenta) = (0, 0);
-    for (i, (a, b)) in with
-        .picture
-        .rgb
-        .chunks(3)
-        .zip(without.picture.rgb.chunks(3))
-        .enumerate()
-    {
-        if a != b {
-            changed += 1;
-            magenta += usize::from(a[0] > 150 && a[2] > 120 && a[1] < 60);
-            let (x, y) = (
-                (i as u32 % SIDE) as f64 + 0.5,
-                (i as u32 / SIDE) as f64 + 0.5,
-            );
-            assert!(
-                segments
-                    .iter()
-                    .any(|&(a, b)| distance_to_segment([x, y], a, b) <= 2.25),
-                "pixel ({x}, {y}) changed away from the slice"
-            );
-        }
+    for (x, y, ink) in changed_pixels(&with, &without) {
+        changed += 1;
+        magenta += usize::from(ink[0] > 150 && ink[2] > 120 && ink[1] < 60);
+        assert!(
+            near(&segments, x, y, 2.25),
+            "pixel ({x}, {y}) changed away from the slice"
+        );
     }
     assert!(
         magenta > 100,
@@ -373,16 +352,56 @@ fn the_explorer_shows_the_slices_halo4d_slice_makes_over_the_surfaces() {
     );
 }
 
-/// The distance from `p` to the segment from `a` to `b`.
-fn distance_to_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let len2 = dx * dx + dy * dy;
-    let s = if len2 > 0.0 {
-        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a[0] + s * dx - p[0]).hypot(a[1] + s * dy - p[1])
+/// The segments of `lines` (points in the asset's frame, and whether each closes) in
+/// pixels of a `SIDE` x `SIDE` frame through `camera`.
+fn pixel_segments(
+    camera: &halo4d::render::CameraSettings,
+    asset: &Asset,
+    lines: impl Iterator<Item = (Vec<glam::DVec3>, bool)>,
+) -> Vec<([f64; 2], [f64; 2])> {
+    let placement = asset.placement(camera, SIDE, SIDE);
+    let camera = halo4d::internals::Camera::new(camera, &placement, SIDE, SIDE, 0.0).unwrap();
+    let mut segments = Vec::new();
+    for (points, closed) in lines {
+        let p: Vec<[f64; 2]> = points
+            .iter()
+            .filter_map(|&q| camera.project(q, SIDE, SIDE).map(|(xy, _)| xy))
+            .collect();
+        segments.extend(p.windows(2).map(|w| (w[0], w[1])));
+        if closed && p.len() > 2 {
+            segments.push((p[p.len() - 1], p[0]));
+        }
+    }
+    segments
+}
+
+/// Whether the pixel centre (x + 0.5, y + 0.5) lies within `reach` pixels of a segment.
+fn near(segments: &[([f64; 2], [f64; 2])], x: u32, y: u32, reach: f64) -> bool {
+    let p = [f64::from(x) + 0.5, f64::from(y) + 0.5];
+    segments.iter().any(|&(a, b)| {
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len2 = dx * dx + dy * dy;
+        let s = if len2 > 0.0 {
+            (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (a[0] + s * dx - p[0]).hypot(a[1] + s * dy - p[1]) <= reach
+    })
+}
+
+/// The pixels where frames `a` and `b` of `SIDE` x `SIDE` differ: x, y and `a`'s colour.
+fn changed_pixels<'a>(
+    a: &'a viewer::Frame,
+    b: &'a viewer::Frame,
+) -> impl Iterator<Item = (u32, u32, &'a [u8])> + 'a {
+    a.picture
+        .rgb
+        .chunks(3)
+        .zip(b.picture.rgb.chunks(3))
+        .enumerate()
+        .filter(|(_, (p, q))| p != q)
+        .map(|(i, (p, _))| (i as u32 % SIDE, i as u32 / SIDE, p))
 }
 
 /// Seeded 4D rotations: each of the six planes turned by up to 35 degrees either way.
@@ -649,18 +668,9 @@ fn curves_colour_and_transparency_toggle_what_they_should() {
         })
     };
     let (mut outlined, mut at_jump) = (0u32, 0u32);
-    for (i, (a, b)) in without
-        .picture
-        .rgb
-        .chunks(3)
-        .zip(bare.picture.rgb.chunks(3))
-        .enumerate()
-    {
-        if a != b {
-            outlined += 1;
-            let (x, y) = ((i as u32 % SIDE) as i64, (i as u32 / SIDE) as i64);
-            at_jump += u32::from(near_jump(x, y));
-        }
+    for (x, y, _) in changed_pixels(&without, &bare) {
+        outlined += 1;
+        at_jump += u32::from(near_jump(i64::from(x), i64::from(y)));
     }
     assert!(
         outlined > 200,
@@ -675,45 +685,22 @@ fn curves_colour_and_transparency_toggle_what_they_should() {
     );
     // Every pixel the curves change is on a projected curve segment: within half the
     // curves' 2.5-pixel width and a pixel.
-    let placement = asset.placement(&scene.camera, SIDE, SIDE);
-    let camera =
-        halo4d::internals::Camera::new(&scene.camera, &placement, SIDE, SIDE, 0.0).unwrap();
-    let mut segments = Vec::new();
-    for curve in &built.curves.curves {
-        let p: Vec<[f64; 2]> = curve
-            .points
+    let segments = pixel_segments(
+        &scene.camera,
+        &asset,
+        built
+            .curves
+            .curves
             .iter()
-            .filter_map(|q| camera.project(q.position, SIDE, SIDE).map(|(xy, _)| xy))
-            .collect();
-        segments.extend(p.windows(2).map(|w| (w[0], w[1])));
-        if curve.closed && p.len() > 2 {
-            segments.push((p[p.len() - 1], p[0]));
-        }
-    }
-    let near_curve = |x: f64, y: f64| {
-        segments
-            .iter()
-            .any(|&(a, b)| distance_to_segment([x, y], a, b) <= 2.25)
-    };
+            .map(|c| (c.points.iter().map(|p| p.position).collect(), c.closed)),
+    );
     let mut changed = 0;
-    for (i, (a, b)) in with
-        .picture
-        .rgb
-        .chunks(3)
-        .zip(without.picture.rgb.chunks(3))
-        .enumerate()
-    {
-        if a != b {
-            changed += 1;
-            let (x, y) = (
-                (i as u32 % SIDE) as f64 + 0.5,
-                (i as u32 / SIDE) as f64 + 0.5,
-            );
-            assert!(
-                near_curve(x, y),
-                "pixel ({x}, {y}) changed away from every curve"
-            );
-        }
+    for (x, y, _) in changed_pixels(&with, &without) {
+        changed += 1;
+        assert!(
+            near(&segments, x, y, 2.25),
+            "pixel ({x}, {y}) changed away from every curve"
+        );
     }
     // The default view hides most of its curves inside the outer sheet: a dozen or so
     // pixels show (14 on the current mesh).
