@@ -305,3 +305,34 @@ except KeyboardInterrupt:
     word, seconds = out.split()
     assert word == "interrupted", out
     assert float(seconds) < 5.0, out
+
+
+def test_the_type_stubs_name_what_the_module_has():
+    # Every public class, method, property and function of the native module has its stub
+    # in `_native.pyi`, and every stub names something the module has.
+    import ast
+    import halo4d._native as native
+
+    tree = ast.parse((Path(halo4d.__file__).parent / "_native.pyi").read_text())
+    stubbed = {}
+    for node in tree.body:
+        if isinstance(node, ast.ClassDef):
+            stubbed[node.name] = {
+                n.target.id if isinstance(n, ast.AnnAssign) else n.name
+                for n in node.body
+                if isinstance(n, (ast.FunctionDef, ast.AnnAssign))
+            }
+        elif isinstance(node, ast.FunctionDef):
+            stubbed[node.name] = None
+    public = {n for n in dir(native) if not n.startswith("_")}
+    assert set(stubbed) == public, (set(stubbed) ^ public)
+    for name, members in stubbed.items():
+        if members is None:
+            continue
+        cls = getattr(native, name)
+        own = {m for m in vars(cls) if not m.startswith("_")} | (
+            {"__init__"} if name == "Scene" else set()
+        ) | ({"__len__"} if "__len__" in vars(cls) else set())
+        if issubclass(cls, Exception):
+            own |= {"field", "file"} if name == "SceneError" else set()
+        assert members == own, (name, members ^ own)
