@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The viewer's window on a virtual X display: it opens, shows its settings in the title,
 # answers the keys, a drag and the wheel, and quits on Q; on a scene file it turns in 4D (a
-# plane key, a Shift drag), settles its curves, searches a view, resets and saves the view.
+# plane key, a Shift drag), settles its curves, searches a view, resets, shows and moves the
+# slice by a hyperplane, and saves the view.
 # Usage: .ci/window-check.sh SCENE.glb SCENE.json (a scene whose view turns only yw by 30)
 set -euo pipefail
 glb=$1
@@ -102,7 +103,13 @@ xdotool key v; expect "4D xy 0 xz 0 xw 0 yz 0 yw 30 zw 0 orthographic"
 # A held turn key repeats its step: 3 held 1.5 s turns xw by 15 degrees, then 15 more per repeat.
 xdotool keydown 3; sleep 1.5; xdotool keyup 3; expect_not "4D xy 0 xz 0 xw 0 "; expect_not " xw 15 "
 xdotool key v; expect "4D xy 0 xz 0 xw 0 yz 0 yw 30 zw 0 orthographic"
+# The moving hyperplane: L shows its slice (the title names its level and curves), the
+# period key moves it up, L again hides it.
+xdotool key l; expect "| slice h = "
+level=$(xdotool getwindowname "$w" | grep -o 'slice h = [-0-9.]*')
+xdotool key period; expect_not "$level"; expect "| slice h = "
+xdotool key l; expect_not "slice h = "
 xdotool key f; expect "saved exports/views/"
 xdotool key q
 wait "$viewer"
-echo "the explorer turned the scene in 4D, settled its curves and saved the view"
+echo "the explorer turned the scene in 4D, settled its curves, moved its hyperplane and saved the view"
