@@ -340,6 +340,35 @@ def run():
     check("verified" in labels and root.halo4d.status in labels, f"the panel shows {labels}")
     done.append(f"the panel draws {labels}; the Add dialog draws for {', '.join(draw_dialog())}")
 
+    # A wider halo builds from the same sampling: its boundary is that of halo4d's build.
+    from halo4d_blender import geometry
+
+    root.halo4d.gap_px = 12.0
+    check(root.halo4d.error == "", f"the halo's rebuild failed: {root.halo4d.error}")
+    check(build._cache[root.name].sampled is sampled, "a new halo width sampled again")
+    wide = json.loads(json.dumps(scene))
+    wide["halo"]["gap_px"] = 12.0
+    wide_halo = halo4d.Scene(wide).build().surfaces[0].halo
+    expected_co, _ = geometry.halo_boundary(wide_halo.vertices, wide_halo.tetrahedra)
+    halo_co, _ = mesh_arrays(build.children(root)[("halo", 0)])
+    check(
+        np.array_equal(halo_co, np.asarray(expected_co, dtype=np.float32)),
+        "gap 12 px: the halo's boundary is not that of halo4d's build",
+    )
+    narrow_co, _ = geometry.halo_boundary(
+        turned.surfaces[0].halo.vertices, turned.surfaces[0].halo.tetrahedra
+    )
+    check(
+        not np.array_equal(halo_co, np.asarray(narrow_co, dtype=np.float32)),
+        "gap 12 px: the halo did not change",
+    )
+    root.halo4d.gap_px = 8.0
+    same_as_build(turned, build.children(root), "gap back to 8 px")
+    done.append(
+        f"gap 8 -> 12 px: the halo rebuilt from the same sampling, its {len(halo_co)} boundary "
+        "vertices equal to halo4d's build with that gap"
+    )
+
     # A tolerance samples again, and back to the scene's samples as the scene does.
     root.halo4d.tolerance = 4e-3
     check(root.halo4d.error == "", f"the tolerance's rebuild failed: {root.halo4d.error}")

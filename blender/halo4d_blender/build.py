@@ -25,13 +25,14 @@ _suspended = 0
 
 
 class Entry:
-    """A root's sampling (halo4d.Sampled), the scene it sampled, and its latest build."""
+    """A root's sampling (halo4d.Sampled) with what it depends on, and its latest build with
+    the scene it built."""
 
     def __init__(self, key, sampled):
         self.key = key
         self.sampled = sampled
         self.built = None
-        self.view = None
+        self.scene = None
 
 
 @contextmanager
@@ -98,8 +99,8 @@ def settings_scene(settings):
 
 
 def build(root):
-    """Builds the root's scene in its view, re-using its sampling where the scene but the
-    view is unchanged. Raises halo4d.SceneError or halo4d.BuildError."""
+    """Builds the root's scene in its view, re-using its sampling where the surfaces and the
+    sampling are unchanged. Raises halo4d.SceneError or halo4d.BuildError."""
     h = package()
     scene = settings_scene(root.halo4d)
     key = scenes.sampling_key(scene)
@@ -107,8 +108,8 @@ def build(root):
     if entry is None or entry.key != key:
         entry = Entry(key, h.Scene(scene).sample())
         _cache[root.name] = entry
-    entry.built = entry.sampled.build(view=scene["view"])
-    entry.view = scene["view"]
+    entry.built = entry.sampled.build(view=scene["view"], scene=h.Scene(scene))
+    entry.scene = scene
     return entry.built
 
 
@@ -120,7 +121,7 @@ def latest(root):
         entry is None
         or entry.built is None
         or entry.key != scenes.sampling_key(scene)
-        or entry.view != scene["view"]
+        or entry.scene != scene
     ):
         return build(root)
     return entry.built

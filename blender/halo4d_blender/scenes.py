@@ -169,7 +169,7 @@ def effective_scene(stored, angles, translation, width, tolerance):
 
 
 def sampling_key(scene):
-    """What a sampling depends on: the scene but its view (halo4d's `Sampled` keeps the
-    scene, so a change of halo or outputs samples again too)."""
-    rest = {k: v for k, v in scene.items() if k != "view"}
+    """What a sampling depends on: the surfaces and the sampling (a change of view, halo or
+    anything else builds from the same sampling, `Sampled.build(view=..., scene=...)`)."""
+    rest = {k: scene.get(k) for k in ("surfaces", "sampling")}
     return json.dumps(rest, sort_keys=True)

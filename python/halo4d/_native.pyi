@@ -42,7 +42,8 @@ class Scene:
 class Sampled:
     """A scene's surfaces sampled in 4D."""
 
-    def build(self, view: View = None) -> Built: ...
+    def build(self, view: View = None, scene: Optional[Scene] = None) -> Built:
+        """Builds in `view`; `scene`: another scene of the same surfaces and sampling."""
     @property
     def triangles(self) -> int: ...
 

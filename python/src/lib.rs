@@ -270,7 +270,7 @@ impl Scene {
     /// build` makes them, nothing written.
     #[pyo3(signature = (view = None))]
     fn build(&self, py: Python<'_>, view: Option<&Bound<'_, PyAny>>) -> PyResult<Built> {
-        self.sample(py)?.build(py, view)
+        self.sample(py)?.build(py, view, None)
     }
 
     fn __repr__(&self) -> String {
@@ -293,10 +293,30 @@ struct Sampled {
 impl Sampled {
     /// Builds the sampled surfaces in the 4D `view` (a dict as a scene file's `view`, else
     /// the scene's; a scene's `"view": "auto"` is searched first, as `halo4d build` does):
-    /// projected surfaces, halos, curves and their verification.
-    #[pyo3(signature = (view = None))]
-    fn build(&self, py: Python<'_>, view: Option<&Bound<'_, PyAny>>) -> PyResult<Built> {
-        let scene = self.scene.in_view(py, view)?;
+    /// projected surfaces, halos, curves and their verification. `scene` builds another
+    /// scene with the same surfaces and sampling (another halo, camera, picture or
+    /// outputs) without sampling again; one with other surfaces or sampling is refused.
+    #[pyo3(signature = (view = None, scene = None))]
+    fn build(
+        &self,
+        py: Python<'_>,
+        view: Option<&Bound<'_, PyAny>>,
+        scene: Option<PyRef<'_, Scene>>,
+    ) -> PyResult<Built> {
+        let base = match &scene {
+            None => &self.scene,
+            Some(other) => {
+                let (mine, theirs) = (&self.scene.scene, &other.scene);
+                if theirs.surfaces != mine.surfaces || theirs.sampling != mine.sampling {
+                    return Err(PyValueError::new_err(format!(
+                        "scene `{}` has other surfaces or sampling than `{}`, which was sampled: sample it (`scene.sample()`)",
+                        theirs.name, mine.name
+                    )));
+                }
+                &**other
+            }
+        };
+        let scene = base.in_view(py, view)?;
         let sampled = Arc::clone(&self.sampled);
         let (scene, built) = run(py, move || {
             let mut scene = (*scene).clone();
@@ -307,7 +327,7 @@ impl Sampled {
             Ok::<_, PyErr>((scene, built))
         })??;
         Ok(Built {
-            scene: self.scene.sibling(Arc::new(scene)),
+            scene: base.sibling(Arc::new(scene)),
             built: Arc::new(built),
         })
     }

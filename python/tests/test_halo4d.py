@@ -244,6 +244,27 @@ def test_sampling_once_builds_every_view_as_a_whole_build_of_that_view():
         assert once.verified == whole.verified
 
 
+def test_one_sampling_builds_another_halo_without_sampling_again():
+    d = json.loads(DEFAULT.read_text())
+    sampled = halo4d.Scene(d).sample()
+    d["halo"] = {"rho": 0.02, "delta_d": 0.5, "delta_t": 0.3}
+    wider = halo4d.Scene(d)
+    once = sampled.build(scene=wider)
+    whole = wider.build()
+    assert once.scene.to_dict()["halo"]["rho"] == 0.02
+    assert np.array_equal(once.surfaces[0].halo.vertices, whole.surfaces[0].halo.vertices)
+    assert not np.array_equal(
+        once.surfaces[0].halo.vertices, sampled.build().surfaces[0].halo.vertices
+    )
+    # With a view too; and a scene of other surfaces is refused.
+    view = wider.to_dict()["view"]
+    view["rotation"]["xw"] += 5.0
+    assert sampled.build(view=view, scene=wider).scene.to_dict()["halo"]["rho"] == 0.02
+    d["surfaces"][0]["surface"]["scale"] = 0.5
+    with pytest.raises(ValueError, match="other surfaces or sampling"):
+        sampled.build(scene=halo4d.Scene(d))
+
+
 def test_two_threads_build_at_once_and_get_what_one_gets():
     alone = halo4d.Scene(DEFAULT).build()
     results = [None, None]
