@@ -1,9 +1,11 @@
 //! halo4d from Python (`import halo4d`): scenes read as the command line reads them, built
 //! once sampled for any number of views, and the results as NumPy arrays.
 //!
-//! Every array is one copy of the build's own buffer (`memcpy`, never a loop over elements
-//! in Python), made when it is asked for: `built.surfaces[0].positions` twice is two
-//! arrays with the same values. The work runs with the GIL released, on a thread of its
+//! Every array is made in Rust in one pass over the build's own data, when it is asked for
+//! (`built.surfaces[0].positions` twice is two arrays with the same values), never by a
+//! loop over elements in Python: a `memcpy` of the build's vector where it keeps the array
+//! as such; the halo's tetrahedra put in the files' vertex order, and each curve's points
+//! gathered from its point records, in one loop. The work runs with the GIL released, on a thread of its
 //! own, while the calling thread waits in slices of 50 ms and checks for signals between
 //! them: Ctrl-C raises `KeyboardInterrupt` at once (the work itself finishes in the
 //! background and its result is dropped, since a build has no point at which it can stop
