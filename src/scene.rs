@@ -217,29 +217,7 @@ impl Scene {
     /// Parses and validates scene text; `file` names it in errors, and its folder is where
     /// the paths of mesh files start.
     pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
-        // A surface's own field joins the path (`surfaces[0].surface.x`), as its checks
-        // name it.
-        let syntax = |path: &str, inner: serde_json::Error| {
-            let FieldError { field, message } =
-                FieldError::from_serde(path, &strip_position(&inner.to_string()));
-            SceneError::Syntax {
-                file: file.to_string(),
-                field,
-                message,
-                line: inner.line(),
-                column: inner.column(),
-            }
-        };
-        let mut de = serde_json::Deserializer::from_str(text);
-        let mut scene: Scene = serde_path_to_error::deserialize(&mut de).map_err(|e| {
-            let path = match e.path().to_string() {
-                // `?`: where the text stopped being JSON, before any key.
-                p if p == "." || p == "?" => "(top level)".to_string(),
-                p => p,
-            };
-            syntax(&path, e.into_inner())
-        })?;
-        de.end().map_err(|e| syntax("(after the scene)", e))?;
+        let mut scene: Scene = from_json(text, file, None)?;
         let folder = Path::new(file).parent().unwrap_or(Path::new(""));
         let invalid = |FieldError { field, message }| SceneError::Invalid {
             file: file.to_string(),
@@ -256,6 +234,28 @@ impl Scene {
             }
         }
         scene.validate().map_err(invalid)?;
+        Ok(scene)
+    }
+
+    /// This scene in the view that `text` gives (a scene file's `view` as JSON, or
+    /// `"auto"`), checked as [`Scene::parse`] checks a scene, its errors' fields under
+    /// `view`; `file` names the text in them. The surfaces are kept as they are: a mesh
+    /// file is not read again.
+    pub fn with_view(&self, text: &str, file: &str) -> Result<Scene, SceneError> {
+        #[derive(Deserialize)]
+        struct Only(#[serde(deserialize_with = "crate::view::view_or_auto")] View);
+        let Only(view) = from_json(text, file, Some("view"))?;
+        let scene = Scene {
+            view,
+            ..self.clone()
+        };
+        scene
+            .validate()
+            .map_err(|FieldError { field, message }| SceneError::Invalid {
+                file: file.to_string(),
+                field,
+                message,
+            })?;
         Ok(scene)
     }
 
@@ -410,6 +410,41 @@ fn check_name(name: &str) -> Result<(), String> {
 }
 
 /// serde_json appends " at line L column C"; we report the position ourselves.
+/// A `T` read from JSON `text` (named `file` in errors), every error a
+/// [`SceneError::Syntax`] naming its field's path, under `within` where given (a surface's
+/// own field joins the path, `surfaces[0].surface.x`, as its checks name it).
+fn from_json<T: serde::de::DeserializeOwned>(
+    text: &str,
+    file: &str,
+    within: Option<&str>,
+) -> Result<T, SceneError> {
+    let syntax = |path: &str, inner: serde_json::Error| {
+        let FieldError { field, message } =
+            FieldError::from_serde(path, &strip_position(&inner.to_string()));
+        SceneError::Syntax {
+            file: file.to_string(),
+            field,
+            message,
+            line: inner.line(),
+            column: inner.column(),
+        }
+    };
+    let mut de = serde_json::Deserializer::from_str(text);
+    let value = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        let path = match (e.path().to_string(), within) {
+            // `?`: where the text stopped being JSON, before any key.
+            (p, None) if p == "." || p == "?" => "(top level)".to_string(),
+            (p, None) => p,
+            (p, Some(w)) if p == "." || p == "?" => w.to_string(),
+            (p, Some(w)) => format!("{w}.{p}"),
+        };
+        syntax(&path, e.into_inner())
+    })?;
+    de.end()
+        .map_err(|e| syntax(within.unwrap_or("(after the scene)"), e))?;
+    Ok(value)
+}
+
 fn strip_position(message: &str) -> String {
     match message.rfind(" at line ") {
         Some(i) => message[..i].to_string(),

@@ -627,3 +627,37 @@ fn text_that_is_not_json_from_its_start_is_named_at_the_top_level() {
         }
     }
 }
+
+#[test]
+fn a_view_given_as_json_is_checked_under_view_and_keeps_the_surfaces() {
+    let scene = Scene::load(&fixture("scenes/mesh-clifford-torus.json")).unwrap();
+    let mut view = serde_json::to_value(scene.view).unwrap();
+    view["rotation"]["xw"] = 12.5.into();
+    let turned = scene.with_view(&view.to_string(), "v").unwrap();
+    assert_eq!(turned.view.rotation.xw, 12.5);
+    assert_eq!(turned.surfaces, scene.surfaces);
+    // The mesh is the same one, not read again.
+    let mesh = |s: &Scene| match &s.surfaces[0].surface {
+        halo4d::sample::Source::Mesh(m) => std::sync::Arc::clone(&m.mesh),
+        other => panic!("{other:?}"),
+    };
+    assert!(std::sync::Arc::ptr_eq(&mesh(&turned), &mesh(&scene)));
+    assert!(scene.with_view("\"auto\"", "v").unwrap().view.auto);
+    for (text, field) in [
+        (r#"{"rotation": {"xw": "ten"}}"#, "view.rotation.xw"),
+        (r#"{"rotation": {"xq": 1}}"#, "view.rotation.xq"),
+        ("{not json", "view"),
+        (
+            r#"{"projection": {"type": "perspective", "eye_distance": -1}}"#,
+            "view.projection.eye_distance",
+        ),
+    ] {
+        let e = scene.with_view(text, "v").unwrap_err();
+        match &e {
+            SceneError::Syntax { field: f, .. } | SceneError::Invalid { field: f, .. } => {
+                assert_eq!(f, field, "{text}: {e}")
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+}

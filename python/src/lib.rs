@@ -97,18 +97,13 @@ fn dumps(value: &Bound<'_, PyAny>) -> PyResult<String> {
         .extract()
 }
 
-/// Python's `json.loads(text)`.
-fn loads<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
-    py.import("json")?.call_method1("loads", (text,))
-}
-
 /// A serializable value as Python objects (through JSON, as the files have it).
 fn to_python<'py>(py: Python<'py>, value: &impl serde::Serialize) -> PyResult<Bound<'py, PyAny>> {
     let text = serde_json::to_string(value).map_err(build_error)?;
-    loads(py, &text)
+    py.import("json")?.call_method1("loads", (text,))
 }
 
-/// `values` (f64 components, `width` per row) as an (n, width) array: one copy.
+/// `values` (`width` per row) as an (n, width) array: one copy.
 fn matrix<'py, T: numpy::Element + Copy>(
     py: Python<'py>,
     values: &[T],
@@ -133,11 +128,13 @@ struct Scene {
 }
 
 impl Scene {
+    /// Scene text not from a file: its mesh files' relative paths start from the working
+    /// directory, as it is now.
     fn parse(py: Python<'_>, text: &str, file: &str) -> PyResult<Scene> {
         halo4d::Scene::parse(text, file)
             .map(|scene| Scene {
                 scene: Arc::new(scene),
-                folder: PathBuf::new(),
+                folder: std::env::current_dir().unwrap_or_default(),
             })
             .map_err(|e| scene_error(py, &e))
     }
@@ -170,7 +167,8 @@ impl Scene {
         Ok(json)
     }
 
-    /// This scene in the 4D `view` (a dict as a scene file's `view`), validated.
+    /// This scene in the 4D `view` (a dict as a scene file's `view`), validated; its
+    /// surfaces kept, not read again.
     fn in_view(
         &self,
         py: Python<'_>,
@@ -179,18 +177,11 @@ impl Scene {
         let Some(view) = view.filter(|v| !v.is_none()) else {
             return Ok(Arc::clone(&self.scene));
         };
-        let mut json = self.json()?;
         let file = format!("<{} with a view>", self.scene.name);
-        let view: serde_json::Value = serde_json::from_str(&dumps(view)?).map_err(|e| {
-            scene_error_at(
-                py,
-                format!("{file}: view: not a scene file's view ({e}; numbers must be finite)"),
-                Some("view"),
-                &file,
-            )
-        })?;
-        json["view"] = view;
-        Ok(Scene::parse(py, &json.to_string(), &file)?.scene)
+        self.scene
+            .with_view(&dumps(view)?, &file)
+            .map(Arc::new)
+            .map_err(|e| scene_error(py, &e))
     }
 }
 
