@@ -25,12 +25,15 @@ _suspended = 0
 
 
 class Entry:
-    """A root's sampling (halo4d.Sampled) with what it depends on, and its latest build with
-    the scene it built."""
+    """A root's sampling (halo4d.Sampled) with what it depends on; the halo4d.Scene of its
+    settings but the view, read once (a mesh file is not read again for each view); its
+    latest build with the scene it built."""
 
-    def __init__(self, key, sampled):
+    def __init__(self, key, scene):
         self.key = key
-        self.sampled = sampled
+        self.sampled = scene.sample()
+        self.rest = None
+        self.other = scene
         self.built = None
         self.scene = None
 
@@ -104,11 +107,15 @@ def build(root):
     h = package()
     scene = settings_scene(root.halo4d)
     key = scenes.sampling_key(scene)
+    rest = json.dumps({k: v for k, v in scene.items() if k != "view"}, sort_keys=True)
     entry = _cache.get(root.name)
     if entry is None or entry.key != key:
-        entry = Entry(key, h.Scene(scene).sample())
+        entry = Entry(key, h.Scene(scene))
+        entry.rest = rest
         _cache[root.name] = entry
-    entry.built = entry.sampled.build(view=scene["view"], scene=h.Scene(scene))
+    elif entry.rest != rest:
+        entry.other, entry.rest = h.Scene(scene), rest
+    entry.built = entry.sampled.build(view=scene["view"], scene=entry.other)
     entry.scene = scene
     return entry.built
 
