@@ -104,10 +104,13 @@ xdotool key v; expect "4D xy 0 xz 0 xw 0 yz 0 yw 30 zw 0 orthographic"
 xdotool keydown 3; sleep 1.5; xdotool keyup 3; expect_not "4D xy 0 xz 0 xw 0 "; expect_not " xw 15 "
 xdotool key v; expect "4D xy 0 xz 0 xw 0 yz 0 yw 30 zw 0 orthographic"
 # The moving hyperplane: L shows its slice (the title names its level and curves), the
-# period key moves it up, L again hides it.
+# period key moves it up, L hides it and shows it again at the level it had.
 xdotool key l; expect "| slice h = "
 level=$(xdotool getwindowname "$w" | grep -o 'slice h = [-0-9.]*')
 xdotool key period; expect_not "$level"; expect "| slice h = "
+moved=$(xdotool getwindowname "$w" | grep -o 'slice h = [-0-9.]*:')
+xdotool key l; expect_not "slice h = "
+xdotool key l; expect "$moved"
 xdotool key l; expect_not "slice h = "
 xdotool key f; expect "saved exports/views/"
 xdotool key q

@@ -14,12 +14,12 @@
 //! switches the 4D projection between orthographic and perspective; `V` resets the 4D view;
 //! `F` writes the current view as a scene file (`exports/views/<name>-<k>.json`) and `B`
 //! builds it in the background (`exports/<name>-<k>/`), its verification in the title; `L`
-//! shows the slice by the hyperplane of the scene's `slicing` (as `halo4d slice` cuts: the
-//! curves where the surfaces cross a level of the height along that direction, drawn over
-//! them in magenta) and `,` and `.` move the level down and up by 1/64 of the surfaces'
-//! range of heights (with Shift, 1/640); the title names the level, its number of curves
-//! and the critical levels either side of it. The title shows the 4D view in the scene
-//! file's terms.
+//! shows or hides the slice by the hyperplane of the scene's `slicing` (as `halo4d slice`
+//! cuts: the curves where the surfaces cross a level of the height along that direction,
+//! drawn over them in magenta; hidden, it keeps its level) and `,` and `.` move the level
+//! down and up by 1/64 of the surfaces' range of heights (with Shift, 1/640); the title
+//! names the level, its number of curves and the critical levels either side of it. The
+//! title shows the 4D view in the scene file's terms.
 
 use super::{
     Gpu, HaloMode, Hyperplane, Renderer, SLICE_COUNTS, Source, StippleSet, ViewSettings,
@@ -87,6 +87,7 @@ pub fn run(
         search: None,
         note: String::new(),
         stipples: None,
+        slice_shown: hyperplane.is_some(),
         hyperplane,
         slice_drawn: false,
     };
@@ -143,8 +144,10 @@ struct App {
     note: String,
     /// The stipples being made in the background, until the renderer has them.
     stipples: Option<Receiver<Result<StippleSet, ViewerError>>>,
-    /// The hyperplane whose slice is shown (`L`).
+    /// The hyperplane (made the first time `L` shows it, kept when it is hidden: its level
+    /// and the surfaces' critical points) and whether its slice is shown.
     hyperplane: Option<Hyperplane>,
+    slice_shown: bool,
     /// Whether the renderer draws the hyperplane's slice as it is now.
     slice_drawn: bool,
 }
@@ -272,10 +275,10 @@ impl App {
             return Ok(());
         };
         if !self.slice_drawn {
-            let polylines = self
-                .hyperplane
-                .as_ref()
-                .map_or_else(Vec::new, |h| h.polylines(&view));
+            let polylines = match &self.hyperplane {
+                Some(h) if self.slice_shown => h.polylines(&view),
+                _ => Vec::new(),
+            };
             state.renderer.set_slice(&state.gpu, &polylines)?;
             self.slice_drawn = true;
         }
@@ -405,9 +408,10 @@ impl App {
                 describe(&v),
                 self.turn_ms
                     .map_or_else(String::new, |ms| format!(" (halos rebuilt in {ms:.0} ms)")),
-                self.hyperplane
-                    .as_ref()
-                    .map_or_else(String::new, |h| format!(" | {}", h.describe())),
+                match &self.hyperplane {
+                    Some(h) if self.slice_shown => format!(" | {}", h.describe()),
+                    _ => String::new(),
+                },
                 if self.note.is_empty() {
                     String::new()
                 } else {
@@ -522,7 +526,7 @@ impl App {
             _ => None,
         };
         if let Some(step) = step {
-            if let Some(plane) = &mut self.hyperplane {
+            if let Some(plane) = self.hyperplane.as_mut().filter(|_| self.slice_shown) {
                 plane.step(model, step * SLICE_STEP);
                 self.slice_drawn = false;
             } else {
@@ -536,16 +540,13 @@ impl App {
         let reach = model.radius_4d();
         match c.to_lowercase().as_str() {
             "l" => {
-                self.hyperplane = match self.hyperplane.take() {
-                    Some(_) => None,
-                    None => match model.hyperplane(None) {
-                        Ok(plane) => Some(plane),
-                        Err(e) => {
-                            self.note = format!("no slice: {e}");
-                            None
-                        }
-                    },
-                };
+                if self.hyperplane.is_none() {
+                    match model.hyperplane(None) {
+                        Ok(plane) => self.hyperplane = Some(plane),
+                        Err(e) => self.note = format!("no slice: {e}"),
+                    }
+                }
+                self.slice_shown = !self.slice_shown && self.hyperplane.is_some();
                 self.slice_drawn = false;
                 return true;
             }
