@@ -82,6 +82,9 @@ pub struct CheckStats {
     pub duplicate_tets: usize,
     /// Faces in more than two tetrahedra.
     pub overshared_faces: usize,
+    /// Faces of two tetrahedra whose fourth vertices lie on the same side of it (exactly):
+    /// the two overlap, however each is oriented.
+    pub folded_faces: usize,
     /// Quads over surface edges not split along one diagonal, the same way from both sides.
     pub quad_mismatches: usize,
     /// Surface triangles whose boundary faces are not exactly two opposite offset faces.
@@ -117,6 +120,7 @@ impl CheckStats {
         self.degenerate == 0
             && self.duplicate_tets == 0
             && self.overshared_faces == 0
+            && self.folded_faces == 0
             && self.quad_mismatches == 0
             && self.missing_offset_faces == 0
             && self.unexpected_boundary_faces == 0
@@ -141,6 +145,7 @@ impl CheckStats {
             ("degenerate", self.degenerate),
             ("duplicate_tets", self.duplicate_tets),
             ("overshared_faces", self.overshared_faces),
+            ("folded_faces", self.folded_faces),
             ("quad_mismatches", self.quad_mismatches),
             ("missing_offset_faces", self.missing_offset_faces),
             ("unexpected_boundary_faces", self.unexpected_boundary_faces),
@@ -305,8 +310,16 @@ fn sorted_tet(tet: [u32; 4], vertices: usize) -> ([u32; 4], bool) {
 }
 
 /// Orientation, volume and angle of `tets` (sorted, with their parities), on positions
-/// [`scaled`], with which vertices are too small to decide.
-fn examine(tets: &[[u32; 4]], odd: &[bool], positions: &[[f64; 3]], tiny: &[bool]) -> CheckStats {
+/// [`scaled`], with which vertices are too small to decide; writes each sorted
+/// tetrahedron's exact orientation (the sign of `orient3d` of its vertices in increasing
+/// order; 0 where flat, degenerate or undecidable) into `signs`.
+fn examine(
+    tets: &[[u32; 4]],
+    odd: &[bool],
+    positions: &[[f64; 3]],
+    tiny: &[bool],
+    signs: &mut [i8],
+) -> CheckStats {
     let mut s = CheckStats {
         min_volume: f64::INFINITY,
         max_volume: f64::NEG_INFINITY,
@@ -314,7 +327,7 @@ fn examine(tets: &[[u32; 4]], odd: &[bool], positions: &[[f64; 3]], tiny: &[bool
         ..CheckStats::default()
     };
     let mut dihedral_cosine = -1.0f64;
-    for (tet, &odd) in tets.iter().zip(odd) {
+    for ((tet, &odd), out) in tets.iter().zip(odd).zip(signs) {
         if *tet == DEGENERATE {
             s.degenerate += 1;
             continue;
@@ -322,13 +335,23 @@ fn examine(tets: &[[u32; 4]], odd: &[bool], positions: &[[f64; 3]], tiny: &[bool
         let sign = if odd { -1.0 } else { 1.0 };
         let p = tet.map(|i| positions[i as usize]);
         // Exact, so its sign turns over exactly with the vertex order.
-        let o = sign * robust::orient3d(c3(p[0]), c3(p[1]), c3(p[2]), c3(p[3]));
+        let sorted = robust::orient3d(c3(p[0]), c3(p[1]), c3(p[2]), c3(p[3]));
+        let o = sign * sorted;
         if tet.iter().any(|&i| tiny[i as usize]) {
             s.undecidable += 1;
-        } else if o < 0.0 {
-            s.inverted += 1;
-        } else if o == 0.0 {
-            s.flat += 1;
+        } else {
+            *out = if sorted > 0.0 {
+                1
+            } else if sorted < 0.0 {
+                -1
+            } else {
+                0
+            };
+            if o < 0.0 {
+                s.inverted += 1;
+            } else if o == 0.0 {
+                s.flat += 1;
+            }
         }
         let v = sign * volume(p);
         s.volume += v.abs();
@@ -370,17 +393,21 @@ fn bucket_sort<T: Ord + Copy + Default + Send>(
 
 /// The tetrahedra that can hold a face whose smallest vertex is v: those whose smallest or
 /// second smallest vertex is v, each listed under v by its other three vertices in
-/// increasing order (every tetrahedron is listed twice, degenerate ones never). A face is
-/// found by its smallest vertex among a few entries side by side in memory, with no list of
-/// all faces (at a million triangles that list would be 24 million faces, sorted).
+/// increasing order (every tetrahedron is listed twice, degenerate ones never), with the
+/// tetrahedron's exact orientation in that order. A face is found by its smallest vertex
+/// among a few entries side by side in memory, with no list of all faces (at a million
+/// triangles that list would be 24 million faces, sorted).
 struct Incidence {
     starts: Vec<usize>,
     others: Vec<[u32; 3]>,
+    /// The sign of `orient3d` of each entry's tetrahedron, its vertices in increasing order
+    /// (0 where flat or undecidable).
+    signs: Vec<i8>,
 }
 
 impl Incidence {
-    /// From sorted tetrahedra.
-    fn new(tets: &[[u32; 4]], vertices: usize) -> Self {
+    /// From sorted tetrahedra and their orientations ([`examine`]'s signs).
+    fn new(tets: &[[u32; 4]], tet_signs: &[i8], vertices: usize) -> Self {
         let mut starts = vec![0usize; vertices + 1];
         for t in tets.iter().filter(|&t| *t != DEGENERATE) {
             starts[t[0] as usize + 1] += 1;
@@ -391,17 +418,31 @@ impl Incidence {
         }
         let mut fill = starts.clone();
         let mut others = vec![[0u32; 3]; starts[vertices]];
-        for &[a, b, c, d] in tets.iter().filter(|&t| *t != DEGENERATE) {
+        let mut signs = vec![0i8; starts[vertices]];
+        for (&[a, b, c, d], &sign) in tets.iter().zip(tet_signs) {
+            if [a, b, c, d] == DEGENERATE {
+                continue;
+            }
             for (v, rest) in [(a, [b, c, d]), (b, [a, c, d])] {
                 others[fill[v as usize]] = rest;
+                signs[fill[v as usize]] = sign;
                 fill[v as usize] += 1;
             }
         }
-        Incidence { starts, others }
+        Incidence {
+            starts,
+            others,
+            signs,
+        }
     }
 
     fn at(&self, v: u32) -> &[[u32; 3]] {
         &self.others[self.starts[v as usize]..self.starts[v as usize + 1]]
+    }
+
+    /// The orientations of [`Self::at`]'s entries.
+    fn signs_at(&self, v: u32) -> &[i8] {
+        &self.signs[self.starts[v as usize]..self.starts[v as usize + 1]]
     }
 
     /// How many tetrahedra hold face f.
@@ -421,21 +462,48 @@ impl Incidence {
 /// come out in the same order on any number of threads.
 const FACE_RUN: usize = 1 << 12;
 
-/// The faces whose smallest vertex is in `vertices`, grouped: counts of interior and
-/// overshared faces and of repeated tetrahedra, and the boundary faces (in increasing order)
-/// with the vertex opposite each.
-fn faces_from(vertices: std::ops::Range<usize>, incidence: &Incidence) -> (CheckStats, Vec<Face>) {
-    let mut s = CheckStats::default();
-    let mut boundary = Vec::new();
-    let mut faces: Vec<Face> = Vec::new();
+/// A face (sorted vertex triple) whose tetrahedra break conformity: more than two hold it,
+/// or its two tetrahedra lie on the same side of it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum FaceFault {
+    /// In more than two tetrahedra.
+    Overshared([u32; 3]),
+    /// Its two tetrahedra's fourth vertices on the same side of it.
+    Folded([u32; 3]),
+}
+
+/// What the faces of sorted tetrahedra are: counts of interior, overshared and folded faces
+/// and of repeated tetrahedra, the boundary faces in increasing order with the vertex
+/// opposite each, and the faulty faces.
+#[derive(Default)]
+struct Faces {
+    stats: CheckStats,
+    boundary: Vec<Face>,
+    faults: Vec<FaceFault>,
+}
+
+/// The faces whose smallest vertex is in `vertices`, grouped ([`Faces`]).
+fn faces_from(vertices: std::ops::Range<usize>, incidence: &Incidence) -> Faces {
+    let mut out = Faces::default();
+    // Each face with the vertex opposite it and the side that vertex lies on (the sign of
+    // `orient3d` of the face's sorted vertices and it; 0 where unknown).
+    let mut faces: Vec<([u32; 3], u32, i8)> = Vec::new();
     for v in vertices {
         let v = v as u32;
         faces.clear();
-        for &[a, b, c] in incidence.at(v) {
+        for (&[a, b, c], &sign) in incidence.at(v).iter().zip(incidence.signs_at(v)) {
+            // Moving the opposite vertex from place k of the sorted tetrahedron to its end
+            // takes 3 - k exchanges, each turning the orientation over.
             if a > v {
-                faces.extend([([v, b, c], a), ([v, a, c], b), ([v, a, b], c)]);
+                // The tetrahedron is (v, a, b, c).
+                faces.extend([
+                    ([v, b, c], a, sign),
+                    ([v, a, c], b, -sign),
+                    ([v, a, b], c, sign),
+                ]);
             } else {
-                faces.push(([v, b, c], a));
+                // The tetrahedron is (a, v, b, c).
+                faces.push(([v, b, c], a, -sign));
             }
         }
         faces.sort_unstable();
@@ -443,39 +511,52 @@ fn faces_from(vertices: std::ops::Range<usize>, incidence: &Incidence) -> (Check
             let k = group[0].0;
             // A repeated tetrahedron repeats every face with the same opposite vertex; count
             // it once, at the face opposite its largest vertex.
-            for (i, &(_, o)) in group.iter().enumerate() {
-                if o > k[2] && group[..i].iter().any(|&(_, other)| other == o) {
-                    s.duplicate_tets += 1;
+            for (i, &(_, o, _)) in group.iter().enumerate() {
+                if o > k[2] && group[..i].iter().any(|&(_, other, _)| other == o) {
+                    out.stats.duplicate_tets += 1;
                 }
             }
-            match group.len() {
-                1 => boundary.push(group[0]),
-                2 => s.interior_faces += 1,
-                _ => s.overshared_faces += 1,
+            match group {
+                [(_, o, _)] => out.boundary.push((k, *o)),
+                [(_, o1, s1), (_, o2, s2)] => {
+                    out.stats.interior_faces += 1;
+                    // Exact sides; a repeated tetrahedron is counted as that instead.
+                    if o1 != o2 && *s1 != 0 && s1 == s2 {
+                        out.stats.folded_faces += 1;
+                        out.faults.push(FaceFault::Folded(k));
+                    }
+                }
+                _ => {
+                    out.stats.overshared_faces += 1;
+                    out.faults.push(FaceFault::Overshared(k));
+                }
             }
         }
     }
-    (s, boundary)
+    out
 }
 
-/// Every face of sorted tetrahedra counted at its smallest vertex: the incidence, the counts
-/// of interior and overshared faces and repeated tetrahedra, and the boundary faces in
-/// increasing order, each with its tetrahedron's fourth vertex.
-fn face_uses(tets: &[[u32; 4]], vertices: usize) -> (Incidence, CheckStats, Vec<Face>) {
-    let incidence = Incidence::new(tets, vertices);
-    let runs: Vec<(CheckStats, Vec<Face>)> = (0..vertices.div_ceil(FACE_RUN))
+/// Every face of sorted tetrahedra (with their orientations) counted at its smallest
+/// vertex: the incidence and the faces ([`Faces`]).
+fn face_uses(tets: &[[u32; 4]], signs: &[i8], vertices: usize) -> (Incidence, Faces) {
+    let incidence = Incidence::new(tets, signs, vertices);
+    let runs: Vec<Faces> = (0..vertices.div_ceil(FACE_RUN))
         .into_par_iter()
         .map(|r| faces_from(r * FACE_RUN..vertices.min((r + 1) * FACE_RUN), &incidence))
         .collect();
-    let mut s = CheckStats::default();
-    let mut boundary: Vec<Face> = Vec::with_capacity(runs.iter().map(|r| r.1.len()).sum());
-    for (q, faces) in runs {
-        s.duplicate_tets += q.duplicate_tets;
-        s.interior_faces += q.interior_faces;
-        s.overshared_faces += q.overshared_faces;
-        boundary.extend(faces);
+    let mut out = Faces {
+        boundary: Vec::with_capacity(runs.iter().map(|r| r.boundary.len()).sum()),
+        ..Faces::default()
+    };
+    for run in runs {
+        out.stats.duplicate_tets += run.stats.duplicate_tets;
+        out.stats.interior_faces += run.stats.interior_faces;
+        out.stats.overshared_faces += run.stats.overshared_faces;
+        out.stats.folded_faces += run.stats.folded_faces;
+        out.boundary.extend(run.boundary);
+        out.faults.extend(run.faults);
     }
-    (incidence, s, boundary)
+    (incidence, out)
 }
 
 /// The faces of `tets` that belong to exactly one of them (degenerate tetrahedra left out),
@@ -486,7 +567,10 @@ pub fn boundary_faces(tets: &[[u32; 4]], vertices: usize) -> Vec<([u32; 3], u32)
         .par_iter()
         .map(|&t| sorted_tet(t, vertices).0)
         .collect();
-    face_uses(&sorted, vertices).2
+    // Orientations are not needed for the boundary: every one 0.
+    face_uses(&sorted, &vec![0; sorted.len()], vertices)
+        .1
+        .boundary
 }
 
 /// Checks a tetrahedral halo (see the module documentation).
@@ -501,30 +585,82 @@ pub fn check(mesh: &TetMesh) -> CheckStats {
 
 /// The checks that need no halo layout, on any tetrahedra (another program's mesh): every
 /// tetrahedron positively oriented, with four distinct vertices and no repeat; every face in
-/// one or two tetrahedra; the volumes adding up to the volume the boundary encloses. The
-/// counts only a halo has (offset faces, quads, surface faces, collapsed vertices) are 0.
+/// one or two tetrahedra, two on opposite sides of it; the volumes adding up to the volume
+/// the boundary encloses. The counts only a halo has (offset faces, quads, surface faces,
+/// collapsed vertices) are 0.
 pub fn check_tetrahedra<P: Copy + Into<[f64; 3]> + Sync>(
     positions: &[P],
     tets: &[[u32; 4]],
 ) -> CheckStats {
+    examine_tetrahedra(positions, tets).stats
+}
+
+/// What [`check_tetrahedra`] found, with what a closer look at the mesh
+/// ([`crate::certify`]) goes on from.
+#[derive(Clone, Debug, Default)]
+pub struct Examined {
+    /// The counts.
+    pub stats: CheckStats,
+    /// The positions scaled as a whole by the power of two that brings the largest
+    /// coordinate into [0.5, 1): every orientation as it was, and no exact predicate
+    /// overflows.
+    pub scaled: Vec<[f64; 3]>,
+    /// Which vertices have a coordinate too small, against the largest, for the exact
+    /// predicates ([`SAFE_RANGE`]).
+    pub tiny: Vec<bool>,
+    /// Each tetrahedron's exact orientation as given: 1 positive, -1 inverted, 0 flat,
+    /// degenerate or undecidable.
+    pub orientation: Vec<i8>,
+    /// The faces of exactly one tetrahedron, each as its sorted vertex triple with the
+    /// fourth vertex of its tetrahedron, in increasing order.
+    pub boundary: Vec<([u32; 3], u32)>,
+    /// The faces in more than two tetrahedra, or between two on the same side of it.
+    pub face_faults: Vec<FaceFault>,
+}
+
+/// [`check_tetrahedra`], keeping what it found on the way ([`Examined`]).
+pub fn examine_tetrahedra<P: Copy + Into<[f64; 3]> + Sync>(
+    positions: &[P],
+    tets: &[[u32; 4]],
+) -> Examined {
     let nv = positions.len();
-    let (tets, odd): (Vec<[u32; 4]>, Vec<bool>) =
+    let (sorted, odd): (Vec<[u32; 4]>, Vec<bool>) =
         tets.par_iter().map(|&t| sorted_tet(t, nv)).unzip();
     let (scaled, volume_scale, tiny) = scaled(positions);
-    let mut s = tet_stats(&tets, odd, &scaled, &tiny);
-    let (_, faces, boundary) = face_uses(&tets, nv);
-    s.duplicate_tets = faces.duplicate_tets;
-    s.interior_faces = faces.interior_faces;
-    s.overshared_faces = faces.overshared_faces;
-    s.boundary_faces = boundary.len();
-    s.boundary_volume = boundary
+    let (mut s, signs) = tet_stats(&sorted, &odd, &scaled, &tiny);
+    let (_, faces) = face_uses(&sorted, &signs, nv);
+    drop(sorted);
+    let orientation = signs
+        .par_iter()
+        .zip(&odd)
+        .map(|(&sign, &odd)| if odd { -sign } else { sign })
+        .collect();
+    merge_faces(&mut s, &faces);
+    s.boundary_volume = faces
+        .boundary
         .par_chunks(CHECK_RUN)
         .map(|part| part.iter().map(|&f| enclosed(f, &scaled)).sum::<f64>())
         .collect::<Vec<f64>>()
         .iter()
         .sum();
     finish_volumes(&mut s, volume_scale);
-    s
+    Examined {
+        stats: s,
+        scaled,
+        tiny,
+        orientation,
+        boundary: faces.boundary,
+        face_faults: faces.faults,
+    }
+}
+
+/// The face counts of [`face_uses`] into `s`.
+fn merge_faces(s: &mut CheckStats, faces: &Faces) {
+    s.duplicate_tets = faces.stats.duplicate_tets;
+    s.interior_faces = faces.stats.interior_faces;
+    s.overshared_faces = faces.stats.overshared_faces;
+    s.folded_faces = faces.stats.folded_faces;
+    s.boundary_faces = faces.boundary.len();
 }
 
 /// A boundary face's share of the volume the boundary encloses (the divergence theorem),
@@ -568,17 +704,16 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
         .map(|t| sorted_tet(t.map(|i| layout.canon(i)), nv))
         .unzip();
     let (scaled, volume_scale, tiny) = scaled(positions);
-    let mut s = tet_stats(&tets, odd, &scaled, &tiny);
+    let (mut s, signs) = tet_stats(&tets, &odd, &scaled, &tiny);
+    drop(odd);
     s.collapsed_vertices = layout.collapsed.iter().filter(|&&c| c).count();
 
     // Every face counted at its smallest vertex; boundary faces kept with their
     // tetrahedron's fourth vertex, in increasing order.
-    let (incidence, faces, boundary) = face_uses(&tets, nv);
-    drop(tets);
-    s.duplicate_tets = faces.duplicate_tets;
-    s.interior_faces = faces.interior_faces;
-    s.overshared_faces = faces.overshared_faces;
-    s.boundary_faces = boundary.len();
+    let (incidence, faces) = face_uses(&tets, &signs, nv);
+    drop((tets, signs));
+    merge_faces(&mut s, &faces);
+    let boundary = faces.boundary;
 
     let (boundary_volume, offset_faces, others) = classify_boundary(boundary, &scaled, &layout);
     s.boundary_volume = boundary_volume;
@@ -675,21 +810,22 @@ impl<'a, P: Copy + Into<[f64; 3]>> Layout<'a, P> {
 
 /// The checks of each tetrahedron on its own (sorted, with its parity, on the positions
 /// [`scaled`]): orientation, degeneracy, volume and angles, with the vertex and tetrahedron
-/// counts.
+/// counts; and each sorted tetrahedron's orientation ([`examine`]'s signs).
 fn tet_stats(
     tets: &[[u32; 4]],
-    odd: Vec<bool>,
+    odd: &[bool],
     positions: &[[f64; 3]],
     tiny: &[bool],
-) -> CheckStats {
+) -> (CheckStats, Vec<i8>) {
     // Runs of CHECK_RUN tetrahedra on the cores, summed in order: the volume's rounding
     // depends on the runs only, not on the number of threads.
+    let mut signs = vec![0i8; tets.len()];
     let partials: Vec<CheckStats> = tets
         .par_chunks(CHECK_RUN)
         .zip(odd.par_chunks(CHECK_RUN))
-        .map(|(part, odd)| examine(part, odd, positions, tiny))
+        .zip(signs.par_chunks_mut(CHECK_RUN))
+        .map(|((part, odd), signs)| examine(part, odd, positions, tiny, signs))
         .collect();
-    drop(odd);
     let mut s = CheckStats {
         vertices: positions.len(),
         tets: tets.len(),
@@ -711,7 +847,7 @@ fn tet_stats(
     if s.tets == s.degenerate {
         (s.min_volume, s.max_volume, s.min_dihedral_deg) = (0.0, 0.0, 0.0);
     }
-    s
+    (s, signs)
 }
 
 /// Sorts the boundary faces into offset faces (three offsets of three surface vertices), by

@@ -1,16 +1,23 @@
 //! `halo4d check`: what a build wrote, checked again from the files alone.
 //!
-//! Takes: a `.glb` or legacy `.vtk` file ([`check_file`]; a `.vtk` without halo4d's layout
-//! gets the checks that need none, [`check_tetrahedra`]), or a build's output folder with
-//! its one scene `.glb` ([`check_dir`]). Gives: [`Checked`], each halo's [`CheckStats`] and,
-//! for a folder, the intersection curves recomputed from the file's surfaces and the halos'
-//! [`Verification`] against them.
+//! Takes: a `.glb` or legacy `.vtk` file of halos, or any tetrahedral mesh another program
+//! wrote ([`check_file`]; a mesh without halo4d's layout is certified, [`certify`]), or a
+//! build's output folder with its one scene `.glb` ([`check_dir`]). Gives: [`Checked`], each
+//! halo's [`CheckStats`] (a plain mesh's [`Certificate`]) and, for a folder, the
+//! intersection curves recomputed from the file's surfaces and the halos' [`Verification`]
+//! against them; as text ([`Checked::text`]) or JSON ([`Checked::json`]), and a plain
+//! mesh's faults per tetrahedron as a `.vtu` ([`Checked::write_marks`]).
 //! Guarantees: the verdict ([`Checked::failures`]) is a build's ([`crate::Built::failures`]),
 //! from the same library functions: [`CheckStats::verdict`], [`CurvesReport::failures`],
 //! [`Verification::failures`].
 
-use crate::check::{CheckStats, HALO_ONLY, check, check_tetrahedra};
-use crate::import::{self, FileTetrahedra, ImportError, ImportedHalo, ImportedScene};
+use crate::certify::{Certificate, Fault, certify};
+use crate::check::{CheckStats, HALO_ONLY, check};
+use crate::convention::file_order;
+use crate::export::{CellValues, write_tetrahedra_vtu};
+use crate::import::{
+    self, FileTetrahedra, ImportError, ImportedHalo, ImportedScene, PlainTetrahedra,
+};
 use crate::intersect::{self, Curves, CurvesReport};
 use crate::verify::{self, Verification};
 use std::fmt::Write;
@@ -24,12 +31,17 @@ pub struct Checked {
     /// The scene's name, when the file records it.
     pub scene: Option<String>,
     /// Each halo's name and the checker's statistics (for a file without halo4d's layout,
-    /// its tetrahedra's, from [`check_tetrahedra`]).
+    /// its tetrahedra's, from [`certify`]).
     pub halos: Vec<(String, CheckStats)>,
-    /// For a `.vtk` without halo4d's layout: why it is not read as a halo. Its tetrahedra
-    /// get the checks that need no layout; the halo's own (offset faces, quads, surface
-    /// faces) cannot be made.
+    /// For a mesh without halo4d's layout: why it is not read as a halo. Its tetrahedra
+    /// are certified instead ([`Self::certificate`]); the halo's own checks (offset faces,
+    /// quads, surface faces) cannot be made.
     pub plain: Option<String>,
+    /// For a mesh without halo4d's layout: what [`certify`] found.
+    pub certificate: Option<Certificate>,
+    /// For a mesh without halo4d's layout: its tetrahedra as read, for
+    /// [`Self::write_marks`].
+    pub mesh: Option<PlainTetrahedra>,
     /// For a folder: the curves recomputed from the file's surfaces, and the halos
     /// verified against them.
     pub verification: Option<(CurvesReport, Verification)>,
@@ -62,22 +74,30 @@ pub fn check_file(file: &Path) -> Result<Checked, InspectError> {
         file: file.to_path_buf(),
         source,
     })?;
-    let (halos, plain) = match read {
-        FileTetrahedra::Halos(halos) => (check_halos(halos.iter()), None),
-        FileTetrahedra::Plain(mesh) => (
-            vec![(
-                mesh.name.clone(),
-                check_tetrahedra(&mesh.positions, &mesh.tets),
-            )],
-            Some(mesh.why),
-        ),
-    };
-    Ok(Checked {
+    let checked = Checked {
         file: file.to_path_buf(),
         scene: None,
-        halos,
-        plain,
+        halos: Vec::new(),
+        plain: None,
+        certificate: None,
+        mesh: None,
         verification: None,
+    };
+    Ok(match read {
+        FileTetrahedra::Halos(halos) => Checked {
+            halos: check_halos(halos.iter()),
+            ..checked
+        },
+        FileTetrahedra::Plain(mesh) => {
+            let certificate = certify(&mesh.positions, &mesh.tets);
+            Checked {
+                halos: vec![(mesh.name.clone(), certificate.stats)],
+                plain: Some(mesh.why.clone()),
+                certificate: Some(certificate),
+                mesh: Some(mesh),
+                ..checked
+            }
+        }
     })
 }
 
@@ -103,6 +123,8 @@ pub fn check_dir(dir: &Path) -> Result<Checked, InspectError> {
         scene: scene.name.clone(),
         halos,
         plain: None,
+        certificate: None,
+        mesh: None,
         verification: Some((curves.report, verification)),
     })
 }
@@ -124,6 +146,9 @@ impl Checked {
     /// passes the checker; for a folder also every curve is resolved and the verification
     /// finds no wrong curve sample and no spuriously hidden surface sample.
     pub fn failures(&self) -> Vec<String> {
+        if let Some(certificate) = &self.certificate {
+            return certificate.failures();
+        }
         let mut out: Vec<String> = self
             .halos
             .iter()
@@ -149,13 +174,16 @@ impl Checked {
         }
         if let Some(why) = &self.plain {
             out += &format!(
-                "not a halo: {why}. Checked as tetrahedra: orientation, repeated tetrahedra, faces in more than two, the volume against the boundary's; not checked: the halo's offset faces, quads and surface faces\n"
+                "not a halo: {why}. Certified as a tetrahedral mesh: its cells, how they meet, its boundary and that no two overlap; not checked: the halo's offset faces, quads and surface faces\n"
             );
         }
         if self.halos.is_empty() {
             out += "no halo in the file\n";
         } else {
             out += &stats_table(&self.halos, self.plain.is_some());
+        }
+        if let Some(c) = &self.certificate {
+            out += &certificate_text(c);
         }
         if let Some((curves, v)) = &self.verification {
             out += &format!("\n{}\n", curves.summary());
@@ -170,8 +198,15 @@ impl Checked {
         for f in &failures {
             out += &format!("FAILED {f}\n");
         }
-        if failures.is_empty() && self.plain.is_some() {
-            out += "ok: no inverted, flat or repeated tetrahedron, no face in more than two, and the tetrahedra fill the volume their boundary encloses\n";
+        if let (true, Some(c)) = (failures.is_empty(), &self.certificate) {
+            let b = &c.boundary;
+            out += &format!(
+                "ok: a valid tetrahedralization of the region its boundary encloses: every tetrahedron positive, every two meeting face to face or not at all, the boundary manifold, not meeting itself and wound once around ({} {}, {} {})\n",
+                b.components,
+                plural(b.components, "component", "components"),
+                b.cavities,
+                plural(b.cavities, "cavity", "cavities"),
+            );
         } else if failures.is_empty() {
             let n = self.halos.len();
             let conform = if n == 1 {
@@ -191,6 +226,146 @@ impl Checked {
         }
         out
     }
+}
+
+impl Checked {
+    /// What `halo4d check --json` prints: the file, the verdict (`passes`, `failures`), each
+    /// mesh's name, statistics and (for a mesh without halo4d's layout) certificate, and for
+    /// a folder the curves and the verification.
+    pub fn json(&self) -> serde_json::Value {
+        let failures = self.failures();
+        serde_json::json!({
+            "file": self.file,
+            "scene": self.scene,
+            "passes": failures.is_empty(),
+            "failures": failures,
+            "plain": self.plain,
+            "meshes": self.halos.iter().map(|(name, stats)| serde_json::json!({
+                "name": name,
+                "stats": stats,
+                "certificate": self.certificate,
+            })).collect::<Vec<_>>(),
+            "verification": self.verification.as_ref().map(|(curves, v)| serde_json::json!({
+                "curves": curves,
+                "halos": v,
+            })),
+        })
+    }
+
+    /// Writes the checked mesh (one without halo4d's layout) to `path` as a `.vtu` with
+    /// each tetrahedron's faults as the cell field `fault` (the bits of [`Fault`]), and its
+    /// `min_dihedral_deg`, `max_dihedral_deg` and `radius_ratio`: to open in ParaView and
+    /// threshold on `fault`. The tetrahedra as the file gave them.
+    pub fn write_marks(&self, path: &Path) -> Result<(), String> {
+        let (Some(mesh), Some(c)) = (&self.mesh, &self.certificate) else {
+            return Err(
+                "--mark is for tetrahedral meshes without halo4d's layout; a halo's faults are counted by kind only".into(),
+            );
+        };
+        let tets: Vec<[u32; 4]> = mesh.tets.iter().map(|&t| file_order(t)).collect();
+        let column = |k: usize| c.shapes.iter().map(|s| s[k]).collect::<Vec<f32>>();
+        let (lo, hi, ratio) = (column(0), column(1), column(2));
+        write_tetrahedra_vtu(
+            path,
+            &mesh.positions,
+            &tets,
+            &[
+                ("fault", CellValues::U32(&c.faults)),
+                ("min_dihedral_deg", CellValues::F32(&lo)),
+                ("max_dihedral_deg", CellValues::F32(&hi)),
+                ("radius_ratio", CellValues::F32(&ratio)),
+            ],
+        )
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))
+    }
+
+    /// How many tetrahedra have each fault bit, for the line `--mark` prints.
+    pub fn marked(&self) -> Vec<(&'static str, usize)> {
+        let Some(c) = &self.certificate else {
+            return Vec::new();
+        };
+        Fault::NAMES
+            .iter()
+            .map(|&(bit, name)| (name, c.faults.iter().filter(|&&f| f & bit != 0).count()))
+            .filter(|&(_, n)| n > 0)
+            .collect()
+    }
+}
+
+fn plural<'a>(n: usize, one: &'a str, many: &'a str) -> &'a str {
+    if n == 1 { one } else { many }
+}
+
+/// A certificate's convention, boundary and quality as text.
+fn certificate_text(c: &Certificate) -> String {
+    let b = &c.boundary;
+    let q = &c.quality;
+    let mut out = String::new();
+    match c.convention {
+        crate::certify::Convention::Positive => {}
+        crate::certify::Convention::Reversed => {
+            out += "convention: every tetrahedron is negative in the file's convention; read in the other (its vertices' order reversed)\n"
+        }
+    }
+    let windings: Vec<String> = b
+        .windings
+        .iter()
+        .map(|w| w.map_or("?".into(), |w| w.to_string()))
+        .collect();
+    let rows = [
+        ("boundary faces", b.faces.to_string()),
+        ("components", b.components.to_string()),
+        ("cavities", b.cavities.to_string()),
+        ("nonmanifold_edges", b.nonmanifold_edges.to_string()),
+        ("misoriented_edges", b.misoriented_edges.to_string()),
+        ("nonmanifold_vertices", b.nonmanifold_vertices.to_string()),
+        ("hanging_vertices", b.hanging_vertices.to_string()),
+        ("self_intersections", b.self_intersections.to_string()),
+        ("wrong_winding", b.wrong_winding.to_string()),
+        ("undecided_windings", b.undecided_windings.to_string()),
+        (
+            "windings just inside",
+            if windings.len() > 12 {
+                format!("{} ...", windings[..12].join(" "))
+            } else {
+                windings.join(" ")
+            },
+        ),
+    ];
+    out += "\nboundary\n";
+    for (k, v) in rows {
+        let _ = writeln!(out, "  {k:<22}{v}");
+    }
+    let _ = writeln!(
+        out,
+        "\nquality (reported, not judged)\n  dihedral angles       {:.3} to {:.3} degrees\n  radius ratio          {:.4} smallest, {:.4} mean (1 for the regular tetrahedron)",
+        q.min_dihedral_deg, q.max_dihedral_deg, q.min_radius_ratio, q.mean_radius_ratio
+    );
+    let most = q
+        .radius_ratio_histogram
+        .iter()
+        .map(|b| b.count)
+        .max()
+        .unwrap_or(0)
+        .max(1);
+    out += "  radius ratio histogram\n";
+    for bin in &q.radius_ratio_histogram {
+        let bar = "#".repeat((40 * bin.count).div_ceil(most));
+        let _ = writeln!(
+            out,
+            "    {:.1} to {:.1}  {:>10}  {bar}",
+            bin.from, bin.to, bin.count
+        );
+    }
+    out += "  worst (smallest radius ratio)\n";
+    for w in q.worst.iter().take(5) {
+        let _ = writeln!(
+            out,
+            "    tetrahedron {:>10}: radius ratio {:.3e}, dihedral angles {:.4} to {:.4} degrees",
+            w.tet, w.radius_ratio, w.min_dihedral_deg, w.max_dihedral_deg
+        );
+    }
+    out
 }
 
 /// The one `.glb` in `dir`, or why there is none.

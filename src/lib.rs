@@ -54,6 +54,7 @@
 
 pub mod animate;
 mod animation;
+pub mod certify;
 pub mod check;
 mod convention;
 mod error;

@@ -6,7 +6,8 @@
 //! `quality`, for MeshLab), `-curves.ply` (the intersection curves as PLY edges, with the
 //! depth gap dw as vertex `quality`, for MeshLab), `.obj` (Wavefront, positions and normals
 //! only), `.vtk` (legacy VTK unstructured grids of the halos' tetrahedra, for ParaView and
-//! meshio) and `report.json`. Guarantees: each file in its format's conventions
+//! meshio), `report.json`, and any tetrahedra with cell fields as `.vtu`
+//! ([`write_tetrahedra_vtu`], what `halo4d check --mark` writes). Guarantees: each file in its format's conventions
 //! (`convention`); every file is written to a temporary name and renamed into place,
 //! so a failure never leaves a half-written file, and a build's files move into place
 //! together ([`Staged`]). [`crate::import`] reads the halos and
@@ -18,12 +19,14 @@ mod off4;
 mod ply;
 mod tubes;
 mod vtk;
+mod vtu;
 
 pub use gltf::{glb_chunks, glb_container, stills_glb, to_glb, write_glb_container};
 pub use obj::to_obj;
 pub use off4::to_4off;
 pub use ply::{segments, to_curves_ply, to_ply, to_still_ply, to_stipples_ply};
 pub use vtk::write_vtk;
+pub use vtu::{CellValues, write_tetrahedra_vtu};
 
 mod staged;
 pub use staged::{LOCK, Staged, StagedError};

@@ -235,9 +235,22 @@ pub struct ViewArgs {
 #[derive(Args)]
 pub struct CheckArgs {
     /// A .glb (every mesh with `halo` extras) or legacy .vtk (with `surface_vertices`
-    /// field data) file, or a folder with one scene .glb, as `halo4d build` writes them.
+    /// field data) file, or a folder with one scene .glb, as `halo4d build` writes them; or
+    /// any tetrahedral mesh: legacy .vtk, .vtu, Gmsh .msh (2.2, 4.1), Medit .mesh, TetGen
+    /// .node/.ele.
     #[arg(value_name = "FILE|DIR")]
     pub file: PathBuf,
+    /// Print everything found as one JSON object (the verdict as `passes` and `failures`)
+    /// instead of the tables.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the checked mesh (one without halo4d's layout) to this .vtu, each tetrahedron
+    /// with its faults as the cell field `fault` (bits: 1 inverted, 2 flat, 4
+    /// undecidable, 8 degenerate, 16 duplicate, 32 overshared face, 64 folded face, 128
+    /// hanging vertex, 256 non-manifold boundary, 512 self-intersecting boundary, 1024
+    /// wrong winding, 2048 cavity), and its dihedral angles and radius ratio.
+    #[arg(long, value_name = "OUT.vtu")]
+    pub mark: Option<PathBuf>,
 }
 
 /// The arguments of `halo4d slice`.

@@ -377,25 +377,62 @@ pub fn list() -> Outcome {
 /// `halo4d check`.
 pub fn check(args: CheckArgs) -> Outcome {
     let file = args.file;
+    if let Some(mark) = &args.mark {
+        let vtu = mark
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("vtu"));
+        if !vtu || mark.is_dir() {
+            eprintln!(
+                "error: --mark {}: give a .vtu file to write the marked mesh to",
+                mark.display()
+            );
+            return Ok(ExitCode::from(2));
+        }
+    }
     let checked = if file.is_dir() {
         halo4d::check_dir(&file)
     } else {
         halo4d::check_file(&file)
     };
-    match checked {
-        Ok(c) => {
-            print!("{}", c.text());
-            Ok(if c.failures().is_empty() {
-                ExitCode::SUCCESS
-            } else {
-                ExitCode::FAILURE
-            })
-        }
+    let c = match checked {
+        Ok(c) => c,
         Err(e) => {
             eprintln!("error: {e}");
-            Ok(ExitCode::from(2))
+            return Ok(ExitCode::from(2));
+        }
+    };
+    if let Some(mark) = &args.mark {
+        if let Err(e) = c.write_marks(mark) {
+            eprintln!("error: {e}");
+            return Ok(ExitCode::from(2));
         }
     }
+    if args.json {
+        println!("{}", c.json());
+    } else {
+        print!("{}", c.text());
+        if let Some(mark) = &args.mark {
+            let marked: Vec<String> = c
+                .marked()
+                .iter()
+                .map(|(name, n)| format!("{n} {name}"))
+                .collect();
+            println!(
+                "wrote {} (cell field `fault`: {})",
+                mark.display(),
+                if marked.is_empty() {
+                    "no tetrahedron marked".to_string()
+                } else {
+                    marked.join(", ")
+                }
+            );
+        }
+    }
+    Ok(if c.failures().is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
 }
 
 /// The name a flag gives a value (`stipple`, `exact`).

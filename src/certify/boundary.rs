@@ -1,0 +1,361 @@
+//! The boundary of a tetrahedral mesh, judged exactly: each face turned outward, its edges
+//! and vertices manifold and consistently oriented, its components and which are cavities,
+//! no vertex on a face not its own, no two faces meeting beyond what they share, and the
+//! winding number just inside each component.
+
+use super::exact::{P, orient, point_in_triangle, segment_meets_triangle, triangles_meet};
+use crate::intersect::broad;
+use obvhs::aabb::Aabb;
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// How many faces of a component the winding number is tried from before it is left
+/// undecided: each try fails only where the ray from a point inside the face's tetrahedron
+/// passes exactly through an edge or a vertex of the boundary, or a face lies between the
+/// point and the face.
+const WINDING_TRIES: usize = 32;
+
+/// What the boundary is.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Boundary {
+    /// Faces of exactly one tetrahedron.
+    pub faces: usize,
+    /// Its connected pieces (faces joined across their edges).
+    pub components: usize,
+    /// Components that bound a hole inside the mesh (their faces turned into it): the
+    /// mesh winds 0 times around it. Reported, not a fault.
+    pub cavities: usize,
+    /// Edges in more than two boundary faces (any set of tetrahedra puts an even number
+    /// of boundary faces at every edge: the boundary is closed).
+    pub nonmanifold_edges: usize,
+    /// Edges of two boundary faces that run the same way along it: the two faces, turned
+    /// away from their tetrahedra, face opposite ways.
+    pub misoriented_edges: usize,
+    /// Boundary vertices whose boundary faces form more than one fan (two pieces of the
+    /// mesh touching at a point).
+    pub nonmanifold_vertices: usize,
+    /// Vertices lying on a boundary face or edge that is not their own (a T-junction: a
+    /// face of one tetrahedron against smaller faces of others).
+    pub hanging_vertices: usize,
+    /// Pairs of boundary faces that meet beyond the vertices they share.
+    pub self_intersections: usize,
+    /// Components whose winding number just inside is not 1: where the mesh covers space
+    /// twice (or turns inside out).
+    pub wrong_winding: usize,
+    /// Components whose winding number could not be decided.
+    pub undecided_windings: usize,
+    /// The winding number of the whole boundary just inside each component (`None` where
+    /// undecided), in the order of each component's first face.
+    pub windings: Vec<Option<i64>>,
+}
+
+/// Fault bits of boundary faces ([`super::Fault`]), by boundary face (in the order given).
+pub type FaceMarks = Vec<u32>;
+
+/// A union-find over `n` items.
+struct Sets(Vec<u32>);
+
+impl Sets {
+    fn new(n: usize) -> Self {
+        Sets((0..n as u32).collect())
+    }
+
+    fn find(&mut self, mut i: u32) -> u32 {
+        while self.0[i as usize] != i {
+            let up = self.0[self.0[i as usize] as usize];
+            self.0[i as usize] = up;
+            i = up;
+        }
+        i
+    }
+
+    fn union(&mut self, a: u32, b: u32) {
+        let (a, b) = (self.find(a), self.find(b));
+        // The smaller root wins, so that the sets do not depend on the order of unions.
+        if a < b {
+            self.0[b as usize] = a;
+        } else {
+            self.0[a as usize] = b;
+        }
+    }
+}
+
+/// Judges the boundary faces (each a sorted vertex triple with the fourth vertex of its
+/// tetrahedron) on `positions` (scaled, as the checker's): the [`Boundary`] and each face's
+/// fault bits.
+pub fn judge(faces: &[([u32; 3], u32)], positions: &[P]) -> (Boundary, FaceMarks) {
+    use super::Fault;
+    let at = |i: u32| positions[i as usize];
+    // Each face turned outward: away from its tetrahedron's fourth vertex.
+    let outward: Vec<[u32; 3]> = faces
+        .par_iter()
+        .map(|&(k, o)| {
+            if orient(at(k[0]), at(k[1]), at(k[2]), at(o)) < 0 {
+                [k[0], k[2], k[1]]
+            } else {
+                k
+            }
+        })
+        .collect();
+    let mut b = Boundary {
+        faces: faces.len(),
+        ..Boundary::default()
+    };
+    let mut marks = vec![0u32; faces.len()];
+
+    // Edges: each face's three, with the way it runs along it.
+    let mut edges: Vec<([u32; 2], bool, u32)> = outward
+        .iter()
+        .enumerate()
+        .flat_map(|(f, t)| {
+            (0..3).map(move |i| {
+                let (a, c) = (t[i], t[(i + 1) % 3]);
+                ([a.min(c), a.max(c)], a < c, f as u32)
+            })
+        })
+        .collect();
+    edges.par_sort_unstable();
+    let mut sets = Sets::new(faces.len());
+    for group in edges.chunk_by(|x, y| x.0 == y.0) {
+        let fault = match group {
+            [(_, d1, _), (_, d2, _)] if d1 == d2 => {
+                b.misoriented_edges += 1;
+                Fault::NONMANIFOLD
+            }
+            [_, _] => 0,
+            _ => {
+                b.nonmanifold_edges += 1;
+                Fault::NONMANIFOLD
+            }
+        };
+        for &(_, _, f) in group {
+            marks[f as usize] |= fault;
+            sets.union(group[0].2, f);
+        }
+    }
+    drop(edges);
+
+    // Vertices: the link of each (the opposite edges of its faces) one cycle, or one path
+    // where the edges already fail.
+    let mut fans: Vec<(u32, [u32; 2], u32)> = outward
+        .iter()
+        .enumerate()
+        .flat_map(|(f, t)| (0..3).map(move |i| (t[i], [t[(i + 1) % 3], t[(i + 2) % 3]], f as u32)))
+        .collect();
+    fans.par_sort_unstable();
+    let split: Vec<Vec<u32>> = fans
+        .par_chunk_by(|x, y| x.0 == y.0)
+        .filter_map(|group| (fan_pieces(group) > 1).then(|| group.iter().map(|g| g.2).collect()))
+        .collect();
+    b.nonmanifold_vertices = split.len();
+    for f in split.into_iter().flatten() {
+        marks[f as usize] |= Fault::NONMANIFOLD;
+    }
+    drop(fans);
+
+    // Components, numbered in the order of their first face.
+    let roots: Vec<u32> = (0..faces.len() as u32).map(|f| sets.find(f)).collect();
+    let mut number = vec![u32::MAX; faces.len()];
+    let mut component = vec![0u32; faces.len()];
+    for (f, &r) in roots.iter().enumerate() {
+        if number[r as usize] == u32::MAX {
+            number[r as usize] = b.components as u32;
+            b.components += 1;
+        }
+        component[f] = number[r as usize];
+    }
+
+    let tris: Vec<[P; 3]> = outward.iter().map(|t| t.map(at)).collect();
+    let boxes: Vec<Aabb> = tris
+        .iter()
+        .map(|t| {
+            let lo = (0..3).map(|k| t.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min));
+            let hi = (0..3).map(|k| t.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max));
+            let (lo, hi): (Vec<f64>, Vec<f64>) = (lo.collect(), hi.collect());
+            broad::outward(
+                glam::DVec3::new(lo[0], lo[1], lo[2]),
+                glam::DVec3::new(hi[0], hi[1], hi[2]),
+            )
+        })
+        .collect();
+    let bvh = broad::build(&boxes, 4);
+
+    // Hanging vertices: a boundary vertex on a boundary face that is not its own.
+    let mut vertices: Vec<u32> = outward.iter().flatten().copied().collect();
+    vertices.par_sort_unstable();
+    vertices.dedup();
+    let hanging: Vec<Vec<u32>> = vertices
+        .par_iter()
+        .filter_map(|&v| {
+            let x = at(v);
+            let probe = broad::outward(x.into(), x.into());
+            let mut on = Vec::new();
+            bvh.aabb_traverse(probe, |bvh, node| {
+                let node = &bvh.nodes[node as usize];
+                let first = node.first_index as usize;
+                for &f in &bvh.primitive_indices[first..first + node.prim_count as usize] {
+                    if !outward[f as usize].contains(&v) && point_in_triangle(x, tris[f as usize]) {
+                        on.push(f);
+                    }
+                }
+                true
+            });
+            (!on.is_empty()).then_some(on)
+        })
+        .collect();
+    b.hanging_vertices = hanging.len();
+    for f in hanging.into_iter().flatten() {
+        marks[f as usize] |= Fault::HANGING;
+    }
+
+    // Faces meeting beyond what they share.
+    let crossing: Vec<Vec<(u32, u32)>> =
+        broad::self_pairs_par(&bvh, &boxes, Vec::new, |out, f, g| {
+            if triangles_meet(outward[f as usize], outward[g as usize], positions) {
+                out.push((f, g));
+            }
+        });
+    for (f, g) in crossing.into_iter().flatten() {
+        b.self_intersections += 1;
+        marks[f as usize] |= Fault::SELF_INTERSECTION;
+        marks[g as usize] |= Fault::SELF_INTERSECTION;
+    }
+
+    // The winding number just inside each component, and which are cavities.
+    let mut firsts: Vec<Vec<u32>> = vec![Vec::new(); b.components];
+    for (f, &c) in component.iter().enumerate() {
+        if firsts[c as usize].len() < WINDING_TRIES {
+            firsts[c as usize].push(f as u32);
+        }
+    }
+    let windings: Vec<Option<(i64, i64)>> = firsts
+        .iter()
+        .map(|tries| {
+            tries.iter().find_map(|&f| {
+                winding(
+                    f as usize,
+                    faces[f as usize].1,
+                    &tris,
+                    &component,
+                    positions,
+                )
+            })
+        })
+        .collect();
+    for (c, w) in windings.iter().enumerate() {
+        match w {
+            Some((total, own)) => {
+                b.windings.push(Some(*total));
+                if *total != 1 {
+                    b.wrong_winding += 1;
+                } else if *own == 0 {
+                    b.cavities += 1;
+                }
+            }
+            None => {
+                b.windings.push(None);
+                b.undecided_windings += 1;
+            }
+        }
+        let fault = match w {
+            Some((1, 0)) => Fault::CAVITY,
+            Some((1, _)) => 0,
+            _ => Fault::WINDING,
+        };
+        if fault != 0 {
+            for (f, &k) in component.iter().enumerate() {
+                if k as usize == c {
+                    marks[f] |= fault;
+                }
+            }
+        }
+    }
+    (b, marks)
+}
+
+/// How many pieces the link of a vertex falls into: its faces' opposite edges joined at
+/// shared ends.
+fn fan_pieces(group: &[(u32, [u32; 2], u32)]) -> usize {
+    let mut ends: Vec<u32> = group.iter().flat_map(|g| g.1).collect();
+    ends.sort_unstable();
+    ends.dedup();
+    let index = |v: u32| ends.binary_search(&v).unwrap_or(0) as u32;
+    let mut sets = Sets::new(ends.len());
+    for (_, [x, y], _) in group {
+        sets.union(index(*x), index(*y));
+    }
+    (0..ends.len() as u32)
+        .filter(|&i| sets.find(i) == i)
+        .count()
+}
+
+/// The winding number of the boundary at a point just inside face f (its tetrahedron's
+/// centroid, whose fourth vertex is `apex`), and that of f's own component alone; `None`
+/// when the centroid is not strictly inside its tetrahedron (rounded onto a face of a
+/// sliver), a boundary face lies between it and f, or the ray from it through f passes
+/// exactly through an edge or vertex.
+fn winding(
+    f: usize,
+    apex: u32,
+    tris: &[[P; 3]],
+    component: &[u32],
+    positions: &[P],
+) -> Option<(i64, i64)> {
+    let [a, b, c] = tris[f];
+    let d = positions[apex as usize];
+    let mean = |ps: &[P]| {
+        let n = ps.len() as f64;
+        [0, 1, 2].map(|k| ps.iter().map(|p| p[k]).sum::<f64>() / n)
+    };
+    let p = mean(&[a, b, c, d]);
+    // Strictly inside: on the tetrahedron's side of each of its four faces.
+    let inside = [(a, b, c, d), (a, b, d, c), (a, c, d, b), (b, c, d, a)]
+        .iter()
+        .all(|&(x, y, z, w)| {
+            let side = orient(x, y, z, w);
+            side != 0 && orient(x, y, z, p) == side
+        });
+    if !inside {
+        return None;
+    }
+    let g = mean(&[a, b, c]);
+    let dir = [g[0] - p[0], g[1] - p[1], g[2] - p[2]];
+    let len = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
+    if !(len > 0.0) {
+        return None;
+    }
+    // The positions lie within [-1, 1]^3: 4 away is past every face.
+    let q = [0, 1, 2].map(|k| p[k] + 4.0 * dir[k] / len);
+    let own = component[f];
+    // (total, own component's) crossings, or None on a degenerate one.
+    (0..tris.len())
+        .into_par_iter()
+        .map(|j| {
+            let t = tris[j];
+            if j != f && segment_meets_triangle(p, g, t) {
+                return None;
+            }
+            let (op, oq) = (orient(t[0], t[1], t[2], p), orient(t[0], t[1], t[2], q));
+            if op * oq > 0 {
+                return Some((0, 0));
+            }
+            if op == 0 || oq == 0 {
+                return (!segment_meets_triangle(p, q, t)).then_some((0, 0));
+            }
+            let s = [
+                orient(p, q, t[0], t[1]),
+                orient(p, q, t[1], t[2]),
+                orient(p, q, t[2], t[0]),
+            ];
+            if s.iter().all(|&x| x > 0) || s.iter().all(|&x| x < 0) {
+                // Leaving through an outward face counts +1.
+                let w = i64::from(op);
+                Some((w, if component[j] == own { w } else { 0 }))
+            } else if s.iter().all(|&x| x >= 0) || s.iter().all(|&x| x <= 0) {
+                None
+            } else {
+                Some((0, 0))
+            }
+        })
+        .try_reduce(|| (0, 0), |x, y| Some((x.0 + y.0, x.1 + y.1)))
+}
