@@ -3,6 +3,7 @@
 mod adaptive;
 mod animate;
 mod architecture;
+mod certify;
 mod cli;
 mod common;
 mod curves_export;

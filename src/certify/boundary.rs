@@ -359,3 +359,99 @@ fn winding(
         })
         .try_reduce(|| (0, 0), |x, y| Some((x.0 + y.0, x.1 + y.1)))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::certify::kuhn_cube;
+    use crate::check::examine_tetrahedra;
+
+    /// Two Kuhn cubes, the second moved by `by`, as one mesh's boundary faces and scaled
+    /// positions.
+    fn two_cubes(by: [f64; 3]) -> (Vec<([u32; 3], u32)>, Vec<P>) {
+        let (mut p, mut t) = kuhn_cube(3);
+        let (q, s) = kuhn_cube(2);
+        let n = p.len() as u32;
+        p.extend(q.iter().map(|x| [x[0] + by[0], x[1] + by[1], x[2] + by[2]]));
+        t.extend(s.iter().map(|x| x.map(|i| i + n)));
+        let e = examine_tetrahedra(&p, &t);
+        (e.boundary, e.scaled)
+    }
+
+    /// The solid angle of triangle abc seen from x (Van Oosterom and Strackee), over 4 pi:
+    /// the generalized winding number's share of the face, in floating point.
+    fn solid_angle(x: P, [a, b, c]: [P; 3]) -> f64 {
+        let d = |p: P| [p[0] - x[0], p[1] - x[1], p[2] - x[2]];
+        let (a, b, c) = (d(a), d(b), d(c));
+        let len = |v: P| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let dot = |u: P, v: P| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+        let det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+            + a[2] * (b[0] * c[1] - b[1] * c[0]);
+        let (la, lb, lc) = (len(a), len(b), len(c));
+        let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+        2.0 * det.atan2(den) / (4.0 * std::f64::consts::PI)
+    }
+
+    #[test]
+    fn the_bvh_finds_every_crossing_pair_that_all_pairs_find() {
+        for by in [[1.5, 0.5, 0.5], [3.0, 0.0, 0.0], [0.5, 0.5, 0.5], [10.0, 0.0, 0.0]] {
+            let (faces, positions) = two_cubes(by);
+            let (b, _) = judge(&faces, &positions);
+            let at = |i: u32| positions[i as usize];
+            let outward: Vec<[u32; 3]> = faces
+                .iter()
+                .map(|&(k, o)| {
+                    if orient(at(k[0]), at(k[1]), at(k[2]), at(o)) < 0 {
+                        [k[0], k[2], k[1]]
+                    } else {
+                        k
+                    }
+                })
+                .collect();
+            let mut all = 0;
+            for i in 0..outward.len() {
+                for j in i + 1..outward.len() {
+                    all += usize::from(triangles_meet(outward[i], outward[j], &positions));
+                }
+            }
+            assert_eq!(b.self_intersections, all, "{by:?}");
+            // Crossing, and touching face to face, meet; inside or apart, they do not.
+            let meet = by[0] == 1.5 || by[0] == 3.0;
+            assert_eq!(all > 0, meet, "{by:?}: {all}");
+        }
+    }
+
+    #[test]
+    fn the_exact_winding_numbers_are_the_solid_angles_sums() {
+        // Nested (the second cube inside the first), touching face to face, apart: at the
+        // centroid of every boundary face's tetrahedron.
+        for by in [[0.5, 0.5, 0.5], [3.0, 0.0, 0.0], [10.0, 0.0, 0.0]] {
+            let (faces, positions) = two_cubes(by);
+            let (b, _) = judge(&faces, &positions);
+            assert_eq!(b.undecided_windings, 0);
+            let mut seen = Vec::new();
+            for &(k, o) in &faces {
+                let t = [k[0], k[1], k[2], o].map(|i| positions[i as usize]);
+                let x = [0, 1, 2].map(|c| t.iter().map(|p| p[c]).sum::<f64>() / 4.0);
+                let sum: f64 = faces
+                    .iter()
+                    .map(|&(f, apex)| {
+                        let at = |i: u32| positions[i as usize];
+                        let mut f = f;
+                        if orient(at(f[0]), at(f[1]), at(f[2]), at(apex)) < 0 {
+                            f.swap(1, 2);
+                        }
+                        solid_angle(x, [at(f[0]), at(f[1]), at(f[2])])
+                    })
+                    .sum();
+                seen.push(sum.round() as i64);
+            }
+            let mut expected: Vec<i64> = b.windings.iter().map(|w| w.unwrap()).collect();
+            expected.sort_unstable();
+            seen.sort_unstable();
+            seen.dedup();
+            expected.dedup();
+            assert_eq!(seen, expected, "{by:?}");
+        }
+    }
+}

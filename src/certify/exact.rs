@@ -121,16 +121,9 @@ pub fn segment_meets_triangle(p: P, q: P, t: [P; 3]) -> bool {
     s.iter().all(|&x| x >= 0) || s.iter().all(|&x| x <= 0)
 }
 
-/// Whether the segment from the triangle t's corner `at` to x, lying in t's plane, runs into
-/// t beyond that corner: x's direction within t's closed angle at the corner.
-fn into_corner(t: [P; 3], at: usize, x: P) -> bool {
-    let [a, b, c] = t;
-    if orient(a, b, c, x) != 0 {
-        return false;
-    }
-    let Some(f) = Flat::of(a, b, c) else {
-        return false;
-    };
+/// Whether x, in the plane of triangle t (seen along `f`), lies in t's closed angle at
+/// corner `at`: the segment from that corner to x runs into t.
+fn in_corner(f: Flat, t: [P; 3], at: usize, x: P) -> bool {
     let (p, u, v) = (t[at], t[(at + 1) % 3], t[(at + 2) % 3]);
     let s = f.orient(p, u, v);
     f.orient(p, u, x) * s >= 0 && f.orient(p, x, v) * s >= 0
@@ -147,31 +140,81 @@ pub fn triangles_meet(t: [u32; 3], u: [u32; 3], positions: &[P]) -> bool {
         .flat_map(|i| (0..3).map(move |j| (i, j)))
         .filter(|&(i, j)| t[i] == u[j])
         .collect();
+    // Where u's corners lie against t's plane (a shared corner in it).
+    let sides = [0, 1, 2].map(|j| {
+        if t.contains(&u[j]) {
+            0
+        } else {
+            orient(pt[0], pt[1], pt[2], pu[j])
+        }
+    });
+    if sides.iter().all(|&s| s == 0) {
+        let Some(f) = Flat::of(pt[0], pt[1], pt[2]) else {
+            return false;
+        };
+        return coplanar_meet(f, pt, pu, &shared);
+    }
+    // The corners u does not share strictly on one side: u meets t's plane at most in
+    // what they share.
+    let own = (0..3).filter(|&j| !t.contains(&u[j]));
+    if own.clone().all(|j| sides[j] > 0) || own.clone().all(|j| sides[j] < 0) {
+        return false;
+    }
     match shared.as_slice() {
         [] => {
             (0..3).any(|i| segment_meets_triangle(pt[i], pt[(i + 1) % 3], pu))
                 || (0..3).any(|j| segment_meets_triangle(pu[j], pu[(j + 1) % 3], pt))
         }
         &[(i, j)] => {
-            // The edges opposite the shared corner touch the other triangle nowhere, and
-            // the edges from it leave it at once.
+            // The edges opposite the shared corner; the edges from it leave the other
+            // triangle at once unless they lie in its plane, within its angle there.
             let (ti, uj) = ([(i + 1) % 3, (i + 2) % 3], [(j + 1) % 3, (j + 2) % 3]);
+            let into = |tri: [P; 3], corner: usize, x: P| {
+                orient(tri[0], tri[1], tri[2], x) == 0
+                    && Flat::of(tri[0], tri[1], tri[2])
+                        .is_some_and(|f| in_corner(f, tri, corner, x))
+            };
             segment_meets_triangle(pt[ti[0]], pt[ti[1]], pu)
                 || segment_meets_triangle(pu[uj[0]], pu[uj[1]], pt)
-                || ti.iter().any(|&k| into_corner(pu, j, pt[k]))
-                || uj.iter().any(|&k| into_corner(pt, i, pu[k]))
+                || ti.iter().any(|&k| into(pu, j, pt[k]))
+                || uj.iter().any(|&k| into(pt, i, pu[k]))
         }
-        &[(i1, _), (i2, _)] => {
-            // Sharing an edge, they overlap where the third corners lie in one plane on the
-            // same side of it.
+        // Sharing an edge, not in one plane: they meet only along it.
+        _ => false,
+    }
+}
+
+/// [`triangles_meet`] for two triangles in one plane, seen along `f`.
+fn coplanar_meet(f: Flat, pt: [P; 3], pu: [P; 3], shared: &[(usize, usize)]) -> bool {
+    let edges = |p: [P; 3]| [0, 1, 2].map(|i| (p[i], p[(i + 1) % 3]));
+    match *shared {
+        [] => {
+            edges(pt)
+                .iter()
+                .any(|&(a, b)| edges(pu).iter().any(|&(c, d)| f.segments_meet(a, b, c, d)))
+                || pu.iter().any(|&x| f.in_triangle(x, pt))
+                || pt.iter().any(|&x| f.in_triangle(x, pu))
+        }
+        // Each lies in its angle at the shared corner: they meet beyond it exactly where
+        // the two angles overlap, where an edge of one runs into the other's angle.
+        [(i, j)] => {
+            [(i + 1) % 3, (i + 2) % 3]
+                .iter()
+                .any(|&k| in_corner(f, pu, j, pt[k]))
+                || [(j + 1) % 3, (j + 2) % 3]
+                    .iter()
+                    .any(|&k| in_corner(f, pt, i, pu[k]))
+        }
+        // Sharing an edge: they overlap where the third corners are on the same side of it.
+        [(i1, _), (i2, _)] => {
             let (a, b) = (pt[i1], pt[i2]);
             let x = pt[3 - i1 - i2];
-            let y = (0..3)
-                .find(|&j| u[j] != t[i1] && u[j] != t[i2])
-                .map(|j| pu[j])
-                .unwrap_or(x);
-            orient(a, b, x, y) == 0
-                && Flat::of(a, b, x).is_some_and(|f| f.orient(a, b, x) == f.orient(a, b, y))
+            let y = pu
+                .iter()
+                .zip(0..3)
+                .find(|&(_, j)| shared.iter().all(|&(_, sj)| sj != j))
+                .map_or(x, |(&y, _)| y);
+            f.orient(a, b, x) == f.orient(a, b, y)
         }
         _ => true,
     }

@@ -29,9 +29,11 @@
 
 mod boundary;
 mod exact;
+mod grid;
 mod quality;
 
 pub use boundary::Boundary;
+pub use grid::kuhn_cube;
 pub use quality::{BINS, Bin, Cell, Quality, WORST};
 
 use crate::check::{CheckStats, FaceFault, examine_tetrahedra};

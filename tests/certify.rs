@@ -1,0 +1,251 @@
+//! The certified check of any tetrahedral mesh (`certify`, `halo4d check` on meshes without
+//! halo4d's layout): the fixtures of Gmsh's meshes with planted faults get the verdict their
+//! README names, faults planted exactly in Kuhn's cube are each caught, named and marked
+//! on the right tetrahedra, and a clean mesh passes at any scale.
+
+use crate::common::{fixture, halo4d};
+use halo4d::certify::{Certificate, Convention, Fault, certify, kuhn_cube};
+
+/// The names of a certificate's failures (`3 self_intersections (...)` is
+/// `self_intersections`).
+fn names(c: &Certificate) -> Vec<String> {
+    c.failures()
+        .iter()
+        .map(|f| f.split_whitespace().nth(1).unwrap_or("").to_string())
+        .collect()
+}
+
+/// The tetrahedra with fault bit `bit`.
+fn marked(c: &Certificate, bit: u32) -> Vec<usize> {
+    (0..c.faults.len())
+        .filter(|&i| c.faults[i] & bit != 0)
+        .collect()
+}
+
+/// Every vertex index of `tets` and the coordinates of `p`, moved to make room for more.
+fn translated(p: &[[f64; 3]], by: [f64; 3]) -> Vec<[f64; 3]> {
+    p.iter()
+        .map(|q| [q[0] + by[0], q[1] + by[1], q[2] + by[2]])
+        .collect()
+}
+
+/// Two meshes in one: the second's vertex indices after the first's.
+fn joined(
+    (p1, t1): (Vec<[f64; 3]>, Vec<[u32; 4]>),
+    (p2, t2): (Vec<[f64; 3]>, Vec<[u32; 4]>),
+) -> (Vec<[f64; 3]>, Vec<[u32; 4]>) {
+    let n = p1.len() as u32;
+    let mut p = p1;
+    p.extend(p2);
+    let mut t = t1;
+    t.extend(t2.iter().map(|q| q.map(|i| i + n)));
+    (p, t)
+}
+
+/// A tetrahedron of the cube none of whose vertices is on its boundary.
+fn interior(p: &[[f64; 3]], t: &[[u32; 4]], n: f64) -> usize {
+    let inside = |i: u32| p[i as usize].iter().all(|&x| x > 0.0 && x < n);
+    t.iter()
+        .position(|q| q.iter().all(|&i| inside(i)))
+        .expect("an interior tetrahedron")
+}
+
+#[test]
+fn every_fixture_mesh_gets_the_verdict_its_readme_names() {
+    let dir = fixture("tetmeshes/faults");
+    let readme = std::fs::read_to_string(dir.join("README.md")).unwrap();
+    let mut rows = 0;
+    for line in readme.lines().filter(|l| l.starts_with("| ") && l.contains(".vtk")) {
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        let (file, tets, verdict) = (cells[1], cells[2], cells[3]);
+        let checked = halo4d::check_file(&dir.join(file)).unwrap();
+        let c = checked.certificate.as_ref().expect("a plain mesh is certified");
+        assert_eq!(c.stats.tets.to_string(), tets, "{file}");
+        let expected: Vec<String> = verdict
+            .strip_prefix("fails: ")
+            .map(|names| {
+                names
+                    .split(", ")
+                    .map(|n| n.trim_matches('`').to_string())
+                    .collect()
+            })
+            .unwrap_or_default();
+        let found = names(c);
+        if expected.is_empty() {
+            assert!(verdict.starts_with("passes"), "{file}: {verdict}");
+            assert!(found.is_empty(), "{file} must pass: {found:?}");
+        } else {
+            for name in &expected {
+                assert!(found.contains(name), "{file}: {name} not among {found:?}");
+            }
+        }
+        // `meshes[0].certificate.boundary.cavities == 1` and the like, read off the JSON.
+        if let Some((path, value)) = verdict
+            .split('`')
+            .find(|s| s.starts_with("meshes"))
+            .and_then(|s| s.split_once(" == "))
+        {
+            let pointer = format!("/{}", path.replace(['[', '.'], "/").replace(']', ""));
+            let json = checked.json();
+            let got = json.pointer(&pointer).unwrap_or_else(|| panic!("{pointer}"));
+            assert_eq!(got.to_string(), value, "{file}: {path}");
+        }
+        rows += 1;
+    }
+    assert!(rows >= 16, "{rows} rows in the README");
+}
+
+#[test]
+fn faults_planted_exactly_in_kuhns_cube_are_caught_named_and_marked() {
+    let (p, t) = kuhn_cube(4);
+    let clean = certify(&p, &t);
+    assert!(clean.failures().is_empty(), "{:?}", clean.failures());
+    assert_eq!(clean.boundary.windings, [Some(1)]);
+    let i = interior(&p, &t, 4.0);
+
+    // One tetrahedron flipped: inverted, that one marked.
+    let mut flipped = t.clone();
+    flipped[i].swap(0, 1);
+    let c = certify(&p, &flipped);
+    assert_eq!(names(&c)[0], "inverted");
+    assert_eq!(marked(&c, Fault::INVERTED), [i]);
+
+    // Every tetrahedron flipped: the other convention, and valid in it.
+    let all: Vec<[u32; 4]> = t.iter().map(|q| [q[1], q[0], q[2], q[3]]).collect();
+    let c = certify(&p, &all);
+    assert_eq!(c.convention, Convention::Reversed);
+    assert!(c.failures().is_empty(), "{:?}", c.failures());
+
+    // One listed twice: both copies marked.
+    let mut twice = t.clone();
+    twice.push(t[i]);
+    let c = certify(&p, &twice);
+    assert!(names(&c).contains(&"duplicate_tets".to_string()));
+    assert_eq!(marked(&c, Fault::DUPLICATE), [i, t.len()]);
+
+    // One removed from the inside: not a fault, a cavity whose four neighbours are marked.
+    let mut cavity = t.clone();
+    cavity.remove(i);
+    let c = certify(&p, &cavity);
+    assert!(c.failures().is_empty(), "{:?}", c.failures());
+    assert_eq!((c.boundary.components, c.boundary.cavities), (2, 1));
+    assert_eq!(c.boundary.windings, [Some(1), Some(1)]);
+    assert_eq!(marked(&c, Fault::CAVITY).len(), 4);
+
+    // A vertex exactly on a face (a + b + 2c) / 4, the neighbour across it keeping the
+    // face whole.
+    let [a, b, cc, d] = t[i];
+    let at = |k: u32| p[k as usize];
+    let h = [0, 1, 2].map(|k| (at(a)[k] + at(b)[k] + 2.0 * at(cc)[k]) / 4.0);
+    let mut hp = p.clone();
+    hp.push(h);
+    let hv = p.len() as u32;
+    let mut ht: Vec<[u32; 4]> = t.clone();
+    ht.remove(i);
+    // Each part keeps the orientation of (a, b, c, d) with one corner of the face moved to h.
+    ht.extend([[a, b, hv, d], [hv, b, cc, d], [a, hv, cc, d]]);
+    let c = certify(&hp, &ht);
+    assert_eq!(c.stats.inverted + c.stats.flat, 0);
+    assert!(names(&c).contains(&"hanging_vertices".to_string()), "{:?}", c.failures());
+    let neighbour = t
+        .iter()
+        .position(|q| q != &t[i] && [a, b, cc].iter().all(|v| q.contains(v)))
+        .unwrap();
+    let neighbour = if neighbour > i { neighbour - 1 } else { neighbour };
+    assert!(marked(&c, Fault::HANGING).contains(&neighbour));
+
+    // A tetrahedron outside touching the cube at a corner, then along an edge.
+    let corner = |extra: Vec<[f64; 3]>, shared: &[u32]| {
+        let mut q = p.clone();
+        let n = q.len() as u32;
+        q.extend(extra);
+        let mut tet: Vec<u32> = shared.to_vec();
+        tet.extend(n..n + (4 - shared.len() as u32));
+        let mut tt = t.clone();
+        let mut tet: [u32; 4] = tet.try_into().unwrap();
+        let pos = tet.map(|k| q[k as usize]);
+        let c3 = |x: [f64; 3]| robust::Coord3D { x: x[0], y: x[1], z: x[2] };
+        if robust::orient3d(c3(pos[0]), c3(pos[1]), c3(pos[2]), c3(pos[3])) < 0.0 {
+            tet.swap(0, 1);
+        }
+        tt.push(tet);
+        certify(&q, &tt)
+    };
+    let top = (p.len() - 1) as u32; // (4, 4, 4)
+    let c = corner(vec![[5.0, 4.5, 4.5], [4.5, 5.0, 4.5], [4.5, 4.5, 5.0]], &[top]);
+    assert_eq!(names(&c), ["nonmanifold_vertices"]);
+    assert!(marked(&c, Fault::NONMANIFOLD).contains(&t.len()));
+    let below = top - 1; // (3, 4, 4): the edge along x on the top back edge of the cube
+    let c = corner(vec![[3.5, 5.0, 5.0], [3.5, 5.0, 6.0]], &[below, top]);
+    assert!(names(&c).contains(&"nonmanifold_edges".to_string()), "{:?}", c.failures());
+
+    // Two cubes apart pass; overlapping, their boundaries cross and the overlap is wound
+    // twice; one inside the other, the inner one is wound twice.
+    let far = joined(kuhn_cube(4), (translated(&p, [10.0, 0.0, 0.0]), t.clone()));
+    let c = certify(&far.0, &far.1);
+    assert!(c.failures().is_empty(), "{:?}", c.failures());
+    assert_eq!((c.boundary.components, c.boundary.cavities), (2, 0));
+    let over = joined(kuhn_cube(4), (translated(&p, [2.5, 0.5, 0.5]), t.clone()));
+    let c = certify(&over.0, &over.1);
+    let found = names(&c);
+    assert!(found.contains(&"self_intersections".to_string()), "{found:?}");
+    let (small_p, small_t) = kuhn_cube(1);
+    let nested = joined(kuhn_cube(4), (translated(&small_p, [1.5, 1.5, 1.5]), small_t));
+    let c = certify(&nested.0, &nested.1);
+    assert_eq!(names(&c), ["wrong_winding"]);
+    assert_eq!(c.boundary.windings, [Some(1), Some(2)]);
+    assert_eq!(marked(&c, Fault::WINDING), (t.len()..t.len() + 6).collect::<Vec<_>>());
+}
+
+#[test]
+fn a_mesh_scaled_by_powers_of_two_gets_the_same_certificate_and_1e150_is_still_exact() {
+    let (p, t) = kuhn_cube(3);
+    let mut faulty = t.clone();
+    faulty[40].swap(2, 3);
+    for tets in [&t, &faulty] {
+        let reference = certify(&p, tets);
+        for e in [-1000, -400, 400, 1000] {
+            let s = 2f64.powi(e);
+            let scaled: Vec<[f64; 3]> = p.iter().map(|q| q.map(|x| x * s)).collect();
+            let c = certify(&scaled, tets);
+            assert_eq!(c.failures(), reference.failures(), "2^{e}");
+            assert_eq!(c.boundary, reference.boundary, "2^{e}");
+            assert_eq!(c.faults, reference.faults, "2^{e}");
+        }
+        for s in [1e150, 1e-150] {
+            let scaled: Vec<[f64; 3]> = p.iter().map(|q| q.map(|x| x * s)).collect();
+            assert_eq!(names(&certify(&scaled, tets)), names(&reference), "{s}");
+        }
+    }
+}
+
+#[test]
+fn check_prints_json_and_marks_each_faulty_tetrahedron_in_a_vtu() {
+    let dir = tempfile::tempdir().unwrap();
+    let faults = fixture("tetmeshes/faults");
+    let file = faults.join("nested-balls.vtk");
+    let out = halo4d(&["check", file.to_str().unwrap(), "--json"], dir.path());
+    assert_eq!(out.status.code(), Some(1));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["passes"], false);
+    assert_eq!(json["meshes"][0]["certificate"]["boundary"]["windings"][1], 2);
+
+    let mark = dir.path().join("marked.vtu");
+    let out = halo4d(
+        &["check", file.to_str().unwrap(), "--mark", mark.to_str().unwrap()],
+        dir.path(),
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("wrong winding"), "{text}");
+    let bytes = std::fs::read(&mark).unwrap();
+    assert!(bytes.starts_with(b"<?xml") && bytes.ends_with(b"</VTKFile>\n"));
+
+    // A clean mesh passes and says why; --mark wants a .vtu, and a mesh of its own kind.
+    let out = halo4d(&["check", faults.join("cube.vtk").to_str().unwrap()], dir.path());
+    assert_eq!(out.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("ok: a valid tetrahedralization"));
+    let out = halo4d(&["check", file.to_str().unwrap(), "--mark", "x.vtk"], dir.path());
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("give a .vtu file"));
+}
