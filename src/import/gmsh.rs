@@ -44,7 +44,8 @@ pub fn read_gmsh(bytes: &[u8], name: &str) -> Result<PlainTetrahedra> {
         t => return Err(s.err(format!("the file type is {t}, not 0 (ASCII) or 1 (binary)"))),
     };
     let size = s.u64("the data size")? as usize;
-    if !(size == 4 || size == 8) || (!v4 && size != 8) {
+    let sizes: &[usize] = if v4 { &[4, 8] } else { &[8] };
+    if !sizes.contains(&size) {
         return Err(s.err(format!(
             "the data size is {size}; a {} file has {}",
             if v4 { "4.1" } else { "2.2" },

@@ -77,10 +77,7 @@ pub fn read_medit(bytes: &[u8], name: &str) -> Result<PlainTetrahedra> {
     let mut positions: Option<Vec<[f64; 3]>> = None;
     let mut cells = Cells::default();
     let mut pending: Option<&[u8]> = None;
-    loop {
-        let Some(word) = pending.take().or_else(|| s.token()) else {
-            break;
-        };
+    while let Some(word) = pending.take().or_else(|| s.token()) {
         let is = |k: &str| word.eq_ignore_ascii_case(k.as_bytes());
         if is("End") {
             break;

@@ -203,7 +203,7 @@ pub enum ImportError {
     Io(#[from] std::io::Error),
     /// The file name's extension is none that [`read`] takes.
     #[error(
-        "unknown file type `{}`: give a .glb or .vtk file written by halo4d build, or a tetrahedral mesh: .vtu, .vtk, .msh (Gmsh 2.2 or 4.1), .mesh (Medit), .node or .ele (TetGen)",
+        "unknown file type `{}`: give a .glb or a .vtk file written by halo4d build, or another program's tetrahedral mesh: .vtu, .vtk, .msh (Gmsh 2.2 or 4.1), .mesh (Medit), .node or .ele (TetGen)",
         shorten(.0)
     )]
     UnknownType(String),

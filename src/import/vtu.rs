@@ -69,7 +69,7 @@ pub fn read_vtu(bytes: &[u8], name: &str) -> Result<PlainTetrahedra> {
             ),
         ));
     }
-    let xyz = d.floats(&points, np.checked_mul(3).unwrap_or(usize::MAX))?;
+    let xyz = d.floats(&points, np.saturating_mul(3))?;
     let positions: Vec<[f64; 3]> = xyz.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
     drop(xyz);
 
