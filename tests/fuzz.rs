@@ -1,5 +1,6 @@
 //! Seeded, structure-aware fuzzing of the input parsers: scene files ([`Scene::parse`]),
-//! `.glb` ([`read_glb`], [`read_scene_glb`]) and legacy `.vtk` ([`read_vtk`]).
+//! `.glb` ([`read_glb`], [`read_scene_glb`]), legacy `.vtk` ([`read_vtk`]) and other
+//! programs' tetrahedral meshes (`.vtu`, `.msh`, `.mesh`, `.node`/`.ele`).
 //!
 //! Each target starts from valid inputs and applies a short list of mutations that know the
 //! format. proptest draws the lists from a fixed ChaCha seed (the same cases on every run, no

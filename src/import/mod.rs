@@ -27,9 +27,11 @@
 //! corners) is read, a cell of lower dimension (point, line, triangle, quadrilateral) is
 //! skipped, and any other solid (hexahedron, prism, pyramid, ...) is an error that says how
 //! many of which kind: halo4d checks tetrahedral meshes. All these formats take a tetrahedron
-//! (a, b, c, d) as positive when det[b − a, c − a, d − a] > 0 (VTK and Gmsh by their
-//! reference elements; Medit's and TetGen's files as meshio exchanges them with VTK
-//! unchanged); halo4d's orientation is the opposite, converted at the file boundary
+//! (a, b, c, d) as positive when det[b − a, c − a, d − a] > 0: VTK and Gmsh by their
+//! reference elements; Medit by P. L. George's convention for INRIA's meshes (the trihedron
+//! (ab, ac, ad) direct); TetGen by its sources, for which d lies "above" the plane of a, b, c
+//! (Shewchuk's orient3d < 0); and meshio hands tetrahedra between all four unchanged.
+//! halo4d's orientation is the opposite, converted at the file boundary
 //! ([`crate::convention::file_order`]). They are read from the file's bytes in one pass,
 //! without a token list of the whole file: a 10 million tetrahedra binary file reads in
 //! seconds.
