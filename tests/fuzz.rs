@@ -1,5 +1,6 @@
 //! Seeded, structure-aware fuzzing of the input parsers: scene files ([`Scene::parse`]),
-//! `.glb` ([`read_glb`], [`read_scene_glb`]) and legacy `.vtk` ([`read_vtk`]).
+//! `.glb` ([`read_glb`], [`read_scene_glb`]), legacy `.vtk` ([`read_vtk`]) and other
+//! programs' tetrahedral meshes (`.vtu`, `.msh`, `.mesh`, `.node`/`.ele`).
 //!
 //! Each target starts from valid inputs and applies a short list of mutations that know the
 //! format. proptest draws the lists from a fixed ChaCha seed (the same cases on every run, no
@@ -20,7 +21,10 @@
 //!   the header lines' counts, types and keywords changed, lines deleted, duplicated, swapped
 //!   or inserted, numbers in the ASCII data changed, bytes flipped, the file cut; also an
 //!   ASCII file without halo4d's FIELD data (another program's) and halos cut to half and
-//!   to no tetrahedra.
+//!   to no tetrahedra;
+//! - other programs' tetrahedral meshes (`.vtu`, `.msh`, `.mesh`, TetGen's `.node` and
+//!   `.ele`): the fixtures of `fixtures/tetmeshes/`, a word replaced by an extreme (huge
+//!   counts, -1, NaN, a section's end), bytes flipped, inserted, the file cut.
 //!
 //! Properties: no input panics a parser; every error message is non-empty and shorter than
 //! [`MAX_MESSAGE`] bytes (a scene's starts with the file's name); a scene that parses writes
@@ -66,6 +70,9 @@ const SCENE_CASES: u32 = 20_000;
 const GLB_CASES: u32 = 6000;
 /// `.vtk` cases of the default run.
 const VTK_CASES: u32 = 8000;
+/// Cases of the default run per format of other programs' tetrahedral meshes (`.vtu`,
+/// `.msh`, `.mesh`, `.node`, `.ele`).
+const MESH_CASES: u32 = 2000;
 
 // ---------------------------------------------------------------------------------------
 // The runner
@@ -2085,6 +2092,159 @@ fn fuzz_vtk_reader() {
     fuzz_vtk(VTK_CASES, false);
 }
 
+// ---------------------------------------------------------------------------------------
+// Other programs' tetrahedral meshes: .vtu, .msh, .mesh, TetGen's .node/.ele
+// ---------------------------------------------------------------------------------------
+
+/// The words a text mutation puts in place of a word of a mesh file.
+const MESH_WORDS: [&str; 12] = [
+    "0",
+    "-1",
+    "1",
+    "13",
+    "4294967295",
+    "18446744073709551616",
+    "1000000000000",
+    "nan",
+    "inf",
+    "1e400",
+    "$EndNodes",
+    "End",
+];
+
+/// A mutation of a tetrahedral mesh file: a word replaced (text formats and the text of
+/// binary ones), then bytes changed.
+#[derive(Clone, Debug)]
+struct MeshCase {
+    seed: u32,
+    words: Vec<(u32, u8)>,
+    bytes: Vec<ByteOp>,
+}
+
+fn mesh_strategy() -> impl Strategy<Value = MeshCase> {
+    (
+        any::<u32>(),
+        vec((any::<u32>(), any::<u8>()), 0..3),
+        vec(byte_op_strategy(), 0..3),
+    )
+        .prop_map(|(seed, words, bytes)| MeshCase { seed, words, bytes })
+}
+
+/// The fixtures of `fixtures/tetmeshes/` whose name ends with `ext`.
+fn mesh_seeds(ext: &str) -> Vec<Vec<u8>> {
+    let mut names: Vec<_> = std::fs::read_dir(fixture("tetmeshes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.to_string_lossy().ends_with(ext))
+        .collect();
+    names.sort();
+    assert!(!names.is_empty(), "no fixtures/tetmeshes/*{ext}");
+    names.iter().map(|p| std::fs::read(p).unwrap()).collect()
+}
+
+fn render_mesh(seeds: &[Vec<u8>], case: &MeshCase) -> Vec<u8> {
+    let mut bytes = seeds[case.seed as usize % seeds.len()].clone();
+    for &(index, word) in &case.words {
+        let starts: Vec<usize> = (0..bytes.len())
+            .filter(|&i| {
+                !bytes[i].is_ascii_whitespace() && (i == 0 || bytes[i - 1].is_ascii_whitespace())
+            })
+            .collect();
+        if starts.is_empty() {
+            break;
+        }
+        let start = starts[index as usize % starts.len()];
+        let end = (start..bytes.len())
+            .find(|&i| bytes[i].is_ascii_whitespace())
+            .unwrap_or(bytes.len());
+        let new = MESH_WORDS[word as usize % MESH_WORDS.len()].as_bytes();
+        bytes.splice(start..end, new.iter().copied());
+    }
+    for op in &case.bytes {
+        apply_bytes(&mut bytes, op);
+    }
+    bytes
+}
+
+fn check_mesh(
+    read: impl Fn(&[u8]) -> Result<PlainTetrahedra, halo4d::import::ImportError>,
+    bytes: &[u8],
+    tally: &Tally,
+) -> Result<(), String> {
+    tally.add("cases");
+    match read(bytes) {
+        Ok(m) => {
+            tally.add("read");
+            plain_ok(&m)?;
+            let _ = halo4d::check::check_tetrahedra(&m.positions, &m.tets);
+            Ok(())
+        }
+        Err(e) => {
+            tally.add("failed");
+            let message = e.to_string();
+            message_ok("tetrahedral mesh", &message)?;
+            if !(message.contains(", line ") || message.contains(", byte ")) {
+                tally.add("failed without a line or byte");
+            }
+            Ok(())
+        }
+    }
+}
+
+fn fuzz_meshes(cases: u32, long: bool) {
+    let node = std::fs::read(fixture("tetmeshes/cube.node")).unwrap();
+    let ele = std::fs::read(fixture("tetmeshes/cube.ele")).unwrap();
+    type Read<'a> = Box<dyn Fn(&[u8]) -> Result<PlainTetrahedra, halo4d::import::ImportError> + 'a>;
+    let targets: [(&str, Read); 5] = [
+        ("vtu", Box::new(|b: &[u8]| halo4d::import::read_vtu(b, "m"))),
+        (
+            "msh",
+            Box::new(|b: &[u8]| halo4d::import::read_gmsh(b, "m")),
+        ),
+        (
+            "mesh",
+            Box::new(|b: &[u8]| halo4d::import::read_medit(b, "m")),
+        ),
+        (
+            "node",
+            Box::new(|b: &[u8]| halo4d::import::read_tetgen(b, &ele, "m")),
+        ),
+        (
+            "ele",
+            Box::new(|b: &[u8]| halo4d::import::read_tetgen(&node, b, "m")),
+        ),
+    ];
+    for (ext, read) in targets {
+        let seeds = mesh_seeds(&format!(".{ext}"));
+        let tally = Tally::default();
+        fuzz(
+            &format!("tetmesh-{ext}"),
+            ext,
+            cases,
+            long,
+            mesh_strategy(),
+            |case| render_mesh(&seeds, case),
+            |bytes| check_mesh(&read, bytes, &tally),
+        );
+        eprintln!("{ext}:");
+        tally.assert_share("read", 0.05);
+        tally.assert_share("failed", 0.2);
+        // Nearly every error names its line or byte (those that cannot: a file without
+        // tetrahedra, or without a section it needs).
+        let named = tally.get("failed") - tally.get("failed without a line or byte");
+        assert!(
+            named as f64 >= 0.8 * tally.get("failed") as f64,
+            "{ext}: only {named} of {} errors name a line or byte",
+            tally.get("failed")
+        );
+    }
+}
+
+#[test]
+fn fuzz_tetrahedral_mesh_readers() {
+    fuzz_meshes(MESH_CASES, false);
+}
+
 // The long runs: `HALO4D_FUZZ_CASES` cases (default 100,000) per target, on another seed.
 
 #[test]
@@ -2103,6 +2263,12 @@ fn fuzz_long_glb_reader() {
 #[ignore = "long: HALO4D_FUZZ_CASES=200000 cargo test --release --test main fuzz -- --ignored"]
 fn fuzz_long_vtk_reader() {
     fuzz_vtk(long_cases(), true);
+}
+
+#[test]
+#[ignore = "long: HALO4D_FUZZ_CASES=200000 cargo test --release --test main fuzz -- --ignored"]
+fn fuzz_long_tetrahedral_mesh_readers() {
+    fuzz_meshes(long_cases(), true);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -25,6 +25,7 @@ mod sample;
 mod scene;
 mod stipple;
 mod surfaces;
+mod tetmeshes;
 mod view;
 #[cfg(feature = "viewer")]
 mod viewer;

@@ -1,5 +1,5 @@
-//! Import: halos and surfaces read back from the files [`crate::export`] writes, for
-//! `halo4d check`.
+//! Import: halos and surfaces read back from the files [`crate::export`] writes, and other
+//! programs' tetrahedral meshes, for `halo4d check`.
 //!
 //! Takes: the bytes of a `.glb` (every mesh whose extras carry `halo`) or of a legacy `.vtk`
 //! (an `UNSTRUCTURED_GRID` of tetrahedra whose field data has `surface_vertices`, ASCII or
@@ -8,20 +8,59 @@
 //! from a scene's `.glb` also its surfaces ([`read_scene_glb`]: positions, w-depth and
 //! triangles, each with its halo, and the curves' polylines), which [`ImportedScene::parts`] hands on as the
 //! verification and the renderer read a build.
-//! Guarantees: malformed input (truncated, wrong magic, bad JSON, references out of range,
-//! counts that disagree, non-finite coordinates) is an [`ImportError`] that names the
-//! problem, never a panic; a count claimed in a file is checked against the bytes actually
-//! there before anything is allocated for it; everything comes back in halo4d's frame and
-//! orientation (`convention`); an accessor that another program re-used (the
-//! tetrahedra's, the polylines') is never read as ours.
+//!
+//! Also takes the tetrahedral meshes other programs write, which have no halo layout and
+//! become [`PlainTetrahedra`] ([`read`] chooses by the extension):
+//! - VTU, VTK's XML `UnstructuredGrid` ([`read_vtu`]): data arrays `ascii`, `binary`
+//!   (base64) or `appended` (`raw` or `base64`), with UInt32 or UInt64 headers, plain or
+//!   `vtkZLibDataCompressor`, little- or big-endian;
+//! - Gmsh `.msh` 2.2 and 4.1, ASCII and binary ([`read_gmsh`]): `$Nodes` and `$Elements`,
+//!   node tags sparse or in any order (vertices come in the order of their tags), every other
+//!   section skipped to its `$End` line;
+//! - Medit `.mesh`, ASCII ([`read_medit`]): `Vertices` and `Tetrahedra` (indices from 1),
+//!   other sections skipped;
+//! - TetGen `.node` with its `.ele` ([`read_tetgen`]): indices from 0 or 1 as the `.node`
+//!   file's first says, 4 or 10 nodes per tetrahedron, attributes and markers skipped;
+//! - legacy `.vtk` without halo4d's layout ([`read_vtk_tetrahedra`]).
+//!
+//! In each, a tetrahedron (quadratic and higher-order ones: their first four nodes, the
+//! corners) is read, a cell of lower dimension (point, line, triangle, quadrilateral) is
+//! skipped, and any other solid (hexahedron, prism, pyramid, ...) is an error that says how
+//! many of which kind: halo4d checks tetrahedral meshes. All these formats take a tetrahedron
+//! (a, b, c, d) as positive when det[b − a, c − a, d − a] > 0: VTK and Gmsh by their
+//! reference elements; Medit by P. L. George's convention for INRIA's meshes (the trihedron
+//! (ab, ac, ad) direct); TetGen by its sources, for which d lies "above" the plane of a, b, c
+//! (Shewchuk's orient3d < 0); and meshio hands tetrahedra between all four unchanged.
+//! halo4d's orientation is the opposite, converted at the file boundary
+//! ([`crate::convention::file_order`]). They are read from the file's bytes in one pass,
+//! without a token list of the whole file: a 10 million tetrahedra binary file reads in
+//! seconds.
+//!
+//! Guarantees: malformed input (truncated, wrong magic, bad JSON, bad base64 or zlib,
+//! references out of range, counts that disagree, non-finite coordinates) is an
+//! [`ImportError`] that names the problem, and for other programs' meshes the line (text) or
+//! byte offset (binary) where it is ([`ImportError::Tetrahedra`]), never a panic; a count
+//! claimed in a file is checked against the bytes actually there before anything is
+//! allocated for it; everything comes back in halo4d's frame and orientation
+//! (`convention`); an accessor that another program re-used (the tetrahedra's, the
+//! polylines') is never read as ours.
 
 mod glb;
+mod gmsh;
+mod medit;
 mod mesh;
+mod tetfile;
+mod tetgen;
 mod vtk;
+mod vtu;
 
 pub use glb::{read_glb, read_scene_glb};
+pub use gmsh::read_gmsh;
+pub use medit::read_medit;
 pub use mesh::{MeshFileError, MeshFileLocation, MeshFormat, parse_mesh4, read_mesh4};
+pub use tetgen::read_tetgen;
 pub use vtk::{read_vtk, read_vtk_tetrahedra};
+pub use vtu::read_vtu;
 
 use crate::check::{LAYERS, TetMesh};
 use crate::intersect::Curves;
@@ -164,9 +203,25 @@ pub enum ImportError {
     /// The file could not be read at all.
     #[error("cannot read the file: {0}")]
     Io(#[from] std::io::Error),
-    /// The file name says neither `.glb` nor `.vtk`.
-    #[error("unknown file type `{}`: give a .glb or a .vtk file written by halo4d build", shorten(.0))]
+    /// The file name's extension is none that [`read`] takes.
+    #[error(
+        "unknown file type `{}`: give a .glb or a .vtk file written by halo4d build, or another program's tetrahedral mesh: .vtu, .vtk, .msh (Gmsh 2.2 or 4.1), .mesh (Medit), .node or .ele (TetGen)",
+        shorten(.0)
+    )]
     UnknownType(String),
+    /// Another program's tetrahedral mesh (VTU, Gmsh, Medit, TetGen) that is malformed or
+    /// holds other solids than tetrahedra. Displays like `Gmsh 4.1 binary, byte 96: ...` or
+    /// `Medit .mesh, line 12: ...`.
+    #[error("{format}{}: {}", tetfile::location(.at), shorten(.message))]
+    Tetrahedra {
+        /// The format as far as it was read (`Gmsh 4.1 binary`, `VTU`), or which of a
+        /// format's files (`TetGen cube.node`).
+        format: String,
+        /// Where in the file: a line of text, or a byte offset.
+        at: MeshFileLocation,
+        /// What is wrong.
+        message: String,
+    },
     /// The bytes are not a well-formed `.glb`.
     #[error("not a valid .glb: {}", shorten(.0))]
     Glb(String),
@@ -218,8 +273,10 @@ pub enum ImportError {
     },
 }
 
-/// Reads the tetrahedra of a `.glb` or `.vtk` file, chosen by its extension: its halos, or
-/// a `.vtk`'s tetrahedra without halo4d's layout.
+/// Reads the tetrahedra of a file, chosen by its extension (in any case): the halos of a
+/// `.glb`, or of a `.vtk` in halo4d's layout; the tetrahedra alone of another program's
+/// `.vtk`, `.vtu`, `.msh` (Gmsh), `.mesh` (Medit), or `.node` and `.ele` (TetGen: given
+/// either, the other with the same stem is read too).
 pub fn read(path: &Path) -> Result<FileTetrahedra, ImportError> {
     // A path that is not there is that, whatever its extension says.
     std::fs::metadata(path)?;
@@ -227,9 +284,18 @@ pub fn read(path: &Path) -> Result<FileTetrahedra, ImportError> {
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let plain = |read: Result<PlainTetrahedra, ImportError>| read.map(FileTetrahedra::Plain);
     match ext.as_str() {
         "glb" => read_glb(&std::fs::read(path)?).map(FileTetrahedra::Halos),
         "vtk" => read_vtk_tetrahedra(&std::fs::read(path)?),
+        "vtu" => plain(read_vtu(&std::fs::read(path)?, &name)),
+        "msh" => plain(read_gmsh(&std::fs::read(path)?, &name)),
+        "mesh" => plain(read_medit(&std::fs::read(path)?, &name)),
+        "node" | "ele" => plain(tetgen::read_tetgen_files(path, &name)),
         _ => Err(ImportError::UnknownType(if ext.is_empty() {
             "(no extension)".into()
         } else {
@@ -243,15 +309,16 @@ pub fn read(path: &Path) -> Result<FileTetrahedra, ImportError> {
 pub enum FileTetrahedra {
     /// Halos in halo4d's layout (every halo of a `.glb`; a `.vtk` that gives the layout).
     Halos(Vec<ImportedHalo>),
-    /// A `.vtk` of tetrahedra without halo4d's layout.
+    /// Tetrahedra without halo4d's layout: another program's mesh (`.vtk`, `.vtu`, `.msh`,
+    /// `.mesh`, `.node`/`.ele`).
     Plain(PlainTetrahedra),
 }
 
-/// Tetrahedra without halo4d's halo layout (another program's `.vtk`, or an earlier
-/// halo4d's): what [`crate::check::check_tetrahedra`] checks.
+/// Tetrahedra without halo4d's halo layout (another program's mesh, or an earlier
+/// halo4d's `.vtk`): what [`crate::check::check_tetrahedra`] checks.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PlainTetrahedra {
-    /// The title up to its first `: `.
+    /// For a legacy `.vtk`, the title up to its first `: `; otherwise the file's stem.
     pub name: String,
     /// Vertex positions, all finite.
     pub positions: Vec<[f64; 3]>,
@@ -259,6 +326,9 @@ pub struct PlainTetrahedra {
     pub tets: Vec<[u32; 4]>,
     /// Why the file is not read as a halo: what says that halo4d's layout is missing.
     pub why: String,
+    /// The format read: `legacy VTK ASCII`, `VTU appended raw zlib`, `Gmsh 4.1 binary`,
+    /// `Medit .mesh`, `TetGen .node/.ele`, ...
+    pub format: String,
 }
 
 impl PlainTetrahedra {

@@ -1,4 +1,6 @@
-//! Halos from legacy VTK: an `UNSTRUCTURED_GRID` of tetrahedra (cell type 10), ASCII or
+//! Halos from legacy VTK: an `UNSTRUCTURED_GRID` of tetrahedra (cell type 10; of 24, the
+//! quadratic tetrahedron, the corners; cells of lower dimension skipped, other solids an
+//! error), ASCII or
 //! binary (big-endian), with the CELLS layout of file versions up to 4.2 (a count before each
 //! cell's ids) and of 5.1 (OFFSETS and CONNECTIVITY arrays). `surface_vertices`, `rho`,
 //! `delta_d` and `delta_t` come from the dataset's FIELD data, `t` and `d_orig` from the
@@ -6,6 +8,7 @@
 //! attributes, lookup tables, METADATA) are read past. A file without halo4d's layout is
 //! read as tetrahedra alone for `halo4d check` ([`read_vtk_tetrahedra`]).
 
+use super::tetfile::{Kind, vtk_kind};
 use super::{FileParams, FileTetrahedra, ImportError, ImportedHalo, PlainTetrahedra};
 use crate::check::TetMesh;
 use crate::convention::file_order;
@@ -17,9 +20,6 @@ type Result<T> = std::result::Result<T, ImportError>;
 fn err(message: String) -> ImportError {
     ImportError::Vtk(message)
 }
-
-/// The tetrahedron's VTK cell type.
-const VTK_TETRA: f64 = 10.0;
 
 /// Reads the halo of a legacy VTK file (see [`crate::export::write_vtk`]).
 pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
@@ -34,6 +34,7 @@ pub fn read_vtk(bytes: &[u8]) -> Result<ImportedHalo> {
 pub fn read_vtk_tetrahedra(bytes: &[u8]) -> Result<FileTetrahedra> {
     let (mut r, title) = header(bytes)?;
     let grid = r.grid()?;
+    let format = format!("legacy VTK {}", if r.ascii { "ASCII" } else { "binary" });
     let has = |key: &str| grid.field.contains_key(key);
     let why = match (has("surface_vertices"), has("layers")) {
         (true, true) => return Ok(FileTetrahedra::Halos(vec![halo(grid, &title)?])),
@@ -48,7 +49,8 @@ pub fn read_vtk_tetrahedra(bytes: &[u8]) -> Result<FileTetrahedra> {
         name: name(&title),
         positions: grid.points,
         tets: grid.tets,
-        why: why.to_string(),
+        why: format!("a {format} mesh: {why}"),
+        format,
     }
     .validate()
     .map(FileTetrahedra::Plain)
@@ -311,6 +313,13 @@ struct Grid {
     d_orig: Option<Vec<f64>>,
 }
 
+/// The cells of a CELLS section: all their point ids, and where each cell's are.
+struct CellList {
+    ids: Vec<f64>,
+    /// Each cell's first id in `ids`, and how many it has.
+    spans: Vec<(usize, usize)>,
+}
+
 /// Where attribute sections belong.
 #[derive(Clone, Copy, PartialEq)]
 enum Attach {
@@ -395,7 +404,7 @@ impl Reader<'_> {
     fn grid(&mut self) -> Result<Grid> {
         let mut g = Grid::default();
         let mut points: Option<usize> = None;
-        let mut cells: Option<Vec<[f64; 4]>> = None;
+        let mut cells: Option<CellList> = None;
         let mut types: Option<Vec<f64>> = None;
         let mut attach = Attach::Dataset;
         while let Some(words) = self.keyword_line()? {
@@ -430,7 +439,7 @@ impl Reader<'_> {
                 }
                 "CELL_DATA" => {
                     let n = count(words.get(1), "CELL_DATA")?;
-                    let have = cells.as_ref().map(Vec::len);
+                    let have = cells.as_ref().map(|c| c.spans.len());
                     if Some(n) != have {
                         return Err(err(format!(
                             "CELL_DATA is for {n} cells, CELLS lists {}",
@@ -458,21 +467,44 @@ impl Reader<'_> {
         let points = points.ok_or_else(|| err("no POINTS section".into()))?;
         let cells = cells.ok_or_else(|| err("no CELLS section".into()))?;
         let types = types.ok_or_else(|| err("no CELL_TYPES section".into()))?;
-        if types.len() != cells.len() {
+        if types.len() != cells.spans.len() {
             return Err(err(format!(
                 "CELL_TYPES lists {} cells, CELLS {}",
                 types.len(),
-                cells.len()
+                cells.spans.len()
             )));
         }
-        if let Some(k) = types.iter().position(|&t| t != VTK_TETRA) {
-            return Err(err(format!(
-                "cell {k} has type {}, not 10 (tetrahedron): halos are made of tetrahedra only",
-                types[k]
-            )));
-        }
-        g.tets = Vec::with_capacity(cells.len());
-        for (k, ids) in cells.iter().enumerate() {
+        g.tets = Vec::with_capacity(cells.spans.len());
+        // Each kind of solid other than a tetrahedron: how many, and the first's cell and type.
+        let mut others: Vec<(&str, usize, usize, f64)> = Vec::new();
+        for (k, (&t, &(start, len))) in types.iter().zip(&cells.spans).enumerate() {
+            let kind = (t >= 0.0 && t.fract() == 0.0)
+                .then(|| vtk_kind(t as u64))
+                .flatten()
+                .ok_or_else(|| err(format!("cell {k} has type {t}, which VTK does not define")))?;
+            let ids = &cells.ids[start..start + len];
+            match kind {
+                Kind::Lower => continue,
+                Kind::Solid(name) => {
+                    match others.iter_mut().find(|o| o.0 == name) {
+                        Some(o) => o.1 += 1,
+                        None => others.push((name, 1, k, t)),
+                    }
+                    continue;
+                }
+                Kind::Tet => {}
+            }
+            let wanted = match t as u64 {
+                10 => Some(4),
+                24 => Some(10),
+                _ => None,
+            };
+            if wanted.is_some_and(|w| w != len) || len < 4 {
+                return Err(err(format!(
+                    "cell {k} has {len} points, but a tetrahedron of type {t} has {}",
+                    wanted.unwrap_or(4)
+                )));
+            }
             let mut tet = [0u32; 4];
             for (slot, &id) in tet.iter_mut().zip(ids) {
                 if !(id >= 0.0 && id.fract() == 0.0 && id < points as f64) {
@@ -484,46 +516,61 @@ impl Reader<'_> {
             }
             g.tets.push(file_order(tet));
         }
+        if let Some(&(_, _, k, t)) = others.first() {
+            let list: Vec<String> = others
+                .iter()
+                .map(|(name, n, _, _)| format!("{n} {name}"))
+                .collect();
+            return Err(err(format!(
+                "cell {k} has type {t}, not 10 (a tetrahedron): the mesh has {} besides its {} tetrahedra, and halo4d checks tetrahedral meshes only; split the other cells into tetrahedra first",
+                list.join(", "),
+                g.tets.len()
+            )));
+        }
         Ok(g)
     }
 
-    /// The cells of a CELLS section, each of which must have 4 point ids.
-    fn cells(&mut self, words: &[String]) -> Result<Vec<[f64; 4]>> {
+    /// The cells of a CELLS section: their point ids, of any number (the cell types say
+    /// which are tetrahedra).
+    fn cells(&mut self, words: &[String]) -> Result<CellList> {
         let first = count(words.get(1), "CELLS")?;
         let size = count(words.get(2), "CELLS")?;
-        let four = |k: usize, ids: &[f64]| -> Result<[f64; 4]> {
-            <[f64; 4]>::try_from(ids).map_err(|_| {
-                err(format!(
-                    "cell {k} has {} points, but halos are made of tetrahedra (4 points) only",
-                    ids.len()
-                ))
-            })
-        };
         if !self.new_cells {
-            let data = self.numbers(size, Type::Int(4, true), "CELLS")?;
-            let mut out = Vec::with_capacity(first.min(data.len() / 5));
+            let ids = self.numbers(size, Type::Int(4, true), "CELLS")?;
+            let mut spans: Vec<(usize, usize)> = Vec::with_capacity(first.min(ids.len()));
+            // Where the counts go wrong, the first cell that is not a tetrahedron is the
+            // likely culprit.
+            let hint = |spans: &[(usize, usize)]| {
+                spans
+                    .iter()
+                    .position(|s| s.1 != 4)
+                    .map(|k| format!(" (cell {k} has {} points: is its count right?)", spans[k].1))
+                    .unwrap_or_default()
+            };
             let mut at = 0;
             for k in 0..first {
-                let len = data.get(at).copied().ok_or_else(|| {
+                let len = ids.get(at).copied().ok_or_else(|| {
                     err(format!(
-                        "CELLS: its {size} values end at cell {k} of {first}"
+                        "CELLS: its {size} values end at cell {k} of {first}{}",
+                        hint(&spans)
                     ))
                 })?;
-                if !(len >= 0.0 && len.fract() == 0.0 && (len as usize) < data.len() - at) {
+                if !(len >= 0.0 && len.fract() == 0.0 && (len as usize) < ids.len() - at) {
                     return Err(err(format!(
-                        "CELLS: cell {k} claims {len} points, more than its {size} values hold"
+                        "CELLS: cell {k} claims {len} points, more than its {size} values hold{}",
+                        hint(&spans)
                     )));
                 }
-                let end = at + 1 + len as usize;
-                out.push(four(k, &data[at + 1..end])?);
-                at = end;
+                spans.push((at + 1, len as usize));
+                at += 1 + len as usize;
             }
-            if at != data.len() {
+            if at != ids.len() {
                 return Err(err(format!(
-                    "CELLS: {first} cells use {at} of its {size} values"
+                    "CELLS: {first} cells use {at} of its {size} values{}",
+                    hint(&spans)
                 )));
             }
-            return Ok(out);
+            return Ok(CellList { ids, spans });
         }
         // Version 5: `CELLS offsets connectivity`, then the two arrays.
         let mut array = |name: &str, n: usize| -> Result<Vec<f64>> {
@@ -538,7 +585,7 @@ impl Reader<'_> {
             }
         };
         let offsets = array("OFFSETS", first)?;
-        let connectivity = array("CONNECTIVITY", size)?;
+        let ids = array("CONNECTIVITY", size)?;
         if offsets.first().is_some_and(|&o| o != 0.0)
             || offsets.last().is_some_and(|&o| o != size as f64)
         {
@@ -546,7 +593,7 @@ impl Reader<'_> {
                 "CELLS: OFFSETS must run from 0 to the {size} CONNECTIVITY values"
             )));
         }
-        let mut out = Vec::with_capacity(offsets.len().saturating_sub(1));
+        let mut spans = Vec::with_capacity(offsets.len().saturating_sub(1));
         for (k, w) in offsets.windows(2).enumerate() {
             let (a, b) = (w[0], w[1]);
             if !(a.fract() == 0.0 && b.fract() == 0.0 && 0.0 <= a && a <= b && b <= size as f64) {
@@ -554,9 +601,9 @@ impl Reader<'_> {
                     "CELLS: the OFFSETS of cell {k} ({a}, {b}) are out of order"
                 )));
             }
-            out.push(four(k, &connectivity[a as usize..b as usize])?);
+            spans.push((a as usize, (b - a) as usize));
         }
-        Ok(out)
+        Ok(CellList { ids, spans })
     }
 
     /// A FIELD section: `FIELD name arrays`, then per array `name components tuples type`

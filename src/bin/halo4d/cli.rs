@@ -59,7 +59,9 @@ pub enum Command {
     /// Check the halos of a .glb or .vtk file with the independent checker, or a build's
     /// output folder: its halos and their verification against the intersection curves.
     ///
-    /// With a FILE, prints the checker's statistics, one column per halo. Exit status 0 when
+    /// With a FILE, prints the checker's statistics, one column per halo. Another program's
+    /// tetrahedral mesh (.vtk, .vtu, Gmsh .msh 2.2 or 4.1, Medit .mesh, TetGen .node/.ele)
+    /// gets the checks that need no halo layout. Exit status 0 when
     /// every halo passes the checker (conforms, no inverted, flat or undecidable
     /// tetrahedron, a volume defect of at most 1e-9), 1 when one does not, 2 when the file
     /// cannot be read as halos.
