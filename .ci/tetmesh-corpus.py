@@ -449,13 +449,41 @@ def run_halo4d(binary, path):
     names = []
     if report is not None:
         for failure in report.get("failures") or []:
+            # "<count> <name> (...)", or "volume_defect <value> (...)": the first word that
+            # is a name.
             words = str(failure).split()
-            names.append(words[1] if len(words) > 1 else str(failure))
+            names.append(next((w for w in words if w[:1].isalpha()), str(failure)))
     note = ""
     if report is None:
         # The first line halo4d wrote, for a report that did not come.
         note = next((line.strip() for line in (proc.stderr + proc.stdout).splitlines() if line.strip()), "")[:120]
     return {"status": proc.returncode, "report": report, "names": names, "ms": t, "note": note}
+
+
+def check_marks(binary, path, case, out):
+    """halo4d check FILE --mark OUT.vtu, then OUT.vtu read by meshio, by VTK's XML reader and by
+    halo4d check itself: the `fault` cell field the same in both readers, a tetrahedron
+    marked exactly when the case has a fault (a cavity's bit, 2048, alone on a clean mesh),
+    and the marked file, the same tetrahedra, the same verdict. What went wrong, or None."""
+    marked = out / f"{path.stem}-marked.vtu"
+    proc = subprocess.run([binary, "check", str(path), "--mark", str(marked)], capture_output=True, text=True, timeout=120)
+    if proc.returncode not in (0, 1) or not marked.exists():
+        return f"--mark exited {proc.returncode}: {proc.stderr.strip()[:120]}"
+    by_meshio = np.asarray(meshio.read(marked).cell_data["fault"][0])
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(str(marked))
+    reader.Update()
+    grid = reader.GetOutput()
+    by_vtk = np.array([grid.GetCellData().GetArray("fault").GetValue(i) for i in range(grid.GetNumberOfCells())])
+    if len(by_meshio) != len(case.tets) or not np.array_equal(by_meshio, by_vtk):
+        return f"meshio and VTK read {len(by_meshio)} and {len(by_vtk)} faults for {len(case.tets)} tetrahedra, or differ"
+    faults = int(np.count_nonzero(by_meshio & ~2048))
+    if bool(case.names) != (faults > 0):
+        return f"{faults} tetrahedra marked with a fault"
+    again = run_halo4d(binary, marked)
+    if again["status"] != proc.returncode:
+        return f"the marked .vtu checks with exit {again['status']}, the file with {proc.returncode}"
+    return None
 
 
 def judge_halo4d(run, case):
@@ -640,6 +668,10 @@ def corpus(binary, out, table_path):
         print(f"{path.name}: {cell}" + ("" if ok or not run["note"] else f" ({run['note']})"))
         if not ok:
             failed.append(f"{path.name}: {cell}")
+        marks = check_marks(binary, path, case, fault_dir)
+        if marks:
+            print(f"{path.name}: --mark: {marks}")
+            failed.append(f"{path.name}: --mark: {marks}")
         should_fail = bool(case.names)
         read, detail, t = run_meshio(path)
         meshio_cell = (f"missed (read, no checks) {ms(t)}" if should_fail else f"passed (read) {ms(t)}") if read \

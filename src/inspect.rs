@@ -242,6 +242,7 @@ impl Checked {
             "plain": self.plain,
             "meshes": self.halos.iter().map(|(name, stats)| serde_json::json!({
                 "name": name,
+                "format": self.mesh.as_ref().map(|m| &m.format),
                 "stats": stats,
                 "certificate": self.certificate,
             })).collect::<Vec<_>>(),

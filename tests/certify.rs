@@ -55,11 +55,17 @@ fn every_fixture_mesh_gets_the_verdict_its_readme_names() {
     let dir = fixture("tetmeshes/faults");
     let readme = std::fs::read_to_string(dir.join("README.md")).unwrap();
     let mut rows = 0;
-    for line in readme.lines().filter(|l| l.starts_with("| ") && l.contains(".vtk")) {
+    for line in readme
+        .lines()
+        .filter(|l| l.starts_with("| ") && l.contains(".vtk"))
+    {
         let cells: Vec<&str> = line.split('|').map(str::trim).collect();
         let (file, tets, verdict) = (cells[1], cells[2], cells[3]);
         let checked = halo4d::check_file(&dir.join(file)).unwrap();
-        let c = checked.certificate.as_ref().expect("a plain mesh is certified");
+        let c = checked
+            .certificate
+            .as_ref()
+            .expect("a plain mesh is certified");
         assert_eq!(c.stats.tets.to_string(), tets, "{file}");
         let expected: Vec<String> = verdict
             .strip_prefix("fails: ")
@@ -87,7 +93,9 @@ fn every_fixture_mesh_gets_the_verdict_its_readme_names() {
         {
             let pointer = format!("/{}", path.replace(['[', '.'], "/").replace(']', ""));
             let json = checked.json();
-            let got = json.pointer(&pointer).unwrap_or_else(|| panic!("{pointer}"));
+            let got = json
+                .pointer(&pointer)
+                .unwrap_or_else(|| panic!("{pointer}"));
             assert_eq!(got.to_string(), value, "{file}: {path}");
         }
         rows += 1;
@@ -146,12 +154,20 @@ fn faults_planted_exactly_in_kuhns_cube_are_caught_named_and_marked() {
     ht.extend([[a, b, hv, d], [hv, b, cc, d], [a, hv, cc, d]]);
     let c = certify(&hp, &ht);
     assert_eq!(c.stats.inverted + c.stats.flat, 0);
-    assert!(names(&c).contains(&"hanging_vertices".to_string()), "{:?}", c.failures());
+    assert!(
+        names(&c).contains(&"hanging_vertices".to_string()),
+        "{:?}",
+        c.failures()
+    );
     let neighbour = t
         .iter()
         .position(|q| q != &t[i] && [a, b, cc].iter().all(|v| q.contains(v)))
         .unwrap();
-    let neighbour = if neighbour > i { neighbour - 1 } else { neighbour };
+    let neighbour = if neighbour > i {
+        neighbour - 1
+    } else {
+        neighbour
+    };
     assert!(marked(&c, Fault::HANGING).contains(&neighbour));
 
     // A tetrahedron outside touching the cube at a corner, then along an edge.
@@ -164,7 +180,11 @@ fn faults_planted_exactly_in_kuhns_cube_are_caught_named_and_marked() {
         let mut tt = t.clone();
         let mut tet: [u32; 4] = tet.try_into().unwrap();
         let pos = tet.map(|k| q[k as usize]);
-        let c3 = |x: [f64; 3]| robust::Coord3D { x: x[0], y: x[1], z: x[2] };
+        let c3 = |x: [f64; 3]| robust::Coord3D {
+            x: x[0],
+            y: x[1],
+            z: x[2],
+        };
         if robust::orient3d(c3(pos[0]), c3(pos[1]), c3(pos[2]), c3(pos[3])) < 0.0 {
             tet.swap(0, 1);
         }
@@ -172,12 +192,19 @@ fn faults_planted_exactly_in_kuhns_cube_are_caught_named_and_marked() {
         certify(&q, &tt)
     };
     let top = (p.len() - 1) as u32; // (4, 4, 4)
-    let c = corner(vec![[5.0, 4.5, 4.5], [4.5, 5.0, 4.5], [4.5, 4.5, 5.0]], &[top]);
+    let c = corner(
+        vec![[5.0, 4.5, 4.5], [4.5, 5.0, 4.5], [4.5, 4.5, 5.0]],
+        &[top],
+    );
     assert_eq!(names(&c), ["nonmanifold_vertices"]);
     assert!(marked(&c, Fault::NONMANIFOLD).contains(&t.len()));
     let below = top - 1; // (3, 4, 4): the edge along x on the top back edge of the cube
     let c = corner(vec![[3.5, 5.0, 5.0], [3.5, 5.0, 6.0]], &[below, top]);
-    assert!(names(&c).contains(&"nonmanifold_edges".to_string()), "{:?}", c.failures());
+    assert!(
+        names(&c).contains(&"nonmanifold_edges".to_string()),
+        "{:?}",
+        c.failures()
+    );
 
     // Two cubes apart pass; overlapping, their boundaries cross and the overlap is wound
     // twice; one inside the other, the inner one is wound twice.
@@ -188,13 +215,22 @@ fn faults_planted_exactly_in_kuhns_cube_are_caught_named_and_marked() {
     let over = joined(kuhn_cube(4), (translated(&p, [2.5, 0.5, 0.5]), t.clone()));
     let c = certify(&over.0, &over.1);
     let found = names(&c);
-    assert!(found.contains(&"self_intersections".to_string()), "{found:?}");
+    assert!(
+        found.contains(&"self_intersections".to_string()),
+        "{found:?}"
+    );
     let (small_p, small_t) = kuhn_cube(1);
-    let nested = joined(kuhn_cube(4), (translated(&small_p, [1.5, 1.5, 1.5]), small_t));
+    let nested = joined(
+        kuhn_cube(4),
+        (translated(&small_p, [1.5, 1.5, 1.5]), small_t),
+    );
     let c = certify(&nested.0, &nested.1);
     assert_eq!(names(&c), ["wrong_winding"]);
     assert_eq!(c.boundary.windings, [Some(1), Some(2)]);
-    assert_eq!(marked(&c, Fault::WINDING), (t.len()..t.len() + 6).collect::<Vec<_>>());
+    assert_eq!(
+        marked(&c, Fault::WINDING),
+        (t.len()..t.len() + 6).collect::<Vec<_>>()
+    );
 }
 
 #[test]
@@ -228,11 +264,19 @@ fn check_prints_json_and_marks_each_faulty_tetrahedron_in_a_vtu() {
     assert_eq!(out.status.code(), Some(1));
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(json["passes"], false);
-    assert_eq!(json["meshes"][0]["certificate"]["boundary"]["windings"][1], 2);
+    assert_eq!(
+        json["meshes"][0]["certificate"]["boundary"]["windings"][1],
+        2
+    );
 
     let mark = dir.path().join("marked.vtu");
     let out = halo4d(
-        &["check", file.to_str().unwrap(), "--mark", mark.to_str().unwrap()],
+        &[
+            "check",
+            file.to_str().unwrap(),
+            "--mark",
+            mark.to_str().unwrap(),
+        ],
         dir.path(),
     );
     assert_eq!(out.status.code(), Some(1));
@@ -242,10 +286,16 @@ fn check_prints_json_and_marks_each_faulty_tetrahedron_in_a_vtu() {
     assert!(bytes.starts_with(b"<?xml") && bytes.ends_with(b"</VTKFile>\n"));
 
     // A clean mesh passes and says why; --mark wants a .vtu, and a mesh of its own kind.
-    let out = halo4d(&["check", faults.join("cube.vtk").to_str().unwrap()], dir.path());
+    let out = halo4d(
+        &["check", faults.join("cube.vtk").to_str().unwrap()],
+        dir.path(),
+    );
     assert_eq!(out.status.code(), Some(0));
     assert!(String::from_utf8_lossy(&out.stdout).contains("ok: a valid tetrahedralization"));
-    let out = halo4d(&["check", file.to_str().unwrap(), "--mark", "x.vtk"], dir.path());
+    let out = halo4d(
+        &["check", file.to_str().unwrap(), "--mark", "x.vtk"],
+        dir.path(),
+    );
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("give a .vtu file"));
 }

@@ -394,7 +394,12 @@ mod tests {
 
     #[test]
     fn the_bvh_finds_every_crossing_pair_that_all_pairs_find() {
-        for by in [[1.5, 0.5, 0.5], [3.0, 0.0, 0.0], [0.5, 0.5, 0.5], [10.0, 0.0, 0.0]] {
+        for by in [
+            [1.5, 0.5, 0.5],
+            [3.0, 0.0, 0.0],
+            [0.5, 0.5, 0.5],
+            [10.0, 0.0, 0.0],
+        ] {
             let (faces, positions) = two_cubes(by);
             let (b, _) = judge(&faces, &positions);
             let at = |i: u32| positions[i as usize];

@@ -58,6 +58,10 @@ mod tests {
         assert_eq!(c.stats.inverted + c.stats.flat, 0);
         assert!(c.failures().is_empty(), "{:?}", c.failures());
         assert_eq!(c.boundary.faces, 6 * 9 * 2);
-        assert!((c.stats.volume - 27.0).abs() < 1e-12 * 27.0, "{}", c.stats.volume);
+        assert!(
+            (c.stats.volume - 27.0).abs() < 1e-12 * 27.0,
+            "{}",
+            c.stats.volume
+        );
     }
 }

@@ -63,9 +63,15 @@ pub fn write_tetrahedra_vtu(
         offsets.push(at);
         at += 8 + s;
     }
+    // Scalars without NumberOfComponents, which meshio would read as columns of one.
     let array = |ty: &str, name: &str, components: usize, offset: usize| {
+        let components = if components > 1 {
+            format!(" NumberOfComponents=\"{components}\"")
+        } else {
+            String::new()
+        };
         format!(
-            "        <DataArray type=\"{ty}\" Name=\"{name}\" NumberOfComponents=\"{components}\" format=\"appended\" offset=\"{offset}\"/>\n"
+            "        <DataArray type=\"{ty}\" Name=\"{name}\"{components} format=\"appended\" offset=\"{offset}\"/>\n"
         )
     };
     let mut head = String::from(
