@@ -352,11 +352,11 @@ fn certificate_text(c: &Certificate) -> String {
     out += "  radius ratio histogram\n";
     for bin in &q.radius_ratio_histogram {
         let bar = "#".repeat((40 * bin.count).div_ceil(most));
-        let _ = writeln!(
-            out,
+        let line = format!(
             "    {:.1} to {:.1}  {:>10}  {bar}",
             bin.from, bin.to, bin.count
         );
+        let _ = writeln!(out, "{}", line.trim_end());
     }
     out += "  worst (smallest radius ratio)\n";
     for w in q.worst.iter().take(5) {

@@ -6,12 +6,18 @@
 use crate::common::{fixture, halo4d};
 use halo4d::certify::{Certificate, Convention, Fault, certify, kuhn_cube};
 
-/// The names of a certificate's failures (`3 self_intersections (...)` is
-/// `self_intersections`).
+/// The names of a certificate's failures, each its first word that is a name
+/// (`3 self_intersections (...)` is `self_intersections`, `volume_defect 1e-3 (...)` is
+/// `volume_defect`).
 fn names(c: &Certificate) -> Vec<String> {
     c.failures()
         .iter()
-        .map(|f| f.split_whitespace().nth(1).unwrap_or("").to_string())
+        .map(|f| {
+            let word = f
+                .split_whitespace()
+                .find(|w| w.starts_with(char::is_alphabetic));
+            word.unwrap_or("").to_string()
+        })
         .collect()
 }
 

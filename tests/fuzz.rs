@@ -2045,7 +2045,7 @@ fn check_vtk(bytes: &[u8], tally: &Tally) -> Result<(), String> {
                 Ok(FileTetrahedra::Plain(plain)) => {
                     tally.add("read as plain tetrahedra");
                     plain_ok(&plain)?;
-                    let _ = halo4d::check::check_tetrahedra(&plain.positions, &plain.tets);
+                    let _ = halo4d::certify::certify(&plain.positions, &plain.tets);
                     Ok(())
                 }
                 Ok(FileTetrahedra::Halos(_)) => Err(format!(
@@ -2176,7 +2176,7 @@ fn check_mesh(
         Ok(m) => {
             tally.add("read");
             plain_ok(&m)?;
-            let _ = halo4d::check::check_tetrahedra(&m.positions, &m.tets);
+            let _ = halo4d::certify::certify(&m.positions, &m.tets);
             Ok(())
         }
         Err(e) => {

@@ -750,8 +750,11 @@ fn catalogue<'py>(py: Python<'py>) -> PyResult<Vec<Bound<'py, PyAny>>> {
 /// `halo4d check` on a file (a `.glb` or `.vtk`) or a build's folder: a dict with
 /// `verified`, `failures`, `halos` (each halo's name and the checker's statistics), for a
 /// folder the `curves` recomputed from its surfaces and the halos' `verification` against
-/// them, the `scene` the file records, `plain` (why a `.vtk` is not read as a halo, or None)
-/// and `text` (what the command prints). A file that cannot be read raises `OSError`.
+/// them, the `scene` the file records, `plain` (why a mesh is not read as a halo, or None),
+/// for another program's tetrahedral mesh (`.vtk`, `.vtu`, `.msh`, `.mesh`, `.node`/`.ele`)
+/// its `certificate` (`convention`, `boundary`, `quality`, and `faults`: each tetrahedron's
+/// fault bits) and `format`, and `text` (what the command prints). A file that cannot be
+/// read raises `OSError`.
 #[pyfunction]
 fn check<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
     let target = path.clone();
@@ -783,6 +786,12 @@ fn check<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
     }
     out.set_item("scene", checked.scene.clone())?;
     out.set_item("plain", checked.plain.clone())?;
+    if let Some(certificate) = &checked.certificate {
+        let entry = to_python(py, certificate)?;
+        entry.set_item("faults", certificate.faults.clone())?;
+        out.set_item("certificate", entry)?;
+    }
+    out.set_item("format", checked.mesh.as_ref().map(|m| m.format.clone()))?;
     out.set_item("text", checked.text())?;
     Ok(out.into_any())
 }

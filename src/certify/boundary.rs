@@ -321,7 +321,7 @@ fn winding(
     let g = mean(&[a, b, c]);
     let dir = [g[0] - p[0], g[1] - p[1], g[2] - p[2]];
     let len = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
-    if !(len > 0.0) {
+    if len.is_nan() || len <= 0.0 {
         return None;
     }
     // The positions lie within [-1, 1]^3: 4 away is past every face.

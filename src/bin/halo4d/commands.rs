@@ -401,11 +401,11 @@ pub fn check(args: CheckArgs) -> Outcome {
             return Ok(ExitCode::from(2));
         }
     };
-    if let Some(mark) = &args.mark {
-        if let Err(e) = c.write_marks(mark) {
-            eprintln!("error: {e}");
-            return Ok(ExitCode::from(2));
-        }
+    if let Some(mark) = &args.mark
+        && let Err(e) = c.write_marks(mark)
+    {
+        eprintln!("error: {e}");
+        return Ok(ExitCode::from(2));
     }
     if args.json {
         println!("{}", c.json());
