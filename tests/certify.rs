@@ -290,6 +290,16 @@ fn check_prints_json_and_marks_each_faulty_tetrahedron_in_a_vtu() {
     assert!(text.contains("wrong winding"), "{text}");
     let bytes = std::fs::read(&mark).unwrap();
     assert!(bytes.starts_with(b"<?xml") && bytes.ends_with(b"</VTKFile>\n"));
+    // The marked file reads back as the same mesh, with the same verdict and faults.
+    let original = halo4d::check_file(&file).unwrap();
+    let again = halo4d::check_file(&mark).unwrap();
+    assert_eq!(
+        again.mesh.as_ref().unwrap().tets,
+        original.mesh.as_ref().unwrap().tets
+    );
+    assert_eq!(again.failures(), original.failures());
+    let marks = |c: &halo4d::Checked| c.certificate.as_ref().unwrap().faults.clone();
+    assert_eq!(marks(&again), marks(&original));
 
     // A clean mesh passes and says why; --mark wants a .vtu, and a mesh of its own kind.
     let out = halo4d(
@@ -304,4 +314,32 @@ fn check_prints_json_and_marks_each_faulty_tetrahedron_in_a_vtu() {
     );
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("give a .vtu file"));
+}
+
+#[test]
+fn a_soup_of_ten_thousand_separate_tetrahedra_is_ten_thousand_components() {
+    // Every component's winding number is a few BVH queries, not a pass over every face:
+    // a pass each would be 10^4 components times 4 10^4 faces.
+    let corner = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let (mut p, mut t) = (Vec::new(), Vec::new());
+    for i in 0..10_000u32 {
+        let at = [(i % 100) as f64 * 2.0, (i / 100) as f64 * 2.0, 0.0];
+        p.extend(
+            corner
+                .iter()
+                .map(|q| [q[0] + at[0], q[1] + at[1], q[2] + at[2]]),
+        );
+        // (0, 1, 2, 3) turns clockwise seen from the corner: halo4d's positive order.
+        t.push([4 * i, 4 * i + 2, 4 * i + 1, 4 * i + 3]);
+    }
+    let c = certify(&p, &t);
+    assert!(c.failures().is_empty(), "{:?}", c.failures());
+    assert_eq!(c.convention, Convention::Positive);
+    assert_eq!((c.boundary.components, c.boundary.cavities), (10_000, 0));
+    assert!(c.boundary.windings.iter().all(|&w| w == Some(1)));
 }

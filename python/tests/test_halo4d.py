@@ -137,6 +137,20 @@ def test_write_gives_the_files_and_the_report_of_halo4d_build(cli_build, tmp_pat
     assert any("inverted" in f for f in checked["failures"]), checked["failures"]
 
 
+def test_any_tetrahedral_mesh_is_certified_with_its_faults_per_tetrahedron():
+    faults = ROOT / "fixtures" / "tetmeshes" / "faults"
+    clean = halo4d.check(faults / "cube.vtk")
+    assert clean["verified"] and clean["format"] == "legacy VTK ASCII", clean["failures"]
+    assert clean["certificate"]["boundary"]["windings"] == [1]
+    assert not any(clean["certificate"]["faults"])
+    nested = halo4d.check(faults / "nested-balls.vtk")
+    assert not nested["verified"]
+    assert nested["certificate"]["boundary"]["windings"] == [1, 2]
+    assert any(f.split()[1] == "wrong_winding" for f in nested["failures"]), nested["failures"]
+    marked = np.asarray(nested["certificate"]["faults"])
+    assert len(marked) == nested["halos"][0]["tets"] and np.count_nonzero(marked & 1024) > 0
+
+
 def test_the_picture_is_the_command_lines(cli_build, tmp_path):
     _, built = cli_build
     small = built.render(160, 120, samples=1)

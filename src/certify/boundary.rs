@@ -6,13 +6,14 @@
 use super::exact::{P, orient, point_in_triangle, segment_meets_triangle, triangles_meet};
 use crate::intersect::broad;
 use obvhs::aabb::Aabb;
+use obvhs::bvh2::Bvh2;
 use rayon::prelude::*;
 use serde::Serialize;
 
 /// How many faces of a component the winding number is tried from before it is left
-/// undecided: each try fails only where the ray from a point inside the face's tetrahedron
-/// passes exactly through an edge or a vertex of the boundary, or a face lies between the
-/// point and the face.
+/// undecided: each try fails only where all six rays from a point inside the face's
+/// tetrahedron pass exactly through an edge or a vertex of the boundary, or a face lies
+/// between the point and the face.
 const WINDING_TRIES: usize = 32;
 
 /// What the boundary is.
@@ -228,47 +229,37 @@ pub fn judge(faces: &[([u32; 3], u32)], positions: &[P]) -> (Boundary, FaceMarks
             firsts[c as usize].push(f as u32);
         }
     }
+    let shell = Shell {
+        tris: &tris,
+        component: &component,
+        bvh: &bvh,
+        boxes: &boxes,
+    };
     let windings: Vec<Option<(i64, i64)>> = firsts
-        .iter()
+        .par_iter()
         .map(|tries| {
-            tries.iter().find_map(|&f| {
-                winding(
-                    f as usize,
-                    faces[f as usize].1,
-                    &tris,
-                    &component,
-                    positions,
-                )
-            })
+            tries
+                .iter()
+                .find_map(|&f| winding(f as usize, faces[f as usize].1, &shell, positions))
         })
         .collect();
-    for (c, w) in windings.iter().enumerate() {
+    let mut component_marks = Vec::with_capacity(windings.len());
+    for w in &windings {
+        b.windings.push(w.map(|(total, _)| total));
         match w {
-            Some((total, own)) => {
-                b.windings.push(Some(*total));
-                if *total != 1 {
-                    b.wrong_winding += 1;
-                } else if *own == 0 {
-                    b.cavities += 1;
-                }
-            }
-            None => {
-                b.windings.push(None);
-                b.undecided_windings += 1;
-            }
+            Some((1, 0)) => b.cavities += 1,
+            Some((1, _)) => {}
+            Some(_) => b.wrong_winding += 1,
+            None => b.undecided_windings += 1,
         }
-        let fault = match w {
+        component_marks.push(match w {
             Some((1, 0)) => Fault::CAVITY,
             Some((1, _)) => 0,
             _ => Fault::WINDING,
-        };
-        if fault != 0 {
-            for (f, &k) in component.iter().enumerate() {
-                if k as usize == c {
-                    marks[f] |= fault;
-                }
-            }
-        }
+        });
+    }
+    for (mark, &c) in marks.iter_mut().zip(&component) {
+        *mark |= component_marks[c as usize];
     }
     (b, marks)
 }
@@ -289,19 +280,45 @@ fn fan_pieces(group: &[(u32, [u32; 2], u32)]) -> usize {
         .count()
 }
 
+/// The boundary faces as the winding number reads them: their corners, their components,
+/// and a BVH of their boxes.
+struct Shell<'a> {
+    tris: &'a [[P; 3]],
+    component: &'a [u32],
+    bvh: &'a Bvh2,
+    boxes: &'a [Aabb],
+}
+
+impl Shell<'_> {
+    /// The faces whose boxes meet the box of `a` and `b` (rounded outward: none is missed).
+    fn near(&self, a: P, b: P) -> Vec<u32> {
+        let lo = glam::DVec3::new(a[0].min(b[0]), a[1].min(b[1]), a[2].min(b[2]));
+        let hi = glam::DVec3::new(a[0].max(b[0]), a[1].max(b[1]), a[2].max(b[2]));
+        let query = broad::outward(lo, hi);
+        let mut out = Vec::new();
+        self.bvh.aabb_traverse(query, |bvh, node| {
+            let node = &bvh.nodes[node as usize];
+            let first = node.first_index as usize;
+            out.extend(
+                bvh.primitive_indices[first..first + node.prim_count as usize]
+                    .iter()
+                    .filter(|&&f| self.boxes[f as usize].intersect_aabb(&query)),
+            );
+            true
+        });
+        out
+    }
+}
+
 /// The winding number of the boundary at a point just inside face f (its tetrahedron's
 /// centroid, whose fourth vertex is `apex`), and that of f's own component alone; `None`
 /// when the centroid is not strictly inside its tetrahedron (rounded onto a face of a
-/// sliver), a boundary face lies between it and f, or the ray from it through f passes
-/// exactly through an edge or vertex.
-fn winding(
-    f: usize,
-    apex: u32,
-    tris: &[[P; 3]],
-    component: &[u32],
-    positions: &[P],
-) -> Option<(i64, i64)> {
-    let [a, b, c] = tris[f];
+/// sliver), a boundary face lies between it and f's centroid, or each of the six rays from
+/// it along the axes passes exactly through an edge or vertex. A ray along an axis meets
+/// only the faces whose boxes its line crosses, found in the BVH: each component costs a
+/// few queries, not a pass over every face.
+fn winding(f: usize, apex: u32, shell: &Shell, positions: &[P]) -> Option<(i64, i64)> {
+    let [a, b, c] = shell.tris[f];
     let d = positions[apex as usize];
     let mean = |ps: &[P]| {
         let n = ps.len() as f64;
@@ -319,28 +336,37 @@ fn winding(
         return None;
     }
     let g = mean(&[a, b, c]);
-    let dir = [g[0] - p[0], g[1] - p[1], g[2] - p[2]];
-    let len = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
-    if len.is_nan() || len <= 0.0 {
+    let blocked = shell
+        .near(p, g)
+        .into_iter()
+        .any(|j| j as usize != f && segment_meets_triangle(p, g, shell.tris[j as usize]));
+    if blocked {
         return None;
     }
-    // The positions lie within [-1, 1]^3: 4 away is past every face.
-    let q = [0, 1, 2].map(|k| p[k] + 4.0 * dir[k] / len);
-    let own = component[f];
-    // (total, own component's) crossings, or None on a degenerate one.
-    (0..tris.len())
-        .into_par_iter()
-        .map(|j| {
-            let t = tris[j];
-            if j != f && segment_meets_triangle(p, g, t) {
-                return None;
-            }
+    let own = shell.component[f];
+    'rays: for (axis, sign) in [
+        (0, 1.0),
+        (1, 1.0),
+        (2, 1.0),
+        (0, -1.0),
+        (1, -1.0),
+        (2, -1.0),
+    ] {
+        // The positions lie within [-1, 1]^3: 2 is past every face.
+        let mut q = p;
+        q[axis] = 2.0 * sign;
+        let (mut total, mut mine) = (0, 0);
+        for j in shell.near(p, q) {
+            let t = shell.tris[j as usize];
             let (op, oq) = (orient(t[0], t[1], t[2], p), orient(t[0], t[1], t[2], q));
             if op * oq > 0 {
-                return Some((0, 0));
+                continue;
             }
             if op == 0 || oq == 0 {
-                return (!segment_meets_triangle(p, q, t)).then_some((0, 0));
+                if segment_meets_triangle(p, q, t) {
+                    continue 'rays;
+                }
+                continue;
             }
             let s = [
                 orient(p, q, t[0], t[1]),
@@ -350,14 +376,17 @@ fn winding(
             if s.iter().all(|&x| x > 0) || s.iter().all(|&x| x < 0) {
                 // Leaving through an outward face counts +1.
                 let w = i64::from(op);
-                Some((w, if component[j] == own { w } else { 0 }))
+                total += w;
+                if shell.component[j as usize] == own {
+                    mine += w;
+                }
             } else if s.iter().all(|&x| x >= 0) || s.iter().all(|&x| x <= 0) {
-                None
-            } else {
-                Some((0, 0))
+                continue 'rays;
             }
-        })
-        .try_reduce(|| (0, 0), |x, y| Some((x.0 + y.0, x.1 + y.1)))
+        }
+        return Some((total, mine));
+    }
+    None
 }
 
 #[cfg(test)]
