@@ -3,22 +3,12 @@
 //! README names, faults planted exactly in Kuhn's cube are each caught, named and marked
 //! on the right tetrahedra, and a clean mesh passes at any scale.
 
-use crate::common::{fixture, halo4d};
+use crate::common::{failure_names, fixture, halo4d};
 use halo4d::certify::{Certificate, Convention, Fault, certify, kuhn_cube};
 
-/// The names of a certificate's failures, each its first word that is a name
-/// (`3 self_intersections (...)` is `self_intersections`, `volume_defect 1e-3 (...)` is
-/// `volume_defect`).
+/// The names of a certificate's failures.
 fn names(c: &Certificate) -> Vec<String> {
-    c.failures()
-        .iter()
-        .map(|f| {
-            let word = f
-                .split_whitespace()
-                .find(|w| w.starts_with(char::is_alphabetic));
-            word.unwrap_or("").to_string()
-        })
-        .collect()
+    failure_names(&c.failures())
 }
 
 /// The tetrahedra with fault bit `bit`.

@@ -63,6 +63,21 @@ impl Rng {
     }
 }
 
+/// The name of each failure of a verdict: its first word that is a name (`3
+/// self_intersections (...)` is `self_intersections`, `volume_defect 1e-3 (...)` is
+/// `volume_defect`).
+pub fn failure_names(failures: &[String]) -> Vec<String> {
+    failures
+        .iter()
+        .map(|f| {
+            let word = f
+                .split_whitespace()
+                .find(|w| w.starts_with(char::is_alphabetic));
+            word.unwrap_or("").to_string()
+        })
+        .collect()
+}
+
 /// Runs the `halo4d` binary with `args` in `dir`.
 pub fn halo4d(args: &[&str], dir: &Path) -> Output {
     halo4d_with(args, dir, &[])

@@ -2,7 +2,9 @@
 //! (by halo4d's readers and by the gltf crate) unchanged; faults planted in the files caught
 //! by `halo4d check`; malformed files rejected with errors, never panics.
 
-use crate::common::{Rng, assert_unreadable, fixture, fixture_scenes, halo4d, with_json};
+use crate::common::{
+    Rng, assert_unreadable, failure_names, fixture, fixture_scenes, halo4d, with_json,
+};
 use glam::{DVec3, Vec3};
 use halo4d::Scene;
 use halo4d::SurfaceProduct;
@@ -631,16 +633,7 @@ fn tetrahedra_without_the_halo_layout_are_certified_as_a_mesh() {
             assert!(stdout.contains(w), "{file}: `{w}` not in {stdout}");
         }
         let checked = halo4d::check_file(&dir.path().join(file)).unwrap();
-        let mut found: Vec<String> = checked
-            .failures()
-            .iter()
-            .map(|f| {
-                let word = f
-                    .split_whitespace()
-                    .find(|w| w.starts_with(char::is_alphabetic));
-                word.unwrap_or("").to_string()
-            })
-            .collect();
+        let mut found = failure_names(&checked.failures());
         found.sort();
         let mut want: Vec<&str> = names.to_vec();
         want.push("self_intersections");

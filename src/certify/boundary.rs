@@ -81,14 +81,11 @@ impl Sets {
     }
 }
 
-/// Judges the boundary faces (each a sorted vertex triple with the fourth vertex of its
-/// tetrahedron) on `positions` (scaled, as the checker's): the [`Boundary`] and each face's
-/// fault bits.
-pub fn judge(faces: &[([u32; 3], u32)], positions: &[P]) -> (Boundary, FaceMarks) {
-    use super::Fault;
+/// Each boundary face turned outward: away from its tetrahedron's fourth vertex (as it is
+/// where that tetrahedron is flat).
+fn outward(faces: &[([u32; 3], u32)], positions: &[P]) -> Vec<[u32; 3]> {
     let at = |i: u32| positions[i as usize];
-    // Each face turned outward: away from its tetrahedron's fourth vertex.
-    let outward: Vec<[u32; 3]> = faces
+    faces
         .par_iter()
         .map(|&(k, o)| {
             if orient(at(k[0]), at(k[1]), at(k[2]), at(o)) < 0 {
@@ -97,7 +94,16 @@ pub fn judge(faces: &[([u32; 3], u32)], positions: &[P]) -> (Boundary, FaceMarks
                 k
             }
         })
-        .collect();
+        .collect()
+}
+
+/// Judges the boundary faces (each a sorted vertex triple with the fourth vertex of its
+/// tetrahedron) on `positions` (scaled, as the checker's): the [`Boundary`] and each face's
+/// fault bits.
+pub fn judge(faces: &[([u32; 3], u32)], positions: &[P]) -> (Boundary, FaceMarks) {
+    use super::Fault;
+    let at = |i: u32| positions[i as usize];
+    let outward = outward(faces, positions);
     let mut b = Boundary {
         faces: faces.len(),
         ..Boundary::default()
@@ -431,17 +437,7 @@ mod tests {
         ] {
             let (faces, positions) = two_cubes(by);
             let (b, _) = judge(&faces, &positions);
-            let at = |i: u32| positions[i as usize];
-            let outward: Vec<[u32; 3]> = faces
-                .iter()
-                .map(|&(k, o)| {
-                    if orient(at(k[0]), at(k[1]), at(k[2]), at(o)) < 0 {
-                        [k[0], k[2], k[1]]
-                    } else {
-                        k
-                    }
-                })
-                .collect();
+            let outward = outward(&faces, &positions);
             let mut all = 0;
             for i in 0..outward.len() {
                 for j in i + 1..outward.len() {
@@ -464,20 +460,12 @@ mod tests {
             let (b, _) = judge(&faces, &positions);
             assert_eq!(b.undecided_windings, 0);
             let mut seen = Vec::new();
+            let out = outward(&faces, &positions);
+            let at = |i: u32| positions[i as usize];
             for &(k, o) in &faces {
-                let t = [k[0], k[1], k[2], o].map(|i| positions[i as usize]);
+                let t = [k[0], k[1], k[2], o].map(at);
                 let x = [0, 1, 2].map(|c| t.iter().map(|p| p[c]).sum::<f64>() / 4.0);
-                let sum: f64 = faces
-                    .iter()
-                    .map(|&(f, apex)| {
-                        let at = |i: u32| positions[i as usize];
-                        let mut f = f;
-                        if orient(at(f[0]), at(f[1]), at(f[2]), at(apex)) < 0 {
-                            f.swap(1, 2);
-                        }
-                        solid_angle(x, [at(f[0]), at(f[1]), at(f[2])])
-                    })
-                    .sum();
+                let sum: f64 = out.iter().map(|f| solid_angle(x, f.map(at))).sum();
                 seen.push(sum.round() as i64);
             }
             let mut expected: Vec<i64> = b.windings.iter().map(|w| w.unwrap()).collect();
