@@ -21,7 +21,9 @@
 //!   with four distinct vertices (`degenerate`) and no repeat (`duplicate_tets`); decided on
 //!   the coordinates scaled as a whole by a power of two, so that the predicates neither
 //!   overflow nor underflow, and counted `undecidable` where no scaling can do that;
-//! - every face in one or two tetrahedra (`overshared_faces`);
+//! - every face in one or two tetrahedra (`overshared_faces`), the fourth vertices of two on
+//!   opposite sides of it (`folded_faces`, from the orientations already decided: two
+//!   tetrahedra on one side of their face overlap, however each is listed);
 //! - each half of every quad over a surface edge (offset edge to surface edge) split along
 //!   one of its diagonals, the same way from both sides (`quad_mismatches`);
 //! - every surface triangle has exactly two offset faces on the boundary, each vertex of one
@@ -34,8 +36,8 @@
 //! - the tetrahedra's volumes add up to the volume the boundary encloses (`volume_defect`).
 //!
 //! Tetrahedra without the layout (another program's mesh) get the checks that need none
-//! ([`check_tetrahedra`]): orientation, degenerate and repeated tetrahedra, overshared
-//! faces, and the volume.
+//! ([`check_tetrahedra`]): orientation, degenerate and repeated tetrahedra, overshared and
+//! folded faces, and the volume; [`crate::certify`] goes on from there to the boundary.
 
 use crate::limits::VOLUME_DEFECT;
 use rayon::prelude::*;
