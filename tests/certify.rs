@@ -202,6 +202,9 @@ fn faults_planted_exactly_in_kuhns_cube_are_caught_named_and_marked() {
         c.failures()
     );
 
+    // No tetrahedra at all: vacuously valid, but not what anyone meant to check.
+    assert_eq!(names(&certify(&p, &[])), ["tetrahedra"]);
+
     // Two cubes apart pass; overlapping, their boundaries cross and the overlap is wound
     // twice; one inside the other, the inner one is wound twice.
     let far = joined(kuhn_cube(4), (translated(&p, [10.0, 0.0, 0.0]), t.clone()));

@@ -121,11 +121,16 @@ pub struct Certificate {
 }
 
 impl Certificate {
-    /// What keeps the mesh from passing: [`CheckStats::failures`], then each non-zero count
-    /// of the boundary's faults as `<count> <name>`; empty when it passes.
+    /// What keeps the mesh from passing: [`CheckStats::failures`], a mesh without
+    /// tetrahedra, then each non-zero count of the boundary's faults as `<count> <name>`;
+    /// empty when it passes.
     pub fn failures(&self) -> Vec<String> {
         let b = &self.boundary;
         let mut out = self.stats.failures();
+        // An empty mesh is vacuously valid, and almost surely not what was meant.
+        if self.stats.tets == 0 {
+            out.push("0 tetrahedra (the file holds none to check)".into());
+        }
         for (name, count, what) in [
             (
                 "nonmanifold_edges",
