@@ -18,7 +18,7 @@ fn marked(c: &Certificate, bit: u32) -> Vec<usize> {
         .collect()
 }
 
-/// Every vertex index of `tets` and the coordinates of `p`, moved to make room for more.
+/// The positions `p` moved by `by`.
 fn translated(p: &[[f64; 3]], by: [f64; 3]) -> Vec<[f64; 3]> {
     p.iter()
         .map(|q| [q[0] + by[0], q[1] + by[1], q[2] + by[2]])

@@ -176,16 +176,17 @@ pub fn judge(faces: &[([u32; 3], u32)], positions: &[P]) -> (Boundary, FaceMarks
     let boxes: Vec<Aabb> = tris
         .iter()
         .map(|t| {
-            let lo = (0..3).map(|k| t.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min));
-            let hi = (0..3).map(|k| t.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max));
-            let (lo, hi): (Vec<f64>, Vec<f64>) = (lo.collect(), hi.collect());
-            broad::outward(
-                glam::DVec3::new(lo[0], lo[1], lo[2]),
-                glam::DVec3::new(hi[0], hi[1], hi[2]),
-            )
+            let [a, b, c] = t.map(glam::DVec3::from);
+            broad::outward(a.min(b).min(c), a.max(b).max(c))
         })
         .collect();
     let bvh = broad::build(&boxes, 4);
+    let shell = Shell {
+        tris: &tris,
+        component: &component,
+        bvh: &bvh,
+        boxes: &boxes,
+    };
 
     // Hanging vertices: a boundary vertex on a boundary face that is not its own.
     let mut vertices: Vec<u32> = outward.iter().flatten().copied().collect();
@@ -195,18 +196,13 @@ pub fn judge(faces: &[([u32; 3], u32)], positions: &[P]) -> (Boundary, FaceMarks
         .par_iter()
         .filter_map(|&v| {
             let x = at(v);
-            let probe = broad::outward(x.into(), x.into());
-            let mut on = Vec::new();
-            bvh.aabb_traverse(probe, |bvh, node| {
-                let node = &bvh.nodes[node as usize];
-                let first = node.first_index as usize;
-                for &f in &bvh.primitive_indices[first..first + node.prim_count as usize] {
-                    if !outward[f as usize].contains(&v) && point_in_triangle(x, tris[f as usize]) {
-                        on.push(f);
-                    }
-                }
-                true
-            });
+            let on: Vec<u32> = shell
+                .near(x, x)
+                .into_iter()
+                .filter(|&f| {
+                    !outward[f as usize].contains(&v) && point_in_triangle(x, tris[f as usize])
+                })
+                .collect();
             (!on.is_empty()).then_some(on)
         })
         .collect();
@@ -235,12 +231,6 @@ pub fn judge(faces: &[([u32; 3], u32)], positions: &[P]) -> (Boundary, FaceMarks
             firsts[c as usize].push(f as u32);
         }
     }
-    let shell = Shell {
-        tris: &tris,
-        component: &component,
-        bvh: &bvh,
-        boxes: &boxes,
-    };
     let windings: Vec<Option<(i64, i64)>> = firsts
         .par_iter()
         .map(|tries| {

@@ -23,10 +23,18 @@ impl CellValues<'_> {
         }
     }
 
-    fn bytes(&self) -> Vec<u8> {
+    fn len(&self) -> usize {
         match self {
-            CellValues::U32(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
-            CellValues::F32(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
+            CellValues::U32(v) => v.len(),
+            CellValues::F32(v) => v.len(),
+        }
+    }
+
+    /// The values, little-endian, each 4 bytes wide.
+    fn write(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        match self {
+            CellValues::U32(v) => v.iter().try_for_each(|x| w.write_all(&x.to_le_bytes())),
+            CellValues::F32(v) => v.iter().try_for_each(|x| w.write_all(&x.to_le_bytes())),
         }
     }
 }
@@ -41,10 +49,7 @@ pub fn write_tetrahedra_vtu(
     fields: &[(&str, CellValues)],
 ) -> std::io::Result<()> {
     for (name, values) in fields {
-        let n = match values {
-            CellValues::U32(v) => v.len(),
-            CellValues::F32(v) => v.len(),
-        };
+        let n = values.len();
         if n != tets.len() {
             return Err(std::io::Error::other(format!(
                 "cell field {name} has {n} values for {} tetrahedra",
@@ -113,7 +118,7 @@ pub fn write_tetrahedra_vtu(
         w.write_all(&vec![10u8; nt])?;
         for ((_, values), &size) in fields.iter().zip(&sizes[4..]) {
             block(w, size)?;
-            w.write_all(&values.bytes())?;
+            values.write(w)?;
         }
         w.write_all(b"\n  </AppendedData>\n</VTKFile>\n")
     })
