@@ -240,6 +240,29 @@ fn a_budget_refines_the_worst_triangles_first() {
 }
 
 #[test]
+fn one_patch_refines_to_the_same_mesh_on_any_number_of_threads() {
+    // The spun trefoil is one patch: its queued triangles are checked in batches on the
+    // cores, and the splits stay in the queue's order.
+    let s = Surface::SpunTrefoil(SpunTrefoil::default());
+    let tol = 2e-4 * bounding_diagonal(&s);
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| sample_adaptive(&s, tol, 1_000_000))
+    };
+    let one = on(1);
+    assert!(one.complete);
+    assert!(
+        one.mesh.triangles.len() > 50_000,
+        "{}",
+        one.mesh.triangles.len()
+    );
+    assert!(one.mesh == on(3).mesh);
+}
+
+#[test]
 fn refinement_stops_at_the_shortest_edge_the_files_resolve() {
     // The 9-twist-spun trefoil is so tangled that refinement in the order of a plain queue
     // once piled 600,000 triangles onto points that f32 cannot tell apart, and the curves

@@ -31,8 +31,10 @@
 //! triangle left is within a factor of about 4 of the best error the budget allows, not
 //! fine in one place and coarse in another. Patches refine in parallel, each within a share
 //! of the budget in proportion to its failing triangles (the mesh does not depend on the
-//! number of threads); between rounds every new side point is inserted on the sides glued
-//! to it, so seams
+//! number of threads); within a patch, the triangles queued unchecked are checked in
+//! batches on the cores, the splits staying in the queue's order (so the mesh is the same
+//! as one thread checking them in turn). Between rounds every new side point is inserted
+//! on the sides glued to it, so seams
 //! conform: side points are dyadic fractions of the side (the starting grids have powers of
 //! two of cells, and splits halve), and the glue maps (σ ↦ offset ± σ with offsets that are
 //! multiples of 1/2) send them to dyadic fractions exactly. At the end the patches are
@@ -367,21 +369,48 @@ enum Verdict {
 }
 
 /// A triangle in the refinement's queue. A triangle made by a split is queued unchecked on
-/// its parent's level, behind the triangles already there, and checked only when it comes
-/// first: most are split away by their neighbours' refinement before, and never need the
-/// check.
+/// its parent's level, behind the triangles already there. When the first of them comes to
+/// the front, every unchecked triangle of the level that is still standing is checked at
+/// once, on the cores (a check reads the triangulation and evaluates the surface, and
+/// changes nothing; the splits that follow stay in the queue's order, so the mesh does not
+/// depend on the number of threads).
 #[derive(Clone, Copy)]
 struct Queued {
     face: Face,
-    /// Whether the triangle failed its check (else it is still to check).
-    checked: bool,
-    /// Which edges to split (when checked), bit k for the edge from corner k.
-    edges: u8,
+    check: Check,
+}
+
+/// What a queued triangle's check found.
+#[derive(Clone, Copy)]
+enum Check {
+    /// Not checked yet.
+    Due,
+    /// It passes.
+    Passed,
+    /// It fails: the edges to split (bit k for the edge from corner k) and its level.
+    Failed { edges: u8, level: usize },
+}
+
+impl Check {
+    fn of(verdict: Verdict, tolerance: f64) -> Check {
+        match verdict {
+            Verdict::Pass => Check::Passed,
+            Verdict::Split { edges, score } => Check::Failed {
+                edges: edges.iter().fold(0, |m, &k| m | 1 << k),
+                level: level(score, tolerance),
+            },
+        }
+    }
 }
 
 /// A triangle of a patch's triangulation: the face that held it and its corners (the face
 /// holds another triangle once a split has changed it).
 type Face = (FixedFaceHandle<InnerTag>, [FixedVertexHandle; 3]);
+
+/// Queued triangles checked together: enough to keep the cores busy, few enough that not
+/// many of them are split away by the triangles ahead of them before their turn (their
+/// check is then wasted).
+const CHECK_BATCH: usize = 2048;
 
 /// Levels of the refinement's queue.
 const LEVELS: usize = 64;
@@ -446,12 +475,9 @@ impl Patch {
     /// Checks a triangle and queues it on its level when it fails.
     fn queue_checked(&mut self, surface: &Surface, patch: usize, tolerance: f64, face: Face) {
         let t = face.1.map(|h| h.index());
-        if let Verdict::Split { edges, score } = self.check(surface, patch, tolerance, t) {
-            self.queue[level(score, tolerance)].push_back(Queued {
-                face,
-                checked: true,
-                edges: edges.iter().fold(0, |m, &k| m | 1 << k),
-            });
+        let check = Check::of(self.check(surface, patch, tolerance, t), tolerance);
+        if let Check::Failed { level, .. } = check {
+            self.queue[level].push_back(Queued { face, check });
         }
     }
 
@@ -511,31 +537,27 @@ impl Patch {
             if at == floor {
                 return true;
             }
-            let Some(mut q) = self.queue[at].pop_front() else {
+            let Some(q) = self.queue[at].pop_front() else {
                 continue;
             };
             let (t, tri) = (q.face.1.map(|h| h.index()), q.face.1);
             if !self.alive(q.face) {
                 continue;
             }
-            if !q.checked {
-                let Verdict::Split { edges, score } =
-                    self.check(cx.surface, patch, cx.tolerance, t)
-                else {
-                    continue;
-                };
-                let real = level(score, cx.tolerance);
-                q = Queued {
-                    face: q.face,
-                    checked: true,
-                    edges: edges.iter().fold(0, |m, &k| m | 1 << k),
-                };
-                if real < at {
-                    self.queue[real].push_back(q);
+            let split = match q.check {
+                Check::Due => {
+                    self.queue[at].push_front(q);
+                    self.check_level(patch, cx, at);
                     continue;
                 }
-            }
-            let mut edges: Vec<usize> = (0..3).filter(|k| q.edges & 1 << k != 0).collect();
+                Check::Passed => continue,
+                Check::Failed { level, .. } if level < at => {
+                    self.queue[level].push_back(q);
+                    continue;
+                }
+                Check::Failed { edges, .. } => edges,
+            };
+            let mut edges: Vec<usize> = (0..3).filter(|k| split & 1 << k != 0).collect();
             edges.retain(|&k| (self.p[t[k]] - self.p[t[(k + 1) % 3]]).length() >= cx.min_edge);
             if edges.is_empty() {
                 self.stuck += 1;
@@ -566,11 +588,26 @@ impl Patch {
             for face in self.pending.drain(..) {
                 self.queue[at].push_back(Queued {
                     face,
-                    checked: false,
-                    edges: 0,
+                    check: Check::Due,
                 });
             }
         }
+    }
+
+    /// Checks the unchecked triangles still standing among the first [`CHECK_BATCH`] of level
+    /// `at`, on the cores.
+    fn check_level(&mut self, patch: usize, cx: &Context, at: usize) {
+        let mut queue = std::mem::take(&mut self.queue[at]);
+        let this = &*self;
+        queue
+            .par_iter_mut()
+            .take(CHECK_BATCH)
+            .filter(|q| matches!(q.check, Check::Due) && this.alive(q.face))
+            .for_each(|q| {
+                let t = q.face.1.map(|h| h.index());
+                q.check = Check::of(this.check(cx.surface, patch, cx.tolerance, t), cx.tolerance);
+            });
+        self.queue[at] = queue;
     }
 
     /// Splits the edge from `sa` to `sb` (normalized parameters) at its midpoint, or the

@@ -257,6 +257,69 @@ impl Jet {
     }
 }
 
+/// The numbers a surface's formula is written over once and evaluated twice: as plain
+/// values (`f64`, for a point alone, which the samplers and the audit ask for millions of
+/// times) and as [`Jet`]s (for a point with its derivatives). Each operation computes the
+/// value the same way in both, so a point is the same bits either way.
+pub trait Real:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Neg<Output = Self>
+    + Add<f64, Output = Self>
+    + Sub<f64, Output = Self>
+    + Mul<f64, Output = Self>
+{
+    /// A constant.
+    fn constant(v: f64) -> Self;
+    /// The value.
+    fn value(self) -> f64;
+    /// sin and cos, from one evaluation.
+    fn sin_cos(self) -> (Self, Self);
+    /// Square.
+    fn sqr(self) -> Self;
+    /// Cube.
+    fn cube(self) -> Self;
+}
+
+impl Real for f64 {
+    fn constant(v: f64) -> Self {
+        v
+    }
+    fn value(self) -> f64 {
+        self
+    }
+    fn sin_cos(self) -> (Self, Self) {
+        f64::sin_cos(self)
+    }
+    fn sqr(self) -> Self {
+        self * self
+    }
+    fn cube(self) -> Self {
+        self * self * self
+    }
+}
+
+impl Real for Jet {
+    fn constant(v: f64) -> Self {
+        Jet::constant(v)
+    }
+    fn value(self) -> f64 {
+        self.v
+    }
+    fn sin_cos(self) -> (Self, Self) {
+        let (s, c) = self.v.sin_cos();
+        (self.chain(s, c, -s), self.chain(c, -s, -c))
+    }
+    fn sqr(self) -> Self {
+        Jet::sqr(self)
+    }
+    fn cube(self) -> Self {
+        Jet::cube(self)
+    }
+}
+
 impl From<f64> for Jet {
     fn from(v: f64) -> Self {
         Jet::constant(v)

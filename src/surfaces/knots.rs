@@ -20,8 +20,9 @@
 //! on that line, and the pieces meet it vertically to second order, so the turned arc stays
 //! embedded and the surface stays twice differentiable.
 
-use super::{Domain, Eval4, Jet, Parametric, Side, SideRule, Topology};
+use super::{Domain, Eval4, Jet, Parametric, Real, Side, SideRule, Topology};
 use crate::limits::{FieldError, SURFACE_LENGTH, TWISTS};
+use glam::DVec4;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, TAU};
 
@@ -68,71 +69,78 @@ fn joins() -> Vec<f64> {
 }
 
 /// Quintic smoothstep 6t^5 - 15t^4 + 10t^3: first and second derivatives vanish at 0 and 1.
-fn smoothstep(t: Jet) -> Jet {
+fn smoothstep<T: Real>(t: T) -> T {
     t.cube() * ((t * 6.0 - 15.0) * t + 10.0)
 }
 
 /// The knotted arc at s in [0, 1]: (x, y, c), and whether the point belongs to the knotted
 /// part that the twist turns.
-fn arc(s: Jet) -> ([Jet; 3], bool) {
+fn arc<T: Real>(s: T) -> ([T; 3], bool) {
     let g = s * total();
     let mut start = 0.0;
     let mut piece = PIECES.len() - 1;
     for (i, len) in PIECES.iter().enumerate() {
-        if g.v <= start + len || i == PIECES.len() - 1 {
+        if g.value() <= start + len || i == PIECES.len() - 1 {
             piece = i;
             break;
         }
         start += len;
     }
     let t = (g - start) * (1.0 / PIECES[piece]);
-    let c = Jet::constant;
+    let c = T::constant;
     let braid = || smoothstep(t) * (3.0 * PI);
     let climb = t * (H1 - H0) + H0;
     match piece {
         0 => ([c(-D), c(0.0), t * H0], false),
         1 => {
-            let phi = braid();
-            ([phi.cos() * -D, phi.sin() * -D, climb], true)
+            let (sin, cos) = braid().sin_cos();
+            ([cos * -D, sin * -D, climb], true)
         }
         2 => {
-            let psi = t * TAU;
-            let out = ((1.0 - psi.cos()) * 0.5).sqr() * LOOP_REACH + D;
-            (
-                [out, c(0.0), t * -(H1 - H0) + H1 + psi.sin() * LOOP_RISE],
-                true,
-            )
+            let (sin, cos) = (t * TAU).sin_cos();
+            let out = ((c(1.0) - cos) * 0.5).sqr() * LOOP_REACH + D;
+            ([out, c(0.0), t * -(H1 - H0) + H1 + sin * LOOP_RISE], true)
         }
         3 => {
-            let phi = braid();
-            ([phi.cos() * D, phi.sin() * D, climb], true)
+            let (sin, cos) = braid().sin_cos();
+            ([cos * D, sin * D, climb], true)
         }
         4 => ([c(-D), c(0.0), t * (H2 - H1) + H1], false),
         _ => {
-            let height = (t * ARCH_SPEED + H2) * (1.0 - t.cube());
+            let height = (t * ARCH_SPEED + H2) * (c(1.0) - t.cube());
             ([smoothstep(t) * -ARCH_REACH - D, c(0.0), height], false)
         }
     }
 }
 
 /// Spins the arc: s in [0, 1] along the arc (u), θ in [0, 2π] around the plane (v), with the
-/// knotted part turned by `twists` θ about the line x = -d.
-fn spin(scale: f64, twists: u32, s: f64, theta: f64) -> Eval4 {
-    let (s, theta) = (Jet::u(s), Jet::v(theta));
+/// knotted part turned by `twists` θ about the line x = -d. Over `f64` it gives the point,
+/// over [`Jet`]s the point with its derivatives.
+fn spin<T: Real>(scale: f64, twists: u32, s: T, theta: T) -> [T; 4] {
     let ([mut x, mut y, c], knotted) = arc(s);
     if knotted && twists > 0 {
-        let turn = theta * twists as f64;
-        let (cos, sin) = (turn.cos(), turn.sin());
+        let (sin, cos) = (theta * twists as f64).sin_cos();
         let dx = x + D;
         x = dx * cos - y * sin - D;
         y = dx * sin + y * cos;
     }
-    Eval4::from_jets([
+    let (sin, cos) = theta.sin_cos();
+    [
         (x - X_CENTRE) * scale,
         y * scale,
-        c * theta.cos() * scale,
-        c * theta.sin() * scale,
-    ])
+        c * cos * scale,
+        c * sin * scale,
+    ]
+}
+
+/// [`spin`] with its derivatives in (u, v) = (s, θ).
+fn spin_eval(scale: f64, twists: u32, s: f64, theta: f64) -> Eval4 {
+    Eval4::from_jets(spin(scale, twists, Jet::u(s), Jet::v(theta)))
+}
+
+/// [`spin`]'s point alone.
+fn spin_point(scale: f64, twists: u32, s: f64, theta: f64) -> DVec4 {
+    DVec4::from_array(spin(scale, twists, s, theta))
 }
 
 fn sphere_domain() -> Domain {
@@ -179,7 +187,10 @@ impl Parametric for SpunTrefoil {
         sphere_domain()
     }
     fn eval(&self, _: usize, u: f64, v: f64) -> Eval4 {
-        spin(self.scale, 0, u, v)
+        spin_eval(self.scale, 0, u, v)
+    }
+    fn point(&self, _: usize, u: f64, v: f64) -> DVec4 {
+        spin_point(self.scale, 0, u, v)
     }
     fn topology(&self) -> Topology {
         SPHERE
@@ -217,7 +228,10 @@ impl Parametric for TwistSpunTrefoil {
         sphere_domain()
     }
     fn eval(&self, _: usize, u: f64, v: f64) -> Eval4 {
-        spin(self.scale, self.twists, u, v)
+        spin_eval(self.scale, self.twists, u, v)
+    }
+    fn point(&self, _: usize, u: f64, v: f64) -> DVec4 {
+        spin_point(self.scale, self.twists, u, v)
     }
     fn topology(&self) -> Topology {
         SPHERE
@@ -240,11 +254,32 @@ mod tests {
     fn polyline(angle: f64, n: usize) -> Vec<[f64; 3]> {
         (0..=n)
             .map(|i| {
-                let p = spin(1.0, 1, i as f64 / n as f64, angle);
+                let p = spin_point(1.0, 1, i as f64 / n as f64, angle);
                 // Undo the spin: radius in the zw plane is c.
-                [p.p.x, p.p.y, (p.p.z * p.p.z + p.p.w * p.p.w).sqrt()]
+                [p.x, p.y, (p.z * p.z + p.w * p.w).sqrt()]
             })
             .collect()
+    }
+
+    #[test]
+    fn points_are_the_values_of_the_jets_bit_for_bit() {
+        // Every piece of the arc, and parameters on both sides of each join.
+        let mut us: Vec<f64> = (0..=997).map(|i| f64::from(i) / 997.0).collect();
+        for j in joins() {
+            us.extend([j.next_down(), j, j.next_up()]);
+        }
+        for twists in [0, 2, 5] {
+            for &u in &us {
+                for k in 0..13 {
+                    let v = f64::from(k) * 0.53;
+                    let (p, e) = (spin_point(0.4, twists, u, v), spin_eval(0.4, twists, u, v));
+                    assert_eq!(
+                        p.to_array().map(f64::to_bits),
+                        e.p.to_array().map(f64::to_bits)
+                    );
+                }
+            }
+        }
     }
 
     #[test]

@@ -19,7 +19,7 @@ mod simple;
 
 pub use formula::{Bound, Formula, FormulaEdge, FormulaSeam, FormulaSides, FormulaSource};
 pub use holomorphic::{Fermat, ProductPolynomial};
-pub use jet::Jet;
+pub use jet::{Jet, Real};
 pub use knots::{SpunTrefoil, TwistSpunTrefoil};
 pub use simple::{FlatTorus, KleinBottle, Patches, ProjectivePlane};
 
