@@ -126,10 +126,25 @@ pub struct Renderer {
     /// The model's passes, when the renderer turns a model in 4D.
     turner: Option<Turner>,
     stipple_pipeline: wgpu::RenderPipeline,
-    /// The stipples, once given: (per stipple, per triangle's area ratio, how many).
-    stipples: Option<(wgpu::Buffer, wgpu::Buffer, u32)>,
+    stipple_place: wgpu::ComputePipeline,
+    /// The stipples, once given.
+    stipples: Option<StippleBuffers>,
     /// A hyperplane's slice, once given: (points, segments, how many segments).
     slice: Option<(wgpu::Buffer, wgpu::Buffer, u32)>,
+}
+
+/// The stipples on the GPU: the set, and what one frame decides to draw of it.
+struct StippleBuffers {
+    /// Per stipple (triangle, rank, barycentric coordinates).
+    instances: wgpu::Buffer,
+    /// Per triangle, its surface's 4D area over its own.
+    ratio: wgpu::Buffer,
+    /// How many stipples there are.
+    count: u32,
+    /// The stipples a frame draws (clip position and colour, 32 bytes each), room for all.
+    placed: wgpu::Buffer,
+    /// Their indirect draw: three vertices per placed stipple.
+    draw: wgpu::Buffer,
 }
 
 /// The asset's buffers on the GPU.
@@ -212,6 +227,7 @@ struct Pipelines {
     cut: wgpu::RenderPipeline,
     voxelize: wgpu::ComputePipeline,
     stipple_pipeline: wgpu::RenderPipeline,
+    stipple_place: wgpu::ComputePipeline,
 }
 
 impl Pipelines {
@@ -339,14 +355,18 @@ impl Pipelines {
             None,
         );
         let cut = cut_pipeline(device, &module);
-        let voxelize = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("voxelize"),
-            layout: None,
-            module: &module,
-            entry_point: Some("voxelize"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let compute = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: None,
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let voxelize = compute("voxelize");
+        let stipple_place = compute("stipple_place");
         Pipelines {
             surface_grid,
             surface_view,
@@ -360,6 +380,7 @@ impl Pipelines {
             cut,
             voxelize,
             stipple_pipeline,
+            stipple_place,
         }
     }
 }
@@ -401,6 +422,7 @@ impl Renderer {
             cut,
             voxelize,
             stipple_pipeline,
+            stipple_place,
         } = Pipelines::new(device, colour_format);
         let empty_grid = device
             .create_texture(&wgpu::TextureDescriptor {
@@ -452,6 +474,7 @@ impl Renderer {
             targets: None,
             turner: None,
             stipple_pipeline,
+            stipple_place,
             stipples: None,
             slice: None,
         })
@@ -477,7 +500,27 @@ impl Renderer {
             bytemuck::cast_slice(&set.area_ratio),
             wgpu::BufferUsages::STORAGE,
         )?;
-        self.stipples = Some((instances, ratio, set.len() as u32));
+        // Room for every stipple (one at least: a binding is never empty).
+        let placed_size = 32 * set.len().max(1) as u64;
+        gpu.fits("placed stipples", placed_size, wgpu::BufferUsages::STORAGE)?;
+        let placed = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("placed stipples"),
+            size: placed_size,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let draw = gpu.buffer(
+            "stipple draw",
+            bytemuck::cast_slice(&[0u32, 1, 0, 0]),
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+        )?;
+        self.stipples = Some(StippleBuffers {
+            instances,
+            ratio,
+            count: set.len() as u32,
+            placed,
+            draw,
+        });
         Ok(())
     }
 
@@ -819,7 +862,8 @@ impl Renderer {
         }
     }
 
-    /// The stipples, on the opaque surfaces drawn before.
+    /// The stipples, on the opaque surfaces drawn before: each decided once, on the GPU's
+    /// compute units, then the drawn ones by an indirect draw.
     fn stipples_pass(
         &self,
         gpu: &Gpu,
@@ -827,28 +871,47 @@ impl Renderer {
         target: &wgpu::TextureView,
         targets: &Targets,
     ) {
-        let Some((instances, ratio, count)) = &self.stipples else {
+        let Some(stipples) = &self.stipples else {
             return;
         };
+        // No stipple placed yet; one instance of what will be.
+        gpu.queue
+            .write_buffer(&stipples.draw, 0, bytemuck::cast_slice(&[0u32, 1, 0, 0]));
+        if stipples.count > 0 {
+            let bind = self.bind(
+                gpu,
+                self.stipple_place.get_bind_group_layout(0),
+                &[
+                    (1, self.vertices.as_entire_binding()),
+                    (13, self.face_normals.as_entire_binding()),
+                    (14, wgpu::BindingResource::TextureView(&targets.depth_view)),
+                    (16, stipples.instances.as_entire_binding()),
+                    (17, self.triangles.as_entire_binding()),
+                    (18, stipples.ratio.as_entire_binding()),
+                    (19, stipples.placed.as_entire_binding()),
+                    (20, stipples.draw.as_entire_binding()),
+                ],
+            );
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.stipple_place);
+            pass.set_bind_group(0, &bind, &[]);
+            let groups = stipples.count.div_ceil(64);
+            let max = gpu.limits().max_compute_workgroups_per_dimension.max(1);
+            pass.dispatch_workgroups(groups.min(max), groups.div_ceil(max), 1);
+        }
+        let bind = self.bind(
+            gpu,
+            self.stipple_pipeline.get_bind_group_layout(0),
+            &[(21, stipples.placed.as_entire_binding())],
+        );
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("stipples"),
             color_attachments: &[attachment(target, false, wgpu::Color::WHITE)],
             ..Default::default()
         });
-        self.draw(
-            gpu,
-            &mut pass,
-            &self.stipple_pipeline,
-            &[
-                (1, self.vertices.as_entire_binding()),
-                (13, self.face_normals.as_entire_binding()),
-                (14, wgpu::BindingResource::TextureView(&targets.depth_view)),
-                (16, instances.as_entire_binding()),
-                (17, self.triangles.as_entire_binding()),
-                (18, ratio.as_entire_binding()),
-            ],
-            (0..3 * *count, 0..1),
-        );
+        pass.set_pipeline(&self.stipple_pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.draw_indirect(&stipples.draw, 0);
     }
 
     /// The transparency composite, then the curves and silhouettes.

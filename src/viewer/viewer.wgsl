@@ -64,6 +64,10 @@ struct View {
 @group(0) @binding(17) var<storage, read> triangle_indices: array<u32>;
 // Per triangle, its surface's 4D area over its own.
 @group(0) @binding(18) var<storage, read> area_ratio: array<f32>;
+// The stipples placed this frame: written by `stipple_place` (19, 20), drawn from 21.
+@group(0) @binding(19) var<storage, read_write> placing: array<Placed>;
+@group(0) @binding(20) var<storage, read_write> stipple_draw: StippleDraw;
+@group(0) @binding(21) var<storage, read> placed: array<Placed>;
 
 const QUANTUM: f32 = 2147483648.0;
 const INK: vec3<f32> = vec3<f32>(0.02, 0.02, 0.02);
@@ -644,6 +648,20 @@ struct Stipple {
     bary: vec2<f32>,
 }
 
+// A stipple `stipple_place` decided to draw: its disc's centre in clip space and its colour.
+struct Placed {
+    clip: vec4<f32>,
+    colour: vec4<f32>,
+}
+
+// The stipples' indirect draw (wgpu's DrawIndirectArgs): three vertices per placed stipple.
+struct StippleDraw {
+    vertex_count: atomic<u32>,
+    instance_count: u32,
+    first_vertex: u32,
+    first_instance: u32,
+}
+
 struct StippleOut {
     @builtin(position) clip: vec4<f32>,
     // From the disc's centre, in pixels.
@@ -675,8 +693,8 @@ fn density(tone: f32, size: f32) -> f32 {
     return x / area;
 }
 
-// Vertex i of the stipples: corner i % 3 of stipple i / 3, a triangle whose incircle is the stipple's
-// disc, or nothing when the CPU renderer would not draw it. The CPU's decision: the tone of
+// Stipple `index` placed: its disc's centre in clip space (w 0 when the CPU renderer would
+// not draw it) and its colour. The CPU's decision: the tone of
 // a white surface under the shaded style's lights at the stipple (normal interpolated, the
 // face's where that vanishes), its density per square pixel, times the triangle's screen
 // area over its 4D area times the surface's 4D area: the stipple is drawn when its rank is
@@ -696,18 +714,10 @@ fn density(tone: f32, size: f32) -> f32 {
 // there; the tolerance is the smallest measured that keeps the tests' tiles within 3% of
 // the CPU's (half a pixel plus a tenth per unit of slope let the default scene turned in
 // 4D, its inner ring edge-on, reach 7%).
-//
-// One draw of three vertices per stipple, not instances of three: a software rasterizer
-// (lavapipe) shades the vertices of one instance together, three lanes of its eight, and
-// the frame took four times as long.
-@vertex
-fn stipple_vs(@builtin(vertex_index) i: u32) -> StippleOut {
-    let index = i / 3u;
-    let vertex = i % 3u;
-    var out: StippleOut;
-    out.clip = NOTHING;
-    out.offset = vec2<f32>(0.0);
-    out.colour = INK;
+fn place_stipple(index: u32) -> Placed {
+    var out: Placed;
+    out.clip = vec4<f32>(0.0);
+    out.colour = vec4<f32>(INK, 1.0);
     let s = stipples[index];
     let t = s.triangle;
     let a = vertices[triangle_indices[3u * t]];
@@ -790,17 +800,47 @@ fn stipple_vs(@builtin(vertex_index) i: u32) -> StippleOut {
     }
     if view.stipple.y > 0.5 {
         let w = a.w * l.x + b.w * l.y + c.w * l.z;
-        out.colour = colormap((w - view.w_norm.x) * view.w_norm.y) * 0.75;
+        out.colour = vec4<f32>(colormap((w - view.w_norm.x) * view.w_norm.y) * 0.75, 1.0);
     }
+    out.clip = cp;
+    return out;
+}
+
+// Each stipple decided once per frame: the drawn ones are appended to `placing`, three
+// vertices each counted in the stipples' indirect draw. Deciding in the vertex shader
+// decided every stipple three times (once per corner), and the draw then ran the vertex
+// shader for all of them, drawn or not.
+@compute @workgroup_size(64)
+fn stipple_place(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let index = id.x + id.y * groups.x * 64u;
+    if index >= arrayLength(&stipples) {
+        return;
+    }
+    let p = place_stipple(index);
+    if p.clip.w > 0.0 {
+        placing[atomicAdd(&stipple_draw.vertex_count, 3u) / 3u] = p;
+    }
+}
+
+// Vertex i of the placed stipples: corner i % 3 of placed stipple i / 3, a triangle whose
+// incircle is the stipple's disc. One draw of three vertices per stipple, not instances of
+// three: a software rasterizer (lavapipe) shades the vertices of one instance together,
+// three lanes of its eight, and the frame took four times as long.
+@vertex
+fn stipple_vs(@builtin(vertex_index) i: u32) -> StippleOut {
+    let p = placed[i / 3u];
     let r = view.stipple.x * 0.5;
     let corners = array<vec2<f32>, 3>(
         vec2<f32>(0.0, 2.0), vec2<f32>(-1.7320508, -1.0), vec2<f32>(1.7320508, -1.0),
     );
-    let offset = corners[vertex] * r;
+    let offset = corners[i % 3u] * r;
+    var out: StippleOut;
     out.offset = offset;
-    out.clip = vec4<f32>(cp.xy + offset / (view.viewport.xy * 0.5) * cp.w, 0.0, cp.w);
+    out.colour = p.colour.rgb;
+    out.clip = vec4<f32>(p.clip.xy + offset / (view.viewport.xy * 0.5) * p.clip.w, 0.0, p.clip.w);
     return out;
 }
+
 
 @fragment
 fn stipple_fs(in: StippleOut) -> @location(0) vec4<f32> {
