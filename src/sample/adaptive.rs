@@ -936,22 +936,25 @@ impl<'a> Sampler<'a> {
             }
         }
 
-        let mut mesh = Mesh4::default();
         let mut vertex_of = vec![u32::MAX; total];
         let locate = |id: usize| {
             let patch = offsets.partition_point(|&o| o <= id) - 1;
             (patch, id - offsets[patch])
         };
+        let mut at = Vec::new();
         for id in 0..total {
             let rep = classes.find(id);
             if vertex_of[rep] == u32::MAX {
                 let (patch, i) = locate(rep);
                 let p = &self.patches[patch];
                 let [u, v] = p.uv(p.st[i]);
-                vertex_of[rep] = mesh.push_vertex(self.surface, patch, u, v);
+                vertex_of[rep] = at.len() as u32;
+                at.push((patch, u, v));
             }
             vertex_of[id] = vertex_of[rep];
         }
+        let mut mesh = Mesh4::default();
+        mesh.push_vertices(self.surface, &at);
         for (patch, p) in self.patches.iter().enumerate() {
             for f in p.cdt.inner_faces() {
                 let local = f.vertices().map(|v| v.fix().index());

@@ -27,6 +27,7 @@ pub use uniform::sample_uniform;
 use crate::limits::{ABSOLUTE_TOLERANCE, FieldError, GRID_CELLS, RELATIVE_TOLERANCE, TRIANGLES};
 use crate::surfaces::{Eval4, Surface};
 use glam::DVec4;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// How to sample a surface.
@@ -331,15 +332,26 @@ impl Mesh4 {
         stats
     }
 
-    /// Appends the vertex at (u, v) of a patch (see [`eval_vertex`]); returns its index.
-    fn push_vertex(&mut self, surface: &Surface, patch: usize, u: f64, v: f64) -> u32 {
-        let e = eval_vertex(surface, patch, u, v);
-        self.positions.push(e.p);
-        self.tangent_u.push(e.du);
-        self.tangent_v.push(e.dv);
-        self.uv.push([u, v]);
-        self.patch.push(patch as u32);
-        (self.positions.len() - 1) as u32
+    /// Appends the vertices at `at`, (patch, u, v) each (see [`eval_vertex`]), in that order,
+    /// evaluated on the cores.
+    fn push_vertices(&mut self, surface: &Surface, at: &[(usize, f64, f64)]) {
+        let start = self.positions.len();
+        let end = start + at.len();
+        self.positions.resize(end, DVec4::ZERO);
+        self.tangent_u.resize(end, DVec4::ZERO);
+        self.tangent_v.resize(end, DVec4::ZERO);
+        self.positions[start..]
+            .par_iter_mut()
+            .zip(&mut self.tangent_u[start..])
+            .zip(&mut self.tangent_v[start..])
+            .zip(at)
+            .for_each(|(((p, du), dv), &(patch, u, v))| {
+                let e = eval_vertex(surface, patch, u, v);
+                (*p, *du, *dv) = (e.p, e.du, e.dv);
+            });
+        self.uv.extend(at.iter().map(|&(_, u, v)| [u, v]));
+        self.patch
+            .extend(at.iter().map(|&(patch, _, _)| patch as u32));
     }
 
     /// Appends a triangle cut from `patch` with its corners' parameters, unless welding made

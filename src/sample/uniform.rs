@@ -61,7 +61,7 @@ pub fn sample_uniform(surface: &Surface, nu: usize, nv: usize) -> Mesh4 {
 
     // One vertex per class, evaluated at its representative (smallest) node.
     let mut vertex_of = vec![u32::MAX; patches * per_patch];
-    let mut mesh = Mesh4::default();
+    let mut at = Vec::new();
     for id in 0..patches * per_patch {
         let rep = classes.find(id);
         if vertex_of[rep] == u32::MAX {
@@ -70,10 +70,13 @@ pub fn sample_uniform(surface: &Surface, nu: usize, nv: usize) -> Mesh4 {
             let d = &domains[patch];
             let u = d.u[0] + (d.u[1] - d.u[0]) * i as f64 / nu as f64;
             let v = d.v[0] + (d.v[1] - d.v[0]) * j as f64 / nv as f64;
-            vertex_of[rep] = mesh.push_vertex(surface, patch, u, v);
+            vertex_of[rep] = at.len() as u32;
+            at.push((patch, u, v));
         }
         vertex_of[id] = vertex_of[rep];
     }
+    let mut mesh = Mesh4::default();
+    mesh.push_vertices(surface, &at);
 
     for (patch, d) in domains.iter().enumerate() {
         let uv = |i: usize, j: usize| {
