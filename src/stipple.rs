@@ -17,28 +17,40 @@
 //! dart throwing at a radius that shrinks level by level by `LEVEL_RATIO` (an approximation
 //! of farthest-point sampling that needs only local queries). A candidate is accepted at a
 //! level when no accepted point lies nearer than that level's radius; a rejected one waits
-//! for the level whose radius is below its distance to the nearest accepted point, so each
-//! candidate is looked at only a few times. A point accepted at level j is at least r_j from
-//! every earlier one, so a prefix ending in level j has all its distances at least r_j. No
-//! crate gives ranked (progressive) Poisson-disc sets on a triangle mesh in 4D, hence this
-//! module.
+//! for the level whose radius is below its distance to an accepted point nearer than the
+//! radius, so each candidate is looked at only a few times. A point accepted at level j is at
+//! least r_j from every earlier one, so a prefix ending in level j has all its distances at
+//! least r_j. Candidates join when a level needs them, those of smallest priority (a random
+//! number each) first. No crate gives ranked (progressive) Poisson-disc sets on a triangle
+//! mesh in 4D, hence this module.
+//!
+//! Each level, on the cores: every waiting candidate is checked against the points of the
+//! earlier levels (the first one found nearer than the radius rejects it); those that pass
+//! are checked against each other, listing for each the ones before it in priority nearer
+//! than the radius; then, in priority order, one is accepted when none it lists was (the
+//! greedy dart throwing of the level, decided in one short pass over those lists). The
+//! candidates are numbered along a Z curve (Morton order) of a fine 4D lattice, and a level's
+//! grid has cells a power of two of the lattice's cells wide, so the points of one grid cell
+//! are one run of a list sorted by that number: a grid is rebuilt each level from the
+//! accepted points in that order, a queue is swept in that order, and neighbouring queries
+//! read neighbouring memory.
 //!
 //! Deterministic: the same mesh, count and seed give the same points in the same order on any
-//! number of threads (the random numbers are hashes of the seed and an index).
+//! number of threads (the random numbers are hashes of the seed and an index; every parallel
+//! step computes per candidate what does not depend on the others, and the one decision that
+//! does is taken in priority order).
 
 use glam::DVec4;
 use rayon::prelude::*;
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
 
 /// Candidates drawn per stipple kept.
 const OVERSAMPLE: usize = 4;
 /// Ratio of one level's radius to the previous one's.
 const LEVEL_RATIO: f64 = 0.917_004_043_204_671_2; // 2^(-1/8)
-/// Levels between rebuilds of the neighbour grid.
-const LEVELS_PER_GRID: usize = 4;
-/// The grid's cell over the radius when it is built: a query looks up p's own cell and those
-/// its ball reaches across a face into, on average about 4 of the 16 it can meet.
+/// The least ratio of a grid's cell to the level's radius (the cell is the smallest power of
+/// two of lattice cells at least this): a query looks up p's own cell and those its ball
+/// reaches across a face into, on average about 2 of the 16 it can meet. Ratios of 2 and 2.8
+/// looked up more cells and ranked slower, 5.6 and 8 tested more points and ranked slower.
 const CELL: f64 = 4.0;
 
 /// A progressive blue-noise point set on one surface's mesh, in rank order.
@@ -117,12 +129,12 @@ impl Stipples {
             p * b[0] + q * b[1] + r * b[2]
         };
         let points: Vec<DVec4> = candidates.par_iter().map(point).collect();
-        // A random order of the candidates.
-        let mut order: Vec<(u64, u32)> = (0..candidates.len() as u32)
-            .map(|i| (hash(seed ^ 0x5EED_0003, u64::from(i)), i))
+        // A random priority of each candidate.
+        let priority: Vec<u32> = (0..candidates.len() as u64)
+            .into_par_iter()
+            .map(|i| (hash(seed ^ 0x5EED_0003, i) >> 32) as u32)
             .collect();
-        order.par_sort_unstable();
-        let ranked = rank(&points, order.into_iter().map(|(_, i)| i), count, area);
+        let ranked = rank(&points, &priority, count, area);
         out.triangle = ranked.iter().map(|&i| candidates[i as usize].0).collect();
         out.bary = ranked.iter().map(|&i| candidates[i as usize].1).collect();
         out
@@ -157,14 +169,9 @@ fn area4(e: DVec4, f: DVec4) -> f64 {
     0.5 * g.max(0.0).sqrt()
 }
 
-/// The candidates `order` lists, accepted level by level into a ranking of at most `count`
-/// (indices into `points`).
-fn rank(
-    points: &[DVec4],
-    mut order: impl Iterator<Item = u32>,
-    count: usize,
-    area: f64,
-) -> Vec<u32> {
+/// The candidates ranked level by level into a ranking of at most `count` (indices into
+/// `points`); `priority` orders them (a random number each, ties broken by place).
+fn rank(points: &[DVec4], priority: &[u32], count: usize, area: f64) -> Vec<u32> {
     let (lo, hi) = points
         .iter()
         .fold((DVec4::INFINITY, DVec4::NEG_INFINITY), |(lo, hi), &p| {
@@ -174,239 +181,409 @@ fn rank(
     // Below a quarter of the candidates' own spacing nothing is gained.
     let last = 0.25 * poisson_radius(points.len(), area) / 0.75;
     let levels = ((last / first).ln() / LEVEL_RATIO.ln()).ceil().max(1.0) as usize + 1;
-    let radius = |j: usize| first * LEVEL_RATIO.powi(j as i32);
-    let mut waiting: Vec<Vec<u32>> = vec![Vec::new(); levels];
+    let radii: Vec<f64> = (0..levels)
+        .map(|j| first * LEVEL_RATIO.powi(j as i32))
+        .collect();
+    // The first level after j whose radius is at most d (at most a few levels on).
+    let level_after = |j: usize, d: f64| {
+        let mut k = j + 1;
+        while k < levels && radii[k] > d {
+            k += 1;
+        }
+        k
+    };
+    let lattice = Lattice::new(lo, hi, CELL * radii[levels - 1]);
+    // The candidates in the order of their fine cells along the Z curve.
+    let code: Vec<u64> = points.par_iter().map(|&p| lattice.code(p)).collect();
+    let order = radix_order(&code);
+    drop(code);
+    // Candidates join when a level needs them: OVERSAMPLE times as many as a Poisson-disc
+    // set of its radius holds, those of smallest priority first, so that the early levels,
+    // which accept few, do not look at every candidate again and again.
+    let n = points.len() as f64;
+    let joins: Vec<u64> = radii
+        .iter()
+        .map(|&r| {
+            let wanted = OVERSAMPLE as f64 * poisson_count(r, area) / n;
+            (wanted.min(1.0) * 2f64.powi(32)) as u64
+        })
+        .collect();
+    let items: Vec<(usize, Item)> = order
+        .par_iter()
+        .enumerate()
+        .map(|(z, &i)| {
+            let priority = priority[i as usize];
+            let join = joins.partition_point(|&t| t <= u64::from(priority));
+            let item = Item {
+                z: z as u32,
+                priority,
+                p: points[i as usize],
+            };
+            (join, item)
+        })
+        .collect();
+    let mut waiting: Vec<Vec<Item>> = vec![Vec::new(); levels];
+    for (j, item) in items {
+        if let Some(list) = waiting.get_mut(j) {
+            list.push(item);
+        }
+    }
     let mut accepted: Vec<u32> = Vec::with_capacity(count);
-    let mut grid = Grid::new(CELL * radius(0));
-    let mut active = 0usize;
-    // The distance each candidate was last found from an earlier level's point (an upper
-    // bound of its nearest), infinite where none was within the radius.
-    let mut near = vec![f64::INFINITY; points.len()];
-    let mut level = Grid::new(CELL * radius(0));
-    for j in 0..levels {
+    // The accepted points of the earlier levels in candidate order.
+    let mut earlier: Vec<Item> = Vec::new();
+    let mut grid = Grid::default();
+    let mut own = Grid::default();
+    for (j, &r) in radii.iter().enumerate() {
         if accepted.len() >= count {
             break;
         }
-        let r = radius(j);
-        if j % LEVELS_PER_GRID == 0 {
-            grid = Grid::of(
-                CELL * r,
-                accepted.iter().map(|&i| points[i as usize]).collect(),
-            );
-        }
-        // Candidates join when a level needs them: OVERSAMPLE times as many as a
-        // Poisson-disc set of this radius holds, so that the early levels, which accept few,
-        // do not look at every candidate again and again.
-        let wanted = (OVERSAMPLE as f64 * poisson_count(r, area)).min(points.len() as f64);
+        let shift = lattice.shift(CELL * r);
+        grid.build(&lattice, shift, &earlier);
+        // The queue is a few runs in candidate order (those that joined, those each earlier
+        // level sent): a stable sort merges them, so that it is swept in one pass.
         let mut queue = std::mem::take(&mut waiting[j]);
-        while (active as f64) < wanted {
-            let Some(i) = order.next() else { break };
-            queue.push(i);
-            active += 1;
-        }
-        // First each candidate against the points of the earlier levels, on the cores (the
-        // grid does not change while they read it; the candidates in index order, which is
-        // the mesh's triangle order, so that neighbours query neighbouring cells one after
-        // another), then, in the queue's order, those that pass against the points accepted
-        // at this level.
-        let mut sorted = queue.clone();
-        sorted.par_sort_unstable();
-        let found: Vec<f64> = sorted
+        queue.sort_by_key(|e| e.z);
+        // Where each goes: the level after the distance of an earlier point nearer than r,
+        // or past the last level when none is.
+        let next: Vec<usize> = queue
             .par_iter()
-            .map(|&i| {
-                grid.near_within(points[i as usize], r)
-                    .unwrap_or(f64::INFINITY)
+            .map(|e| match grid.near(&lattice, e.p, r) {
+                Some(d) => level_after(j, d),
+                None => usize::MAX,
             })
             .collect();
-        for (&i, d) in sorted.iter().zip(found) {
-            near[i as usize] = d;
+        let mut pass: Vec<Item> = Vec::new();
+        for (&e, k) in queue.iter().zip(next) {
+            if k == usize::MAX {
+                pass.push(e);
+            } else if let Some(list) = waiting.get_mut(k) {
+                list.push(e);
+            }
         }
-        level.clear(CELL * r);
-        let start = accepted.len();
-        for i in queue {
-            let p = points[i as usize];
-            let d = near[i as usize];
-            match (d.is_finite())
-                .then_some(d)
-                .or_else(|| level.near_within(p, r))
-            {
-                None => {
-                    level.insert(p);
-                    accepted.push(i);
-                    if accepted.len() >= count {
-                        break;
+        // Those that pass against each other: for each, those before it in priority nearer
+        // than r (pairs of places in `pass`, with their distance, grouped by the first).
+        own.build(&lattice, shift, &pass);
+        let pairs: Vec<(u32, u32, f64)> = (0..pass.len())
+            .into_par_iter()
+            .fold(Vec::new, |mut found, k| {
+                let e = pass[k];
+                own.visit(&lattice, e.p, r, |m, d| {
+                    if pass[m as usize].before(&e) {
+                        found.push((k as u32, m, d));
                     }
-                }
-                Some(d) => {
-                    // The first level whose radius is at most d.
-                    let k = ((d / first).ln() / LEVEL_RATIO.ln()).ceil();
-                    let k = if k.is_finite() { k as usize } else { levels };
-                    if let Some(list) = waiting.get_mut(k.max(j + 1)) {
-                        list.push(i);
-                    }
+                    false
+                });
+                found
+            })
+            .flatten_iter()
+            .collect();
+        let mut from = vec![0u32; pass.len() + 1];
+        for &(k, _, _) in &pairs {
+            from[k as usize + 1] += 1;
+        }
+        for k in 0..pass.len() {
+            from[k + 1] += from[k];
+        }
+        // In priority order (ties in candidate order, as `pass` is), each is accepted when
+        // none before it that it lists was; a rejected one keeps its distance to the
+        // nearest of those.
+        let mut by_priority: Vec<(u32, u32)> = (0..pass.len() as u32)
+            .map(|k| (pass[k as usize].priority, k))
+            .collect();
+        by_priority.par_sort_unstable();
+        let mut taken = vec![false; pass.len()];
+        let mut nearest = vec![f64::INFINITY; pass.len()];
+        for &(_, k) in &by_priority {
+            let k = k as usize;
+            nearest[k] = pairs[from[k] as usize..from[k + 1] as usize]
+                .iter()
+                .filter(|&&(_, m, _)| taken[m as usize])
+                .map(|&(_, _, d)| d)
+                .fold(f64::INFINITY, f64::min);
+            if nearest[k].is_infinite() {
+                taken[k] = true;
+                accepted.push(pass[k].z);
+                if accepted.len() >= count {
+                    break;
                 }
             }
         }
-        for &i in &accepted[start..] {
-            grid.insert(points[i as usize]);
+        // The rejected wait in candidate order.
+        let mut new = Vec::new();
+        for (k, &e) in pass.iter().enumerate() {
+            if taken[k] {
+                new.push(e);
+            } else if nearest[k].is_finite()
+                && let Some(list) = waiting.get_mut(level_after(j, nearest[k]))
+            {
+                list.push(e);
+            }
         }
+        earlier = merge(&earlier, &new);
     }
-    accepted
+    accepted.iter().map(|&z| order[z as usize]).collect()
 }
 
-/// A hash grid over 4D points, holding the points themselves (a query reads each cell's
-/// points in a row of memory, not scattered over the candidates).
-struct Grid {
+/// The order of `keys` ascending, ties in index order: a least-significant-digit radix sort
+/// (11 bits a pass, as many passes as the largest key needs), which on a few million keys
+/// takes a fraction of a comparison sort's time; std and rayon have no radix sort.
+fn radix_order(keys: &[u64]) -> Vec<u32> {
+    const BITS: u32 = 11;
+    let top = keys.iter().fold(0, |a, &k| a | k);
+    let passes = (64 - top.leading_zeros()).div_ceil(BITS);
+    let mut order: Vec<(u64, u32)> = keys.iter().zip(0..).map(|(&k, i)| (k, i)).collect();
+    let mut next = vec![(0u64, 0u32); keys.len()];
+    for pass in 0..passes {
+        let digit = |k: u64| (k >> (pass * BITS)) as usize & ((1 << BITS) - 1);
+        let mut start = vec![0usize; 1 << BITS];
+        for &(k, _) in &order {
+            start[digit(k)] += 1;
+        }
+        let mut sum = 0;
+        for s in &mut start {
+            (*s, sum) = (sum, sum + *s);
+        }
+        for &(k, i) in &order {
+            let d = digit(k);
+            next[start[d]] = (k, i);
+            start[d] += 1;
+        }
+        std::mem::swap(&mut order, &mut next);
+    }
+    order.into_iter().map(|(_, i)| i).collect()
+}
+
+/// A candidate as it waits: its place in candidate order, its priority and its point (a
+/// level reads the point from the queue, not from the whole candidates' list, which a sweep
+/// of a fifth of them would read nearly all of).
+#[derive(Clone, Copy)]
+struct Item {
+    z: u32,
+    priority: u32,
+    p: DVec4,
+}
+
+impl Item {
+    /// Whether it comes before `other` in priority.
+    #[inline]
+    fn before(&self, other: &Item) -> bool {
+        (self.priority, self.z) < (other.priority, other.z)
+    }
+}
+
+/// Two lists sorted by place merged.
+fn merge(a: &[Item], b: &[Item]) -> Vec<Item> {
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let (mut x, mut y) = (0, 0);
+    while x < a.len() && y < b.len() {
+        if a[x].z < b[y].z {
+            out.push(a[x]);
+            x += 1;
+        } else {
+            out.push(b[y]);
+            y += 1;
+        }
+    }
+    out.extend_from_slice(&a[x..]);
+    out.extend_from_slice(&b[y..]);
+    out
+}
+
+/// The finest cells of the grids: a lattice over the candidates' box whose cells are
+/// numbered along the Z curve (Morton order), 16 bits per axis. A grid's cell is 2^s of them
+/// along each axis, so the points of one grid cell lie in a row of the candidates sorted by
+/// their fine cell.
+struct Lattice {
+    /// The box's lower corner.
+    lo: DVec4,
+    /// The cell's side, and its inverse.
     cell: f64,
-    cells: HashMap<Cell, Vec<DVec4>, BuildHasherDefault<CellHasher>>,
+    inverse: f64,
+}
+
+/// The largest fine cell coordinate.
+const SIDE: f64 = 65535.0;
+
+impl Lattice {
+    /// The lattice over the box from `lo` to `hi` whose cell is `smallest`, or larger where
+    /// the box is more than 65,536 of those wide.
+    fn new(lo: DVec4, hi: DVec4, smallest: f64) -> Lattice {
+        let extent = (hi - lo).max_element();
+        let cell = smallest.max(extent / SIDE).max(f64::MIN_POSITIVE);
+        Lattice {
+            lo,
+            cell,
+            inverse: 1.0 / cell,
+        }
+    }
+
+    /// The shift of the grid whose cell is the smallest power of two fine cells at least
+    /// `cell`.
+    fn shift(&self, cell: f64) -> u32 {
+        let mut s = 0;
+        while s < 16 && self.cell * f64::from(1u32 << s) < cell {
+            s += 1;
+        }
+        s
+    }
+
+    /// The fine cell coordinate of `x` along `axis` (clamped to the lattice: cells at its
+    /// edge hold what lies beyond, which costs distance tests, never a wrong answer).
+    #[inline]
+    fn at(&self, x: f64, axis: usize) -> u32 {
+        let t = ((x - self.lo[axis]) * self.inverse).clamp(0.0, SIDE);
+        t as u32
+    }
+
+    /// The Z code of the fine cell of `p`.
+    fn code(&self, p: DVec4) -> u64 {
+        interleave(std::array::from_fn(|axis| self.at(p[axis], axis)))
+    }
+}
+
+/// Four 16-bit coordinates interleaved bit by bit (the Z curve in 4D).
+#[inline]
+fn interleave(c: [u32; 4]) -> u64 {
+    let spread = |x: u32| {
+        let mut x = u64::from(x & 0xFFFF);
+        x = (x | x << 24) & 0x0000_00FF_0000_00FF;
+        x = (x | x << 12) & 0x000F_000F_000F_000F;
+        x = (x | x << 6) & 0x0303_0303_0303_0303;
+        (x | x << 3) & 0x1111_1111_1111_1111
+    };
+    spread(c[0]) | spread(c[1]) << 1 | spread(c[2]) << 2 | spread(c[3]) << 3
+}
+
+/// A grid over some of the candidates: their points in candidate order (so by fine cell), the
+/// runs of its grid cells in that order, and a hash table from each cell to its run (a flat
+/// table of a few megabytes rebuilt in one pass each level, where a map of cells to vectors
+/// was rebuilt point by point and scattered the points over the heap).
+#[derive(Default)]
+struct Grid {
+    /// A cell is 2^shift fine cells wide.
+    shift: u32,
+    points: Vec<DVec4>,
+    /// Each run's cell (its Z code) and start; a last one marks the end.
+    runs: Vec<(u64, u32)>,
+    /// Open addressing: one more than a run's index, 0 where empty.
+    table: Vec<u32>,
+    /// The table's size less one (a power of two less one).
+    mask: usize,
 }
 
 impl Grid {
-    fn new(cell: f64) -> Grid {
-        Grid {
-            cell,
-            cells: HashMap::default(),
+    /// Rebuilds the grid of cells 2^shift fine cells wide over the candidates `list`, in
+    /// candidate order, keeping its memory.
+    fn build(&mut self, lattice: &Lattice, shift: u32, list: &[Item]) {
+        self.shift = shift;
+        self.points.clear();
+        self.points.extend(list.iter().map(|e| e.p));
+        let keys: Vec<u64> = list
+            .par_iter()
+            .map(|e| lattice.code(e.p).checked_shr(4 * shift).unwrap_or(0))
+            .collect();
+        self.runs.clear();
+        for (s, &k) in keys.iter().enumerate() {
+            if self.runs.last().is_none_or(|&(last, _)| last != k) {
+                self.runs.push((k, s as u32));
+            }
+        }
+        let cells = self.runs.len();
+        self.runs.push((u64::MAX, list.len() as u32));
+        let size = (2 * cells).next_power_of_two().max(2);
+        self.mask = size - 1;
+        self.table.clear();
+        self.table.resize(size, 0);
+        for (n, &(k, _)) in self.runs[..cells].iter().enumerate() {
+            let mut at = slot(k) & self.mask;
+            while self.table[at] != 0 {
+                at = (at + 1) & self.mask;
+            }
+            self.table[at] = n as u32 + 1;
         }
     }
 
-    /// The cell of `p`: its four integer coordinates, whole (packed into fewer bits, cells
-    /// far apart would share a key, and a mesh reaching 1e29 along w would pile its stipples
-    /// into one).
-    fn key(&self, p: DVec4) -> Cell {
-        Cell(std::array::from_fn(|axis| {
-            Self::whole((p[axis] / self.cell).floor())
-        }))
-    }
-
-    /// A cell coordinate as an integer. Beyond 2^62 cells (a coordinate of 1e30 over a cell
-    /// of 1e-12) the cells merge, which costs distance tests, never a wrong answer.
-    fn whole(c: f64) -> i64 {
-        const FAR: f64 = (1u64 << 62) as f64;
-        c.clamp(-FAR, FAR) as i64
-    }
-
-    /// The grid of cell `cell` over `points`, built at once: the points sorted by cell on
-    /// the cores, then each cell's run moved into the map (a cell's order does not matter:
-    /// a query takes the nearest of a cell's points).
-    fn of(cell: f64, points: Vec<DVec4>) -> Grid {
-        let mut grid = Grid::new(cell);
-        let mut keyed: Vec<(Cell, DVec4)> =
-            points.into_par_iter().map(|p| (grid.key(p), p)).collect();
-        keyed.par_sort_unstable_by_key(|&(key, _)| key.0);
-        let runs: Vec<&[(Cell, DVec4)]> = keyed.chunk_by(|a, b| a.0 == b.0).collect();
-        grid.cells.reserve(runs.len());
-        for run in runs {
-            grid.cells
-                .insert(run[0].0, run.iter().map(|&(_, p)| p).collect());
+    /// The run of cell `k`.
+    #[inline]
+    fn run(&self, k: u64) -> (usize, usize) {
+        let mut at = slot(k) & self.mask;
+        loop {
+            let n = self.table[at] as usize;
+            if n == 0 {
+                return (0, 0);
+            }
+            if self.runs[n - 1].0 == k {
+                return (self.runs[n - 1].1 as usize, self.runs[n].1 as usize);
+            }
+            at = (at + 1) & self.mask;
         }
-        grid
     }
 
-    /// Empties the grid and sets its cell, keeping its memory.
-    fn clear(&mut self, cell: f64) {
-        self.cell = cell;
-        self.cells.clear();
-    }
-
-    fn insert(&mut self, p: DVec4) {
-        let key = self.key(p);
-        self.cells.entry(key).or_default().push(p);
-    }
-
-    /// The distance to a point nearer than `r` to `p` (`r` at most half a cell), or `None`
-    /// when there is none. Cells are searched from `p`'s own outwards, and the search stops
-    /// at the first that holds one: the distance is the nearest of that cell's, an upper
-    /// bound of the nearest distance (a rejected candidate only comes back sooner).
-    fn near_within(&self, p: DVec4, r: f64) -> Option<f64> {
+    /// Calls `f` with the place in the list and distance of each point nearer than `r` to
+    /// `p` (`r` at most half a cell), p's own cell first, until `f` returns true.
+    #[inline]
+    fn visit(&self, lattice: &Lattice, p: DVec4, r: f64, mut f: impl FnMut(u32, f64) -> bool) {
+        if self.points.is_empty() {
+            return;
+        }
         // The ball of radius r meets at most two cells per axis: p's own, and the next one
-        // down or up where it reaches across a face (floor(y) < c exactly when y < c, for
-        // a whole c: one floor per axis).
-        let mut own = [0i64; 4];
-        let mut step = [0i64; 4];
+        // down or up where it reaches across a face.
+        let s = self.shift;
+        let mut own = [0u32; 4];
+        let mut step = [0u32; 4];
         let mut reach = 0u32;
         for axis in 0..4 {
-            let c = (p[axis] / self.cell).floor();
-            own[axis] = Self::whole(c);
-            if (p[axis] - r) / self.cell < c {
-                (step[axis], reach) = (-1, reach | 1 << axis);
-            } else if (p[axis] + r) / self.cell >= c + 1.0 {
+            own[axis] = lattice.at(p[axis], axis) >> s;
+            if lattice.at(p[axis] - r, axis) >> s < own[axis] {
+                (step[axis], reach) = (u32::MAX, reach | 1 << axis);
+            } else if lattice.at(p[axis] + r, axis) >> s > own[axis] {
                 (step[axis], reach) = (1, reach | 1 << axis);
             }
         }
-        // Every subset of the axes it reaches across, p's own cell first.
         let mut subset = 0u32;
         loop {
-            let key = Cell(std::array::from_fn(|axis| {
-                own[axis]
-                    + if subset >> axis & 1 != 0 {
-                        step[axis]
-                    } else {
-                        0
-                    }
+            let key = interleave(std::array::from_fn(|axis| {
+                own[axis].wrapping_add(if subset >> axis & 1 != 0 {
+                    step[axis]
+                } else {
+                    0
+                })
             }));
-            let best = self
-                .cells
-                .get(&key)
-                .into_iter()
-                .flatten()
-                .map(|q| q.distance_squared(p))
-                .fold(f64::INFINITY, f64::min);
-            if best < r * r {
-                return Some(best.sqrt());
+            let (from, to) = self.run(key);
+            for (m, q) in self.points[from..to].iter().enumerate() {
+                let d = q.distance_squared(p);
+                if d < r * r && f((from + m) as u32, d.sqrt()) {
+                    return;
+                }
             }
-            // The next subset of `reach`.
             subset = subset.wrapping_sub(reach) & reach;
             if subset == 0 {
-                return None;
+                return;
             }
         }
     }
-}
 
-/// A cell of the grid: its integer coordinates, hashed as one word (four words through
-/// the hasher cost more than the distance tests).
-#[derive(Clone, Copy, PartialEq, Eq)]
-struct Cell([i64; 4]);
-
-impl std::hash::Hash for Cell {
-    fn hash<H: Hasher>(&self, state: &mut H) {
-        let [a, b, c, d] = self.0.map(|k| k as u64);
-        state.write_u64(
-            a.wrapping_mul(0x9E37_79B9_7F4A_7C15)
-                ^ b.wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
-                ^ c.wrapping_mul(0x1656_67B1_9E37_79F9)
-                ^ d.wrapping_mul(0x27D4_EB2F_1656_67C5),
-        );
+    /// The distance to a point nearer than `r` to `p`, the first one found (an upper bound
+    /// of the nearest: a rejected candidate comes back sooner, to be rejected again, and
+    /// the ranking is the same), or `None` when there is none.
+    fn near(&self, lattice: &Lattice, p: DVec4, r: f64) -> Option<f64> {
+        let mut found = None;
+        self.visit(lattice, p, r, |_, d| {
+            found = Some(d);
+            true
+        });
+        found
     }
 }
 
-/// A multiplicative hash for grid cells (std's SipHash costs more than the distance tests
-/// it guards, and the keys are not adversarial).
-#[derive(Default)]
-struct CellHasher(u64);
-
-impl Hasher for CellHasher {
-    fn finish(&self) -> u64 {
-        // SplitMix64's finaliser: every bit of the state reaches the bucket bits.
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    fn write(&mut self, bytes: &[u8]) {
-        for chunk in bytes.chunks(8) {
-            let mut word = [0u8; 8];
-            word[..chunk.len()].copy_from_slice(chunk);
-            self.write_u64(u64::from_le_bytes(word));
-        }
-    }
-
-    fn write_u64(&mut self, i: u64) {
-        self.0 = (self.0 ^ i)
-            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
-            .rotate_left(29);
-    }
+/// The table slot of a cell's Z code: the 16 cells of a block two cells wide along each axis
+/// share a row of 16 slots (one cache line), so that a query's cells, mostly in one or two
+/// such blocks, read few lines; the blocks are hashed.
+#[inline]
+fn slot(k: u64) -> usize {
+    let s = k >> 4;
+    let z = (s ^ (s >> 31)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    ((z >> 28) as usize & !15) | (k & 15) as usize
 }
 
 /// SplitMix64 of a seed and an index: the random numbers of the set.
@@ -512,6 +689,56 @@ mod tests {
         // The left strip holds 0.2 of the area.
         let share = left as f64 / s.len() as f64;
         assert!((share - 0.2).abs() < 0.02, "share {share}");
+    }
+
+    #[test]
+    fn the_grid_finds_what_brute_force_finds() {
+        // Random points near a curved sheet in 4D, queried at radii from a tenth of the box
+        // to a thousandth, against all pairs.
+        let points: Vec<DVec4> = (0..3000u64)
+            .map(|i| {
+                let (u, v) = (unit(1, i), unit(2, i));
+                DVec4::new(u, v, (3.0 * u).sin() * 0.3, u * v + 1e-3 * unit(3, i))
+            })
+            .collect();
+        let (lo, hi) = (DVec4::ZERO, DVec4::ONE);
+        let lattice = Lattice::new(lo, hi, CELL * 1e-3);
+        let order = radix_order(&points.iter().map(|&p| lattice.code(p)).collect::<Vec<_>>());
+        let list: Vec<Item> = order
+            .iter()
+            .enumerate()
+            .map(|(z, &i)| Item {
+                z: z as u32,
+                priority: 0,
+                p: points[i as usize],
+            })
+            .collect();
+        let mut grid = Grid::default();
+        for r in [0.1, 0.03, 0.01, 0.003, 0.001] {
+            grid.build(&lattice, lattice.shift(CELL * r), &list);
+            for (k, e) in list.iter().enumerate().step_by(7) {
+                let mut found = Vec::new();
+                grid.visit(&lattice, e.p, r, |m, _| {
+                    found.push(m as usize);
+                    false
+                });
+                found.sort_unstable();
+                let all: Vec<usize> = (0..list.len())
+                    .filter(|&m| list[m].p.distance_squared(e.p) < r * r)
+                    .collect();
+                assert_eq!(found, all, "point {k} at radius {r}");
+                assert_eq!(grid.near(&lattice, e.p, r).is_some(), !all.is_empty());
+            }
+        }
+    }
+
+    #[test]
+    fn the_radix_order_is_the_stable_sorted_order() {
+        let keys: Vec<u64> = (0..5000).map(|i| hash(9, i) >> (i % 50)).collect();
+        let mut sorted: Vec<u32> = (0..keys.len() as u32).collect();
+        sorted.sort_by_key(|&i| keys[i as usize]);
+        assert_eq!(radix_order(&keys), sorted);
+        assert_eq!(radix_order(&[0, 0, 0]), vec![0, 1, 2]);
     }
 
     #[test]
