@@ -227,13 +227,7 @@ fn a_budget_refines_the_worst_triangles_first() {
     // on one thread as on several (the Fermat quartic has 16 patches).
     let s = Surface::Fermat(Fermat { n: 4, y_range: 1.0 });
     let tol = 1e-7 * bounding_diagonal(&s);
-    let on = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| sample_adaptive(&s, tol, 20_000).mesh)
-    };
+    let on = |threads| crate::common::on_threads(threads, || sample_adaptive(&s, tol, 20_000).mesh);
     let one = on(1);
     assert!(one.triangles.len() > 15_000, "{}", one.triangles.len());
     assert!(one == on(4));
@@ -245,13 +239,7 @@ fn one_patch_refines_to_the_same_mesh_on_any_number_of_threads() {
     // cores, and the splits stay in the queue's order.
     let s = Surface::SpunTrefoil(SpunTrefoil::default());
     let tol = 2e-4 * bounding_diagonal(&s);
-    let on = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| sample_adaptive(&s, tol, 1_000_000))
-    };
+    let on = |threads| crate::common::on_threads(threads, || sample_adaptive(&s, tol, 1_000_000));
     let one = on(1);
     assert!(one.complete);
     assert!(

@@ -167,3 +167,13 @@ pub fn formula_surfaces() -> Vec<halo4d::surfaces::Surface> {
 pub fn built(scene: &halo4d::Scene) -> Result<halo4d::Built, halo4d::Error> {
     halo4d::Sampled::of(scene).into_built(scene, halo4d::Stages::of(scene))
 }
+
+/// What `work` gives on a pool of `threads` threads (for tests that results do not depend on
+/// the number of threads).
+pub fn on_threads<T: Send>(threads: usize, work: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a thread pool")
+        .install(work)
+}

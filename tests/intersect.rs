@@ -690,11 +690,7 @@ fn the_curves_do_not_depend_on_the_number_of_threads() {
         triangles: &mesh.triangles,
     }];
     let on = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        let mut c = pool.install(|| curves(&sheets));
+        let mut c = crate::common::on_threads(threads, || curves(&sheets));
         let r = &mut c.report;
         (r.ms, r.bvh_ms, r.traverse_ms, r.exact_ms, r.chain_ms) = (0.0, 0.0, 0.0, 0.0, 0.0);
         c

@@ -131,12 +131,10 @@ fn a_picture_is_the_same_on_any_number_of_threads() {
     let mut settings = scene.render;
     (settings.width, settings.height) = (256, 256);
     let built = crate::common::built(&scene).unwrap();
-    let on = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| built.render(&scene.halo, &settings, &scene.camera).unwrap())
+    let on = |threads| {
+        crate::common::on_threads(threads, || {
+            built.render(&scene.halo, &settings, &scene.camera).unwrap()
+        })
     };
     let one = on(1);
     for threads in [2, 3, 8] {

@@ -1,5 +1,6 @@
 //! Pipelines, targets and the passes of a frame.
 
+use super::gpu::compute_pipeline;
 use super::stipple::StippleSet;
 use super::turn::Turner;
 use super::{
@@ -355,18 +356,8 @@ impl Pipelines {
             None,
         );
         let cut = cut_pipeline(device, &module);
-        let compute = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: None,
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let voxelize = compute("voxelize");
-        let stipple_place = compute("stipple_place");
+        let voxelize = compute_pipeline(device, &module, "voxelize");
+        let stipple_place = compute_pipeline(device, &module, "stipple_place");
         Pipelines {
             surface_grid,
             surface_view,

@@ -26,6 +26,7 @@
 //! in the viewer: 1.16%); with it, 1.63% (with the camera at distance 3.2; fitted to the
 //! picture, 1.64%).
 
+use super::gpu::compute_pipeline;
 use super::{HaloVertex, SurfaceVertex, ViewerError};
 use crate::intersect::Curves;
 use crate::limits::{FieldError, MAX_COORDINATE, MIN_EXTENT};
@@ -575,16 +576,7 @@ impl Turner {
                 concat!(include_str!("vertices.wgsl"), include_str!("turn.wgsl")).into(),
             ),
         });
-        let pipeline = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: None,
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let pipeline = |entry: &str| compute_pipeline(device, &module, entry);
         let (project, shape, faces) = (pipeline("project"), pipeline("shape"), pipeline("faces"));
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(ViewerError::Gpu(e.to_string()));
