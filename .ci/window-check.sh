@@ -96,6 +96,13 @@ case "$t" in
 esac
 echo "  $t"
 expect "settled"
+# While a drag turns the scene in 4D its frames are sliced at 64, at the settings' own once
+# it stops.
+xdotool key s; expect "grid 128 slices"
+xdotool mousemove --window "$w" 150 180 keydown shift mousedown 1 mousemove --window "$w" 200 180 sleep 0.5 mousemove --window "$w" 250 180
+expect "grid 64 slices while turning (128 when still)"
+xdotool mouseup 1 keyup shift; expect "grid 128 slices | "
+expect "settled"
 # The view search runs in the background and turns the view to what it found.
 xdotool key a; expect "searching the view"
 expect "view search:"
