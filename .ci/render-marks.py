@@ -13,6 +13,21 @@ import sys
 
 import vtk
 
+
+
+def actor(mapper, source, colour, opacity=1.0, edges=False):
+    """An actor drawing `source`'s output through `mapper` in one colour."""
+    mapper.SetInputConnection(source.GetOutputPort())
+    mapper.ScalarVisibilityOff()
+    a = vtk.vtkActor()
+    a.SetMapper(mapper)
+    a.GetProperty().SetColor(*colour)
+    a.GetProperty().SetOpacity(opacity)
+    if edges:
+        a.GetProperty().EdgeVisibilityOn()
+    return a
+
+
 out, panels = sys.argv[1], [a.split("=", 1) for a in sys.argv[2:]]
 side = 400
 rw = vtk.vtkRenderWindow()
@@ -29,14 +44,7 @@ for k, (title, path) in enumerate(panels):
     rw.AddRenderer(ren)
     shell = vtk.vtkDataSetSurfaceFilter()
     shell.SetInputData(grid)
-    shell_mapper = vtk.vtkPolyDataMapper()
-    shell_mapper.SetInputConnection(shell.GetOutputPort())
-    shell_mapper.ScalarVisibilityOff()
-    shell_actor = vtk.vtkActor()
-    shell_actor.SetMapper(shell_mapper)
-    shell_actor.GetProperty().SetColor(0.72, 0.72, 0.76)
-    shell_actor.GetProperty().SetOpacity(0.22)
-    ren.AddActor(shell_actor)
+    ren.AddActor(actor(vtk.vtkPolyDataMapper(), shell, (0.72, 0.72, 0.76), opacity=0.22))
     faulty = vtk.vtkThreshold()
     faulty.SetInputData(grid)
     faulty.SetInputArrayToProcess(0, 0, 0, vtk.vtkDataObject.FIELD_ASSOCIATION_CELLS, "fault")
@@ -47,14 +55,7 @@ for k, (title, path) in enumerate(panels):
     count = faulty.GetOutput().GetNumberOfCells()
     if count == 0:
         sys.exit(f"{path}: no tetrahedron is marked")
-    mapper = vtk.vtkDataSetMapper()
-    mapper.SetInputConnection(faulty.GetOutputPort())
-    mapper.ScalarVisibilityOff()
-    actor = vtk.vtkActor()
-    actor.SetMapper(mapper)
-    actor.GetProperty().SetColor(0.85, 0.1, 0.1)
-    actor.GetProperty().EdgeVisibilityOn()
-    ren.AddActor(actor)
+    ren.AddActor(actor(vtk.vtkDataSetMapper(), faulty, (0.85, 0.1, 0.1), edges=True))
     text = vtk.vtkTextActor()
     text.SetInput(f"{title}: {count} marked")
     text.GetTextProperty().SetColor(0.1, 0.1, 0.1)
