@@ -875,18 +875,31 @@ fn legend(
 }
 
 /// Linear [0, 1] to an 8-bit sRGB value: [`srgb8_formula`]'s byte, found among the values
-/// where it steps up (a binary search instead of a power per channel).
+/// where it steps up (instead of a power per channel): the byte at the start of `c`'s
+/// 4096th of [0, 1], then the step within it, if any (the steps lie more than a 4096th
+/// apart).
 fn to_srgb8(c: f64) -> u8 {
-    srgb8_steps().partition_point(|&t| t <= c) as u8
+    let (steps, starts) = srgb8_steps();
+    // Exact (a power of two), saturating: below 0 and NaN to 0, above 1 to the last.
+    let k = ((c * SRGB8_BUCKETS as f64) as usize).min(SRGB8_BUCKETS);
+    let mut b = usize::from(starts[k]);
+    while b < steps.len() && steps[b] <= c {
+        b += 1;
+    }
+    b as u8
 }
+
+/// The buckets of [0, 1] in [`to_srgb8`]'s table.
+const SRGB8_BUCKETS: usize = 4096;
 
 /// The least linear value of each byte 1 to 255 in [`srgb8_formula`], found once by
 /// bisection over the bit patterns of [0, 1] (the formula never falls as its value grows,
-/// and the bits of non-negative f64 order as the values do).
-fn srgb8_steps() -> &'static [f64] {
-    static STEPS: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
-    STEPS.get_or_init(|| {
-        (1..=255u8)
+/// and the bits of non-negative f64 order as the values do); and the byte at `k / 4096`
+/// for each `k` to 4096.
+fn srgb8_steps() -> (&'static [f64], &'static [u8]) {
+    static STEPS: std::sync::OnceLock<(Vec<f64>, Vec<u8>)> = std::sync::OnceLock::new();
+    let (steps, starts) = STEPS.get_or_init(|| {
+        let steps: Vec<f64> = (1..=255u8)
             .map(|b| {
                 let (mut lo, mut hi) = (0u64, 1f64.to_bits());
                 while lo < hi {
@@ -899,8 +912,16 @@ fn srgb8_steps() -> &'static [f64] {
                 }
                 f64::from_bits(lo)
             })
-            .collect()
-    })
+            .collect();
+        let starts = (0..=SRGB8_BUCKETS)
+            .map(|k| {
+                let c = k as f64 / SRGB8_BUCKETS as f64;
+                steps.partition_point(|&t| t <= c) as u8
+            })
+            .collect();
+        (steps, starts)
+    });
+    (steps, starts)
 }
 
 /// Linear [0, 1] to an 8-bit sRGB value, by the sRGB formula.
@@ -1396,7 +1417,14 @@ mod tests {
         // Every step and the f64 on either side of it, and ten million values spread over
         // [-0.1, 1.1] by a fixed chaotic sequence, with NaN and the infinities.
         let mut values = vec![f64::NAN, f64::INFINITY, f64::NEG_INFINITY, -0.0, 0.0, 1.0];
-        values.extend_from_slice(srgb8_steps());
+        let steps = srgb8_steps().0;
+        assert!(
+            steps
+                .windows(2)
+                .all(|s| s[1] - s[0] > 1.0 / SRGB8_BUCKETS as f64)
+        );
+        values.extend_from_slice(steps);
+        values.extend((0..=SRGB8_BUCKETS).map(|k| k as f64 / SRGB8_BUCKETS as f64));
         let mut x = 0.5f64;
         for _ in 0..10_000_000 {
             x = (x * 3.999_999 * (1.0 - x)).clamp(1e-12, 1.0 - 1e-12);

@@ -218,17 +218,60 @@ const TILE: f64 = 8.0;
 /// the better way (long slivers across the picture).
 const MOST_ENTRIES: usize = 16;
 
-/// A triangle of one tile: its BVH slot and its projected box in image coordinates.
+/// A triangle of one tile: its BVH slot and its projection as three edge lines in image
+/// coordinates, each `[a, b, c]` with `a x + b y + c` the signed distance of image point
+/// (x, y) from the line (positive inside) plus a margin: how far outside a point may lie
+/// and still be hit, far more than the rounding of the projection and of the exact test's
+/// shear (a millionth of the projection's box and a billionth of its coordinates, as
+/// [`projected_box`]'s pad). A triangle whose projection has (almost) no area, or none (it
+/// reaches a perspective eye's plane), keeps every point (zero lines): the exact test
+/// decides.
 #[derive(Clone, Copy, Debug, Default)]
 struct Entry {
     slot: u32,
-    lo: [f64; 2],
-    hi: [f64; 2],
+    lines: [[f64; 3]; 3],
 }
 
 impl Entry {
-    fn holds(&self, at: [f64; 2]) -> bool {
-        at[0] >= self.lo[0] && at[0] <= self.hi[0] && at[1] >= self.lo[1] && at[1] <= self.hi[1]
+    /// The entry of the triangle in `slot` with the projection `q` (image coordinates),
+    /// if it has one.
+    fn new(slot: u32, q: Option<[[f64; 2]; 3]>) -> Self {
+        let every = Entry {
+            slot,
+            lines: [[0.0; 3]; 3],
+        };
+        let Some(q) = q else { return every };
+        let (lo, hi) = (
+            [0, 1].map(|k| q[0][k].min(q[1][k]).min(q[2][k])),
+            [0, 1].map(|k| q[0][k].max(q[1][k]).max(q[2][k])),
+        );
+        let diagonal = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
+        let size = [lo[0], lo[1], hi[0], hi[1]]
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let margin = 1e-6 * diagonal + 1e-9 * (1.0 + size);
+        let twice_area =
+            (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]);
+        if !(twice_area.abs() > 1e-12 * diagonal * diagonal) {
+            return every;
+        }
+        let sign = twice_area.signum();
+        let lines = [0, 1, 2].map(|i| {
+            let (from, to) = (q[(i + 1) % 3], q[(i + 2) % 3]);
+            let (dx, dy) = (to[0] - from[0], to[1] - from[1]);
+            let length = dx.hypot(dy);
+            let (a, b) = (-sign * dy / length, sign * dx / length);
+            [a, b, margin - (a * from[0] + b * from[1])]
+        });
+        Entry { slot, lines }
+    }
+
+    /// Whether image point `at` lies within the margin of the projected triangle (without
+    /// branches: most entries of a tile are tested, and half of them pass).
+    #[inline]
+    fn near(&self, at: [f64; 2]) -> bool {
+        let d = self.lines.map(|l| l[0] * at[0] + l[1] * at[1] + l[2]);
+        d[0].min(d[1]).min(d[2]) >= 0.0
     }
 }
 
@@ -320,12 +363,8 @@ impl Tiles {
         let mut total = 0usize;
         for (slot, corners) in tracer.corners.iter().enumerate() {
             let slot = slot as u32;
-            let Some((lo, hi)) = projected_box(cam, corners) else {
-                everywhere.push(Entry {
-                    slot,
-                    lo: [f64::NEG_INFINITY; 2],
-                    hi: [f64::INFINITY; 2],
-                });
+            let Some((image, (lo, hi))) = projected_box(cam, corners) else {
+                everywhere.push(Entry::new(slot, None));
                 continue;
             };
             if hi[0] < -1.0 || lo[0] > 1.0 || hi[1] < -1.0 || lo[1] > 1.0 {
@@ -344,7 +383,7 @@ impl Tiles {
                     total += 1;
                 }
             }
-            placed.push((Entry { slot, lo, hi }, span));
+            placed.push((Entry::new(slot, Some(image)), span));
             if total > MOST_ENTRIES * (tracer.corners.len() + cols * rows) {
                 return None;
             }
@@ -375,7 +414,8 @@ impl Tiles {
     }
 
     /// Every hit beyond `t_min` of the ray through image point `at` on the triangles of its
-    /// tile whose boxes hold the point, unordered, into `hits` (cleared first).
+    /// tile whose projections come near the point ([`Entry::near`]: the exact test of a
+    /// triangle farther away would miss), unordered, into `hits` (cleared first).
     fn collect(
         &self,
         tracer: &Tracer,
@@ -392,7 +432,7 @@ impl Tiles {
         let shear = Shear::new(origin, dir);
         let entries = &self.entries[self.starts[tile]..self.starts[tile + 1]];
         for e in entries.iter().chain(&self.everywhere) {
-            if e.holds(at)
+            if e.near(at)
                 && let Some(hit) = tracer.hit(&shear, e.slot as usize)
                 && hit.t > t_min
             {
@@ -402,15 +442,17 @@ impl Tiles {
     }
 }
 
-/// The box in image coordinates of triangle `p`'s projection by `cam`, grown by far more
+/// Triangle `p`'s projection by `cam` in image coordinates, and its box grown by far more
 /// than the rounding of a hit's image point (a millionth of the box's size, and a
 /// billionth of the picture); `None` where a perspective eye's plane comes near the
 /// triangle (its projection is unbounded).
-fn projected_box(cam: &Camera, p: &[DVec3; 3]) -> Option<([f64; 2], [f64; 2])> {
+#[allow(clippy::type_complexity)]
+fn projected_box(cam: &Camera, p: &[DVec3; 3]) -> Option<([[f64; 2]; 3], ([f64; 2], [f64; 2]))> {
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];
+    let mut images = [[0.0; 2]; 3];
     let (hw, hh) = (cam.half_height * cam.aspect, cam.half_height);
-    for &q in p {
+    for (&q, out) in p.iter().zip(&mut images) {
         let d = q - cam.eye;
         let (x, y, z) = (d.dot(cam.right), d.dot(cam.up), d.dot(cam.forward));
         let image = match cam.projection {
@@ -424,6 +466,7 @@ fn projected_box(cam: &Camera, p: &[DVec3; 3]) -> Option<([f64; 2], [f64; 2])> {
             }
             CameraProjection::Orthographic => [x / hw, y / hh],
         };
+        *out = image;
         for k in 0..2 {
             lo[k] = lo[k].min(image[k]);
             hi[k] = hi[k].max(image[k]);
@@ -434,8 +477,11 @@ fn projected_box(cam: &Camera, p: &[DVec3; 3]) -> Option<([f64; 2], [f64; 2])> {
     }
     let pad = |k: usize| 1e-6 * (hi[k] - lo[k]) + 1e-9;
     Some((
-        [lo[0] - pad(0), lo[1] - pad(1)],
-        [hi[0] + pad(0), hi[1] + pad(1)],
+        images,
+        (
+            [lo[0] - pad(0), lo[1] - pad(1)],
+            [hi[0] + pad(0), hi[1] + pad(1)],
+        ),
     ))
 }
 
@@ -608,6 +654,28 @@ mod primary_tests {
             }
             // Most rays of each camera meet the scene: the comparison is not of misses.
             assert!(hit * 3 > rays, "{name}: {hit} of {rays} rays hit");
+            // Rays aimed at triangles' corners and the midpoints of their edges, where the
+            // exact test and the tiles' edge lines are both at their limits: the same hits.
+            let mut aimed = 0;
+            for (slot, p) in tracer.corners.iter().enumerate().step_by(7) {
+                let Some((image, _)) = projected_box(&cam, p) else {
+                    continue;
+                };
+                for k in 0..3 {
+                    let (a, b) = (image[k], image[(k + 1) % 3]);
+                    for at in [a, [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0]] {
+                        if at.iter().any(|v| v.abs() > 1.0) {
+                            continue;
+                        }
+                        let (origin, dir) = cam.ray(at[0], at[1]);
+                        tracer.hits(origin, dir, 0.0, &mut expected);
+                        primary.hits(at, origin, dir, 0.0, &mut got);
+                        assert_eq!(got, expected, "{name}: hits at corner {k} of {slot}");
+                        aimed += usize::from(!expected.is_empty());
+                    }
+                }
+            }
+            assert!(aimed > 40, "{name}: {aimed} aimed rays hit");
         }
     }
 }
