@@ -9,6 +9,7 @@
 //! the staircase of the pixels does not show.
 
 use glam::DVec2;
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// A crossing of the outline with the segment between two neighbouring pixel centres:
@@ -20,37 +21,38 @@ type Crossing = (u32, u32, u8);
 /// point at the end.
 pub(crate) fn outline(mask: &[bool], width: usize, height: usize) -> Vec<Vec<DVec2>> {
     let at = |x: usize, y: usize| mask[y * width + x];
-    let mut segments: Vec<[Crossing; 2]> = Vec::new();
-    for y in 0..height.saturating_sub(1) {
-        for x in 0..width.saturating_sub(1) {
-            // The square of centres (x, y), (x + 1, y), (x + 1, y + 1), (x, y + 1).
-            let c = [at(x, y), at(x + 1, y), at(x + 1, y + 1), at(x, y + 1)];
-            let (xs, ys) = (x as u32, y as u32);
-            let top = (xs, ys, 0u8);
-            let right = (xs + 1, ys, 1u8);
-            let bottom = (xs, ys + 1, 0u8);
-            let left = (xs, ys, 1u8);
-            let edges = [top, right, bottom, left];
-            let crossed: Vec<Crossing> = (0..4)
-                .filter(|&k| c[k] != c[(k + 1) % 4])
-                .map(|k| edges[k])
-                .collect();
-            match crossed.len() {
-                2 => segments.push([crossed[0], crossed[1]]),
-                // A saddle: the two diagonal corners that are set stay apart.
-                4 => {
-                    if c[0] {
-                        segments.push([top, right]);
-                        segments.push([bottom, left]);
-                    } else {
-                        segments.push([top, left]);
-                        segments.push([right, bottom]);
-                    }
+    // Row by row of squares on the cores, joined in order.
+    let segments: Vec<[Crossing; 2]> = (0..height.saturating_sub(1))
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            let mut row = Vec::new();
+            for x in 0..width.saturating_sub(1) {
+                // The square of centres (x, y), (x + 1, y), (x + 1, y + 1), (x, y + 1).
+                let c = [at(x, y), at(x + 1, y), at(x + 1, y + 1), at(x, y + 1)];
+                if c == [c[0]; 4] {
+                    continue; // most squares: the outline does not pass
                 }
-                _ => {}
+                let (xs, ys) = (x as u32, y as u32);
+                let top = (xs, ys, 0u8);
+                let right = (xs + 1, ys, 1u8);
+                let bottom = (xs, ys + 1, 0u8);
+                let left = (xs, ys, 1u8);
+                let edges = [top, right, bottom, left];
+                let mut crossed = (0..4).filter(|&k| c[k] != c[(k + 1) % 4]).map(|k| edges[k]);
+                if c[0] == c[2] && c[1] == c[3] {
+                    // A saddle: the two diagonal corners that are set stay apart.
+                    if c[0] {
+                        row.extend([[top, right], [bottom, left]]);
+                    } else {
+                        row.extend([[top, left], [right, bottom]]);
+                    }
+                } else if let (Some(a), Some(b)) = (crossed.next(), crossed.next()) {
+                    row.push([a, b]);
+                }
             }
-        }
-    }
+            row
+        })
+        .collect();
     chain(&segments)
         .into_iter()
         .map(|line| {

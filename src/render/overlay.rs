@@ -161,37 +161,39 @@ impl Scene<'_> {
     pub(super) fn rasterize(&self, runs: &[Run]) -> Result<Vec<Lines>, RenderError> {
         let s = self.settings;
         let (w, h) = (s.width as usize, s.height as usize);
-        let mut masks: Vec<Option<(DVec3, Mask)>> =
-            (0..band_class(OVER_BANDS)).map(|_| None).collect();
+        // Each class's runs, in order; the classes drawn and broadened side by side on the
+        // cores, each thread with its own FFT plans.
+        let mut classes: Vec<Vec<&Run>> = vec![Vec::new(); band_class(OVER_BANDS)];
         for run in runs {
-            let (_, mask) = match &mut masks[run.class] {
-                Some(entry) => entry,
-                empty => empty.insert((run.ink, Mask::new(w, h).map_err(line_error)?)),
-            };
-            mask.draw_polyline(&run.points).map_err(line_error)?;
+            classes[run.class].push(run);
         }
-        // The classes side by side on the cores, each thread with its own FFT plans.
-        let drawn: Vec<(usize, DVec3, Mask)> = masks
-            .into_iter()
-            .enumerate()
-            .filter_map(|(class, entry)| {
-                entry
-                    .filter(|(_, m)| !m.is_empty())
-                    .map(|(ink, mask)| (class, ink, mask))
-            })
-            .collect();
-        drawn
+        let lines: Vec<Option<Lines>> = classes
             .into_par_iter()
-            .map_init(Broadener::new, |broadener, (class, ink, mask)| {
+            .enumerate()
+            .map_init(Broadener::new, |broadener, (class, runs)| {
+                let Some(first) = runs.first() else {
+                    return Ok(None);
+                };
+                let mut mask = Mask::new(w, h).map_err(line_error)?;
+                for run in &runs {
+                    mask.draw_polyline(&run.points).map_err(line_error)?;
+                }
+                if mask.is_empty() {
+                    return Ok(None);
+                }
                 let coverage = match (s.line_width_far, class) {
                     (_, BROKEN) => broadener.broaden(&mask, s.line_width * BROKEN_WIDTH),
                     (Some(_), _) => broadener.broaden_varying(&mask),
                     (None, _) => broadener.broaden(&mask, s.line_width),
                 }
                 .map_err(line_error)?;
-                Ok(Lines { ink, coverage })
+                Ok(Some(Lines {
+                    ink: first.ink,
+                    coverage,
+                }))
             })
-            .collect()
+            .collect::<Result<_, RenderError>>()?;
+        Ok(lines.into_iter().flatten().collect())
     }
 
     /// The visible runs of the scene's lines in the image of `cam`: the curves, silhouettes

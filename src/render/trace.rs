@@ -8,6 +8,7 @@ use crate::parts::Parts;
 use glam::{DVec3, Vec3A};
 use obvhs::bvh2::Bvh2;
 use obvhs::ray::Ray;
+use rayon::prelude::*;
 
 /// One surface's triangles as the tracer reads them.
 #[derive(Clone, Copy, Debug)]
@@ -252,7 +253,7 @@ impl Entry {
         let margin = 1e-6 * diagonal + 1e-9 * (1.0 + size);
         let twice_area =
             (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]);
-        if !(twice_area.abs() > 1e-12 * diagonal * diagonal) {
+        if !twice_area.is_finite() || twice_area.abs() <= 1e-12 * diagonal * diagonal {
             return every;
         }
         let sign = twice_area.signum();
@@ -340,6 +341,13 @@ impl<'t, 'a> Primary<'t, 'a> {
     }
 }
 
+/// The tiles a triangle's box meets: its first and last column, then its first and last
+/// row.
+type Span = [[usize; 2]; 2];
+
+/// A box in image coordinates: its least and greatest corners.
+type ImageBox = ([f64; 2], [f64; 2]);
+
 /// The tile along one axis that image coordinate `x` falls in, for tiles of `step` image
 /// units and `count` tiles (a coordinate outside the picture goes to the nearest).
 fn tile_index(x: f64, step: f64, count: usize) -> usize {
@@ -355,35 +363,47 @@ impl Tiles {
             2.0 * TILE / f64::from(width),
             2.0 * TILE / f64::from(height),
         ];
-        // Each triangle in the picture with its box and the tiles it meets (columns, then
-        // rows, inclusive); those that reach the eye's plane in every tile.
+        // Each triangle in the picture with its entry and the tiles its box meets (columns,
+        // then rows, inclusive), projected on the cores; those that reach the eye's plane
+        // in every tile.
+        let projected: Vec<Option<(Entry, Option<Span>)>> = tracer
+            .corners
+            .par_iter()
+            .enumerate()
+            .map(|(slot, corners)| {
+                let slot = slot as u32;
+                let Some((image, (lo, hi))) = projected_box(cam, corners) else {
+                    return Some((Entry::new(slot, None), None));
+                };
+                if hi[0] < -1.0 || lo[0] > 1.0 || hi[1] < -1.0 || lo[1] > 1.0 {
+                    return None; // outside the picture: no primary ray meets it
+                }
+                let span = [0, 1].map(|k| {
+                    let count = [cols, rows][k];
+                    [
+                        tile_index(lo[k], step[k], count),
+                        tile_index(hi[k], step[k], count),
+                    ]
+                });
+                Some((Entry::new(slot, Some(image)), Some(span)))
+            })
+            .collect();
         let mut placed = Vec::new();
         let mut everywhere = Vec::new();
         let mut counts = vec![0usize; cols * rows + 1];
         let mut total = 0usize;
-        for (slot, corners) in tracer.corners.iter().enumerate() {
-            let slot = slot as u32;
-            let Some((image, (lo, hi))) = projected_box(cam, corners) else {
-                everywhere.push(Entry::new(slot, None));
+        for (entry, span) in projected.into_iter().flatten() {
+            let Some(span) = span else {
+                everywhere.push(entry);
                 continue;
             };
-            if hi[0] < -1.0 || lo[0] > 1.0 || hi[1] < -1.0 || lo[1] > 1.0 {
-                continue; // outside the picture: no primary ray meets it
-            }
-            let span = [0, 1].map(|k| {
-                let count = [cols, rows][k];
-                [
-                    tile_index(lo[k], step[k], count),
-                    tile_index(hi[k], step[k], count),
-                ]
-            });
             for j in span[1][0]..=span[1][1] {
                 for i in span[0][0]..=span[0][1] {
                     counts[j * cols + i + 1] += 1;
                     total += 1;
                 }
             }
-            placed.push((Entry::new(slot, Some(image)), span));
+            placed.push((entry, span));
             if total > MOST_ENTRIES * (tracer.corners.len() + cols * rows) {
                 return None;
             }
@@ -446,8 +466,7 @@ impl Tiles {
 /// than the rounding of a hit's image point (a millionth of the box's size, and a
 /// billionth of the picture); `None` where a perspective eye's plane comes near the
 /// triangle (its projection is unbounded).
-#[allow(clippy::type_complexity)]
-fn projected_box(cam: &Camera, p: &[DVec3; 3]) -> Option<([[f64; 2]; 3], ([f64; 2], [f64; 2]))> {
+fn projected_box(cam: &Camera, p: &[DVec3; 3]) -> Option<([[f64; 2]; 3], ImageBox)> {
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];
     let mut images = [[0.0; 2]; 3];
