@@ -960,11 +960,16 @@ impl<'a> Scene<'a> {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), w| {
                 (a.min(w), b.max(w))
             });
+        // The triangles' BVH and the halos' side by side on the cores.
+        let (tracer, halos) = rayon::join(
+            || Tracer::of_parts(input),
+            || settings.halos.then(|| TriangleHiders::new(input)),
+        );
         Scene {
             input,
             settings,
-            tracer: Tracer::of_parts(input),
-            halos: settings.halos.then(|| TriangleHiders::new(input)),
+            tracer,
+            halos,
             planes: match settings.lighting {
                 Lighting::ThreeD => Vec::new(),
                 Lighting::FourD => input
@@ -1109,15 +1114,20 @@ impl<'a> Scene<'a> {
             // shows, and only the hits that near are traced.
             if nearest_first {
                 let slack = 2.0 * self.tracer.same();
-                primary.nearest_hits([sx, sy], origin, dir, 0.0, slack, hits);
-                let shown = self.shade(cam, origin, dir, hits, |j, hit, x, wd| {
+                let near = primary.nearest_first([sx, sy], origin, dir, slack, hits);
+                let shown = self.shade(cam, origin, dir, &hits[..near.count], |j, hit, x, wd| {
                     hidden(pixel, j, hit, x, wd)
                 });
                 if !shown.first_hidden {
                     return shown;
                 }
+                // Uncut, so every hit is what the ray shows past the first.
+                if !near.all {
+                    self.trace_primary(&primary, [sx, sy], origin, dir, hits);
+                }
+            } else {
+                self.trace_primary(&primary, [sx, sy], origin, dir, hits);
             }
-            self.trace_primary(&primary, [sx, sy], origin, dir, hits);
             let base = *numbered;
             *numbered += hits.len();
             self.shade(cam, origin, dir, hits, |j, hit, x, wd| {

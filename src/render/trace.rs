@@ -321,6 +321,36 @@ impl<'t, 'a> Primary<'t, 'a> {
         self.tracer.order(hits);
     }
 
+    /// The hits of the primary ray through image point `at` from its start, ordered:
+    /// [`Primary::hits`] through the tiles (which find them all at once), of which the
+    /// first `count` are [`Primary::nearest_hits`] within `slack`; through the BVH, those
+    /// nearest hits alone, found by its closest-hit traversal.
+    pub fn nearest_first(
+        &self,
+        at: [f64; 2],
+        origin: DVec3,
+        dir: DVec3,
+        slack: f64,
+        hits: &mut Vec<Hit>,
+    ) -> Nearest {
+        let Some(tiles) = &self.tiles else {
+            self.tracer.nearest_hits(origin, dir, 0.0, slack, hits);
+            return Nearest {
+                count: hits.len(),
+                all: false,
+            };
+        };
+        tiles.collect(self.tracer, at, origin, dir, 0.0, hits);
+        // Ordering keeps the hits by t, and drops a hit only for one before it: the
+        // nearest hits' order is the start of this one.
+        self.tracer.order(hits);
+        let reach = hits.first().map_or(f64::NEG_INFINITY, |h| h.t + slack);
+        Nearest {
+            count: hits.partition_point(|h| h.t <= reach),
+            all: true,
+        }
+    }
+
     /// [`Tracer::nearest_hits`] of the primary ray through image point `at`.
     pub fn nearest_hits(
         &self,
@@ -347,6 +377,16 @@ type Span = [[usize; 2]; 2];
 
 /// A box in image coordinates: its least and greatest corners.
 type ImageBox = ([f64; 2], [f64; 2]);
+
+/// What [`Primary::nearest_first`] found.
+#[derive(Clone, Copy, Debug)]
+pub struct Nearest {
+    /// How many of the hits lie no farther than the slack past the nearest one.
+    pub count: usize,
+    /// Whether the hits are every hit of the ray (through the tiles), not those alone
+    /// (through the BVH).
+    pub all: bool,
+}
 
 /// The tile along one axis that image coordinate `x` falls in, for tiles of `step` image
 /// units and `count` tiles (a coordinate outside the picture goes to the nearest).
@@ -611,8 +651,8 @@ mod primary_tests {
         // points between them), from its own perspective camera, an orthographic camera
         // along the same axis, and a perspective eye inside the scene (triangles reach its
         // plane and are in every tile; others project across the picture): every ray's
-        // hits, from the start and past a distance, and its nearest hits, are the
-        // tracer's own.
+        // hits, from the start and past a distance, and its nearest hits (alone, and as
+        // the start of all its hits), are the tracer's own.
         let scene = crate::Scene::default_scene();
         let built = crate::Sampled::of(&scene)
             .into_built(&scene, crate::Stages::of(&scene))
@@ -667,6 +707,15 @@ mod primary_tests {
                     tracer.nearest_hits(origin, dir, 0.0, slack, &mut expected);
                     primary.nearest_hits(at, origin, dir, 0.0, slack, &mut got);
                     assert_eq!(got, expected, "{name}: nearest hits at {at:?}");
+                    let near = primary.nearest_first(at, origin, dir, slack, &mut got);
+                    assert!(near.all);
+                    assert_eq!(
+                        got[..near.count],
+                        expected,
+                        "{name}: nearest first at {at:?}"
+                    );
+                    tracer.hits(origin, dir, 0.0, &mut expected);
+                    assert_eq!(got, expected, "{name}: all hits, nearest first, at {at:?}");
                     hit += usize::from(!expected.is_empty());
                     rays += 1;
                 }
@@ -742,6 +791,10 @@ mod fallback_tests {
             tracer.hits(origin, dir, 0.0, &mut expected);
             primary.hits(at, origin, dir, 0.0, &mut got);
             assert_eq!(expected.len(), 64);
+            assert_eq!(got, expected);
+            let near = primary.nearest_first(at, origin, dir, tracer.same(), &mut got);
+            tracer.nearest_hits(origin, dir, 0.0, tracer.same(), &mut expected);
+            assert!(!near.all && near.count == got.len());
             assert_eq!(got, expected);
         }
     }
