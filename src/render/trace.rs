@@ -501,12 +501,14 @@ impl Tiles {
             at[1] as f32,
             (1e-6 * (at[0].abs() + at[1].abs())) as f32,
         ];
-        for e in entries.iter().chain(&self.everywhere) {
-            if e.near(point)
-                && let Some(hit) = tracer.hit(&shear, e.slot as usize)
-                && hit.t > t_min
-            {
-                hits.push(hit);
+        for list in [entries, &self.everywhere] {
+            for e in list {
+                if e.near(point)
+                    && let Some(hit) = tracer.hit(&shear, e.slot as usize)
+                    && hit.t > t_min
+                {
+                    hits.push(hit);
+                }
             }
         }
     }
