@@ -205,13 +205,14 @@ impl<'a> TriangleHiders<'a> {
                 && !off_slab
                 && let Some(n) = Near::new(g, corners)
                 // Kept unless one of its faces has the whole grown triangle clearly
-                // outside: its corners farther out than the grown triangle reaches.
+                // outside: its corners farther out than twice the grown triangle's reach
+                // (the second for the rounding of their distances, far below the pad).
                 && spaces.is_none_or(|(_, reach)| {
                     n.faces.iter().all(|f| {
                         p.iter()
                             .map(|q| f[0] * q.x + f[1] * q.y + f[2] * q.z + f[3])
                             .fold(f64::NEG_INFINITY, f64::max)
-                            >= -reach
+                            >= -2.0 * reach
                     })
                 })
             {
