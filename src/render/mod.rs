@@ -572,14 +572,15 @@ fn render_eyes(
     let mut rgb = vec![0u8; 3 * (w as usize * eyes.len()) * h as usize];
     for (e, &offset) in eyes.iter().enumerate() {
         let cam = Camera::new(camera, &placement, w, h, offset)?;
+        let primary = scene.primary(&cam);
         let mut view = match settings.style {
-            Style::Shaded => scene.view(&cam),
-            Style::Stipple => scene.view_stipples(&cam, want.depth && e == 0)?,
+            Style::Shaded => scene.view(&primary),
+            Style::Stipple => scene.view_stipples(&primary, want.depth && e == 0)?,
         };
         if e == 0 && want.depth {
             depth.clone_from(&view.front);
         }
-        let runs = scene.runs(&cam, &view.gap)?;
+        let runs = scene.runs(&primary, &view.gap)?;
         for lines in scene.rasterize(&runs)? {
             view.rgb
                 .par_iter_mut()
@@ -591,7 +592,7 @@ fn render_eyes(
         }
         if e == 0 && want.seen {
             let camera = visible::PictureCamera::of(&cam, placement.target, w, h);
-            seen = Some((camera, scene.curve_visibility(&cam)));
+            seen = Some((camera, scene.curve_visibility(&primary)));
         }
         if settings.legend {
             legend(
@@ -634,7 +635,7 @@ pub fn stipples_drawn(
 ) -> Result<Vec<stipple::Drawn>, RenderError> {
     let (placement, scene) = prepare(input, settings, camera)?;
     let cam = first_camera(settings, camera, &placement)?;
-    scene.stipples(&cam)
+    scene.stipples(&scene.primary(&cam))
 }
 
 /// The coverage in [0, 1] of the lines (curves and silhouettes, as the settings ask) in the
@@ -1074,11 +1075,11 @@ impl<'a> Scene<'a> {
     }
 
     /// One eye's image.
-    fn view(&self, cam: &Camera) -> View {
+    fn view(&self, primary: &Primary) -> View {
         match (self.settings.mode, &self.halos) {
-            (RenderMode::Slices, Some(h)) => self.view_slices(cam, h.index()),
+            (RenderMode::Slices, Some(h)) => self.view_slices(primary, h.index()),
             _ => self.view_with(
-                cam,
+                primary,
                 self.opaque_and_uncut(),
                 self.settings.adaptive,
                 |_, _, hit, x, w| self.hidden_at(hit, x, w),
@@ -1097,7 +1098,7 @@ impl<'a> Scene<'a> {
     /// samples; the rest are their centre sample.
     fn view_with(
         &self,
-        cam: &Camera,
+        primary: &Primary,
         nearest_first: bool,
         adaptive: bool,
         hidden: impl Fn(usize, usize, &Hit, DVec3, f64) -> bool + Sync,
@@ -1105,7 +1106,7 @@ impl<'a> Scene<'a> {
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
         let n = self.grid_side();
         let centre = (n / 2) * n + n / 2;
-        let primary = Primary::new(&self.tracer, cam, self.settings.width, self.settings.height);
+        let cam = primary.camera();
         // Sample `k` of `pixel`, its hits numbered from `numbered` on (which it advances).
         let sample = |hits: &mut Vec<Hit>, pixel: usize, k: usize, numbered: &mut usize| {
             let (sx, sy) = self.sample_point(pixel % w, pixel / w, k);
@@ -1123,10 +1124,10 @@ impl<'a> Scene<'a> {
                 }
                 // Uncut, so every hit is what the ray shows past the first.
                 if !near.all {
-                    self.trace_primary(&primary, [sx, sy], origin, dir, hits);
+                    self.trace_primary(primary, [sx, sy], origin, dir, hits);
                 }
             } else {
-                self.trace_primary(&primary, [sx, sy], origin, dir, hits);
+                self.trace_primary(primary, [sx, sy], origin, dir, hits);
             }
             let base = *numbered;
             *numbered += hits.len();
@@ -1220,6 +1221,11 @@ impl<'a> Scene<'a> {
             && s.ribbons.is_none()
     }
 
+    /// The triangles binned for the primary rays of `cam`'s picture.
+    fn primary(&self, cam: &Camera) -> Primary<'_, 'a> {
+        Primary::new(&self.tracer, cam, self.settings.width, self.settings.height)
+    }
+
     /// Every hit of a ray that is not clipped away (hither, ribbons), in order.
     fn trace(&self, origin: DVec3, dir: DVec3, hits: &mut Vec<Hit>) {
         self.tracer.hits(origin, dir, self.t_min(), hits);
@@ -1268,7 +1274,8 @@ impl<'a> Scene<'a> {
 
     /// The multi-slice image: every hit of every sample first, then the slices decide which
     /// are hidden, then the samples are composited.
-    fn view_slices(&self, cam: &Camera, index: &HaloIndex) -> View {
+    fn view_slices(&self, primary: &Primary, index: &HaloIndex) -> View {
+        let cam = primary.camera();
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
         // Per pixel, its hits over all its samples, in sample order; row by row on the
         // cores, joined in order.
@@ -1319,7 +1326,7 @@ impl<'a> Scene<'a> {
             &probes,
         );
         drop(probes);
-        self.view_with(cam, false, false, |pixel, k, _, _, _| {
+        self.view_with(primary, false, false, |pixel, k, _, _, _| {
             hidden[starts[pixel] as usize + k]
         })
     }
@@ -1469,11 +1476,12 @@ mod tests {
             let (placement, prepared) = prepare(&parts, &scene.render, &scene.camera).unwrap();
             assert!(prepared.opaque_and_uncut());
             let cam = Camera::new(&scene.camera, &placement, 200, 200, 0.0).unwrap();
+            let primary = prepared.primary(&cam);
             let hidden =
                 |_: usize, _: usize, hit: &Hit, x: DVec3, w: f64| prepared.hidden_at(hit, x, w);
             let (fast, full) = (
-                prepared.view_with(&cam, true, false, hidden),
-                prepared.view_with(&cam, false, false, hidden),
+                prepared.view_with(&primary, true, false, hidden),
+                prepared.view_with(&primary, false, false, hidden),
             );
             assert_eq!(fast.rgb, full.rgb, "{}", scene.name);
             assert_eq!(fast.front, full.front, "{}", scene.name);

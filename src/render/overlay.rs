@@ -9,6 +9,7 @@
 
 use super::camera::Camera;
 use super::lines::{Broadener, Coverage, Mask};
+use super::trace::{Hit, Primary};
 use super::{RenderError, Scene};
 use crate::intersect::Curve;
 use crate::limits::FieldError;
@@ -153,7 +154,7 @@ impl Scene<'_> {
     /// order they are laid over the picture; `gap` marks the pixels whose first surface a
     /// halo hides (empty where unknown), whose outline are the broken edges.
     pub(super) fn lines(&self, cam: &Camera, gap: &[bool]) -> Result<Vec<Lines>, RenderError> {
-        self.rasterize(&self.runs(cam, gap)?)
+        self.rasterize(&self.runs(&self.primary(cam), gap)?)
     }
 
     /// The runs drawn one pixel wide into a mask per ink and broadened, one entry per ink
@@ -196,9 +197,11 @@ impl Scene<'_> {
         Ok(lines.into_iter().flatten().collect())
     }
 
-    /// The visible runs of the scene's lines in the image of `cam`: the curves, silhouettes
-    /// and cut edges where a ray from the eye reaches them, and the outline of `gap`.
-    pub(super) fn runs(&self, cam: &Camera, gap: &[bool]) -> Result<Vec<Run>, RenderError> {
+    /// The visible runs of the scene's lines in the image of `primary`'s camera (its tiles
+    /// trace the rays towards them): the curves, silhouettes and cut edges where a ray from
+    /// the eye reaches them, and the outline of `gap`.
+    pub(super) fn runs(&self, primary: &Primary, gap: &[bool]) -> Result<Vec<Run>, RenderError> {
+        let cam = primary.camera();
         let s = self.settings;
         let (w, h) = (s.width, s.height);
         let mut out = Vec::new();
@@ -271,7 +274,8 @@ impl Scene<'_> {
                             && xy[0] < f64::from(w)
                             && xy[1] < f64::from(h)
                             && !s.clip.is_some_and(|c| c.removes(p));
-                        let visible = inside && (see_through || !self.occluded(cam, seen, hits));
+                        let visible =
+                            inside && (see_through || !self.occluded(primary, seen, hits));
                         if visible {
                             run.push((DVec2::new(xy[0], xy[1]), width_at(p)));
                         } else {
@@ -321,27 +325,23 @@ impl Scene<'_> {
 
     /// Whether a surface the halos leave visible lies between the eye and `p` (surfaces
     /// through `p` itself, as both sheets at a curve point, do not count).
-    pub(super) fn occluded(
-        &self,
-        cam: &Camera,
-        p: DVec3,
-        hits: &mut Vec<super::trace::Hit>,
-    ) -> bool {
-        let (origin, dir) = self.hits_before(cam, p, hits);
+    pub(super) fn occluded(&self, primary: &Primary, p: DVec3, hits: &mut Vec<Hit>) -> bool {
+        let (origin, dir) = self.hits_before(primary, p, hits);
         hits.iter().any(|hit| !self.hidden_hit(origin, dir, hit))
     }
 
-    /// Traces the eye ray through `p` and keeps in `hits` the surfaces it meets before `p`
-    /// (those through `p` itself do not count); gives the ray (origin, unit direction).
+    /// Traces the eye ray through `p` (of `primary`'s camera, through its tiles where `p` is
+    /// in the picture) and keeps in `hits` the surfaces it meets before `p` (those through
+    /// `p` itself do not count); gives the ray (origin, unit direction).
     pub(super) fn hits_before(
         &self,
-        cam: &Camera,
+        primary: &Primary,
         p: DVec3,
-        hits: &mut Vec<super::trace::Hit>,
+        hits: &mut Vec<Hit>,
     ) -> (DVec3, DVec3) {
-        let (origin, dir) = cam.ray_to(p);
-        self.trace(origin, dir, hits);
-        let t_p = cam.ray_distance(p);
+        let (origin, dir) = primary.hits_towards(p, self.t_min(), hits);
+        self.cut(origin, dir, hits);
+        let t_p = primary.camera().ray_distance(p);
         let before = t_p - 1e-9 * self.radius.max(t_p);
         let keep = hits.iter().take_while(|hit| hit.t < before).count();
         hits.truncate(keep);

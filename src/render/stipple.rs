@@ -75,8 +75,9 @@ pub fn density(tone: f64, size: f64) -> f64 {
 }
 
 impl Scene<'_> {
-    /// The stipples the picture of `cam` draws, in the order of their surfaces and ranks.
-    pub(super) fn stipples(&self, cam: &Camera) -> Result<Vec<Drawn>, RenderError> {
+    /// The stipples the picture of `primary`'s camera draws, in the order of their surfaces and ranks.
+    pub(super) fn stipples(&self, primary: &Primary) -> Result<Vec<Drawn>, RenderError> {
+        let cam = primary.camera();
         let s = self.settings;
         let (w, h) = (s.width, s.height);
         let margin = s.stipple.size;
@@ -157,7 +158,7 @@ impl Scene<'_> {
                 .collect();
             candidates.extend(found);
         }
-        let visible = self.stipples_visible(cam, &candidates);
+        let visible = self.stipples_visible(primary, &candidates);
         Ok(candidates
             .into_iter()
             .zip(visible)
@@ -166,7 +167,8 @@ impl Scene<'_> {
     }
 
     /// Whether each candidate is the first sheet the halos leave visible along its eye ray.
-    fn stipples_visible(&self, cam: &Camera, candidates: &[Drawn]) -> Vec<bool> {
+    fn stipples_visible(&self, primary: &Primary, candidates: &[Drawn]) -> Vec<bool> {
+        let cam = primary.camera();
         let triangle_index = |d: &Drawn| {
             let set = self.input.surfaces[d.surface as usize]
                 .stipples
@@ -180,7 +182,7 @@ impl Scene<'_> {
             return candidates
                 .par_iter()
                 .map_init(Vec::new, |hits, d| {
-                    self.hits_before(cam, d.position, hits);
+                    self.hits_before(primary, d.position, hits);
                     hits.is_empty()
                 })
                 .collect();
@@ -190,7 +192,7 @@ impl Scene<'_> {
                 .par_iter()
                 .map_init(Vec::new, |hits, d| {
                     !hiders.hidden(d.position, d.w, d.surface, triangle_index(d))
-                        && !self.occluded(cam, d.position, hits)
+                        && !self.occluded(primary, d.position, hits)
                 })
                 .collect(),
             RenderMode::Slices => {
@@ -205,7 +207,7 @@ impl Scene<'_> {
                     .par_iter()
                     .map_init(Vec::new, |hits, d| {
                         let pixel = pixel_of(d.pixel);
-                        let (origin, dir) = self.hits_before(cam, d.position, hits);
+                        let (origin, dir) = self.hits_before(primary, d.position, hits);
                         let mut probes = vec![slices::Probe {
                             pixel,
                             x: d.position,
@@ -272,8 +274,12 @@ impl Scene<'_> {
     /// One eye's stipple drawing: the stipples as discs over the background, and per pixel
     /// the distance of the first visible surface along its centre ray when `depth` asks for
     /// it (infinite otherwise).
-    pub(super) fn view_stipples(&self, cam: &Camera, depth: bool) -> Result<View, RenderError> {
-        let drawn = self.stipples(cam)?;
+    pub(super) fn view_stipples(
+        &self,
+        primary: &Primary,
+        depth: bool,
+    ) -> Result<View, RenderError> {
+        let drawn = self.stipples(primary)?;
         let s = self.settings;
         let (w, h) = (s.width as usize, s.height as usize);
         let (w0, w1) = self.w_range;
@@ -291,7 +297,7 @@ impl Scene<'_> {
             .map(|(cover, colour)| self.background.lerp(colour, cover))
             .collect();
         let front = if depth {
-            self.front_distances(cam)
+            self.front_distances(primary)
         } else {
             vec![f64::INFINITY; w * h]
         };
@@ -304,7 +310,8 @@ impl Scene<'_> {
 
     /// Per pixel the distance of the first surface the halos leave visible along its centre
     /// ray (infinite where none), as the shaded style reports it.
-    fn front_distances(&self, cam: &Camera) -> Vec<f64> {
+    fn front_distances(&self, primary: &Primary) -> Vec<f64> {
+        let cam = primary.camera();
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
         let sample = |x: usize, y: usize| {
             (
@@ -312,13 +319,12 @@ impl Scene<'_> {
                 1.0 - 2.0 * (y as f64 + 0.5) / h as f64,
             )
         };
-        let primary = Primary::new(&self.tracer, cam, self.settings.width, self.settings.height);
         (0..w * h)
             .into_par_iter()
             .map_init(Vec::new, |hits: &mut Vec<Hit>, pixel| {
                 let (sx, sy) = sample(pixel % w, pixel / w);
                 let (origin, dir) = cam.ray(sx, sy);
-                self.trace_primary(&primary, [sx, sy], origin, dir, hits);
+                self.trace_primary(primary, [sx, sy], origin, dir, hits);
                 hits.iter()
                     .find(|hit| !self.hidden_hit(origin, dir, hit))
                     .map_or(f64::INFINITY, |hit| hit.t)

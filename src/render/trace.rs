@@ -293,6 +293,7 @@ impl Entry {
 /// picture) the rays go through the BVH.
 pub struct Primary<'t, 'a> {
     tracer: &'t Tracer<'a>,
+    cam: Camera,
     tiles: Option<Tiles>,
 }
 
@@ -314,8 +315,28 @@ impl<'t, 'a> Primary<'t, 'a> {
     pub fn new(tracer: &'t Tracer<'a>, cam: &Camera, width: u32, height: u32) -> Self {
         Primary {
             tracer,
+            cam: *cam,
             tiles: Tiles::new(tracer, cam, width, height),
         }
+    }
+
+    /// The camera whose picture the triangles are binned for.
+    pub fn camera(&self) -> &Camera {
+        &self.cam
+    }
+
+    /// [`Tracer::hits`] of the ray from the camera's eye to `p` ([`Camera::ray_to`]),
+    /// which is a primary ray where `p` is in the picture: through the tiles there, through
+    /// the BVH elsewhere. Gives the ray (origin, unit direction).
+    pub fn hits_towards(&self, p: DVec3, t_min: f64, hits: &mut Vec<Hit>) -> (DVec3, DVec3) {
+        let (origin, dir) = self.cam.ray_to(p);
+        match image_point(&self.cam, p) {
+            Some(at) if at[0].abs() <= 1.0 && at[1].abs() <= 1.0 => {
+                self.hits(at, origin, dir, t_min, hits)
+            }
+            _ => self.tracer.hits(origin, dir, t_min, hits),
+        }
+        (origin, dir)
     }
 
     /// [`Tracer::hits`] of the primary ray through image point `at`.
@@ -523,21 +544,8 @@ fn projected_box(cam: &Camera, p: &[DVec3; 3]) -> Option<([[f64; 2]; 3], ImageBo
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];
     let mut images = [[0.0; 2]; 3];
-    let (hw, hh) = (cam.half_height * cam.aspect, cam.half_height);
     for (&q, out) in p.iter().zip(&mut images) {
-        let d = q - cam.eye;
-        let (x, y, z) = (d.dot(cam.right), d.dot(cam.up), d.dot(cam.forward));
-        let image = match cam.projection {
-            CameraProjection::Perspective => {
-                // Far enough in front of the eye that the division is well conditioned (a
-                // NaN compares false and is refused too).
-                if z.partial_cmp(&(1e-9 * d.length())) != Some(std::cmp::Ordering::Greater) {
-                    return None;
-                }
-                [x / (z * hw), y / (z * hh)]
-            }
-            CameraProjection::Orthographic => [x / hw, y / hh],
-        };
+        let image = image_point(cam, q)?;
         *out = image;
         for k in 0..2 {
             lo[k] = lo[k].min(image[k]);
@@ -555,6 +563,25 @@ fn projected_box(cam: &Camera, p: &[DVec3; 3]) -> Option<([[f64; 2]; 3], ImageBo
             [hi[0] + pad(0), hi[1] + pad(1)],
         ),
     ))
+}
+
+/// Where `q` lies in `cam`'s picture, in image coordinates ([-1, 1]^2 across it, y up);
+/// `None` where it is not far enough in front of a perspective eye for the division to be
+/// well conditioned.
+fn image_point(cam: &Camera, q: DVec3) -> Option<[f64; 2]> {
+    let (hw, hh) = (cam.half_height * cam.aspect, cam.half_height);
+    let d = q - cam.eye;
+    let (x, y, z) = (d.dot(cam.right), d.dot(cam.up), d.dot(cam.forward));
+    match cam.projection {
+        CameraProjection::Perspective => {
+            // A NaN compares false and is refused too.
+            if z.partial_cmp(&(1e-9 * d.length())) != Some(std::cmp::Ordering::Greater) {
+                return None;
+            }
+            Some([x / (z * hw), y / (z * hh)])
+        }
+        CameraProjection::Orthographic => Some([x / hw, y / hh]),
+    }
 }
 
 /// A ray set up for watertight ray-triangle intersection (Woop, Benthin and Wald 2013) in
@@ -665,7 +692,8 @@ mod primary_tests {
         // along the same axis, and a perspective eye inside the scene (triangles reach its
         // plane and are in every tile; others project across the picture): every ray's
         // hits, from the start and past a distance, and its nearest hits (alone, and as
-        // the start of all its hits), are the tracer's own.
+        // the start of all its hits), are the tracer's own; and so are the hits of rays
+        // towards points of the surfaces.
         let scene = crate::Scene::default_scene();
         let built = crate::Sampled::of(&scene)
             .into_built(&scene, crate::Stages::of(&scene))
@@ -757,6 +785,26 @@ mod primary_tests {
                 }
             }
             assert!(aimed > 40, "{name}: {aimed} aimed rays hit");
+            // Rays from the eye towards points of the surfaces (their vertices and the
+            // centres of their triangles, in the picture or out of it, behind the eye
+            // too): the same hits through the tiles or the BVH.
+            let mut towards = 0;
+            for surf in &parts.surfaces {
+                for (k, t) in surf.triangles.iter().enumerate().step_by(5) {
+                    let q = t.map(|v| surf.positions[v as usize]);
+                    for p in [q[k % 3], (q[0] + q[1] + q[2]) / 3.0] {
+                        let (origin, dir) = primary.hits_towards(p, 0.0, &mut got);
+                        assert_eq!((origin, dir), cam.ray_to(p));
+                        tracer.hits(origin, dir, 0.0, &mut expected);
+                        assert_eq!(got, expected, "{name}: hits towards {p}");
+                        towards += usize::from(!expected.is_empty());
+                    }
+                }
+            }
+            assert!(
+                towards > 2000,
+                "{name}: {towards} rays towards the surfaces hit"
+            );
         }
     }
 }

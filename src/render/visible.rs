@@ -12,7 +12,7 @@
 //! never hide it.
 
 use super::camera::Camera;
-use super::trace::Hit;
+use super::trace::{Hit, Primary};
 use super::{CameraProjection, CameraSettings, RenderError, Scene};
 use crate::parts::Parts;
 use glam::DVec3;
@@ -116,7 +116,7 @@ pub fn curve_visibility(
     let cam = super::first_camera(settings, camera, &placement)?;
     Ok((
         PictureCamera::of(&cam, placement.target, settings.width, settings.height),
-        scene.curve_visibility(&cam),
+        scene.curve_visibility(&scene.primary(&cam)),
     ))
 }
 
@@ -138,7 +138,7 @@ pub fn curve_visibility_each(
             let (placement, _) = super::place(surfaces.clone(), settings, camera)?;
             Ok(super::first_camera(settings, camera, &placement)
                 .ok()
-                .map(|cam| scene.curve_visibility(&cam)))
+                .map(|cam| scene.curve_visibility(&scene.primary(&cam))))
         })
         .collect()
 }
@@ -153,14 +153,14 @@ struct Segment {
 }
 
 impl Scene<'_> {
-    /// How much of the curves the picture through `cam` shows.
-    pub(super) fn curve_visibility(&self, cam: &Camera) -> CurveVisibility {
+    /// How much of the curves the picture of `primary`'s camera shows.
+    pub(super) fn curve_visibility(&self, primary: &Primary) -> CurveVisibility {
         let segments = self.curve_segments();
         // Per segment on the cores, summed in order: the same total on any number of threads.
         let pieces: Vec<(f64, f64, f64, f64)> = segments
             .par_iter()
             .map_init(Vec::new, |hits, segment| {
-                self.segment_seen(cam, segment, hits)
+                self.segment_seen(primary, segment, hits)
             })
             .collect();
         let (projected, visible, transversal) = pieces
@@ -186,7 +186,7 @@ impl Scene<'_> {
             gaps.last().map_or(0.0, |g| g.0)
         };
         let (gap_p10, gap_median) = (quantile(0.1), quantile(0.5));
-        let (branch_points, seen) = self.marks_seen(cam);
+        let (branch_points, seen) = self.marks_seen(primary);
         let count = |s: &[bool]| s.iter().filter(|&&v| v).count();
         CurveVisibility {
             gap_px_p10: gap_p10,
@@ -232,15 +232,16 @@ impl Scene<'_> {
         segments
     }
 
-    /// One segment in the picture through `cam`, sampled once per pixel of its length: its
+    /// One segment in the picture of `primary`'s camera, sampled once per pixel of its length: its
     /// projected length, the length seen, that length times the sine of the sheets' angle,
     /// and the halo's gap in pixels at its first end. `hits` is scratch.
     fn segment_seen(
         &self,
-        cam: &Camera,
+        primary: &Primary,
         segment: &Segment,
         hits: &mut Vec<Hit>,
     ) -> (f64, f64, f64, f64) {
+        let cam = primary.camera();
         let (w, h) = (self.settings.width, self.settings.height);
         let Segment {
             ends: [(a, sa), (b, sb)],
@@ -265,15 +266,16 @@ impl Scene<'_> {
                 xy[0] >= 0.0 && xy[1] >= 0.0 && xy[0] < f64::from(w) && xy[1] < f64::from(h);
             let clipped = self.settings.clip.is_some_and(|c| c.removes(p));
             if inside && !clipped {
-                seen += piece * self.transmittance(cam, s, hits);
+                seen += piece * self.transmittance(primary, s, hits);
             }
         }
         (length, seen, seen * sine, rho / pixel_size(cam, depth, h))
     }
 
     /// The curves' ends at branch points, then the triple points, each seen or not through
-    /// `cam`; gives how many branch points lead the list.
-    fn marks_seen(&self, cam: &Camera) -> (usize, Vec<bool>) {
+    /// `primary`'s camera; gives how many branch points lead the list.
+    fn marks_seen(&self, primary: &Primary) -> (usize, Vec<bool>) {
+        let cam = primary.camera();
         let (w, h) = (self.settings.width, self.settings.height);
         let mut marks: Vec<DVec3> = Vec::new();
         for c in &self.input.curves.curves {
@@ -293,7 +295,7 @@ impl Scene<'_> {
                 });
                 inside
                     && !self.settings.clip.is_some_and(|c| c.removes(p))
-                    && self.transmittance(cam, p, hits) > 0.5
+                    && self.transmittance(primary, p, hits) > 0.5
             })
             .collect();
         (branch_points, seen)
@@ -326,8 +328,8 @@ impl Scene<'_> {
 
     /// The share of light from `p` that reaches the eye through the surfaces in front of it
     /// that the halos leave visible.
-    pub(super) fn transmittance(&self, cam: &Camera, p: DVec3, hits: &mut Vec<Hit>) -> f64 {
-        let (origin, dir) = self.hits_before(cam, p, hits);
+    pub(super) fn transmittance(&self, primary: &Primary, p: DVec3, hits: &mut Vec<Hit>) -> f64 {
+        let (origin, dir) = self.hits_before(primary, p, hits);
         let mut through = 1.0;
         for hit in hits.iter() {
             if self.hidden_hit(origin, dir, hit) {
