@@ -1122,7 +1122,7 @@ impl<'a> Scene<'a> {
                 if !shown.first_hidden {
                     return shown;
                 }
-                // Uncut, so every hit is what the ray shows past the first.
+                // Uncut: the hits the tiles found are all of the ray's hits.
                 if !near.all {
                     self.trace_primary(primary, [sx, sy], origin, dir, hits);
                 }
