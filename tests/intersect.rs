@@ -581,9 +581,9 @@ fn the_verdict_does_not_depend_on_the_resolution() {
     // excuses lie no farther from it as the mesh refines (within 2 rho by the rule); the
     // share of ambiguous samples does not grow (beyond a few samples: near a cross-cap the
     // collapsed halo spans a fixed distance, so the count there grows with the samples
-    // along the curve); and on the finest mesh none is left to the resolution. With one layer of
-    // tetrahedra per prism, the flat torus had wrong samples next to its cross-caps from
-    // about 700 x 700 on.
+    // along the curve); and on the finest mesh none is left to the resolution. With one
+    // layer of tetrahedra per prism, the flat torus had wrong samples next to its
+    // cross-caps from about 700 x 700 on.
     let cases: [(&str, Vec<Sampling>); 2] = [
         (
             "flat-torus",

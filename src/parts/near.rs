@@ -40,9 +40,9 @@ impl Near {
             let [a, b, c] = [1, 2, 3].map(|k| p[(i + k) % 4]);
             let n = (b - a).cross(c - a);
             let length = n.length();
-            // The normal's direction is good to about eps * |ab| |ac| / |n|; over the
-            // tetrahedron's reach, and with the rounding of the offset, a thousandth of a
-            // millionth of that bounds the error by far.
+            // The normal's direction is good to about eps * |ab| |ac| / |n|: over the
+            // tetrahedron's reach, with the rounding of the offset (eps times the
+            // coordinates), the error is about 10^-7 of the margin, a billionth of both.
             let slack = (b - a).length() * (c - a).length() / length;
             let margin = 1e-9 * (reach * (1.0 + slack) + size);
             let n = n / length;
@@ -122,8 +122,8 @@ fn edge_spaces(p: [DVec3; 3], normal: DVec3, pad: f64) -> Option<([[f64; 4]; 3],
 /// [`HaloIndex::hidden`] for points of the surfaces' triangles, with the same answers: each
 /// triangle's candidates are found by one box query the first time a point of it is asked
 /// about (from any thread), then every point of it is tested against them alone, most often
-/// none (a triangle far from the other sheets). A point outside its triangle's grown box or
-/// slab (a ray's hit rounded far off the triangle) asks the index directly.
+/// none (a triangle far from the other sheets). A point outside its triangle's grown box,
+/// slab or edges (a ray's hit rounded far off the triangle) asks the index directly.
 pub(crate) struct TriangleHiders<'a> {
     index: HaloIndex<'a>,
     surfaces: &'a [SurfacePart<'a>],

@@ -403,7 +403,8 @@ pub enum RenderError {
         /// The surface's index.
         surface: usize,
     },
-    /// The picture would need more memory than the limit (`HALO4D_MAX_MEMORY` gigabytes, or three quarters of the machine's memory).
+    /// The picture would need more memory than the limit (`HALO4D_MAX_MEMORY` gigabytes, or
+    /// three quarters of the machine's memory).
     #[error(
         "the picture would need about {:.2} GB ({what}), more than the limit of {:.2} GB ({source_of_limit}); lower render.width and render.height or render.samples, or use render.mode exact, which needs no per-sample store",
         needed / crate::memory::GB,
@@ -987,11 +988,11 @@ impl<'a> Scene<'a> {
     }
 
     /// Estimates the memory of the picture before anything is allocated, and refuses it
-    /// above the memory limit (`HALO4D_MAX_MEMORY` gigabytes, or three quarters of the machine's
-    /// memory). Per pixel: the image and its distances (48 bytes). In
-    /// `slices` mode also every hit of every sample ([`slices::Probe`]) with its verdict,
-    /// and a slice image per thread; the hits per ray are counted on a grid of up to
-    /// 64 x 64 rays through the picture.
+    /// above the memory limit (`HALO4D_MAX_MEMORY` gigabytes, or three quarters of the
+    /// machine's memory). Per pixel: the image and its distances (48 bytes). In `slices`
+    /// mode also every hit of every sample ([`slices::Probe`]) with its verdict, and a
+    /// slice image per thread; the hits per ray are counted on a grid of up to 64 x 64 rays
+    /// through the picture.
     fn check_memory(&self, cam: &Camera, eyes: usize) -> Result<(), RenderError> {
         let s = self.settings;
         let pixels = f64::from(s.width) * f64::from(s.height);

@@ -215,7 +215,30 @@ impl Scene<'_> {
                 });
             }
         }
-        let polylines = self.polylines(cam);
+        // Each line's runs on the cores, joined in the lines' order.
+        let runs: Vec<Vec<Run>> = self
+            .polylines(cam)
+            .par_iter()
+            .map_init(Vec::new, |hits, (class, line)| {
+                self.line_runs(primary, *class, line, hits)
+            })
+            .collect();
+        out.extend(runs.into_iter().flatten());
+        Ok(out)
+    }
+
+    /// The visible runs of one line of ink class `class`, stepped a pixel at a time in the
+    /// image of `primary`'s camera; `hits` is scratch.
+    fn line_runs(
+        &self,
+        primary: &Primary,
+        class: InkClass,
+        line: &[LinePoint],
+        hits: &mut Vec<Hit>,
+    ) -> Vec<Run> {
+        let cam = primary.camera();
+        let s = self.settings;
+        let (w, h) = (s.width, s.height);
         let depth_of = |p: DVec3| (p - cam.eye).dot(cam.forward);
         let (near, far) = {
             let c = depth_of(self.centre);
@@ -229,66 +252,55 @@ impl Scene<'_> {
             None => s.line_width,
         };
         let see_through = s.opacity < 1.0 || s.opacity_far.is_some_and(|o| o < 1.0);
-        // Each line's runs on the cores, joined in the lines' order.
-        let runs: Vec<Vec<Run>> = polylines
-            .par_iter()
-            .map_init(Vec::new, |hits, (class, line)| {
-                let mut out = Vec::new();
-                let ink = match *class {
-                    0 => INK,
-                    k => band_ink(s.colormap, k - 2),
-                };
-                let mut run: Vec<(DVec2, f64)> = Vec::new();
-                let mut flush = |run: &mut Vec<(DVec2, f64)>| {
-                    if run.len() >= 2 {
-                        out.push(Run {
-                            class: *class,
-                            ink,
-                            points: std::mem::take(run),
-                        });
-                    }
-                    run.clear();
-                };
-                for pair in line.windows(2) {
-                    let (a, b) = (pair[0], pair[1]);
-                    let (Some((pa, _)), Some((pb, _))) =
-                        (cam.project(a.at, w, h), cam.project(b.at, w, h))
-                    else {
-                        flush(&mut run);
-                        continue;
-                    };
-                    let steps =
-                        ((pb[0] - pa[0]).hypot(pb[1] - pa[1]).ceil() as usize).clamp(1, 4096);
-                    for k in 0..=steps {
-                        if k == 0 && !run.is_empty() {
-                            continue;
-                        }
-                        let f = k as f64 / steps as f64;
-                        let (p, seen) = (a.at + (b.at - a.at) * f, a.seen + (b.seen - a.seen) * f);
-                        let Some((xy, _)) = cam.project(p, w, h) else {
-                            flush(&mut run);
-                            continue;
-                        };
-                        let inside = xy[0] >= 0.0
-                            && xy[1] >= 0.0
-                            && xy[0] < f64::from(w)
-                            && xy[1] < f64::from(h)
-                            && !s.clip.is_some_and(|c| c.removes(p));
-                        let visible =
-                            inside && (see_through || !self.occluded(primary, seen, hits));
-                        if visible {
-                            run.push((DVec2::new(xy[0], xy[1]), width_at(p)));
-                        } else {
-                            flush(&mut run);
-                        }
-                    }
-                }
+        let ink = match class {
+            0 => INK,
+            k => band_ink(s.colormap, k - 2),
+        };
+        let mut out = Vec::new();
+        let mut run: Vec<(DVec2, f64)> = Vec::new();
+        let mut flush = |run: &mut Vec<(DVec2, f64)>| {
+            if run.len() >= 2 {
+                out.push(Run {
+                    class,
+                    ink,
+                    points: std::mem::take(run),
+                });
+            }
+            run.clear();
+        };
+        for pair in line.windows(2) {
+            let (a, b) = (pair[0], pair[1]);
+            let (Some((pa, _)), Some((pb, _))) = (cam.project(a.at, w, h), cam.project(b.at, w, h))
+            else {
                 flush(&mut run);
-                out
-            })
-            .collect();
-        out.extend(runs.into_iter().flatten());
-        Ok(out)
+                continue;
+            };
+            let steps = ((pb[0] - pa[0]).hypot(pb[1] - pa[1]).ceil() as usize).clamp(1, 4096);
+            for k in 0..=steps {
+                if k == 0 && !run.is_empty() {
+                    continue;
+                }
+                let f = k as f64 / steps as f64;
+                let (p, seen) = (a.at + (b.at - a.at) * f, a.seen + (b.seen - a.seen) * f);
+                let Some((xy, _)) = cam.project(p, w, h) else {
+                    flush(&mut run);
+                    continue;
+                };
+                let inside = xy[0] >= 0.0
+                    && xy[1] >= 0.0
+                    && xy[0] < f64::from(w)
+                    && xy[1] < f64::from(h)
+                    && !s.clip.is_some_and(|c| c.removes(p));
+                let visible = inside && (see_through || !self.occluded(primary, seen, hits));
+                if visible {
+                    run.push((DVec2::new(xy[0], xy[1]), width_at(p)));
+                } else {
+                    flush(&mut run);
+                }
+            }
+        }
+        flush(&mut run);
+        out
     }
 
     /// The scene's lines in space, each with its ink class: the curves (banded by depth when

@@ -75,7 +75,8 @@ pub fn density(tone: f64, size: f64) -> f64 {
 }
 
 impl Scene<'_> {
-    /// The stipples the picture of `primary`'s camera draws, in the order of their surfaces and ranks.
+    /// The stipples the picture of `primary`'s camera draws, in the order of their surfaces
+    /// and ranks.
     pub(super) fn stipples(&self, primary: &Primary) -> Result<Vec<Drawn>, RenderError> {
         let cam = primary.camera();
         let s = self.settings;

@@ -282,15 +282,15 @@ impl Entry {
 }
 
 /// The triangles of a [`Tracer`] as one camera's picture sees them, for its primary rays
-/// (through image points (sx, sy) in [-1, 1]^2, y up, as [`Camera::ray`] takes them):
-/// each triangle listed in the square tiles of the picture its projected box meets (grown
-/// by far more than rounding), so that a ray tests the few triangles of its tile whose
-/// projections come near its image point (tested in f32 with a margin far above its
-/// rounding), with the tracer's exact test. A triangle whose projection is
-/// unbounded (it reaches the plane of a perspective eye) is in every tile. The hits are the
-/// tracer's own, ordered alike: a triangle a ray meets projects to a triangle that holds
-/// the ray's image point, within rounding. Where binning would make too many entries (slivers across the
-/// picture) the rays go through the BVH.
+/// (through image points (sx, sy) in [-1, 1]^2, y up, as [`Camera::ray`] takes them): each
+/// triangle listed in the square tiles of the picture its projected box meets (grown by far
+/// more than rounding), so that a ray tests the few triangles of its tile whose projections
+/// come near its image point (tested in f32 with a margin far above its rounding), with the
+/// tracer's exact test. A triangle whose projection is unbounded (it reaches the plane of a
+/// perspective eye) is in every tile. The hits are the tracer's own, ordered alike: a
+/// triangle a ray meets projects to a triangle that holds the ray's image point, within
+/// rounding. Where binning would make too many entries (slivers across the picture) the
+/// rays go through the BVH.
 pub struct Primary<'t, 'a> {
     tracer: &'t Tracer<'a>,
     cam: Camera,

@@ -232,9 +232,9 @@ impl Scene<'_> {
         segments
     }
 
-    /// One segment in the picture of `primary`'s camera, sampled once per pixel of its length: its
-    /// projected length, the length seen, that length times the sine of the sheets' angle,
-    /// and the halo's gap in pixels at its first end. `hits` is scratch.
+    /// One segment in the picture of `primary`'s camera, sampled once per pixel of its
+    /// length: its projected length, the length seen, that length times the sine of the
+    /// sheets' angle, and the halo's gap in pixels at its first end. `hits` is scratch.
     fn segment_seen(
         &self,
         primary: &Primary,

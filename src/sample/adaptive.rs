@@ -371,9 +371,9 @@ enum Verdict {
 /// A triangle in the refinement's queue. A triangle made by a split is queued unchecked on
 /// its parent's level, behind the triangles already there. When the first of them comes to
 /// the front, the unchecked triangles still standing among the level's first
-/// [`CHECK_BATCH`] are checked at once, on the cores (a check reads the triangulation and evaluates the surface, and
-/// changes nothing; the splits that follow stay in the queue's order, so the mesh does not
-/// depend on the number of threads).
+/// [`CHECK_BATCH`] are checked at once, on the cores (a check reads the triangulation and
+/// evaluates the surface, and changes nothing; the splits that follow stay in the queue's
+/// order, so the mesh does not depend on the number of threads).
 #[derive(Clone, Copy)]
 struct Queued {
     face: Face,

@@ -4,22 +4,24 @@
 //! settings, the 4D view and the frame time in the title.
 //!
 //! Drag with the left button to turn the camera (azimuth, elevation), wheel to zoom, `R` to
-//! reset the camera (the title shows it, in `halo4d render`'s terms), `S` to cycle the slice
-//! count (64, 128, 256, 512), `M` to switch between the grid and view-slice modes, `H` halos,
-//! `C` curves, `O` silhouettes (outlines), `T` transparency, `W` colour by w, `D` shaded
-//! surfaces or stipples (dots; the stipples are made on the CPU in the background the first
-//! time, the title says so meanwhile), `Escape` or `Q` to quit. In 4D (a scene file): Shift + drag turns the direction of the drag on the screen
-//! towards w (Hanson's rolling ball), its frames sliced at 64 until it stops; the keys `1` to `6` turn the planes xy, xz, xw, yz, yw
-//! and zw by 15 degrees (with Shift, back); `[` and `]` move the surfaces along w; `P`
-//! switches the 4D projection between orthographic and perspective; `V` resets the 4D view;
-//! `F` writes the current view as a scene file (`exports/views/<name>-<k>.json`) and `B`
-//! builds it in the background (`exports/<name>-<k>/`), its verification in the title; `L`
-//! shows or hides the slice by the hyperplane of the scene's `slicing` (as `halo4d slice`
-//! cuts: the curves where the surfaces cross a level of the height along that direction,
-//! drawn over them in magenta; hidden, it keeps its level) and `,` and `.` move the level
-//! down and up by 1/64 of the surfaces' range of heights (with Shift, 1/640); the title
-//! names the level, its number of curves and the critical levels either side of it. The
-//! title shows the 4D view in the scene file's terms.
+//! reset the camera (the title shows it, in `halo4d render`'s terms), `S` to cycle the
+//! slice count (64, 128, 256, 512), `M` to switch between the grid and view-slice modes,
+//! `H` halos, `C` curves, `O` silhouettes (outlines), `T` transparency, `W` colour by w,
+//! `D` shaded surfaces or stipples (dots; the stipples are made on the CPU in the
+//! background the first time, the title says so meanwhile), `Escape` or `Q` to quit. In 4D
+//! (a scene file): Shift + drag turns the direction of the drag on the screen towards w
+//! (Hanson's rolling ball), its frames sliced at 64 until it stops; the keys `1` to `6`
+//! turn the planes xy, xz, xw, yz, yw and zw by 15 degrees (with Shift, back); `[` and `]`
+//! move the surfaces along w; `P` switches the 4D projection between orthographic and
+//! perspective; `V` resets the 4D view; `F` writes the current view as a scene file
+//! (`exports/views/<name>-<k>.json`) and `B` builds it in the background
+//! (`exports/<name>-<k>/`), its verification in the title; `L` shows or hides the slice by
+//! the hyperplane of the scene's `slicing` (as `halo4d slice` cuts: the curves where the
+//! surfaces cross a level of the height along that direction, drawn over them in magenta;
+//! hidden, it keeps its level) and `,` and `.` move the level down and up by 1/64 of the
+//! surfaces' range of heights (with Shift, 1/640); the title names the level, its number of
+//! curves and the critical levels either side of it. The title shows the 4D view in the
+//! scene file's terms.
 
 use super::{
     Gpu, HaloMode, Hyperplane, Renderer, SLICE_COUNTS, Source, StippleSet, ViewSettings,
