@@ -57,13 +57,14 @@ impl Near {
     }
 
     /// Whether `x` may lie in the tetrahedron: no face has it clearly outside (without
-    /// branches: a triangle has a score of candidates, and most turn its points away).
+    /// branches: a triangle has a score of candidates, and most turn its points away; the
+    /// four comparisons joined by `&`, since `f64::min`'s care for NaN costs more than
+    /// they do, and a finite point has none).
     #[inline]
     fn may_hold(&self, x: DVec3) -> bool {
-        let d = self
-            .faces
-            .map(|f| f[0] * x.x + f[1] * x.y + f[2] * x.z + f[3]);
-        d[0].min(d[1]).min(d[2]).min(d[3]) >= 0.0
+        self.faces.iter().fold(true, |inside, f| {
+            inside & (f[0] * x.x + f[1] * x.y + f[2] * x.z + f[3] >= 0.0)
+        })
     }
 }
 

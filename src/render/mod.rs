@@ -1037,21 +1037,21 @@ impl<'a> Scene<'a> {
         (self.settings.samples as f64).sqrt().round() as usize
     }
 
-    /// Sample `k` of pixel (x, y) in [-1, 1]^2 (y up): row `k / n`, column `k % n` of the
-    /// pixel's n x n grid.
-    fn sample_point(&self, x: usize, y: usize, k: usize) -> (f64, f64) {
+    /// Where the samples of a pixel lie in it, in order: sample `k` in row `k / n`, column
+    /// `k % n` of the pixel's n x n grid, as its offset from the pixel's corner in pixels.
+    fn sample_offsets(&self) -> Vec<[f64; 2]> {
         let n = self.grid_side();
-        let (w, h) = (self.settings.width as f64, self.settings.height as f64);
-        let (i, j) = (k % n, k / n);
-        let px = x as f64 + (i as f64 + 0.5) / n as f64;
-        let py = y as f64 + (j as f64 + 0.5) / n as f64;
-        (2.0 * px / w - 1.0, 1.0 - 2.0 * py / h)
+        (0..n * n)
+            .map(|k| [k % n, k / n].map(|i| (i as f64 + 0.5) / n as f64))
+            .collect()
     }
 
-    /// The sample points of pixel (x, y) in [-1, 1]^2 (y up), in order.
-    fn samples(&self, x: usize, y: usize) -> impl Iterator<Item = (f64, f64)> + '_ {
-        let n = self.grid_side();
-        (0..n * n).map(move |k| self.sample_point(x, y, k))
+    /// The point `offset` pixels from the corner of pixel (x, y), in [-1, 1]^2 (y up).
+    fn sample_point(&self, x: usize, y: usize, [dx, dy]: [f64; 2]) -> (f64, f64) {
+        let (w, h) = (self.settings.width as f64, self.settings.height as f64);
+        let px = x as f64 + dx;
+        let py = y as f64 + dy;
+        (2.0 * px / w - 1.0, 1.0 - 2.0 * py / h)
     }
 
     /// Where `hit` of the ray (`origin`, `dir`) is, its w and its triangle's vertices.
@@ -1105,12 +1105,15 @@ impl<'a> Scene<'a> {
         hidden: impl Fn(usize, usize, &Hit, DVec3, f64) -> bool + Sync,
     ) -> View {
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
+        let offsets = self.sample_offsets();
         let n = self.grid_side();
         let centre = (n / 2) * n + n / 2;
         let cam = primary.camera();
-        // Sample `k` of `pixel`, its hits numbered from `numbered` on (which it advances).
-        let sample = |hits: &mut Vec<Hit>, pixel: usize, k: usize, numbered: &mut usize| {
-            let (sx, sy) = self.sample_point(pixel % w, pixel / w, k);
+        // Sample `k` of pixel (x, y), its hits numbered from `numbered` on (which it
+        // advances).
+        let sample = |hits: &mut Vec<Hit>, (x, y), k: usize, numbered: &mut usize| {
+            let pixel = y * w + x;
+            let (sx, sy) = self.sample_point(x, y, offsets[k]);
             let (origin, dir) = cam.ray(sx, sy);
             // Opaque and uncut: where the nearest surface is visible it is all the ray
             // shows, and only the hits that near are traced.
@@ -1136,15 +1139,17 @@ impl<'a> Scene<'a> {
                 hidden(pixel, base + j, hit, x, wd)
             })
         };
-        // The centre samples first, where the pixels are sampled adaptively.
-        let probes: Vec<Shown> = if adaptive && n > 1 {
-            (0..w * h)
-                .into_par_iter()
-                .map_init(Vec::new, |hits, pixel| sample(hits, pixel, centre, &mut 0))
-                .collect()
-        } else {
-            Vec::new()
-        };
+        // The centre samples first, where the pixels are sampled adaptively; row by row.
+        let mut probes = vec![Shown::default(); if adaptive && n > 1 { w * h } else { 0 }];
+        probes
+            .par_chunks_mut(w)
+            .enumerate()
+            .for_each_init(Vec::new, |hits, (y, row)| {
+                for (x, probe) in row.iter_mut().enumerate() {
+                    *probe = sample(hits, (x, y), centre, &mut 0);
+                }
+            });
+        let changes = self.changes(&probes, (w, h));
         let mut rgb = vec![DVec3::ZERO; w * h];
         let mut front = vec![f64::INFINITY; w * h];
         let mut gap = vec![false; w * h];
@@ -1163,7 +1168,7 @@ impl<'a> Scene<'a> {
                     let pixel = y * w + x;
                     let probe = probes.get(pixel);
                     if let Some(p) = probe
-                        && !self.changes_around(&probes, (x, y), (w, h))
+                        && !changes[pixel]
                     {
                         (*c, *f, *g) = (p.colour, p.first, p.first_hidden);
                         continue;
@@ -1173,7 +1178,7 @@ impl<'a> Scene<'a> {
                     for k in 0..n * n {
                         let shown = match probe {
                             Some(&p) if k == centre => p,
-                            _ => sample(hits, pixel, k, &mut numbered),
+                            _ => sample(hits, (x, y), k, &mut numbered),
                         };
                         sum += shown.colour;
                         if k == centre {
@@ -1186,18 +1191,39 @@ impl<'a> Scene<'a> {
         View { rgb, front, gap }
     }
 
-    /// Whether the centre sample of pixel `(x, y)` differs from that of a pixel around it
-    /// ([`Scene::differs`]), in an image of `(w, h)` pixels.
-    fn changes_around(
-        &self,
-        probes: &[Shown],
-        (x, y): (usize, usize),
-        (w, h): (usize, usize),
-    ) -> bool {
-        let p = &probes[y * w + x];
-        (y.saturating_sub(1)..(y + 2).min(h)).any(|j| {
-            (x.saturating_sub(1)..(x + 2).min(w)).any(|i| self.differs(p, &probes[j * w + i]))
-        })
+    /// Per pixel of an image of `(w, h)` pixels, whether its centre sample differs from
+    /// that of a pixel around it ([`Scene::differs`], which is symmetric: each pair of
+    /// neighbours is compared once, by the first of the two, row by row on the cores).
+    fn changes(&self, probes: &[Shown], (w, h): (usize, usize)) -> Vec<bool> {
+        // The neighbours after a pixel (dx, dy): right, below left, below, below right.
+        const AFTER: [(isize, usize); 4] = [(1, 0), (-1, 1), (0, 1), (1, 1)];
+        let mut after = vec![0u8; probes.len()];
+        after.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            for (x, bits) in row.iter_mut().enumerate() {
+                for (k, (dx, dy)) in AFTER.into_iter().enumerate() {
+                    let (i, j) = (x.checked_add_signed(dx), y + dy);
+                    if let Some(i) = i.filter(|&i| i < w && j < h)
+                        && self.differs(&probes[y * w + x], &probes[j * w + i])
+                    {
+                        *bits |= 1 << k;
+                    }
+                }
+            }
+        });
+        let mut changes = vec![false; probes.len()];
+        changes.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            for (x, change) in row.iter_mut().enumerate() {
+                // The pixel after which this one lies as neighbour `k` of AFTER.
+                let before = |k: usize| {
+                    let (dx, dy) = AFTER[k];
+                    let i = x.checked_add_signed(-dx).filter(|&i| i < w)?;
+                    let j = y.checked_sub(dy)?;
+                    Some(after[j * w + i] >> k & 1 == 1)
+                };
+                *change = after[y * w + x] != 0 || (0..4).any(|k| before(k) == Some(true));
+            }
+        });
+        changes
     }
 
     /// Whether what two neighbouring rays show differs enough that the pixels between them
@@ -1278,6 +1304,7 @@ impl<'a> Scene<'a> {
     fn view_slices(&self, primary: &Primary, index: &HaloIndex) -> View {
         let cam = primary.camera();
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
+        let offsets = self.sample_offsets();
         // Per pixel, its hits over all its samples, in sample order; row by row on the
         // cores, joined in order.
         let rows: Vec<(Vec<u32>, Vec<slices::Probe>)> = (0..h)
@@ -1287,7 +1314,8 @@ impl<'a> Scene<'a> {
                 let mut probes = Vec::new();
                 for pixel in y * w..(y + 1) * w {
                     let before = probes.len();
-                    for (sx, sy) in self.samples(pixel % w, y) {
+                    for &offset in &offsets {
+                        let (sx, sy) = self.sample_point(pixel - y * w, y, offset);
                         let (origin, dir) = cam.ray(sx, sy);
                         self.trace(origin, dir, hits);
                         for hit in hits.iter() {
@@ -1400,7 +1428,7 @@ impl<'a> Scene<'a> {
 }
 
 /// What one ray shows ([`Scene::shade`]).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 struct Shown {
     /// The hits composited over the background.
     colour: DVec3,

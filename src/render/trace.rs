@@ -230,7 +230,7 @@ const MOST_ENTRIES: usize = 16;
 /// |a| and |b| at most 1). A triangle whose projection has (almost) no area, or none (it
 /// reaches a perspective eye's plane), keeps every point (zero lines): the exact test
 /// decides.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 struct Entry {
     slot: u32,
     lines: [[f32; 3]; 3],
@@ -270,14 +270,53 @@ impl Entry {
         });
         Entry { slot, lines }
     }
+}
 
-    /// Whether image point `at` (in f32, with its slack: [`Entry`]) lies within the margin
-    /// of the projected triangle (without branches: most entries of a tile are tested, and
-    /// most of them turn the point away).
+/// Entries side by side in a [`Block`].
+const LANES: usize = 8;
+
+/// [`LANES`] entries of one tile, their lines' coefficients lane by lane (`lines[edge][k]`
+/// holds coefficient k of that edge of every lane), so that one ray tests them all at once
+/// in the processor's vector registers. A tile's last block is filled with lanes that turn
+/// every point away.
+#[derive(Clone, Copy, Debug)]
+struct Block {
+    slots: [u32; LANES],
+    lines: [[[f32; LANES]; 3]; 3],
+}
+
+impl Block {
+    /// A block of lanes that hold no triangle.
+    const EMPTY: Block = Block {
+        slots: [u32::MAX; LANES],
+        lines: [[[0.0; LANES], [0.0; LANES], [f32::NEG_INFINITY; LANES]]; 3],
+    };
+
+    /// Puts `entry` in lane `lane`.
+    fn set(&mut self, lane: usize, entry: &Entry) {
+        self.slots[lane] = entry.slot;
+        for (edge, line) in self.lines.iter_mut().zip(&entry.lines) {
+            for (coefficient, &value) in edge.iter_mut().zip(line) {
+                coefficient[lane] = value;
+            }
+        }
+    }
+
+    /// Bit `i` set where image point `at` (in f32, with its slack: [`Entry`]) lies within
+    /// the margin of lane `i`'s projected triangle. No lane's line gives NaN for a finite
+    /// point (their coefficients are finite but for the empty lanes' `c`, minus infinity).
     #[inline]
-    fn near(&self, [x, y, slack]: [f32; 3]) -> bool {
-        let d = self.lines.map(|l| l[0] * x + l[1] * y + l[2]);
-        d[0].min(d[1]).min(d[2]) >= -slack
+    fn near(&self, [x, y, slack]: [f32; 3]) -> u32 {
+        let mut inside = [true; LANES];
+        for [a, b, c] in &self.lines {
+            for i in 0..LANES {
+                inside[i] &= a[i] * x + b[i] * y + c[i] >= -slack;
+            }
+        }
+        inside
+            .iter()
+            .enumerate()
+            .fold(0, |mask, (i, &t)| mask | (u32::from(t) << i))
     }
 }
 
@@ -302,12 +341,12 @@ struct Tiles {
     cols: usize,
     rows: usize,
     step: [f64; 2],
-    /// Each tile's entries: `entries[starts[i]..starts[i + 1]]`, tiles row by row from
-    /// the bottom (sy = -1).
+    /// Each tile's entries in blocks: `blocks[starts[i]..starts[i + 1]]`, tiles row by row
+    /// from the bottom (sy = -1).
     starts: Vec<usize>,
-    entries: Vec<Entry>,
-    /// Triangles in every tile.
-    everywhere: Vec<Entry>,
+    blocks: Vec<Block>,
+    /// Triangles in every tile, in blocks.
+    everywhere: Vec<Block>,
 }
 
 impl<'t, 'a> Primary<'t, 'a> {
@@ -475,17 +514,18 @@ impl Tiles {
                 return None;
             }
         }
-        let mut starts = counts;
+        // Each tile's entries laid out in its blocks, in the order of the triangles.
+        let mut starts = vec![0usize; cols * rows + 1];
         for i in 0..cols * rows {
-            starts[i + 1] += starts[i];
+            starts[i + 1] = starts[i] + counts[i + 1].div_ceil(LANES);
         }
-        let mut fill = starts.clone();
-        let mut entries = vec![Entry::default(); total];
+        let mut fill: Vec<usize> = starts[..cols * rows].iter().map(|s| s * LANES).collect();
+        let mut blocks = vec![Block::EMPTY; starts[cols * rows]];
         for (entry, span) in placed {
             for j in span[1][0]..=span[1][1] {
                 for i in span[0][0]..=span[0][1] {
                     let k = &mut fill[j * cols + i];
-                    entries[*k] = entry;
+                    blocks[*k / LANES].set(*k % LANES, &entry);
                     *k += 1;
                 }
             }
@@ -495,13 +535,13 @@ impl Tiles {
             rows,
             step,
             starts,
-            entries,
-            everywhere,
+            blocks,
+            everywhere: in_blocks(&everywhere),
         })
     }
 
     /// Every hit beyond `t_min` of the ray through image point `at` on the triangles of its
-    /// tile whose projections come near the point ([`Entry::near`]: the exact test of a
+    /// tile whose projections come near the point ([`Block::near`]: the exact test of a
     /// triangle farther away would miss), unordered, into `hits` (cleared first).
     fn collect(
         &self,
@@ -517,16 +557,18 @@ impl Tiles {
         let j = tile_index(at[1], self.step[1], self.rows);
         let tile = j * self.cols + i;
         let shear = Shear::new(origin, dir);
-        let entries = &self.entries[self.starts[tile]..self.starts[tile + 1]];
+        let blocks = &self.blocks[self.starts[tile]..self.starts[tile + 1]];
         let point = [
             at[0] as f32,
             at[1] as f32,
             (1e-6 * (at[0].abs() + at[1].abs())) as f32,
         ];
-        for list in [entries, &self.everywhere] {
-            for e in list {
-                if e.near(point)
-                    && let Some(hit) = tracer.hit(&shear, e.slot as usize)
+        for block in blocks.iter().chain(&self.everywhere) {
+            let mut near = block.near(point);
+            while near != 0 {
+                let lane = near.trailing_zeros() as usize;
+                near &= near - 1;
+                if let Some(hit) = tracer.hit(&shear, block.slots[lane] as usize)
                     && hit.t > t_min
                 {
                     hits.push(hit);
@@ -534,6 +576,20 @@ impl Tiles {
             }
         }
     }
+}
+
+/// `entries` in blocks of [`LANES`], in order.
+fn in_blocks(entries: &[Entry]) -> Vec<Block> {
+    entries
+        .chunks(LANES)
+        .map(|chunk| {
+            let mut block = Block::EMPTY;
+            for (lane, entry) in chunk.iter().enumerate() {
+                block.set(lane, entry);
+            }
+            block
+        })
+        .collect()
 }
 
 /// Triangle `p`'s projection by `cam` in image coordinates, and its box grown by far more
@@ -684,6 +740,29 @@ mod tests {
 mod primary_tests {
     use super::*;
     use crate::render::{Prober, RenderSettings};
+
+    #[test]
+    fn a_block_answers_for_each_lane_alone() {
+        // The triangle (0, 0), (1, 0), (0, 1) in lanes 2 and 7, a triangle with no area
+        // (every point near) in lane 5, the rest empty: each lane's bit is its own entry's
+        // answer, and an empty lane turns every point away.
+        let triangle = Entry::new(3, Some([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]));
+        let flat = Entry::new(9, Some([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]));
+        let mut block = Block::EMPTY;
+        for (lane, entry) in [(2, &triangle), (5, &flat), (7, &triangle)] {
+            block.set(lane, entry);
+        }
+        assert_eq!(block.slots[7], 3);
+        let inside = [0.25, 0.25, 0.0];
+        let outside = [0.75, 0.75, 0.0];
+        let far = [-1e6, 3e6, 4.0];
+        assert_eq!(block.near(inside), 1 << 2 | 1 << 5 | 1 << 7);
+        assert_eq!(block.near(outside), 1 << 5);
+        assert_eq!(block.near(far), 1 << 5);
+        assert_eq!(Block::EMPTY.near(inside), 0);
+        // On an edge, within the margin.
+        assert_eq!(block.near([0.5, 0.5, 0.0]), 1 << 2 | 1 << 5 | 1 << 7);
+    }
 
     #[test]
     fn the_tiles_find_the_hits_the_bvh_finds() {
