@@ -1312,10 +1312,11 @@ impl<'a> Scene<'a> {
             .map_init(Vec::new, |hits, y| {
                 let mut counts = Vec::with_capacity(w);
                 let mut probes = Vec::new();
-                for pixel in y * w..(y + 1) * w {
+                for x in 0..w {
+                    let pixel = y * w + x;
                     let before = probes.len();
                     for &offset in &offsets {
-                        let (sx, sy) = self.sample_point(pixel - y * w, y, offset);
+                        let (sx, sy) = self.sample_point(x, y, offset);
                         let (origin, dir) = cam.ray(sx, sy);
                         self.trace(origin, dir, hits);
                         for hit in hits.iter() {
