@@ -901,17 +901,37 @@ fn count_missing_given<P: Copy + Into<[f64; 3]> + Sync>(
     incidence: &Incidence,
 ) {
     let n = layout.n;
-    let over: std::collections::HashSet<[u32; 3]> = offset_faces.iter().map(|f| f.0).collect();
-    for &t in surface_triangles {
-        let k = key(t);
-        let flat = t
-            .iter()
-            .all(|&v| (v as usize) < n && layout.collapsed[v as usize]);
-        if !flat && !over.contains(&k) && t.iter().all(|&v| (v as usize) < n) {
-            s.missing_offset_faces += 1;
-            s.missing_surface_faces += usize::from(incidence.count(k.map(|x| layout.mid(x))) != 2);
-        }
+    // Where the offset faces over each surface vertex start: they are sorted by their
+    // triangle, whose smallest vertex is below n, so a triangle's offset faces are among
+    // the few over its smallest vertex (a hash set of all of them, built on one core, took
+    // a quarter of the checker's time at a million triangles).
+    let mut starts = vec![0usize; n + 1];
+    for f in offset_faces {
+        starts[f.0[0] as usize + 1] += 1;
     }
+    for v in 0..n {
+        starts[v + 1] += starts[v];
+    }
+    let over = |k: [u32; 3]| {
+        offset_faces[starts[k[0] as usize]..starts[k[0] as usize + 1]]
+            .iter()
+            .any(|f| f.0 == k)
+    };
+    let (offset, surface) = surface_triangles
+        .par_iter()
+        .filter(|t| t.iter().all(|&v| (v as usize) < n))
+        .map(|&t| {
+            let k = key(t);
+            let flat = t.iter().all(|&v| layout.collapsed[v as usize]);
+            if flat || over(k) {
+                return (0, 0);
+            }
+            let surface = incidence.count(k.map(|x| layout.mid(x))) != 2;
+            (1, usize::from(surface))
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    s.missing_offset_faces += offset;
+    s.missing_surface_faces += surface;
 }
 
 /// A surface edge with the side pairing of the offset face's edge over it: `true` when that
