@@ -314,16 +314,10 @@ impl Scene<'_> {
     fn front_distances(&self, primary: &Primary) -> Vec<f64> {
         let cam = primary.camera();
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
-        let sample = |x: usize, y: usize| {
-            (
-                2.0 * (x as f64 + 0.5) / w as f64 - 1.0,
-                1.0 - 2.0 * (y as f64 + 0.5) / h as f64,
-            )
-        };
         (0..w * h)
             .into_par_iter()
             .map_init(Vec::new, |hits: &mut Vec<Hit>, pixel| {
-                let (sx, sy) = sample(pixel % w, pixel / w);
+                let (sx, sy) = self.sample_point(pixel % w, pixel / w, [0.5, 0.5]);
                 let (origin, dir) = cam.ray(sx, sy);
                 self.trace_primary(primary, [sx, sy], origin, dir, hits);
                 hits.iter()
