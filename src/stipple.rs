@@ -107,36 +107,50 @@ impl Stipples {
             return out;
         }
         // Candidates: per triangle a share of the total by its area, the fraction decided
-        // by a random number; uniform in the triangle.
+        // by a random number; uniform in the triangle. Candidate i is the k-th of triangle t
+        // where `start[t] + k = i`, so it is made again from its index when it is ranked.
         let total = count.saturating_mul(OVERSAMPLE) as f64;
-        let candidates: Vec<(u32, [f64; 3])> = out
-            .triangle_area
-            .par_iter()
-            .enumerate()
-            .flat_map_iter(|(t, &a)| {
-                let expected = total * a / area;
-                let n = (expected + unit(seed, 3 * t as u64)).floor() as usize;
-                (0..n).map(move |k| {
-                    let key = ((t as u64) << 20) ^ k as u64;
-                    let s = unit(seed ^ 0x5EED_0001, key).sqrt();
-                    let r = unit(seed ^ 0x5EED_0002, key);
-                    (t as u32, [1.0 - s, s * (1.0 - r), s * r])
-                })
-            })
-            .collect();
-        let point = |&(t, b): &(u32, [f64; 3])| {
-            let [p, q, r] = triangles[t as usize].map(|v| positions[v as usize]);
-            p * b[0] + q * b[1] + r * b[2]
+        let mut start: Vec<usize> = Vec::with_capacity(triangles.len() + 1);
+        start.push(0);
+        for (t, &a) in out.triangle_area.iter().enumerate() {
+            let expected = total * a / area;
+            let n = (expected + unit(seed, 3 * t as u64)).floor() as usize;
+            start.push(start[t] + n);
+        }
+        let bary = |t: usize, k: usize| {
+            let key = ((t as u64) << 20) ^ k as u64;
+            let s = unit(seed ^ 0x5EED_0001, key).sqrt();
+            let r = unit(seed ^ 0x5EED_0002, key);
+            [1.0 - s, s * (1.0 - r), s * r]
         };
-        let points: Vec<DVec4> = candidates.par_iter().map(point).collect();
+        // The triangle of candidate i.
+        let triangle_of = |i: usize| start.partition_point(|&s| s <= i) - 1;
+        let mut points = vec![DVec4::ZERO; start[triangles.len()]];
+        const CHUNK: usize = 4096;
+        points
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, chunk)| {
+                let mut t = triangle_of(c * CHUNK);
+                for (i, slot) in (c * CHUNK..).zip(chunk) {
+                    while start[t + 1] <= i {
+                        t += 1;
+                    }
+                    let b = bary(t, i - start[t]);
+                    let [p, q, r] = triangles[t].map(|v| positions[v as usize]);
+                    *slot = p * b[0] + q * b[1] + r * b[2];
+                }
+            });
         // A random priority of each candidate.
-        let priority: Vec<u32> = (0..candidates.len() as u64)
-            .into_par_iter()
-            .map(|i| (hash(seed ^ 0x5EED_0003, i) >> 32) as u32)
-            .collect();
-        let ranked = rank(&points, &priority, count, area);
-        out.triangle = ranked.iter().map(|&i| candidates[i as usize].0).collect();
-        out.bary = ranked.iter().map(|&i| candidates[i as usize].1).collect();
+        let priority = |i: u32| (hash(seed ^ 0x5EED_0003, u64::from(i)) >> 32) as u32;
+        let ranked = rank(&points, priority, count, area);
+        (out.triangle, out.bary) = ranked
+            .par_iter()
+            .map(|&i| {
+                let t = triangle_of(i as usize);
+                (t as u32, bary(t, i as usize - start[t]))
+            })
+            .unzip();
         out
     }
 
@@ -171,12 +185,22 @@ fn area4(e: DVec4, f: DVec4) -> f64 {
 
 /// The candidates ranked level by level into a ranking of at most `count` (indices into
 /// `points`); `priority` orders them (a random number each, ties broken by place).
-fn rank(points: &[DVec4], priority: &[u32], count: usize, area: f64) -> Vec<u32> {
+fn rank(
+    points: &[DVec4],
+    priority: impl Fn(u32) -> u32 + Sync,
+    count: usize,
+    area: f64,
+) -> Vec<u32> {
     let (lo, hi) = points
-        .iter()
-        .fold((DVec4::INFINITY, DVec4::NEG_INFINITY), |(lo, hi), &p| {
-            (lo.min(p), hi.max(p))
-        });
+        .par_iter()
+        .fold(
+            || (DVec4::INFINITY, DVec4::NEG_INFINITY),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        )
+        .reduce(
+            || (DVec4::INFINITY, DVec4::NEG_INFINITY),
+            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+        );
     let first = (hi - lo).length().max(f64::MIN_POSITIVE);
     // Below a quarter of the candidates' own spacing nothing is gained.
     let last = 0.25 * poisson_radius(points.len(), area) / 0.75;
@@ -193,10 +217,7 @@ fn rank(points: &[DVec4], priority: &[u32], count: usize, area: f64) -> Vec<u32>
         k
     };
     let lattice = Lattice::new(lo, hi, CELL * radii[levels - 1]);
-    // The candidates in the order of their fine cells along the Z curve.
-    let code: Vec<u64> = points.par_iter().map(|&p| lattice.code(p)).collect();
-    let order = radix_order(&code);
-    drop(code);
+    let candidates = Candidates::new(&lattice, points, priority);
     // Candidates join when a level needs them: OVERSAMPLE times as many as a Poisson-disc
     // set of its radius holds, those of smallest priority first, so that the early levels,
     // which accept few, do not look at every candidate again and again.
@@ -208,29 +229,22 @@ fn rank(points: &[DVec4], priority: &[u32], count: usize, area: f64) -> Vec<u32>
             (wanted.min(1.0) * 2f64.powi(32)) as u64
         })
         .collect();
-    let items: Vec<(usize, Item)> = order
+    let join: Vec<usize> = candidates
+        .priority
         .par_iter()
-        .enumerate()
-        .map(|(z, &i)| {
-            let priority = priority[i as usize];
-            let join = joins.partition_point(|&t| t <= u64::from(priority));
-            let item = Item {
-                z: z as u32,
-                priority,
-                p: points[i as usize],
-            };
-            (join, item)
-        })
+        .map(|&p| joins.partition_point(|&t| t <= u64::from(p)))
         .collect();
-    let mut waiting: Vec<Vec<Item>> = vec![Vec::new(); levels];
-    for (j, item) in items {
+    // Each level's list of waiting candidates (their places), in candidate order.
+    let mut waiting: Vec<Vec<u32>> = vec![Vec::new(); levels];
+    for (z, &j) in join.iter().enumerate() {
         if let Some(list) = waiting.get_mut(j) {
-            list.push(item);
+            list.push(z as u32);
         }
     }
+    drop(join);
     let mut accepted: Vec<u32> = Vec::with_capacity(count);
-    // The accepted points of the earlier levels in candidate order.
-    let mut earlier: Vec<Item> = Vec::new();
+    // The accepted candidates of the earlier levels in candidate order.
+    let mut earlier: Vec<u32> = Vec::new();
     let mut grid = Grid::default();
     let mut own = Grid::default();
     for (j, &r) in radii.iter().enumerate() {
@@ -238,37 +252,42 @@ fn rank(points: &[DVec4], priority: &[u32], count: usize, area: f64) -> Vec<u32>
             break;
         }
         let shift = lattice.shift(CELL * r);
-        grid.build(&lattice, shift, &earlier);
+        grid.build(&candidates, shift, &earlier);
         // The queue is a few runs in candidate order (those that joined, those each earlier
-        // level sent): a stable sort merges them, so that it is swept in one pass.
+        // level sent): a sort merges them, so that it is swept in one pass.
         let mut queue = std::mem::take(&mut waiting[j]);
-        queue.sort_by_key(|e| e.z);
+        queue.par_sort();
         // Where each goes: the level after the distance of an earlier point nearer than r,
         // or past the last level when none is.
-        let next: Vec<usize> = queue
+        // (Their points gathered first, in a loop that waits on many loads at once.)
+        let points: Vec<DVec4> = queue
             .par_iter()
-            .map(|e| match grid.near(&lattice, e.p, r) {
+            .map(|&z| candidates.point[z as usize])
+            .collect();
+        let next: Vec<usize> = points
+            .par_iter()
+            .map(|&p| match grid.near(&lattice, p, r) {
                 Some(d) => level_after(j, d),
                 None => usize::MAX,
             })
             .collect();
-        let mut pass: Vec<Item> = Vec::new();
-        for (&e, k) in queue.iter().zip(next) {
+        let mut pass: Vec<u32> = Vec::new();
+        for (&z, k) in queue.iter().zip(next) {
             if k == usize::MAX {
-                pass.push(e);
+                pass.push(z);
             } else if let Some(list) = waiting.get_mut(k) {
-                list.push(e);
+                list.push(z);
             }
         }
         // Those that pass against each other: for each, those before it in priority nearer
         // than r (pairs of places in `pass`, with their distance, grouped by the first).
-        own.build(&lattice, shift, &pass);
+        own.build(&candidates, shift, &pass);
         let pairs: Vec<(u32, u32, f64)> = (0..pass.len())
             .into_par_iter()
             .fold(Vec::new, |mut found, k| {
-                let e = pass[k];
-                own.visit(&lattice, e.p, r, |m, d| {
-                    if pass[m as usize].before(&e) {
+                let z = pass[k];
+                own.visit(&lattice, own.points[k], r, |m, d| {
+                    if candidates.before(pass[m as usize], z) {
                         found.push((k as u32, m, d));
                     }
                     false
@@ -288,7 +307,7 @@ fn rank(points: &[DVec4], priority: &[u32], count: usize, area: f64) -> Vec<u32>
         // none before it that it lists was; a rejected one keeps its distance to the
         // nearest of those.
         let mut by_priority: Vec<(u32, u32)> = (0..pass.len() as u32)
-            .map(|k| (pass[k as usize].priority, k))
+            .map(|k| (candidates.priority[pass[k as usize] as usize], k))
             .collect();
         by_priority.par_sort_unstable();
         let mut taken = vec![false; pass.len()];
@@ -302,7 +321,7 @@ fn rank(points: &[DVec4], priority: &[u32], count: usize, area: f64) -> Vec<u32>
                 .fold(f64::INFINITY, f64::min);
             if nearest[k].is_infinite() {
                 taken[k] = true;
-                accepted.push(pass[k].z);
+                accepted.push(pass[k]);
                 if accepted.len() >= count {
                     break;
                 }
@@ -310,73 +329,69 @@ fn rank(points: &[DVec4], priority: &[u32], count: usize, area: f64) -> Vec<u32>
         }
         // The rejected wait in candidate order.
         let mut new = Vec::new();
-        for (k, &e) in pass.iter().enumerate() {
+        for (k, &z) in pass.iter().enumerate() {
             if taken[k] {
-                new.push(e);
+                new.push(z);
             } else if nearest[k].is_finite()
                 && let Some(list) = waiting.get_mut(level_after(j, nearest[k]))
             {
-                list.push(e);
+                list.push(z);
             }
         }
         earlier = merge(&earlier, &new);
     }
-    accepted.iter().map(|&z| order[z as usize]).collect()
+    accepted
+        .iter()
+        .map(|&z| candidates.index[z as usize])
+        .collect()
 }
 
-/// The order of `keys` ascending, ties in index order: a least-significant-digit radix sort
-/// (11 bits a pass, as many passes as the largest key needs), which on a few million keys
-/// takes a fraction of a comparison sort's time; std and rayon have no radix sort.
-fn radix_order(keys: &[u64]) -> Vec<u32> {
-    const BITS: u32 = 11;
-    let top = keys.iter().fold(0, |a, &k| a | k);
-    let passes = (64 - top.leading_zeros()).div_ceil(BITS);
-    let mut order: Vec<(u64, u32)> = keys.iter().zip(0..).map(|(&k, i)| (k, i)).collect();
-    let mut next = vec![(0u64, 0u32); keys.len()];
-    for pass in 0..passes {
-        let digit = |k: u64| (k >> (pass * BITS)) as usize & ((1 << BITS) - 1);
-        let mut start = vec![0usize; 1 << BITS];
-        for &(k, _) in &order {
-            start[digit(k)] += 1;
+/// The candidates in the order of their fine cells along the Z curve (candidate order): for
+/// each its index among the points, its point, its priority and its cell's Z code. The ranking
+/// refers to a candidate by its place in this order, so its lists are of 32-bit places, not
+/// of points.
+struct Candidates {
+    index: Vec<u32>,
+    point: Vec<DVec4>,
+    priority: Vec<u32>,
+    code: Vec<u64>,
+}
+
+impl Candidates {
+    fn new(
+        lattice: &Lattice,
+        points: &[DVec4],
+        priority: impl Fn(u32) -> u32 + Sync,
+    ) -> Candidates {
+        // The indices are distinct, so the unstable sort of (code, index) is the stable order.
+        let mut keyed: Vec<(u64, u32)> = points
+            .par_iter()
+            .enumerate()
+            .map(|(i, &p)| (lattice.code(p), i as u32))
+            .collect();
+        keyed.par_sort_unstable();
+        let index: Vec<u32> = keyed.par_iter().map(|&(_, i)| i).collect();
+        Candidates {
+            point: index.par_iter().map(|&i| points[i as usize]).collect(),
+            priority: index.par_iter().map(|&i| priority(i)).collect(),
+            code: keyed.into_par_iter().map(|(k, _)| k).collect(),
+            index,
         }
-        let mut sum = 0;
-        for s in &mut start {
-            (*s, sum) = (sum, sum + *s);
-        }
-        for &(k, i) in &order {
-            let d = digit(k);
-            next[start[d]] = (k, i);
-            start[d] += 1;
-        }
-        std::mem::swap(&mut order, &mut next);
     }
-    order.into_iter().map(|(_, i)| i).collect()
-}
 
-/// A candidate as it waits: its place in candidate order, its priority and its point (a
-/// level reads the point from the queue, not from the whole candidates' list, which a sweep
-/// of a fifth of them would read nearly all of).
-#[derive(Clone, Copy)]
-struct Item {
-    z: u32,
-    priority: u32,
-    p: DVec4,
-}
-
-impl Item {
-    /// Whether it comes before `other` in priority.
+    /// Whether the candidate at place `a` comes before the one at `b` in priority.
     #[inline]
-    fn before(&self, other: &Item) -> bool {
-        (self.priority, self.z) < (other.priority, other.z)
+    fn before(&self, a: u32, b: u32) -> bool {
+        (self.priority[a as usize], a) < (self.priority[b as usize], b)
     }
 }
 
-/// Two lists sorted by place merged.
-fn merge(a: &[Item], b: &[Item]) -> Vec<Item> {
+/// Two lists sorted ascending merged.
+fn merge(a: &[u32], b: &[u32]) -> Vec<u32> {
     let mut out = Vec::with_capacity(a.len() + b.len());
     let (mut x, mut y) = (0, 0);
     while x < a.len() && y < b.len() {
-        if a[x].z < b[y].z {
+        if a[x] < b[y] {
             out.push(a[x]);
             x += 1;
         } else {
@@ -472,15 +487,20 @@ struct Grid {
 }
 
 impl Grid {
-    /// Rebuilds the grid of cells 2^shift fine cells wide over the candidates `list`, in
-    /// candidate order, keeping its memory.
-    fn build(&mut self, lattice: &Lattice, shift: u32, list: &[Item]) {
+    /// Rebuilds the grid of cells 2^shift fine cells wide over the candidates at places
+    /// `list` (ascending), keeping its memory.
+    fn build(&mut self, candidates: &Candidates, shift: u32, list: &[u32]) {
         self.shift = shift;
         self.points.clear();
-        self.points.extend(list.iter().map(|e| e.p));
+        self.points
+            .par_extend(list.par_iter().map(|&z| candidates.point[z as usize]));
         let keys: Vec<u64> = list
             .par_iter()
-            .map(|e| lattice.code(e.p).checked_shr(4 * shift).unwrap_or(0))
+            .map(|&z| {
+                candidates.code[z as usize]
+                    .checked_shr(4 * shift)
+                    .unwrap_or(0)
+            })
             .collect();
         self.runs.clear();
         for (s, &k) in keys.iter().enumerate() {
@@ -703,42 +723,44 @@ mod tests {
             .collect();
         let (lo, hi) = (DVec4::ZERO, DVec4::ONE);
         let lattice = Lattice::new(lo, hi, CELL * 1e-3);
-        let order = radix_order(&points.iter().map(|&p| lattice.code(p)).collect::<Vec<_>>());
-        let list: Vec<Item> = order
-            .iter()
-            .enumerate()
-            .map(|(z, &i)| Item {
-                z: z as u32,
-                priority: 0,
-                p: points[i as usize],
-            })
-            .collect();
+        let candidates = Candidates::new(&lattice, &points, |_| 0);
+        let list: Vec<u32> = (0..points.len() as u32).collect();
         let mut grid = Grid::default();
         for r in [0.1, 0.03, 0.01, 0.003, 0.001] {
-            grid.build(&lattice, lattice.shift(CELL * r), &list);
-            for (k, e) in list.iter().enumerate().step_by(7) {
+            grid.build(&candidates, lattice.shift(CELL * r), &list);
+            for k in (0..list.len()).step_by(7) {
+                let p = candidates.point[k];
                 let mut found = Vec::new();
-                grid.visit(&lattice, e.p, r, |m, _| {
+                grid.visit(&lattice, p, r, |m, _| {
                     found.push(m as usize);
                     false
                 });
                 found.sort_unstable();
                 let all: Vec<usize> = (0..list.len())
-                    .filter(|&m| list[m].p.distance_squared(e.p) < r * r)
+                    .filter(|&m| candidates.point[m].distance_squared(p) < r * r)
                     .collect();
                 assert_eq!(found, all, "point {k} at radius {r}");
-                assert_eq!(grid.near(&lattice, e.p, r).is_some(), !all.is_empty());
+                assert_eq!(grid.near(&lattice, p, r).is_some(), !all.is_empty());
             }
         }
     }
 
     #[test]
-    fn the_radix_order_is_the_stable_sorted_order() {
-        let keys: Vec<u64> = (0..5000).map(|i| hash(9, i) >> (i % 50)).collect();
-        let mut sorted: Vec<u32> = (0..keys.len() as u32).collect();
-        sorted.sort_by_key(|&i| keys[i as usize]);
-        assert_eq!(radix_order(&keys), sorted);
-        assert_eq!(radix_order(&[0, 0, 0]), vec![0, 1, 2]);
+    fn the_candidates_are_in_z_order_ties_by_index() {
+        let points: Vec<DVec4> = (0..5000u64)
+            .map(|i| DVec4::new(unit(1, i), unit(2, i % 40), 0.5, unit(3, i % 7)))
+            .collect();
+        let lattice = Lattice::new(DVec4::ZERO, DVec4::ONE, 0.01);
+        let priority: Vec<u32> = (0..points.len() as u32).map(|i| i * 7).collect();
+        let c = Candidates::new(&lattice, &points, |i| priority[i as usize]);
+        let mut sorted: Vec<u32> = (0..points.len() as u32).collect();
+        sorted.sort_by_key(|&i| lattice.code(points[i as usize]));
+        assert_eq!(c.index, sorted);
+        for (z, &i) in c.index.iter().enumerate() {
+            assert_eq!(c.point[z], points[i as usize]);
+            assert_eq!(c.priority[z], priority[i as usize]);
+            assert_eq!(c.code[z], lattice.code(points[i as usize]));
+        }
     }
 
     #[test]
