@@ -281,13 +281,26 @@ fn rank(
         }
         // Those that pass against each other: for each, those before it in priority nearer
         // than r (pairs of places in `pass`, with their distance, grouped by the first).
+        // Their order in priority (ties in candidate order, as `pass` is), and each one's
+        // place in it.
+        let mut by_priority: Vec<(u32, u32)> = pass
+            .par_iter()
+            .enumerate()
+            .map(|(k, &z)| (candidates.priority[z as usize], k as u32))
+            .collect();
+        by_priority.par_sort_unstable();
+        let mut place = vec![0u32; pass.len()];
+        for (n, &(_, k)) in (0u32..).zip(&by_priority) {
+            place[k as usize] = n;
+        }
+        // Those that pass against each other: for each, those before it in priority nearer
+        // than r (pairs of places in `pass`, with their distance, grouped by the first).
         own.build(&candidates, shift, &pass);
         let pairs: Vec<(u32, u32, f64)> = (0..pass.len())
             .into_par_iter()
             .fold(Vec::new, |mut found, k| {
-                let z = pass[k];
                 own.visit(&lattice, own.points[k], r, |m, d| {
-                    if candidates.before(pass[m as usize], z) {
+                    if place[m as usize] < place[k] {
                         found.push((k as u32, m, d));
                     }
                     false
@@ -303,13 +316,8 @@ fn rank(
         for k in 0..pass.len() {
             from[k + 1] += from[k];
         }
-        // In priority order (ties in candidate order, as `pass` is), each is accepted when
-        // none before it that it lists was; a rejected one keeps its distance to the
-        // nearest of those.
-        let mut by_priority: Vec<(u32, u32)> = (0..pass.len() as u32)
-            .map(|k| (candidates.priority[pass[k as usize] as usize], k))
-            .collect();
-        by_priority.par_sort_unstable();
+        // In priority order, each is accepted when none before it that it lists was; a
+        // rejected one keeps its distance to the nearest of those.
         let mut taken = vec![false; pass.len()];
         let mut nearest = vec![f64::INFINITY; pass.len()];
         for &(_, k) in &by_priority {
@@ -377,12 +385,6 @@ impl Candidates {
             code: keyed.into_par_iter().map(|(k, _)| k).collect(),
             index,
         }
-    }
-
-    /// Whether the candidate at place `a` comes before the one at `b` in priority.
-    #[inline]
-    fn before(&self, a: u32, b: u32) -> bool {
-        (self.priority[a as usize], a) < (self.priority[b as usize], b)
     }
 }
 
