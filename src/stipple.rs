@@ -258,13 +258,13 @@ fn rank(
         let mut queue = std::mem::take(&mut waiting[j]);
         queue.par_sort();
         // Where each goes: the level after the distance of an earlier point nearer than r,
-        // or past the last level when none is.
-        // (Their points gathered first, in a loop that waits on many loads at once.)
-        let points: Vec<DVec4> = queue
+        // or past the last level when none is. Their points are gathered first, in a loop
+        // that waits on many loads at once.
+        let queued: Vec<DVec4> = queue
             .par_iter()
             .map(|&z| candidates.point[z as usize])
             .collect();
-        let next: Vec<usize> = points
+        let next: Vec<usize> = queued
             .par_iter()
             .map(|&p| match grid.near(&lattice, p, r) {
                 Some(d) => level_after(j, d),
@@ -279,10 +279,8 @@ fn rank(
                 list.push(z);
             }
         }
-        // Those that pass against each other: for each, those before it in priority nearer
-        // than r (pairs of places in `pass`, with their distance, grouped by the first).
-        // Their order in priority (ties in candidate order, as `pass` is), and each one's
-        // place in it.
+        // Those that pass: their order in priority (ties in candidate order, as `pass` is),
+        // and each one's place in it.
         let mut by_priority: Vec<(u32, u32)> = pass
             .par_iter()
             .enumerate()
