@@ -345,6 +345,41 @@ fn surfaces_touching_tangentially_give_no_crossing() {
 }
 
 #[test]
+fn three_planes_through_one_line_have_no_triple_point() {
+    // Squares in the planes y = 0, z = 0 and y = z, all through the x axis: each pair meets
+    // along it, so each pair's segment lies in the third plane, its ends exactly on it (the
+    // crossings are halfway along edges from -1 to 1). Three sheets through one line have no
+    // triple point, and nothing is left undecided.
+    let square = |plane: fn(f64, f64) -> DVec3| {
+        let corners = [(-1.0, -1.0), (1.3, -1.0), (1.3, 1.0), (-1.0, 1.0)];
+        let positions: Vec<DVec3> = corners.iter().map(|&(u, v)| plane(u, v)).collect();
+        Soup {
+            w: vec![0.0; 4],
+            positions,
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        }
+    };
+    let soups = [
+        square(|u, v| DVec3::new(u, 0.0, v)),
+        square(|u, v| DVec3::new(u, v, 0.0)),
+        square(|u, v| DVec3::new(u, v, v)),
+    ];
+    let sheets: Vec<Sheet> = soups.iter().map(Soup::sheet).collect();
+    let c = curves(&sheets);
+    assert!(
+        c.curves
+            .iter()
+            .flat_map(|c| &c.points)
+            .all(|p| p.position.y == 0.0 && p.position.z == 0.0),
+        "{:?}",
+        c.curves
+    );
+    assert_eq!(c.report.count, 3, "{:?}", c.report);
+    assert_eq!(c.report.triple_points, 0, "{:?}", c.report);
+    assert_eq!(c.report.unresolved, 0, "{:?}", c.report);
+}
+
+#[test]
 fn three_planes_cross_at_one_triple_point() {
     // Three squares in the coordinate planes, split off their diagonals through the origin.
     let square = |axis: usize| {

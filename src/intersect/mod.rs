@@ -160,8 +160,7 @@ pub struct CurvesReport {
     /// perturbation.
     pub perturbed: usize,
     /// What could not be resolved: crossings where more than two segments meet, curves ending
-    /// at an edge that is not a boundary, triangle pairs whose predicates disagreed, and
-    /// triple points whose constructed points lie exactly on a plane.
+    /// at an edge that is not a boundary, and triangle pairs whose predicates disagreed.
     pub unresolved: usize,
     /// Triangles, all sheets.
     pub triangles: usize,
@@ -305,9 +304,8 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
     let (curves, branches) = chain::chain(&soup, &segments, face);
     report.unresolved += branches;
     count_curves(&curves, &soup, &mut report);
-    let (triple_points, undecided) = triple_points(&soup, &segments, face);
+    let triple_points = triple_points(&soup, &segments, face);
     report.triple_points = triple_points.len();
-    report.unresolved += undecided;
     report.chain_ms = ms(t);
     report.ms = ms(start);
     Curves {
@@ -569,14 +567,19 @@ impl BoundaryEdges {
 /// Triple points: in a triangle A crossed by B and by C, the segments A∩B and A∩C cross
 /// where the ends of each lie on opposite sides of the other's plane. Found once, in the
 /// triple's smallest triangle, and placed where A∩B crosses C's plane. The ends are
-/// constructed points, so a side that is exactly zero is not decided: it is returned as
-/// the count. Triangles of a triple that share a vertex, or lie in one plane, are one
-/// sheet, and no triple point.
+/// constructed points, and one can lie exactly in the other's plane (where sheets meet in
+/// symmetry: in the `two-surfaces` fixture three planes through one line, each segment in
+/// the others' planes, its ends off them or on them by rounding alone). An end on the
+/// plane counts as on its positive side, as if moved off it along the normal by an
+/// infinitesimal, the same for every segment ending at that node: a curve crossing the
+/// plane there is counted once, one touching it twice or not at all, and a segment in the
+/// plane crosses nothing. Triangles of a triple that share a vertex, or lie in one plane,
+/// are one sheet, and no triple point.
 fn triple_points(
     soup: &Soup,
     segments: &[Segment],
     face: impl Fn(u32) -> Face,
-) -> (Vec<TriplePoint>, usize) {
+) -> Vec<TriplePoint> {
     let places: Vec<[DVec3; 2]> = segments
         .iter()
         .map(|s| s.ends.map(|n| soup.place(n).position))
@@ -596,10 +599,8 @@ fn triple_points(
         let f = soup.tris[tri as usize].map(|v| soup.positions[v as usize]);
         sos::orient3d(f[0], f[1], f[2], p)
     };
-    let separated = |tri: u32, ends: [DVec3; 2]| -> Option<bool> {
-        let (a, b) = (side(tri, ends[0]), side(tri, ends[1]));
-        (a != 0.0 && b != 0.0).then_some((a > 0.0) != (b > 0.0))
-    };
+    let separated =
+        |tri: u32, ends: [DVec3; 2]| (side(tri, ends[0]) >= 0.0) != (side(tri, ends[1]) >= 0.0);
     // Triangles that share a vertex are one sheet there, not two.
     let touch = |x: u32, y: u32| {
         let (tx, ty) = (soup.tris[x as usize], soup.tris[y as usize]);
@@ -612,7 +613,7 @@ fn triple_points(
             .iter()
             .all(|&v| sos::orient3d(f[0], f[1], f[2], soup.positions[v as usize]) == 0.0)
     };
-    let (mut triples, mut undecided) = (Vec::new(), 0);
+    let mut triples = Vec::new();
     let mut i = 0;
     while i < by_tri.len() {
         let mut j = i;
@@ -633,33 +634,26 @@ fn triple_points(
                 {
                     continue;
                 }
-                match (
-                    separated(c, places[sb as usize]),
-                    separated(b, places[sc as usize]),
-                ) {
-                    (Some(true), Some(true)) => {
-                        let [p, q] = places[sb as usize];
-                        let (sp, sq) = (side(c, p), side(c, q));
-                        let x = p + (q - p) * (sp / (sp - sq));
-                        let w = [a, b, c].map(|t| {
-                            let f = soup.tris[t as usize];
-                            let l = exact::barycentric(x, f.map(|v| soup.positions[v as usize]));
-                            (0..3).map(|k| l[k] * soup.w[f[k] as usize]).sum()
-                        });
-                        triples.push(TriplePoint {
-                            position: x,
-                            w,
-                            faces: [a, b, c].map(&face),
-                        });
-                    }
-                    (Some(false), _) | (_, Some(false)) => {}
-                    _ => undecided += 1,
+                if separated(c, places[sb as usize]) && separated(b, places[sc as usize]) {
+                    let [p, q] = places[sb as usize];
+                    let (sp, sq) = (side(c, p), side(c, q));
+                    let x = p + (q - p) * (sp / (sp - sq));
+                    let w = [a, b, c].map(|t| {
+                        let f = soup.tris[t as usize];
+                        let l = exact::barycentric(x, f.map(|v| soup.positions[v as usize]));
+                        (0..3).map(|k| l[k] * soup.w[f[k] as usize]).sum()
+                    });
+                    triples.push(TriplePoint {
+                        position: x,
+                        w,
+                        faces: [a, b, c].map(&face),
+                    });
                 }
             }
         }
         i = j;
     }
-    (triples, undecided)
+    triples
 }
 
 fn ms(since: Instant) -> f64 {
