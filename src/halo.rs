@@ -443,9 +443,17 @@ pub const HALVINGS: u32 = 10;
 pub const RHO_SLOPE: f64 = 0.25;
 
 /// Lowers `rho` to its graded envelope, the largest field below it that grows by at most
-/// [`RHO_SLOPE`] times the length of every mesh edge (Dijkstra from every vertex at once,
-/// in one deterministic order). Gives the vertices it lowered.
-fn grade(rho: &mut [f64], positions: &[DVec3], triangles: &[[u32; 3]], stars: &Stars) -> Vec<u32> {
+/// [`RHO_SLOPE`] times the length of every mesh edge, where `rho` was graded but at
+/// `sources` (the vertices lowered since; all of them where unknown): only a path from one
+/// of those can lower a vertex. Dijkstra from the sources at once, in one deterministic
+/// order. Gives the vertices it lowered.
+fn grade(
+    rho: &mut [f64],
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    stars: &Stars,
+    sources: &[u32],
+) -> Vec<u32> {
     use std::cmp::Reverse;
     use std::collections::BinaryHeap;
     /// A vertex and its rho, ordered by rho, then by index.
@@ -463,8 +471,9 @@ fn grade(rho: &mut [f64], positions: &[DVec3], triangles: &[[u32; 3]], stars: &S
         }
     }
     let before = rho.to_vec();
-    let mut heap: BinaryHeap<Reverse<Entry>> = (0..rho.len())
-        .map(|v| Reverse(Entry(rho[v], v as u32)))
+    let mut heap: BinaryHeap<Reverse<Entry>> = sources
+        .iter()
+        .map(|&v| Reverse(Entry(rho[v as usize], v)))
         .collect();
     while let Some(Reverse(Entry(r, v))) = heap.pop() {
         if r > rho[v as usize] {
@@ -684,10 +693,22 @@ fn shrink_folds(
         flip,
     } = *surface;
     let floor = rho * 0.5f64.powi(HALVINGS as i32);
-    let mut bad = Vec::new();
-    for (c, f) in corners.iter().zip(forward) {
-        inverted_corners(c, *f, &offsets.positions, &mut bad);
-    }
+    let mut bad = corners
+        .par_iter()
+        .zip(forward)
+        .fold(Vec::new, |mut bad, (c, f)| {
+            inverted_corners(c, *f, &offsets.positions, &mut bad);
+            bad
+        })
+        .reduce(Vec::new, |mut a, mut b| {
+            a.append(&mut b);
+            a
+        });
+    // The vertices lowered since rho was last graded: at first the singular ones, zero
+    // from the start (the rest, all at `rho`, are graded).
+    let mut lowered_since: Vec<u32> = (0..offsets.rho.len() as u32)
+        .filter(|&v| offsets.rho[v as usize] < rho)
+        .collect();
     let mut stamp = vec![usize::MAX; triangles.len()];
     let mut round = 0;
     let mut reexamine = |touched: &[u32], offsets: &Offsets, bad: &mut Vec<u32>| {
@@ -729,15 +750,20 @@ fn shrink_folds(
                 };
                 offsets.place(v);
             }
+            lowered_since.extend_from_slice(&bad);
             let touched = std::mem::take(&mut bad);
             reexamine(&touched, offsets, &mut bad);
         }
+        lowered_since.sort_unstable();
+        lowered_since.dedup();
         let lowered = grade(
             &mut offsets.rho,
             &offsets.projected.positions,
             triangles,
             stars,
+            &lowered_since,
         );
+        lowered_since.clear();
         if lowered.is_empty() {
             break;
         }
@@ -790,9 +816,14 @@ mod tests {
             .flat_map(|i| [[i, i + 1, i + 7], [i, i + 7, i + 6]])
             .collect();
         let stars = Stars::new(12, &triangles);
+        let all: Vec<u32> = (0..12).collect();
         let mut rho = vec![1.0; 12];
         rho[0] = 0.0;
-        let lowered = grade(&mut rho, &positions, &triangles, &stars);
+        // From its one lowered vertex, as from all: the same field.
+        let mut from_all = rho.clone();
+        let lowered = grade(&mut rho, &positions, &triangles, &stars, &[0]);
+        grade(&mut from_all, &positions, &triangles, &stars, &all);
+        assert_eq!(rho, from_all);
         for (v, &r) in rho.iter().enumerate() {
             // The graph distance from vertex 0 along the strip's edges.
             let (x, y) = ((v % 6) as f64, (v / 6) as f64);
@@ -815,7 +846,17 @@ mod tests {
         );
         // Graded once, it is its own envelope.
         let again = rho.clone();
-        assert!(grade(&mut rho, &positions, &triangles, &stars).is_empty());
+        assert!(grade(&mut rho, &positions, &triangles, &stars, &all).is_empty());
         assert_eq!(rho, again);
+        // Lowered again at the far end, graded from there alone as from all.
+        rho[11] = 0.0;
+        from_all = rho.clone();
+        let lowered = grade(&mut rho, &positions, &triangles, &stars, &[11]);
+        assert_eq!(
+            lowered,
+            grade(&mut from_all, &positions, &triangles, &stars, &all)
+        );
+        assert_eq!(rho, from_all);
+        assert!(lowered.contains(&10) && !lowered.contains(&0));
     }
 }
