@@ -38,7 +38,9 @@
 //! conform: side points are dyadic fractions of the side (the starting grids have powers of
 //! two of cells, and splits halve), and the glue maps (σ ↦ offset ± σ with offsets that are
 //! multiples of 1/2) send them to dyadic fractions exactly. At the end the patches are
-//! welded by the domain rules, as in the uniform sampler.
+//! welded by the domain rules, as in the uniform sampler, and numbered for the stages after
+//! it: vertices along a Z curve of each patch's parameters, triangles by their smallest
+//! vertex.
 //!
 //! Guarantees: when `complete`, every triangle passes the audit's test at the tolerance;
 //! closed surfaces give closed manifold meshes, welded by rule, consistently oriented where
@@ -939,8 +941,7 @@ impl<'a> Sampler<'a> {
         // Vertices numbered along a Z curve of each patch's (s, t), triangles by their
         // smallest vertex. The refinement inserts points worst first, anywhere in a patch:
         // numbered in that order, neighbours lie far apart in memory and every later stage
-        // waits on its walks over them (the default scene's halo stage at 1e-5 took 6.0 s
-        // numbered by insertion and 4.5 s numbered so; docs/PERFORMANCE.md § Halos).
+        // waits on its walks over them (what it cost: docs/PERFORMANCE.md § Halos).
         let locate = |id: usize| {
             let patch = offsets.partition_point(|&o| o <= id) - 1;
             (patch, id - offsets[patch])
@@ -968,17 +969,34 @@ impl<'a> Sampler<'a> {
         }
         let mut mesh = Mesh4::default();
         mesh.push_vertices(self.surface, &at);
-        let mut faces = Vec::new();
-        for (patch, p) in self.patches.iter().enumerate() {
-            for f in p.cdt.inner_faces() {
-                let local = f.vertices().map(|v| v.fix().index());
-                let t = local.map(|i| vertex_of[offsets[patch] + i]);
-                let first = t.iter().copied().min().unwrap_or(0);
-                faces.push((first, faces.len(), t, patch, local));
-            }
+        let (vertex_of, offsets) = (&vertex_of, &offsets);
+        let faces: Vec<([u32; 3], usize, [usize; 3])> = self
+            .patches
+            .iter()
+            .enumerate()
+            .flat_map(|(patch, p)| {
+                p.cdt.inner_faces().map(move |f| {
+                    let local = f.vertices().map(|v| v.fix().index());
+                    (local.map(|i| vertex_of[offsets[patch] + i]), patch, local)
+                })
+            })
+            .collect();
+        // A counting sort by the smallest vertex, in the patches' order within one.
+        let first = |t: &[u32; 3]| t[0].min(t[1]).min(t[2]) as usize;
+        let mut next = vec![0usize; at.len() + 1];
+        for (t, _, _) in &faces {
+            next[first(t) + 1] += 1;
         }
-        faces.par_sort_unstable_by_key(|f| (f.0, f.1));
-        for (_, _, t, patch, local) in faces {
+        for v in 0..at.len() {
+            next[v + 1] += next[v];
+        }
+        let mut order = vec![0u32; faces.len()];
+        for (k, (t, _, _)) in faces.iter().enumerate() {
+            order[next[first(t)]] = k as u32;
+            next[first(t)] += 1;
+        }
+        for k in order {
+            let (t, patch, local) = faces[k as usize];
             let p = &self.patches[patch];
             mesh.push_triangle(t, patch, local.map(|i| p.uv(p.st[i])));
         }
