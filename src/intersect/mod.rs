@@ -567,14 +567,14 @@ impl BoundaryEdges {
 /// Triple points: in a triangle A crossed by B and by C, the segments A∩B and A∩C cross
 /// where the ends of each lie on opposite sides of the other's plane. Found once, in the
 /// triple's smallest triangle, and placed where A∩B crosses C's plane. The ends are
-/// constructed points, and one can lie exactly in the other's plane (where sheets meet in
-/// symmetry: in the `two-surfaces` fixture three planes through one line, each segment in
-/// the others' planes, its ends off them or on them by rounding alone). An end on the
-/// plane counts as on its positive side, as if moved off it along the normal by an
-/// infinitesimal, the same for every segment ending at that node: a curve crossing the
-/// plane there is counted once, one touching it twice or not at all, and a segment in the
-/// plane crosses nothing. Triangles of a triple that share a vertex, or lie in one plane,
-/// are one sheet, and no triple point.
+/// constructed points, and one can lie exactly in the other's plane where sheets meet in
+/// symmetry (in the `two-surfaces` fixture a segment of one pair lies in the third sheet's
+/// plane, its ends on that plane or off it by rounding alone, depending on the vertices'
+/// numbering). An end on the plane counts as on its positive side, as if moved off it
+/// along the normal by an infinitesimal, the same for every segment ending at that node: a
+/// curve crossing the plane there is counted once, one touching it twice or not at all,
+/// and a segment in the plane crosses nothing. Triangles of a triple that share a vertex,
+/// or lie in one plane, are one sheet, and no triple point.
 fn triple_points(
     soup: &Soup,
     segments: &[Segment],

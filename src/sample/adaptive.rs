@@ -990,12 +990,12 @@ impl<'a> Sampler<'a> {
         for v in 0..at.len() {
             next[v + 1] += next[v];
         }
-        let mut order = vec![0u32; faces.len()];
+        let mut sorted = vec![0u32; faces.len()];
         for (k, (t, _, _)) in faces.iter().enumerate() {
-            order[next[first(t)]] = k as u32;
+            sorted[next[first(t)]] = k as u32;
             next[first(t)] += 1;
         }
-        for k in order {
+        for k in sorted {
             let (t, patch, local) = faces[k as usize];
             let p = &self.patches[patch];
             mesh.push_triangle(t, patch, local.map(|i| p.uv(p.st[i])));
