@@ -550,7 +550,10 @@ fn unreadable_files_are_errors_of_the_cli_with_the_file_named() {
     std::fs::write(dir.path().join("notes.txt"), "hello").unwrap();
     for (file, words) in [
         ("cut.glb", &["cut.glb", "truncated"][..]),
-        ("notes.txt", &["notes.txt", ".glb or a .vtk"]),
+        (
+            "notes.txt",
+            &["notes.txt", "unknown file type", ".pvtu", ".msh"],
+        ),
         ("absent.vtk", &["absent.vtk", "cannot read"]),
         // Not there, and no extension: not found, not "unknown file type".
         (

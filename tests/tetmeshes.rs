@@ -1,6 +1,7 @@
-//! Other programs' tetrahedral meshes (`fixtures/tetmeshes/`, written by meshio 5.3.5 and
-//! by hand through `make.py`): one mesh in every format and variant, read the same; and
-//! malformed files, each an error that names its line or byte, never a panic.
+//! Other programs' tetrahedral meshes (`fixtures/tetmeshes/`, written by meshio 5.3.5, VTK
+//! 9.5.2, Gmsh 4.15.2 and by hand through `make.py`): one mesh in every format and variant,
+//! read the same; and malformed files, each an error that names its line or byte, never a
+//! panic.
 
 use crate::common::fixture;
 use halo4d::import::{FileTetrahedra, PlainTetrahedra, read, read_tetgen};
@@ -30,6 +31,32 @@ const VARIANTS: [&str; 22] = [
     "cube.mesh",
     "cube.ele",
     "cube.node",
+];
+
+/// The files VTK 9.5.2 and Gmsh 4.15.2 themselves wrote (`make.py`): VTU with InformationKey
+/// children, LZ4 and LZMA; legacy VTK with every kind of array; Gmsh's parametric nodes; a
+/// PVTU of 3 pieces. And copies of other fixtures that begin with a UTF-8 byte-order mark.
+/// Each is the fixture mesh, though Gmsh numbers its nodes by entity and the PVTU's points
+/// come piece by piece.
+const WRITERS: [&str; 18] = [
+    "cube-vtk9-ascii.vtu",
+    "cube-vtk9-binary.vtu",
+    "cube-vtk9-binary-zlib.vtu",
+    "cube-vtk9-binary-lz4.vtu",
+    "cube-vtk9-binary-lzma.vtu",
+    "cube-vtk9-appended-lz4.vtu",
+    "cube-vtk9-appended-lzma.vtu",
+    "cube-vtk9-arrays-ascii.vtk",
+    "cube-vtk9-arrays-binary.vtk",
+    "cube-vtk9-arrays-4.2-binary.vtk",
+    "cube-2.2-parametric-ascii.msh",
+    "cube-2.2-parametric-binary.msh",
+    "cube-4.1-parametric-ascii.msh",
+    "cube-4.1-parametric-binary.msh",
+    "cube-bom.msh",
+    "cube-bom.mesh",
+    "cube-bom.vtk",
+    "cube-pieces.pvtu",
 ];
 
 fn path(name: &str) -> PathBuf {
@@ -101,9 +128,186 @@ fn every_format_and_variant_reads_the_same_positive_tetrahedra() {
     }
 }
 
+/// Each tetrahedron's corners (sorted), all sorted: the mesh whatever its numbering.
+fn corners(m: &PlainTetrahedra) -> Vec<[[u64; 3]; 4]> {
+    let mut all: Vec<[[u64; 3]; 4]> = m
+        .tets
+        .iter()
+        .map(|t| {
+            let mut c = t.map(|i| m.positions[i as usize].map(f64::to_bits));
+            c.sort_unstable();
+            c
+        })
+        .collect();
+    all.sort_unstable();
+    all
+}
+
+fn volume(m: &PlainTetrahedra) -> f64 {
+    m.tets.iter().map(|&t| orient(m, t) / 6.0).sum()
+}
+
+#[test]
+fn what_vtk_and_gmsh_write_reads_as_the_same_mesh() {
+    let reference = plain(&path("cube.mesh"));
+    let v = volume(&reference);
+    assert!((v - 3.0).abs() < 0.5, "{v}");
+    for name in WRITERS {
+        let m = plain(&path(name));
+        assert_eq!(m.tets.len(), reference.tets.len(), "{name}: tetrahedra");
+        assert!(
+            (volume(&m) - v).abs() <= 1e-12 * v,
+            "{name}: volume {} (the reference's {v})",
+            volume(&m)
+        );
+        assert_eq!(corners(&m), corners(&reference), "{name}: corners");
+        assert_eq!(
+            m.positions.len(),
+            reference.positions.len(),
+            "{name}: vertices"
+        );
+        for &t in &m.tets {
+            assert!(
+                orient(&m, t) > 0.0,
+                "{name}: tetrahedron {t:?} is not positive"
+            );
+        }
+        if name.ends_with(".pvtu") {
+            continue;
+        }
+        assert!(m.pieces.is_empty() && m.piece_of.is_empty(), "{name}");
+        if name.contains("bom") || name.ends_with(".vtk") {
+            continue;
+        }
+        // Where the numbering is the file's own (VTK keeps the fixture's), the same arrays.
+        if name.contains("vtk9") {
+            assert_eq!(m.positions, reference.positions, "{name}");
+            assert_eq!(m.tets, reference.tets, "{name}");
+        }
+    }
+    for (name, format) in [
+        ("cube-vtk9-binary-lz4.vtu", "VTU binary lz4"),
+        ("cube-vtk9-appended-lzma.vtu", "VTU appended raw lzma"),
+        ("cube-vtk9-ascii.vtu", "VTU ascii"),
+        ("cube-vtk9-arrays-binary.vtk", "legacy VTK binary"),
+        ("cube-2.2-parametric-binary.msh", "Gmsh 2.2 binary"),
+        ("cube-4.1-parametric-ascii.msh", "Gmsh 4.1 ASCII"),
+        ("cube-bom.vtk", "legacy VTK ASCII"),
+        (
+            "cube-pieces.pvtu",
+            "PVTU, 3 pieces (VTU appended base64 zlib)",
+        ),
+    ] {
+        assert_eq!(plain(&path(name)).format, format, "{name}");
+    }
+    // The byte-order mark's copies are their originals.
+    for (bom, original) in [
+        ("cube-bom.msh", "cube-2.2-ascii.msh"),
+        ("cube-bom.mesh", "cube.mesh"),
+        ("cube-bom.vtk", "cube-4.2-ascii.vtk"),
+    ] {
+        let (a, b) = (plain(&path(bom)), plain(&path(original)));
+        assert_eq!((a.positions, a.tets), (b.positions, b.tets), "{bom}");
+    }
+}
+
+#[test]
+fn a_pvtu_welds_its_pieces_and_records_where_each_tetrahedron_came_from() {
+    let m = plain(&path("cube-pieces.pvtu"));
+    assert_eq!(m.name, "cube-pieces");
+    assert_eq!(
+        m.pieces,
+        [
+            "cube-pieces_0.vtu",
+            "cube-pieces_1.vtu",
+            "cube-pieces_2.vtu"
+        ]
+    );
+    // The pieces hold 7 + 6 + 7 points, those on the cuts twice: welded, the 12 of the box.
+    let pieces: Vec<PlainTetrahedra> = (0..3)
+        .map(|k| plain(&path(&format!("cube-pieces_{k}.vtu"))))
+        .collect();
+    let written: usize = pieces.iter().map(|p| p.positions.len()).sum();
+    assert!(written > 12, "{written}");
+    assert_eq!(m.positions.len(), 12);
+    assert_eq!(m.piece_of.len(), m.tets.len());
+    let mut start = 0;
+    for (k, piece) in pieces.iter().enumerate() {
+        let n = piece.tets.len();
+        assert!(n > 0, "piece {k}");
+        // The pieces' tetrahedra, in order, each recorded as its piece's; the same corners.
+        assert!(
+            m.piece_of[start..start + n]
+                .iter()
+                .all(|&p| p as usize == k)
+        );
+        let own = PlainTetrahedra {
+            tets: m.tets[start..start + n].to_vec(),
+            ..m.clone()
+        };
+        assert_eq!(corners(&own), corners(piece), "piece {k}");
+        // make.py cut the box at x = 1 and 2 by the tetrahedra's centroids.
+        for t in &own.tets {
+            let x: f64 = t.iter().map(|&i| m.positions[i as usize][0]).sum::<f64>() / 4.0;
+            assert!(
+                (k as f64..k as f64 + 1.0).contains(&x) || (k == 2 && x >= 2.0),
+                "{x}"
+            );
+        }
+        start += n;
+    }
+    assert_eq!(start, m.tets.len());
+
+    // Pieces in a folder beside the .pvtu, as ParaView and older VTK write them.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("cube")).unwrap();
+    let mut pvtu = std::fs::read_to_string(path("cube-pieces.pvtu")).unwrap();
+    for k in 0..3 {
+        let piece = format!("cube-pieces_{k}.vtu");
+        std::fs::copy(path(&piece), dir.path().join("cube").join(&piece)).unwrap();
+        pvtu = pvtu.replace(&format!("\"{piece}\""), &format!("\"cube/{piece}\""));
+    }
+    let p = dir.path().join("ball.PVTU");
+    std::fs::write(&p, &pvtu).unwrap();
+    let moved = plain(&p);
+    assert_eq!(
+        (moved.positions, moved.tets),
+        (m.positions.clone(), m.tets.clone())
+    );
+    assert_eq!(moved.pieces[1], "cube/cube-pieces_1.vtu");
+
+    // A piece that is not there: named, with the .pvtu and the byte of its Piece tag.
+    std::fs::remove_file(dir.path().join("cube/cube-pieces_2.vtu")).unwrap();
+    let at = pvtu
+        .find("<Piece Source=\"cube/cube-pieces_2.vtu\"")
+        .unwrap();
+    let e = read(&p).unwrap_err().to_string();
+    for needle in [
+        "PVTU ball.PVTU".to_string(),
+        format!("byte {at}"),
+        "cube/cube-pieces_2.vtu".into(),
+        "cannot be read".into(),
+    ] {
+        assert!(e.contains(&needle), "`{needle}` not in: {e}");
+    }
+
+    // An error inside a piece names the .pvtu, the piece and the byte in the piece.
+    let mut piece = std::fs::read(path("cube-pieces_1.vtu")).unwrap();
+    let data = appended(&piece);
+    piece.truncate(data + 20);
+    std::fs::write(dir.path().join("cube/cube-pieces_2.vtu"), &piece).unwrap();
+    let e = read(&p).unwrap_err().to_string();
+    assert!(
+        e.starts_with(
+            "PVTU ball.PVTU, piece cube/cube-pieces_2.vtu (VTU appended base64 zlib), byte "
+        ),
+        "{e}"
+    );
+}
+
 #[test]
 fn halo4d_check_passes_every_variant() {
-    for name in VARIANTS {
+    for name in VARIANTS.into_iter().chain(WRITERS) {
         let checked = halo4d::check_file(&path(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert!(
             checked.failures().is_empty(),
@@ -202,8 +406,8 @@ fn appended(bytes: &[u8]) -> usize {
 
 #[test]
 fn truncated_files_fail_naming_where() {
-    for name in VARIANTS {
-        if name.ends_with(".vtk") || name == "cube.node" {
+    for name in VARIANTS.into_iter().chain(WRITERS) {
+        if name.ends_with(".vtk") || name.ends_with(".pvtu") || name == "cube.node" {
             continue;
         }
         let bytes = std::fs::read(path(name)).unwrap();
@@ -501,11 +705,360 @@ fn unknown_extensions_list_every_format() {
     let p = dir.path().join("mesh.stl");
     std::fs::write(&p, b"solid").unwrap();
     let e = read(&p).unwrap_err().to_string();
-    for ext in [".vtu", ".msh", ".mesh", ".node", ".ele", ".glb", ".vtk"] {
+    for ext in [
+        ".vtu", ".pvtu", ".msh", ".mesh", ".node", ".ele", ".glb", ".vtk",
+    ] {
         assert!(e.contains(ext), "{e}");
     }
     // Extensions in any case.
     let upper = dir.path().join("CUBE.MSH");
     std::fs::copy(path("cube-4.1-binary.msh"), &upper).unwrap();
     assert_eq!(plain(&upper).tets.len(), 12);
+}
+
+/// The Points' compressed header in an appended raw VTU of UInt32 headers: where it is, its
+/// blocks' compressed sizes, and where its first block begins.
+fn points_blocks(bytes: &[u8]) -> (usize, Vec<u32>, usize) {
+    let text = String::from_utf8_lossy(bytes);
+    let offset: usize = text
+        .split("Name=\"Points\"")
+        .nth(1)
+        .and_then(|t| t.split("offset=\"").nth(1))
+        .and_then(|t| t.split('"').next())
+        .and_then(|o| o.trim().parse().ok())
+        .unwrap();
+    let data = appended(bytes) + offset;
+    let u =
+        |i: usize| u32::from_le_bytes(bytes[data + 4 * i..data + 4 * i + 4].try_into().unwrap());
+    let blocks = u(0) as usize;
+    let sizes = (0..blocks).map(|k| u(3 + k)).collect();
+    (data, sizes, data + 4 * (3 + blocks))
+}
+
+#[test]
+fn bad_lz4_and_xz_blocks_fail_naming_the_block() {
+    for (name, kind) in [
+        ("cube-vtk9-appended-lz4.vtu", "LZ4 block"),
+        ("cube-vtk9-appended-lzma.vtu", ".xz stream"),
+    ] {
+        let raw = std::fs::read(path(name)).unwrap();
+        let (data, sizes, first) = points_blocks(&raw);
+        assert!(sizes.len() > 2, "{name}: {sizes:?}");
+        let last = sizes.len() - 1;
+        if kind == ".xz stream" {
+            // lzma_easy_buffer_encode: each block an .xz stream, magic and all.
+            assert_eq!(&raw[first..first + 6], b"\xFD7zXZ\0", "{name}");
+        }
+        // The last block cut short by a byte (its header says one byte less).
+        let mut bytes = raw.clone();
+        let at = data + 4 * (3 + last);
+        bytes[at..at + 4].copy_from_slice(&(sizes[last] - 1).to_le_bytes());
+        let block_at = first + sizes[..last].iter().map(|&s| s as usize).sum::<usize>();
+        fails(
+            "cube.vtu",
+            &bytes,
+            true,
+            &[&format!("block {last}"), kind, &format!("byte {block_at}")],
+        );
+        // A block's bytes spoilt in the middle.
+        let mut bytes = raw.clone();
+        for b in &mut bytes[first + 4..first + sizes[0] as usize - 2] {
+            *b ^= 0x5a;
+        }
+        fails("cube.vtu", &bytes, true, &["block 0", kind]);
+        // The whole file cut inside the blocks.
+        fails("cube.vtu", &raw[..first + 10], true, &["truncated"]);
+    }
+}
+
+/// A VTU of `np` points whose Points array is appended raw: one compressed block of `block`
+/// bytes that claims to give all of the points' bytes.
+fn one_block_vtu(compressor: &str, np: usize, block: &[u8]) -> Vec<u8> {
+    let mut head = Vec::new();
+    for v in [1u32, 24 * np as u32, 24 * np as u32, block.len() as u32] {
+        head.extend_from_slice(&v.to_le_bytes());
+    }
+    let mut out = format!(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt32\" compressor=\"{compressor}\">\n<!-- {} -->\n<UnstructuredGrid><Piece NumberOfPoints=\"{np}\" NumberOfCells=\"1\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/></Points><Cells><DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">0 1 2 3</DataArray><DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">4</DataArray><DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">10</DataArray></Cells></Piece></UnstructuredGrid>\n<AppendedData encoding=\"raw\">_",
+        " ".repeat(np)
+    )
+    .into_bytes();
+    out.extend_from_slice(&head);
+    out.extend_from_slice(block);
+    out.extend_from_slice(b"\n</AppendedData>\n</VTKFile>\n");
+    out
+}
+
+#[test]
+fn headers_that_claim_more_than_the_compressor_can_give_are_refused() {
+    // 1000 points are 24000 bytes: more than 255 times 2 bytes of LZ4 (plus a block's 64),
+    // or 7500 times 2 bytes of .xz; nothing is allocated for them.
+    for (compressor, name) in [
+        ("vtkLZ4DataCompressor", "lz4"),
+        ("vtkLZMADataCompressor", "lzma"),
+        ("vtkZLibDataCompressor", "zlib"),
+    ] {
+        let bytes = one_block_vtu(compressor, 1000, &[0, 0]);
+        let at = appended(&bytes);
+        fails(
+            "cube.vtu",
+            &bytes,
+            true,
+            &[
+                &format!("byte {at}"),
+                "claims 24000 bytes",
+                &format!("than {name} can give"),
+            ],
+        );
+    }
+    // Within the bound, a block that does not give what it claims is an error all the same.
+    let bytes = one_block_vtu("vtkLZ4DataCompressor", 4, &[0x40, 1, 2, 3, 4]);
+    fails("cube.vtu", &bytes, true, &["block 0", "LZ4 block"]);
+    let bytes = one_block_vtu("vtkLZMADataCompressor", 4, b"\xFD7zXZ\0\0\x04");
+    fails("cube.vtu", &bytes, true, &["block 0", ".xz stream"]);
+    let e = fails(
+        "cube.vtu",
+        &one_block_vtu("vtkBloscDataCompressor", 4, &[]),
+        true,
+        &["vtkLZ4DataCompressor", "vtkLZMADataCompressor"],
+    );
+    assert!(e.contains("Blosc"), "{e}");
+}
+
+#[test]
+fn a_data_array_is_its_own_text() {
+    // VTK writes its InformationKey after the values; one moved among them is read past.
+    let vtu = std::fs::read_to_string(path("cube-vtk9-ascii.vtu")).unwrap();
+    let points = vtu.find("Name=\"Points\"").unwrap();
+    let key_start = points + vtu[points..].find("<InformationKey").unwrap();
+    let key_end = key_start + vtu[key_start..].find("</InformationKey>").unwrap() + 17;
+    let key = &vtu[key_start..key_end];
+    let values = points + vtu[points..].find('>').unwrap() + 1;
+    let middle = values + vtu[values..key_start].find("1.5 ").unwrap();
+    let mut moved = vtu.clone();
+    moved.replace_range(key_start..key_end, "");
+    moved.insert_str(middle, &format!("{key} <!-- a comment --> "));
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("moved.vtu");
+    std::fs::write(&p, &moved).unwrap();
+    let reference = plain(&path("cube-vtk9-ascii.vtu"));
+    assert_eq!(plain(&p).positions, reference.positions);
+    // Glued to a value on one side only: still whitespace between the values.
+    let value = middle + moved[middle..].find("0.0625").unwrap();
+    let mut one_side = moved.clone();
+    one_side.insert_str(value + 6, "<a/>");
+    std::fs::write(&p, &one_side).unwrap();
+    assert_eq!(plain(&p).positions, reference.positions);
+
+    // A child glued to a value on both sides: `0.06<a/>25` is one word to XML and two to a
+    // reader of words; refused, naming the byte of the child.
+    let mut glued = moved.clone();
+    glued.insert_str(value + 4, "<a/>");
+    fails(
+        "cube.vtu",
+        glued.as_bytes(),
+        true,
+        &[&format!("byte {}", value + 4), "cuts a value"],
+    );
+
+    // In base64 a child between two parts of the text is read past: the parts are one text.
+    let vtu = std::fs::read_to_string(path("cube-vtk9-binary.vtu")).unwrap();
+    let points = vtu.find("Name=\"Points\"").unwrap();
+    let values = points + vtu[points..].find('>').unwrap() + 1;
+    let text = values + vtu[values..].find(|c: char| !c.is_whitespace()).unwrap();
+    let mut split = vtu.clone();
+    split.insert_str(text + 10, "<Split/>");
+    std::fs::write(&p, &split).unwrap();
+    assert_eq!(
+        plain(&p).positions,
+        plain(&path("cube-vtk9-binary.vtu")).positions
+    );
+}
+
+#[test]
+fn legacy_vtk_reads_past_every_array_it_does_not_need() {
+    // A string array in the FIELD data refused the whole file once.
+    let ascii = std::fs::read_to_string(path("cube-vtk9-arrays-ascii.vtk")).unwrap();
+    assert!(ascii.contains("notes 1 3 string\nwritten%20by%20VTK\n\n"));
+    // Cut inside its strings: an error that says so, never a panic.
+    let cut = ascii.find("xxxx").unwrap();
+    let e = fails("cube.vtk", &ascii.as_bytes()[..cut], false, &[]);
+    assert!(e.contains("notes") || e.contains("POINTS"), "{e}");
+    // Binary: each string after its length; one that claims more than the file has left.
+    let binary = std::fs::read(path("cube-vtk9-arrays-binary.vtk")).unwrap();
+    let at = find(&binary, b"notes 1 3 string\n").unwrap() + 17;
+    assert_eq!(binary[at], 0xC0 | 14, "a 1-byte length: 11 then 14");
+    let mut bytes = binary.clone();
+    bytes[at] = 0x3F;
+    fails(
+        "cube.vtk",
+        &bytes,
+        false,
+        &["FIELD array notes", "string 0"],
+    );
+    // A type no VTK writes is named.
+    fails(
+        "cube.vtk",
+        ascii.replace("3 bit", "3 quaternion").as_bytes(),
+        false,
+        &["quaternion", "string"],
+    );
+}
+
+#[test]
+fn a_byte_order_mark_is_skipped_and_bytes_stay_the_files() {
+    let bom = |b: &[u8]| [b"\xEF\xBB\xBF".as_slice(), b].concat();
+    let dir = tempfile::tempdir().unwrap();
+    for name in [
+        "cube-ascii.vtu",
+        "cube-appended-raw-zlib.vtu",
+        "cube-4.1-binary.msh",
+    ] {
+        let p = dir.path().join(name);
+        std::fs::write(&p, bom(&std::fs::read(path(name)).unwrap())).unwrap();
+        let (a, b) = (plain(&p), plain(&path(name)));
+        assert_eq!((a.positions, a.tets), (b.positions, b.tets), "{name}");
+    }
+    // TetGen's two files.
+    let node = std::fs::read(path("cube.node")).unwrap();
+    let ele = std::fs::read(path("cube.ele")).unwrap();
+    let m = read_tetgen(&bom(&node), &bom(&ele), "cube").unwrap();
+    assert_eq!(m.tets, plain(&path("cube.mesh")).tets);
+    // An error's byte is the file's, the mark counted: a raw appended value spoilt.
+    let raw = bom(&std::fs::read(path("cube-appended-raw.vtu")).unwrap());
+    let data = appended(&raw);
+    let mut bytes = raw.clone();
+    bytes[data..data + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+    fails("cube.vtu", &bytes, true, &[&format!("byte {data}")]);
+}
+
+#[test]
+fn a_pvtu_piece_without_cells_is_read_as_none() {
+    // VTK 9.5's vtkXMLUnstructuredGridWriter (binary) of an empty grid, as a process that
+    // had no cells writes its piece.
+    let empty = r#"<?xml version="1.0"?>
+<VTKFile type="UnstructuredGrid" version="0.1" byte_order="LittleEndian" header_type="UInt32" compressor="vtkZLibDataCompressor">
+  <UnstructuredGrid>
+    <Piece NumberOfPoints="0" NumberOfCells="0">
+      <PointData>
+      </PointData>
+      <CellData>
+      </CellData>
+      <Points>
+        <DataArray type="Float64" Name="Points" NumberOfComponents="3" format="binary" RangeMin="1e+299" RangeMax="-1e+299">
+          AAAAAACAAAAAAAAA
+          <InformationKey name="L2_NORM_RANGE" location="vtkDataArray" length="2">
+            <Value index="0">
+              1e+299
+            </Value>
+            <Value index="1">
+              -1e+299
+            </Value>
+          </InformationKey>
+        </DataArray>
+      </Points>
+      <Cells>
+        <DataArray type="Int64" Name="connectivity" format="binary" RangeMin="1e+299" RangeMax="-1e+299">
+          AAAAAACAAAAAAAAA
+        </DataArray>
+        <DataArray type="Int64" Name="offsets" format="binary" RangeMin="1e+299" RangeMax="-1e+299">
+          AAAAAACAAAAAAAAA
+        </DataArray>
+        <DataArray type="UInt8" Name="types" format="binary" RangeMin="1e+299" RangeMax="-1e+299">
+          AAAAAACAAAAAAAAA
+        </DataArray>
+      </Cells>
+    </Piece>
+  </UnstructuredGrid>
+</VTKFile>
+"#;
+    let dir = tempfile::tempdir().unwrap();
+    // Alone, it holds no tetrahedron.
+    let alone = dir.path().join("empty.vtu");
+    std::fs::write(&alone, empty).unwrap();
+    let e = read(&alone).unwrap_err().to_string();
+    assert!(e.contains("no tetrahedra"), "{e}");
+    // Among pieces, it adds none.
+    let mut pvtu = std::fs::read_to_string(path("cube-pieces.pvtu")).unwrap();
+    for k in 0..3 {
+        let piece = format!("cube-pieces_{k}.vtu");
+        std::fs::copy(path(&piece), dir.path().join(&piece)).unwrap();
+    }
+    pvtu = pvtu.replace(
+        "<Piece Source=\"cube-pieces_0.vtu\"/>",
+        "<Piece Source=\"empty.vtu\"/>\n    <Piece Source=\"cube-pieces_0.vtu\"/>",
+    );
+    let p = dir.path().join("cube.pvtu");
+    std::fs::write(&p, &pvtu).unwrap();
+    let m = plain(&p);
+    let reference = plain(&path("cube-pieces.pvtu"));
+    assert_eq!(
+        (&m.positions, &m.tets),
+        (&reference.positions, &reference.tets)
+    );
+    assert_eq!(m.pieces.len(), 4);
+    assert!(m.piece_of.iter().all(|&k| k > 0));
+    assert_eq!(
+        m.format,
+        "PVTU, 4 pieces (VTU binary zlib; VTU appended base64 zlib)"
+    );
+    // Only empty pieces: no tetrahedra.
+    std::fs::write(
+        &p,
+        "<VTKFile type=\"PUnstructuredGrid\"><PUnstructuredGrid><Piece Source=\"empty.vtu\"/></PUnstructuredGrid></VTKFile>",
+    )
+    .unwrap();
+    let e = read(&p).unwrap_err().to_string();
+    assert!(
+        e.contains("none of its 1 pieces holds a tetrahedron"),
+        "{e}"
+    );
+}
+
+#[test]
+fn parametric_nodes_that_break_their_layout_fail_naming_where() {
+    // A node on a surface (dimension 2) with one parametric coordinate, not two.
+    fails(
+        "cube.msh",
+        &edit(
+            "cube-2.2-parametric-ascii.msh",
+            "\n4 0.125 1 0 2 1 0.125 1\n",
+            "\n4 0.125 1 0 2 1 0.125\n",
+        ),
+        true,
+        &["line 9", "node 4", "$ParametricNodes", "u v on a surface"],
+    );
+    // A node on no entity: x y z alone, as Gmsh writes it in ASCII.
+    let m = plain(&path("cube-2.2-parametric-ascii.msh"));
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("bare.msh");
+    std::fs::write(
+        &p,
+        edit(
+            "cube-2.2-parametric-ascii.msh",
+            "\n9 1.625 0.0625 0.75 3 1\n",
+            "\n9 1.625 0.0625 0.75\n",
+        ),
+    )
+    .unwrap();
+    assert_eq!(plain(&p).positions, m.positions);
+    // Binary: an entity of dimension 7 (after the node's tag and x, y, z).
+    let mut bytes = std::fs::read(path("cube-2.2-parametric-binary.msh")).unwrap();
+    let nodes = find(&bytes, b"$ParametricNodes\n12\n").unwrap() + 20;
+    let dim = nodes + 4 + 24;
+    bytes[dim..dim + 4].copy_from_slice(&7i32.to_le_bytes());
+    fails(
+        "cube.msh",
+        &bytes,
+        true,
+        &[&format!("byte {dim}"), "dimension 7"],
+    );
+    // $ParametricNodes in a 4.1 file is no section of it.
+    let text = std::fs::read_to_string(path("cube-4.1-parametric-ascii.msh")).unwrap();
+    fails(
+        "cube.msh",
+        text.replace("$Nodes", "$ParametricNodes").as_bytes(),
+        true,
+        &["MSH 2.2", "parametric` flag"],
+    );
 }

@@ -7,9 +7,13 @@
 //! x, y, z) or element (tag, type, tags, nodes) per line, or in binary, elements in blocks
 //! of one type headed by the type, count and number of tags; in 4.1 entity blocks, each of
 //! its nodes' tags then their coordinates (and parametric coordinates where the block says),
-//! or its elements of one type. Node tags are arbitrary (sparse, in any order): vertices
-//! come in the order of their tags. Every other section (`$PhysicalNames`, `$Entities`,
-//! `$NodeData`, `$Periodic`, ...) is skipped to its `$End` line.
+//! or its elements of one type. In 2.2, `$ParametricNodes` (Gmsh's `Mesh.SaveParametric`)
+//! stands for `$Nodes`: each node's tag and x, y, z, then the dimension and tag of the
+//! entity it is on and its parametric coordinates (u on a curve, u and v on a surface, none
+//! on a point or in a volume), skipped; in ASCII a node on no entity has none of these.
+//! Node tags are arbitrary (sparse, in any order): vertices come in the order of their
+//! tags. Every other section (`$PhysicalNames`, `$Entities`, `$NodeData`, `$Periodic`, ...)
+//! is skipped to its `$End` line. A UTF-8 byte-order mark before `$MeshFormat` is skipped.
 
 use super::tetfile::{Cells, Fail, Kind, Result, Scan, TagMap, Tagged, f64_at, non_finite, plain};
 use super::{MeshFileLocation, PlainTetrahedra};
@@ -77,19 +81,34 @@ pub fn read_gmsh(bytes: &[u8], name: &str) -> Result<PlainTetrahedra> {
     let mut cells: Option<Cells> = None;
     while let Some(word) = s.token() {
         match word {
-            b"$Nodes" => {
+            b"$Nodes" | b"$ParametricNodes" => {
+                let parametric = word == b"$ParametricNodes";
                 if nodes.is_some() {
-                    return Err(s.err("a second $Nodes section: halo4d reads one"));
+                    return Err(s.err(
+                        "a second $Nodes or $ParametricNodes section: halo4d reads one, and a file has one",
+                    ));
+                }
+                if parametric && v4 {
+                    return Err(s.err(
+                        "$ParametricNodes is a section of MSH 2.2; a 4.1 file gives parametric coordinates in $Nodes, in entity blocks whose `parametric` flag is 1",
+                    ));
                 }
                 let at = s.here();
                 s.skip_line();
                 let tagged = match (v4, binary) {
-                    (false, false) => nodes_22_ascii(&mut s)?,
-                    (false, true) => nodes_22_binary(&mut s)?,
+                    (false, false) => nodes_22_ascii(&mut s, parametric)?,
+                    (false, true) => nodes_22_binary(&mut s, parametric)?,
                     (true, false) => nodes_41_ascii(&mut s)?,
                     (true, true) => nodes_41_binary(&mut s, size)?,
                 };
-                expect_end(&mut s, b"$EndNodes")?;
+                expect_end(
+                    &mut s,
+                    if parametric {
+                        b"$EndParametricNodes"
+                    } else {
+                        b"$EndNodes"
+                    },
+                )?;
                 nodes = Some(
                     tagged
                         .finish()
@@ -98,7 +117,9 @@ pub fn read_gmsh(bytes: &[u8], name: &str) -> Result<PlainTetrahedra> {
             }
             b"$Elements" => {
                 let Some((positions, map)) = &nodes else {
-                    return Err(s.err("$Elements before $Nodes: the nodes must come first"));
+                    return Err(s.err(
+                        "$Elements before any $Nodes (or, in MSH 2.2, $ParametricNodes): the nodes must come first",
+                    ));
                 };
                 if cells.is_some() {
                     return Err(s.err("a second $Elements section: halo4d reads one"));
@@ -125,7 +146,10 @@ pub fn read_gmsh(bytes: &[u8], name: &str) -> Result<PlainTetrahedra> {
             }
         }
     }
-    let (positions, _) = nodes.ok_or_else(|| s.fail.file("the file has no $Nodes section"))?;
+    let (positions, _) = nodes.ok_or_else(|| {
+        s.fail
+            .file("the file has no $Nodes section (nor, in MSH 2.2, $ParametricNodes)")
+    })?;
     let cells = cells.ok_or_else(|| s.fail.file("the file has no $Elements section"))?;
     let tets = cells.finish(&s.fail)?;
     plain(name, &format, positions, tets)
@@ -221,16 +245,60 @@ fn tag_of(t: i64, s: &Scan, at: usize) -> Result<u64> {
     })
 }
 
-fn nodes_22_ascii(s: &mut Scan) -> Result<Tagged> {
+fn nodes_22_ascii(s: &mut Scan, parametric: bool) -> Result<Tagged> {
     // "1 0 0 0\n": a node takes at least 8 bytes.
     let n = s.count("nodes", 8)?;
     let mut t = Tagged::with_capacity(n);
     for _ in 0..n {
         let tag = s.u64("a node tag")?;
         let p = ascii_point(s, tag)?;
+        if parametric {
+            parametric_rest(s, tag)?;
+        }
         t.push(tag, p);
     }
     Ok(t)
+}
+
+/// How many parametric coordinates a node on an entity of dimension `dim` has in
+/// `$ParametricNodes`: u on a curve, u and v on a surface, none on a point or in a volume.
+fn parameters(dim: i64) -> Option<usize> {
+    match dim {
+        0 | 3 => Some(0),
+        1 => Some(1),
+        2 => Some(2),
+        _ => None,
+    }
+}
+
+/// The rest of a `$ParametricNodes` line after x, y, z: nothing (a node on no entity), or
+/// the entity's dimension and tag and its parametric coordinates.
+fn parametric_rest(s: &mut Scan, tag: u64) -> Result<()> {
+    let line = s.line;
+    let rest = s.rest_of_line();
+    let mut words = rest
+        .split(u8::is_ascii_whitespace)
+        .filter(|w| !w.is_empty());
+    let ok = match words.next() {
+        None => true,
+        Some(dim) => super::tetfile::parse_i64(dim)
+            .and_then(parameters)
+            .is_some_and(|p| {
+                words.next().and_then(super::tetfile::parse_i64).is_some()
+                    && (0..p).all(|_| words.next().and_then(super::tetfile::parse_f64).is_some())
+                    && words.next().is_none()
+            }),
+    };
+    if !ok {
+        return Err(s.fail.at(
+            MeshFileLocation::Line(line),
+            format!(
+                "node {tag}: after x y z, a $ParametricNodes line has the dimension (0 to 3) and tag of the node's entity, then u on a curve, u v on a surface, nothing else; this one has `{}`",
+                shorten(&String::from_utf8_lossy(rest))
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn ascii_point(s: &mut Scan, tag: u64) -> Result<[f64; 3]> {
@@ -242,7 +310,10 @@ fn ascii_point(s: &mut Scan, tag: u64) -> Result<[f64; 3]> {
     ])
 }
 
-fn nodes_22_binary(s: &mut Scan) -> Result<Tagged> {
+fn nodes_22_binary(s: &mut Scan, parametric: bool) -> Result<Tagged> {
+    if parametric {
+        return parametric_nodes_22_binary(s);
+    }
     let n = s.count("nodes", 28)?;
     s.skip_line();
     let start = s.pos;
@@ -252,6 +323,33 @@ fn nodes_22_binary(s: &mut Scan) -> Result<Tagged> {
         let at = start + 28 * k;
         let tag = tag_of(i64::from(i32_at(c, s.little)), s, at)?;
         t.push(tag, binary_point(&c[4..], s, at + 4, tag)?);
+    }
+    Ok(t)
+}
+
+/// Binary `$ParametricNodes`: each node's tag, x, y, z, its entity's dimension and tag (4-byte
+/// ints), then as many doubles as the dimension asks ([`parameters`]).
+fn parametric_nodes_22_binary(s: &mut Scan) -> Result<Tagged> {
+    // A node takes at least 4 + 24 + 8 bytes.
+    let n = s.count("nodes", 36)?;
+    s.skip_line();
+    let mut t = Tagged::with_capacity(n);
+    for _ in 0..n {
+        let at = s.pos;
+        let node = s.take(36, "a node")?;
+        let tag = tag_of(i64::from(i32_at(node, s.little)), s, at)?;
+        let p = binary_point(&node[4..], s, at + 4, tag)?;
+        let dim = i32_at(&node[28..], s.little);
+        let params = parameters(i64::from(dim)).ok_or_else(|| {
+            s.fail.byte(
+                at + 28,
+                format!(
+                    "node {tag} is on an entity of dimension {dim}: a $ParametricNodes entry gives 0 to 3 (a point, a curve, a surface, a volume)"
+                ),
+            )
+        })?;
+        s.take(8 * params, "the node's parametric coordinates")?;
+        t.push(tag, p);
     }
     Ok(t)
 }

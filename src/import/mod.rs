@@ -13,15 +13,26 @@
 //! become [`PlainTetrahedra`] ([`read`] chooses by the extension):
 //! - VTU, VTK's XML `UnstructuredGrid` ([`read_vtu`]): data arrays `ascii`, `binary`
 //!   (base64) or `appended` (`raw` or `base64`), with UInt32 or UInt64 headers, plain or
-//!   `vtkZLibDataCompressor`, little- or big-endian;
-//! - Gmsh `.msh` 2.2 and 4.1, ASCII and binary ([`read_gmsh`]): `$Nodes` and `$Elements`,
-//!   node tags sparse or in any order (vertices come in the order of their tags), every other
-//!   section skipped to its `$End` line;
+//!   compressed (`vtkZLibDataCompressor`, `vtkLZ4DataCompressor`, `vtkLZMADataCompressor`),
+//!   little- or big-endian; an inline array's data are its own text, child elements (VTK 9's
+//!   `InformationKey`) and comments read past;
+//! - PVTU, VTK's parallel XML `PUnstructuredGrid` ([`read_pvtu`]): its pieces' `.vtu` files
+//!   (paths relative to the `.pvtu`'s folder), read side by side and joined into one mesh,
+//!   a point of a piece welded to the point of an earlier piece at exactly its coordinates;
+//!   which piece each tetrahedron came from is kept ([`PlainTetrahedra::piece_of`]);
+//! - Gmsh `.msh` 2.2 and 4.1, ASCII and binary ([`read_gmsh`]): `$Nodes` (or, in 2.2,
+//!   `$ParametricNodes`; in 4.1, entity blocks of parametric nodes) and `$Elements`, node tags
+//!   sparse or in any order (vertices come in the order of their tags), every other section
+//!   skipped to its `$End` line;
 //! - Medit `.mesh`, ASCII ([`read_medit`]): `Vertices` and `Tetrahedra` (indices from 1),
 //!   other sections skipped;
 //! - TetGen `.node` with its `.ele` ([`read_tetgen`]): indices from 0 or 1 as the `.node`
 //!   file's first says, 4 or 10 nodes per tetrahedron, attributes and markers skipped;
-//! - legacy `.vtk` without halo4d's layout ([`read_vtk_tetrahedra`]).
+//! - legacy `.vtk` without halo4d's layout ([`read_vtk_tetrahedra`]), every array it does not
+//!   need read past whatever its type (strings, bits, ...), with its METADATA.
+//!
+//! A text file (or an XML one) may begin with a UTF-8 byte-order mark: each reader skips it,
+//! and byte offsets in errors stay the file's.
 //!
 //! In each, a tetrahedron (quadratic and higher-order ones: their first four nodes, the
 //! corners) is read, a cell of lower dimension (point, line, triangle, quadrilateral) is
@@ -36,7 +47,7 @@
 //! without a token list of the whole file: a 10 million tetrahedra binary file reads in
 //! seconds.
 //!
-//! Guarantees: malformed input (truncated, wrong magic, bad JSON, bad base64 or zlib,
+//! Guarantees: malformed input (truncated, wrong magic, bad JSON, bad base64, zlib, LZ4 or xz,
 //! references out of range, counts that disagree, non-finite coordinates) is an
 //! [`ImportError`] that names the problem, and for other programs' meshes the line (text) or
 //! byte offset (binary) where it is ([`ImportError::Tetrahedra`]), never a panic; a count
@@ -49,6 +60,7 @@ mod glb;
 mod gmsh;
 mod medit;
 mod mesh;
+mod pvtu;
 mod tetfile;
 mod tetgen;
 mod vtk;
@@ -58,6 +70,7 @@ pub use glb::{read_glb, read_scene_glb};
 pub use gmsh::read_gmsh;
 pub use medit::read_medit;
 pub use mesh::{MeshFileError, MeshFileLocation, MeshFormat, parse_mesh4, read_mesh4};
+pub use pvtu::read_pvtu;
 pub use tetgen::read_tetgen;
 pub use vtk::{read_vtk, read_vtk_tetrahedra};
 pub use vtu::read_vtu;
@@ -205,13 +218,14 @@ pub enum ImportError {
     Io(#[from] std::io::Error),
     /// The file name's extension is none that [`read`] takes.
     #[error(
-        "unknown file type `{}`: give a .glb or a .vtk file written by halo4d build, or another program's tetrahedral mesh: .vtu, .vtk, .msh (Gmsh 2.2 or 4.1), .mesh (Medit), .node or .ele (TetGen)",
+        "unknown file type `{}`: halo4d reads tetrahedral meshes from .vtu and .pvtu (VTK XML), .vtk (legacy VTK), .msh (Gmsh 2.2 or 4.1), .mesh (Medit), .node with .ele (TetGen), and halos from .glb or .vtk files halo4d build wrote",
         shorten(.0)
     )]
     UnknownType(String),
-    /// Another program's tetrahedral mesh (VTU, Gmsh, Medit, TetGen) that is malformed or
-    /// holds other solids than tetrahedra. Displays like `Gmsh 4.1 binary, byte 96: ...` or
-    /// `Medit .mesh, line 12: ...`.
+    /// Another program's tetrahedral mesh (VTU, PVTU, Gmsh, Medit, TetGen) that is malformed
+    /// or holds other solids than tetrahedra. Displays like `Gmsh 4.1 binary, byte 96: ...`,
+    /// `Medit .mesh, line 12: ...` or `PVTU ball.pvtu, piece ball_3.vtu (VTU appended raw
+    /// zlib), byte 523: ...`.
     #[error("{format}{}: {}", tetfile::location(.at), shorten(.message))]
     Tetrahedra {
         /// The format as far as it was read (`Gmsh 4.1 binary`, `VTU`), or which of a
@@ -275,8 +289,8 @@ pub enum ImportError {
 
 /// Reads the tetrahedra of a file, chosen by its extension (in any case): the halos of a
 /// `.glb`, or of a `.vtk` in halo4d's layout; the tetrahedra alone of another program's
-/// `.vtk`, `.vtu`, `.msh` (Gmsh), `.mesh` (Medit), or `.node` and `.ele` (TetGen: given
-/// either, the other with the same stem is read too).
+/// `.vtk`, `.vtu`, `.pvtu` (and the pieces it names), `.msh` (Gmsh), `.mesh` (Medit), or
+/// `.node` and `.ele` (TetGen: given either, the other with the same stem is read too).
 pub fn read(path: &Path) -> Result<FileTetrahedra, ImportError> {
     // A path that is not there is that, whatever its extension says.
     std::fs::metadata(path)?;
@@ -293,6 +307,7 @@ pub fn read(path: &Path) -> Result<FileTetrahedra, ImportError> {
         "glb" => read_glb(&std::fs::read(path)?).map(FileTetrahedra::Halos),
         "vtk" => read_vtk_tetrahedra(&std::fs::read(path)?),
         "vtu" => plain(read_vtu(&std::fs::read(path)?, &name)),
+        "pvtu" => plain(read_pvtu(path)),
         "msh" => plain(read_gmsh(&std::fs::read(path)?, &name)),
         "mesh" => plain(read_medit(&std::fs::read(path)?, &name)),
         "node" | "ele" => plain(tetgen::read_tetgen_files(path, &name)),
@@ -309,8 +324,8 @@ pub fn read(path: &Path) -> Result<FileTetrahedra, ImportError> {
 pub enum FileTetrahedra {
     /// Halos in halo4d's layout (every halo of a `.glb`; a `.vtk` that gives the layout).
     Halos(Vec<ImportedHalo>),
-    /// Tetrahedra without halo4d's layout: another program's mesh (`.vtk`, `.vtu`, `.msh`,
-    /// `.mesh`, `.node`/`.ele`).
+    /// Tetrahedra without halo4d's layout: another program's mesh (`.vtk`, `.vtu`, `.pvtu`,
+    /// `.msh`, `.mesh`, `.node`/`.ele`).
     Plain(PlainTetrahedra),
 }
 
@@ -327,12 +342,19 @@ pub struct PlainTetrahedra {
     /// Why the file is not read as a halo: what says that halo4d's layout is missing.
     pub why: String,
     /// The format read: `legacy VTK ASCII`, `VTU appended raw zlib`, `Gmsh 4.1 binary`,
-    /// `Medit .mesh`, `TetGen .node/.ele`, ...
+    /// `Medit .mesh`, `TetGen .node/.ele`, `PVTU, 8 pieces (VTU appended raw zlib)`, ...
     pub format: String,
+    /// The files of a `.pvtu`'s pieces, in its order, as it names them (relative to its
+    /// folder); empty for a mesh of one file.
+    pub pieces: Vec<String>,
+    /// For each tetrahedron, the index in [`PlainTetrahedra::pieces`] of the piece it came
+    /// from; empty for a mesh of one file (else as long as `tets`).
+    pub piece_of: Vec<u32>,
 }
 
 impl PlainTetrahedra {
-    /// Checks what the checker takes for granted: finite positions, indices in range.
+    /// Checks what the checker takes for granted: finite positions, indices in range, and
+    /// for a mesh of pieces, a piece for each tetrahedron.
     fn validate(self) -> Result<Self, ImportError> {
         let bad = |message: String| ImportError::BadTetrahedra {
             name: self.name.clone(),
@@ -353,6 +375,22 @@ impl PlainTetrahedra {
             if let Some(&i) = tet.iter().find(|&&i| i as usize >= nv) {
                 return Err(bad(format!(
                     "tetrahedron {k} names vertex {i}, but there are only {nv} vertices"
+                )));
+            }
+        }
+        if !self.pieces.is_empty() || !self.piece_of.is_empty() {
+            let np = self.pieces.len();
+            if self.piece_of.len() != self.tets.len() {
+                return Err(bad(format!(
+                    "{} pieces recorded for {} tetrahedra",
+                    self.piece_of.len(),
+                    self.tets.len()
+                )));
+            }
+            if let Some(k) = self.piece_of.iter().position(|&p| p as usize >= np) {
+                return Err(bad(format!(
+                    "tetrahedron {k} came from piece {}, but there are {np} pieces",
+                    self.piece_of[k]
                 )));
             }
         }

@@ -1,7 +1,8 @@
 //! What the readers of other programs' tetrahedral meshes (VTU, Gmsh, Medit, TetGen) share:
-//! errors that name the line or byte, a scanner of text and binary bytes, the kinds of
-//! cells (tetrahedra read, lower-dimensional cells skipped, other solids refused), node tags
-//! mapped to dense indices, and the [`PlainTetrahedra`] they give.
+//! errors that name the line or byte, a scanner of text and binary bytes (which skips a
+//! UTF-8 byte-order mark), the kinds of cells (tetrahedra read, lower-dimensional cells
+//! skipped, other solids refused), node tags mapped to dense indices, and the
+//! [`PlainTetrahedra`] they give.
 
 use super::{ImportError, MeshFileLocation, PlainTetrahedra};
 use crate::convention::file_order;
@@ -67,11 +68,23 @@ pub(super) struct Scan<'a> {
     pub fail: Fail,
 }
 
+/// The length of a UTF-8 byte-order mark (EF BB BF) at the start of `bytes`, 3 or 0: Windows
+/// editors write one before text files, and every reader skips it, so that byte offsets
+/// stay the file's.
+pub(super) fn bom(bytes: &[u8]) -> usize {
+    if bytes.starts_with(b"\xEF\xBB\xBF") {
+        3
+    } else {
+        0
+    }
+}
+
 impl<'a> Scan<'a> {
+    /// A scanner at the start of `bytes`, past a byte-order mark.
     pub fn new(bytes: &'a [u8], fail: Fail) -> Self {
         Scan {
             bytes,
-            pos: 0,
+            pos: bom(bytes),
             line: 1,
             word_at: (1, 0),
             comments: false,
@@ -207,6 +220,15 @@ impl<'a> Scan<'a> {
             return Err(self.err(non_finite(vertex, axis, x)));
         }
         Ok(x)
+    }
+
+    /// The rest of the current line (without its `\r\n` or `\n`), moving past its newline.
+    pub fn rest_of_line(&mut self) -> &'a [u8] {
+        let start = self.pos;
+        self.skip_line();
+        let line = &self.bytes[start..self.pos];
+        let line = line.strip_suffix(b"\n").unwrap_or(line);
+        line.strip_suffix(b"\r").unwrap_or(line)
     }
 
     /// Moves past the rest of the current line, its newline included.
@@ -392,6 +414,19 @@ impl Cells {
 
     /// The tetrahedra, unless the file has other solids or no tetrahedron.
     pub fn finish(self, fail: &Fail) -> Result<Vec<[u32; 4]>> {
+        let skipped = self.skipped;
+        let tets = self.finish_allow_empty(fail)?;
+        if tets.is_empty() {
+            return Err(fail.file(format!(
+                "the mesh has no tetrahedra ({skipped} lower-dimensional cells skipped): halo4d checks tetrahedral meshes"
+            )));
+        }
+        Ok(tets)
+    }
+
+    /// The tetrahedra, none or more (a piece of a `.pvtu` may hold none), unless the file
+    /// has other solids.
+    pub fn finish_allow_empty(self, fail: &Fail) -> Result<Vec<[u32; 4]>> {
         if let Some(&(_, _, at)) = self.others.first() {
             let list: Vec<String> = self
                 .others
@@ -410,12 +445,6 @@ impl Cells {
                     self.tets.len()
                 ),
             ));
-        }
-        if self.tets.is_empty() {
-            return Err(fail.file(format!(
-                "the mesh has no tetrahedra ({} lower-dimensional cells skipped): halo4d checks tetrahedral meshes",
-                self.skipped
-            )));
         }
         Ok(self.tets)
     }
@@ -514,6 +543,8 @@ pub(super) fn plain(
         tets,
         why: format!("a {format} mesh, which has no halo layout (another program's tetrahedra)"),
         format: format.to_string(),
+        pieces: Vec::new(),
+        piece_of: Vec::new(),
     }
     .validate()
 }

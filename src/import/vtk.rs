@@ -5,10 +5,17 @@
 //! cell's ids) and of 5.1 (OFFSETS and CONNECTIVITY arrays). `surface_vertices`, `rho`,
 //! `delta_d` and `delta_t` come from the dataset's FIELD data, `t` and `d_orig` from the
 //! point data (SCALARS or FIELD arrays). Sections a halo does not need (other point or cell
-//! attributes, lookup tables, METADATA) are read past. A file without halo4d's layout is
-//! read as tetrahedra alone for `halo4d check` ([`read_vtk_tetrahedra`]).
+//! attributes: SCALARS, COLOR_SCALARS, LOOKUP_TABLE, VECTORS, NORMALS, TEXTURE_COORDINATES,
+//! TENSORS, TENSORS6, GLOBAL_IDS, PEDIGREE_IDS, EDGE_FLAGS; FIELD arrays; the METADATA after
+//! an array, with its COMPONENT_NAMES and INFORMATION) are read past, whatever their data
+//! type, as VTK's vtkDataWriter writes them: numbers of every width (vtkIdType as a 4-byte
+//! int), `bit` (8 to a byte in binary), `string` and `utf8_string` (one a line, `%`-encoded,
+//! in ASCII; each after its length in binary, in 1, 2, 4 or 8 big-endian bytes whose top two
+//! bits say which) and `variant` (a type and a string per value, as text). A file without
+//! halo4d's layout is read as tetrahedra alone for `halo4d check`
+//! ([`read_vtk_tetrahedra`]). A UTF-8 byte-order mark before the first line is skipped.
 
-use super::tetfile::{Kind, vtk_kind};
+use super::tetfile::{Kind, bom, vtk_kind};
 use super::{FileParams, FileTetrahedra, ImportError, ImportedHalo, PlainTetrahedra};
 use crate::check::TetMesh;
 use crate::convention::file_order;
@@ -51,6 +58,8 @@ pub fn read_vtk_tetrahedra(bytes: &[u8]) -> Result<FileTetrahedra> {
         tets: grid.tets,
         why: format!("a {format} mesh: {why}"),
         format,
+        pieces: Vec::new(),
+        piece_of: Vec::new(),
     }
     .validate()
     .map(FileTetrahedra::Plain)
@@ -103,7 +112,10 @@ fn halo(grid: Grid, title: &str) -> Result<ImportedHalo> {
 /// Reads the header: the magic line with the file version, the title, ASCII or BINARY and
 /// `DATASET UNSTRUCTURED_GRID`. Gives the reader of the rest, and the title.
 fn header(bytes: &[u8]) -> Result<(Reader<'_>, String)> {
-    let mut c = Cursor { bytes, pos: 0 };
+    let mut c = Cursor {
+        bytes,
+        pos: bom(bytes),
+    };
     let magic = c.line().unwrap_or_default();
     let version = magic
         .strip_prefix("# vtk DataFile Version ")
@@ -137,6 +149,7 @@ fn header(bytes: &[u8]) -> Result<(Reader<'_>, String)> {
         c,
         ascii,
         new_cells: major >= 5,
+        components: 1,
     };
     match r.keyword_line()?.as_deref() {
         Some([dataset, kind]) if dataset.eq_ignore_ascii_case("DATASET") => {
@@ -247,38 +260,56 @@ impl Cursor<'_> {
     }
 }
 
-/// A numeric data type of legacy VTK and its size in binary files.
+/// A data type of legacy VTK (vtkDataWriter's names), and for numbers, their size in binary
+/// files.
 #[derive(Clone, Copy, PartialEq)]
 enum Type {
     Int(usize, bool),
     Float(usize),
+    /// Bits: `0` and `1` in ASCII, 8 to a byte in binary.
+    Bit,
+    /// `string` or `utf8_string`: one a line in ASCII, each after its length in binary.
+    String,
+    /// `variant`: a type number and a string per value, as text in ASCII and binary files.
+    Variant,
 }
 
 impl Type {
     fn parse(name: &str) -> Result<Type> {
         Ok(match name.to_ascii_lowercase().as_str() {
+            "bit" => Type::Bit,
             "unsigned_char" => Type::Int(1, false),
-            "char" => Type::Int(1, true),
+            "char" | "signed_char" => Type::Int(1, true),
             "unsigned_short" => Type::Int(2, false),
             "short" => Type::Int(2, true),
             "unsigned_int" | "vtktypeuint32" => Type::Int(4, false),
-            "int" | "vtktypeint32" => Type::Int(4, true),
+            // vtkDataWriter writes vtkIdType arrays as 4-byte ints.
+            "int" | "vtktypeint32" | "vtkidtype" => Type::Int(4, true),
             "unsigned_long" | "vtktypeuint64" => Type::Int(8, false),
-            "long" | "vtktypeint64" | "vtkidtype" => Type::Int(8, true),
+            "long" | "vtktypeint64" => Type::Int(8, true),
             "float" => Type::Float(4),
             "double" => Type::Float(8),
+            "string" | "utf8_string" => Type::String,
+            "variant" => Type::Variant,
             other => {
                 return Err(err(format!(
-                    "data type `{}` is not a number type this reader knows",
+                    "data type `{}` is none that legacy VTK writes (bit, char, signed_char, unsigned_char, short, unsigned_short, int, unsigned_int, long, unsigned_long, vtktypeint64, vtktypeuint64, vtkIdType, float, double, string, utf8_string, variant)",
                     shorten(other)
                 )));
             }
         })
     }
 
+    /// Whether the values are numbers of a fixed size.
+    fn is_number(self) -> bool {
+        matches!(self, Type::Int(..) | Type::Float(_))
+    }
+
+    /// The size of a number in binary files.
     fn size(self) -> usize {
         match self {
             Type::Int(s, _) | Type::Float(s) => s,
+            Type::Bit | Type::String | Type::Variant => 1,
         }
     }
 
@@ -288,6 +319,7 @@ impl Type {
         match self {
             Type::Float(4) => f64::from(f32::from_be_bytes(b[..4].try_into().expect("4 bytes"))),
             Type::Float(_) => f64::from_be_bytes(b[..8].try_into().expect("8 bytes")),
+            Type::Bit | Type::String | Type::Variant => f64::NAN,
             Type::Int(size, signed) => {
                 x[8 - size..].copy_from_slice(&b[..size]);
                 let u = u64::from_be_bytes(x);
@@ -333,6 +365,9 @@ struct Reader<'a> {
     ascii: bool,
     /// Version 5 CELLS: OFFSETS and CONNECTIVITY arrays.
     new_cells: bool,
+    /// The components of the last array read: as many COMPONENT_NAMES as its METADATA may
+    /// list.
+    components: usize,
 }
 
 /// A count from a header line, as usize.
@@ -357,6 +392,35 @@ impl Reader<'_> {
     /// `count` numbers of type `ty`; `what` names them in errors. The claimed count is
     /// checked against the bytes left before anything is allocated.
     fn numbers(&mut self, count: usize, ty: Type, what: &str) -> Result<Vec<f64>> {
+        if !ty.is_number() {
+            return Err(err(format!(
+                "{what}: the data type must be a number type (int, float, ...), this one holds {}",
+                match ty {
+                    Type::Bit => "bits",
+                    Type::String => "strings",
+                    _ => "variants",
+                }
+            )));
+        }
+        let mut out = Vec::new();
+        self.each_number(count, ty, what, |k, x| {
+            if k == 0 {
+                out.reserve_exact(count);
+            }
+            out.push(x);
+        })?;
+        Ok(out)
+    }
+
+    /// `count` numbers of type `ty`, each given to `each` with its index; `what` names them
+    /// in errors. The claimed count is checked against the bytes left first.
+    fn each_number(
+        &mut self,
+        count: usize,
+        ty: Type,
+        what: &str,
+        mut each: impl FnMut(usize, f64),
+    ) -> Result<()> {
         let left = self.c.remaining();
         if self.ascii {
             // Every ASCII number takes a character and a separator (the last one may lack it).
@@ -365,38 +429,154 @@ impl Reader<'_> {
                     "{what}: {count} values claimed, but only {left} bytes are left"
                 )));
             }
-            let mut out = Vec::with_capacity(count);
             for k in 0..count {
                 let word = self.c.token().ok_or_else(|| {
                     err(format!("{what}: the file ends after {k} of {count} values"))
                 })?;
-                let text = String::from_utf8_lossy(word);
+                let len = word.len();
+                let text = String::from_utf8_lossy(word).into_owned();
                 let value = match ty {
                     Type::Float(_) => text.parse::<f64>().ok(),
-                    Type::Int(..) => text.parse::<i64>().ok().map(|i| i as f64),
+                    _ => text.parse::<i64>().ok().map(|i| i as f64),
                 };
-                out.push(value.ok_or_else(|| {
-                    err(format!(
-                        "{what}: value {k} is {:?}, not a number of the declared type",
-                        shorten(&text)
-                    ))
-                })?);
+                let at = self.c.pos - len;
+                each(
+                    k,
+                    value.ok_or_else(|| {
+                        err(format!(
+                            "{what}: value {k} is {:?} (byte {at}), not a number of the declared type",
+                            shorten(&text)
+                        ))
+                    })?,
+                );
             }
-            Ok(out)
         } else {
             let size = ty.size();
             if count.checked_mul(size).is_none_or(|b| b > left) {
                 return Err(err(format!(
-                    "{what}: {count} values of {size} bytes claimed, but only {left} bytes are left (truncated?)"
+                    "{what}: {count} values of {size} bytes claimed at byte {}, but only {left} bytes are left (truncated?)",
+                    self.c.pos
                 )));
             }
             let bytes = &self.c.bytes[self.c.pos..self.c.pos + count * size];
             self.c.pos += count * size;
-            // Binary blocks end with a newline.
-            if self.c.bytes.get(self.c.pos) == Some(&b'\n') {
-                self.c.pos += 1;
+            self.end_of_binary();
+            for (k, b) in bytes.chunks_exact(size).enumerate() {
+                each(k, ty.decode(b));
             }
-            Ok(bytes.chunks_exact(size).map(|b| ty.decode(b)).collect())
+        }
+        Ok(())
+    }
+
+    /// Binary data end with a newline.
+    fn end_of_binary(&mut self) {
+        if self.c.bytes.get(self.c.pos) == Some(&b'\n') {
+            self.c.pos += 1;
+        }
+    }
+
+    /// Reads past an array this reader does not need, of `tuples` tuples of `components`
+    /// values of type `ty`, as vtkDataWriter writes it; `what` names it in errors.
+    fn skip(&mut self, tuples: usize, components: usize, ty: Type, what: &str) -> Result<()> {
+        let count = tuples
+            .checked_mul(components)
+            .ok_or_else(|| err(format!("{what}: {tuples} tuples of {components}: too many")))?;
+        self.components = components;
+        let left = self.c.remaining();
+        let at = self.c.pos;
+        match ty {
+            Type::Int(..) | Type::Float(_) => self.each_number(count, ty, what, |_, _| ()),
+            Type::Bit if self.ascii => {
+                self.each_number(count, Type::Int(1, false), what, |_, _| ())
+            }
+            Type::Bit => {
+                // VTK's reader reads (tuples components + 7) / 8 bytes, its writer writes
+                // (tuples - 1) / 8 + 1 whatever the components: the two agree for one
+                // component. Where they differ, the writer's count is taken when the file
+                // goes on after it as after an array (a newline, then a line that begins
+                // with a letter, or the end), else the reader's.
+                let read = count.div_ceil(8);
+                let written = if tuples == 0 { 0 } else { (tuples - 1) / 8 + 1 };
+                let after = |n: usize| {
+                    let b = &self.c.bytes[(at + n).min(self.c.bytes.len())..];
+                    n <= left
+                        && (b.is_empty()
+                            || (b[0] == b'\n' && b.get(1).is_none_or(u8::is_ascii_alphabetic)))
+                };
+                let n = if written != read && after(written) {
+                    written
+                } else {
+                    read
+                };
+                if n > left {
+                    return Err(err(format!(
+                        "{what}: {count} bits take {n} bytes from byte {at}, but only {left} are left (truncated?)"
+                    )));
+                }
+                self.c.pos += n;
+                self.end_of_binary();
+                Ok(())
+            }
+            Type::String if self.ascii => {
+                // One a line (an empty string an empty line), each line at least its newline.
+                if count > left {
+                    return Err(err(format!(
+                        "{what}: {count} strings claimed, but only {left} bytes are left"
+                    )));
+                }
+                for k in 0..count {
+                    if self.c.line().is_none() {
+                        return Err(err(format!(
+                            "{what}: the file ends after {k} of {count} strings"
+                        )));
+                    }
+                }
+                Ok(())
+            }
+            Type::String => {
+                for k in 0..count {
+                    let at = self.c.pos;
+                    let rest = &self.c.bytes[at..];
+                    let Some(&first) = rest.first() else {
+                        return Err(err(format!(
+                            "{what}: the file ends after {k} of {count} strings"
+                        )));
+                    };
+                    // The top two bits say the length's size: 11 one byte, 10 two, 01 four,
+                    // 00 eight; the rest of it is the length, big-endian.
+                    let head = [8, 4, 2, 1][usize::from(first >> 6)];
+                    let mask = [u64::MAX, 0x3fff_ffff, 0x3fff, 0x3f][usize::from(first >> 6)];
+                    let len = rest
+                        .get(..head)
+                        .map(|b| super::tetfile::uint(b, false) & mask)
+                        .filter(|&len| len <= (rest.len() - head) as u64)
+                        .ok_or_else(|| {
+                            err(format!(
+                                "{what}: string {k} of {count}, at byte {at}, claims more bytes than the file has left (truncated?)"
+                            ))
+                        })?;
+                    self.c.pos += head + len as usize;
+                }
+                self.end_of_binary();
+                Ok(())
+            }
+            Type::Variant => {
+                // A type and a string per value, each a word (and a separator).
+                if count > left / 2 {
+                    return Err(err(format!(
+                        "{what}: {count} variants claimed, but only {left} bytes are left"
+                    )));
+                }
+                for k in 0..2 * count {
+                    if self.c.token().is_none() {
+                        return Err(err(format!(
+                            "{what}: the file ends after {} of {count} variants",
+                            k / 2
+                        )));
+                    }
+                }
+                Ok(())
+            }
         }
     }
 
@@ -421,11 +601,16 @@ impl Reader<'_> {
                     )?;
                     g.points = xyz.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
                     points = Some(n);
+                    self.components = 3;
                 }
-                "CELLS" => cells = Some(self.cells(&words)?),
+                "CELLS" => {
+                    cells = Some(self.cells(&words)?);
+                    self.components = 1;
+                }
                 "CELL_TYPES" => {
                     let n = count(words.get(1), "CELL_TYPES")?;
                     types = Some(self.numbers(n, Type::Int(4, true), "CELL_TYPES")?);
+                    self.components = 1;
                 }
                 "POINT_DATA" => {
                     let n = count(words.get(1), "POINT_DATA")?;
@@ -607,7 +792,7 @@ impl Reader<'_> {
     }
 
     /// A FIELD section: `FIELD name arrays`, then per array `name components tuples type`
-    /// and its values.
+    /// and its values (or `NULL_ARRAY`), each perhaps followed by its METADATA.
     fn field(&mut self, words: &[String], attach: Attach) -> Result<Vec<(String, Vec<f64>)>> {
         let arrays = count(words.get(2), "FIELD")?;
         let mut out = Vec::new();
@@ -618,6 +803,10 @@ impl Reader<'_> {
                 .ok_or_else(|| err(format!("FIELD: the file ends after {k} of {arrays} arrays")))?;
             if line[0].eq_ignore_ascii_case("METADATA") {
                 self.skip_metadata();
+                continue;
+            }
+            if line[0] == "NULL_ARRAY" {
+                k += 1;
                 continue;
             }
             let [name, components, tuples, ty] = &line[..] else {
@@ -637,10 +826,17 @@ impl Reader<'_> {
             let total = components
                 .checked_mul(tuples)
                 .ok_or_else(|| err(format!("{what}: size too large")))?;
-            let values = self.numbers(total, Type::parse(ty)?, &what)?;
-            // Only single-component arrays matter to a halo, and the surface's triangles.
-            if components == 1 || (components == 3 && name == "surface_triangles") {
+            let ty = Type::parse(ty)?;
+            // Only single-component arrays of numbers matter to a halo, and the surface's
+            // triangles.
+            if ty.is_number()
+                && (components == 1 || (components == 3 && name == "surface_triangles"))
+            {
+                let values = self.numbers(total, ty, &what)?;
+                self.components = components;
                 out.push((name.clone(), values));
+            } else {
+                self.skip(tuples, components, ty, &what)?;
             }
             k += 1;
         }
@@ -683,18 +879,36 @@ impl Reader<'_> {
                         )));
                     }
                 }
-                let values = self.numbers(components * n, ty, &format!("SCALARS {}", word(1)))?;
-                if components == 1 && matches!(attach, Attach::Points(_)) {
+                let what = format!("SCALARS {}", word(1));
+                if ty.is_number() && components == 1 && matches!(attach, Attach::Points(_)) {
+                    let values = self.numbers(n, ty, &what)?;
+                    self.components = 1;
                     g.point_array(word(1), values);
+                } else {
+                    self.skip(n, components, ty, &what)?;
                 }
             }
-            "VECTORS" | "NORMALS" | "TENSORS" => {
-                let size = if key == "TENSORS" { 9 } else { 3 };
-                self.numbers(size * n, Type::parse(word(2))?, &key)?;
+            "VECTORS" | "NORMALS" | "TENSORS" | "TENSORS6" | "GLOBAL_IDS" | "PEDIGREE_IDS"
+            | "EDGE_FLAGS" => {
+                let components = match key.as_str() {
+                    "VECTORS" | "NORMALS" => 3,
+                    "TENSORS" => 9,
+                    "TENSORS6" => 6,
+                    _ => 1,
+                };
+                let what = format!("{key} {}", word(1));
+                self.skip(n, components, Type::parse(word(2))?, &what)?;
             }
             "TEXTURE_COORDINATES" => {
-                let dim = count(words.get(2), &key)?.min(3);
-                self.numbers(dim * n, Type::parse(word(3))?, &key)?;
+                let dim = count(words.get(2), &key)?;
+                if !(1..=3).contains(&dim) {
+                    return Err(err(format!(
+                        "TEXTURE_COORDINATES {}: {dim} components (1 to 3 allowed)",
+                        word(1)
+                    )));
+                }
+                let what = format!("{key} {}", word(1));
+                self.skip(n, dim, Type::parse(word(3))?, &what)?;
             }
             "COLOR_SCALARS" => {
                 let m = count(words.get(2), &key)?.min(4);
@@ -703,7 +917,7 @@ impl Reader<'_> {
                 } else {
                     Type::Int(1, false)
                 };
-                self.numbers(m * n, ty, &key)?;
+                self.skip(n, m, ty, &key)?;
             }
             "LOOKUP_TABLE" => {
                 let m = count(words.get(2), &key)?;
@@ -712,10 +926,7 @@ impl Reader<'_> {
                 } else {
                     Type::Int(1, false)
                 };
-                let values = m
-                    .checked_mul(4)
-                    .ok_or_else(|| err("LOOKUP_TABLE: size too large".into()))?;
-                self.numbers(values, ty, &key)?;
+                self.skip(m, 4, ty, &key)?;
             }
             _ => {
                 return Err(err(format!(
@@ -727,11 +938,19 @@ impl Reader<'_> {
         Ok(())
     }
 
-    /// METADATA blocks end with a blank line.
+    /// Reads past a METADATA block (its line read): COMPONENT_NAMES, one a line for each
+    /// component of the array before it (a name may be empty), and INFORMATION, up to the
+    /// blank line that ends the block.
     fn skip_metadata(&mut self) {
         while let Some(line) = self.c.line() {
-            if line.trim().is_empty() {
+            let line = line.trim();
+            if line.is_empty() {
                 break;
+            }
+            if line.eq_ignore_ascii_case("COMPONENT_NAMES") {
+                for _ in 0..self.components {
+                    self.c.line();
+                }
             }
         }
     }

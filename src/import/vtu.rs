@@ -4,16 +4,23 @@
 //!
 //! A `DataArray` is `ascii` (numbers in the text), `binary` (base64 in the text) or
 //! `appended` (at its `offset` in the `AppendedData` after the `_`, `raw` bytes or `base64`).
-//! Binary data start with a header of `header_type` (UInt32, the default, or UInt64): the
-//! number of bytes that follow; with `compressor="vtkZLibDataCompressor"`, the number of
-//! blocks, the size of a block before compression, the size of the last one, then each
-//! block's compressed size, and the zlib streams. Numbers are in `byte_order`
-//! (LittleEndian or BigEndian). VTK encodes a header and its data as two base64 texts (each
-//! with its padding), other writers as one: both read. The XML is parsed up to the
-//! `AppendedData` tag only, so that raw bytes after it are never taken for markup.
+//! An inline array's data are its own text: the text directly inside the element, not what is
+//! inside its children (VTK 9 writes an `InformationKey` child after the values once their
+//! range was computed) or comments; ascii values are read where they lie, a base64 text is
+//! decoded (copied first only to drop its whitespace). Binary data start with a
+//! header of `header_type` (UInt32, the default, or UInt64): the number of bytes that follow;
+//! with a `compressor` (`vtkZLibDataCompressor`, `vtkLZ4DataCompressor` or
+//! `vtkLZMADataCompressor`), the number of blocks, the size of a block before compression,
+//! the size of the last one, then each block's compressed size, and the blocks: a zlib
+//! stream, a raw LZ4 block (`LZ4_compress_default`, no frame) or an `.xz` stream
+//! (`lzma_easy_buffer_encode`) each. Numbers are in `byte_order` (LittleEndian or
+//! BigEndian). VTK encodes a header and its data as two base64 texts (each with its
+//! padding), other writers as one: both read. The XML is parsed up to the `AppendedData`
+//! tag only, so that raw bytes after it are never taken for markup. A UTF-8 byte-order mark
+//! before the XML is skipped.
 
 use super::PlainTetrahedra;
-use super::tetfile::{Cells, Fail, Kind, Result, parse_f64, parse_i64, plain, uint, vtk_kind};
+use super::tetfile::{Cells, Fail, Kind, Result, bom, parse_f64, parse_i64, plain, uint, vtk_kind};
 use crate::limits::shorten;
 use base64::Engine;
 use base64::engine::{DecodePaddingMode, GeneralPurpose, GeneralPurposeConfig};
@@ -21,6 +28,7 @@ use quick_xml::events::{BytesStart, Event};
 use quick_xml::reader::Reader;
 use rayon::prelude::*;
 use std::borrow::Cow;
+use std::io::Read;
 use std::ops::Range;
 
 /// Standard base64 that takes a last text with or without its padding.
@@ -29,15 +37,36 @@ const BASE64: GeneralPurpose = GeneralPurpose::new(
     GeneralPurposeConfig::new().with_decode_padding_mode(DecodePaddingMode::Indifferent),
 );
 
-/// zlib never expands data more than about 1032 times: a block header that claims more is
-/// not believed (and nothing is allocated for it).
+/// zlib never expands data more than about 1032 times (a deflate match of 258 bytes costs at
+/// least 2 bits): a block header that claims more is not believed (and nothing is allocated
+/// for it).
 const ZLIB_MAX_RATIO: u64 = 1032;
+
+/// An LZ4 block gives at most 255 bytes for each byte it holds: a match's length grows by
+/// 255 with each byte of its length field, and nothing else gives more per byte.
+const LZ4_MAX_RATIO: u64 = 255;
+
+/// An `.xz` stream of LZMA2 gives at most about 7,300 bytes for each byte it holds: an LZMA2
+/// chunk gives at most 2 MiB, and even with the range coder's probabilities saturated (no
+/// decision costs less than 0.022 bits) its 7,700 longest matches (273 bytes, 13 decisions
+/// each) take about 280 bytes, with its 5-byte header. liblzma reaches 6,900 on zeros.
+const XZ_MAX_RATIO: u64 = 7_500;
+
+/// Added to the bytes a header may claim from its compressed ones, per block: a small block
+/// (a few bytes of data) takes more room compressed than plain, with every compressor.
+const BLOCK_SLACK: u64 = 64;
 
 /// Reads the tetrahedra of a VTU file (VTK XML `UnstructuredGrid`); `name` names the mesh
 /// (the file's stem). Cells of types 10 (tetrahedron), 24 (quadratic tetrahedron), 71 and 78
 /// (Lagrange and Bézier tetrahedra: their first four points, the corners) are read; cells
 /// of lower dimension are skipped; other solids are an error.
 pub fn read_vtu(bytes: &[u8], name: &str) -> Result<PlainTetrahedra> {
+    read_vtu_piece(bytes, name, false)
+}
+
+/// [`read_vtu`], or where `piece` (a piece of a `.pvtu`, which may hold no cell), one that
+/// may hold no tetrahedron.
+pub(super) fn read_vtu_piece(bytes: &[u8], name: &str, piece: bool) -> Result<PlainTetrahedra> {
     let xml = Xml::parse(bytes)?;
     let d = Decoder::new(bytes, &xml);
     let (np, nc) = xml
@@ -145,7 +174,11 @@ pub fn read_vtu(bytes: &[u8], name: &str) -> Result<PlainTetrahedra> {
         }
         start = end;
     }
-    let tets = cells.finish(&d.fail)?;
+    let tets = if piece {
+        cells.finish_allow_empty(&d.fail)?
+    } else {
+        cells.finish(&d.fail)?
+    };
     plain(name, &format, positions, tets)
 }
 
@@ -195,10 +228,69 @@ struct Array {
     ty: Num,
     components: usize,
     format: Format,
-    /// Its text (inline data), as a range of the file's bytes.
-    text: Range<usize>,
+    /// Its own text (inline data), as ranges of the file's bytes: the runs of text directly
+    /// inside the element, in order, without what its children and comments hold.
+    text: Vec<Range<usize>>,
     /// The byte where its tag begins.
     at: usize,
+    /// The byte after its start tag, where its text begins.
+    text_at: usize,
+}
+
+impl Array {
+    /// How many bytes its own text has.
+    fn text_len(&self) -> usize {
+        self.text.iter().map(|r| r.len()).sum()
+    }
+}
+
+/// How a file's binary arrays are compressed (the VTKFile's `compressor`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+enum Compressor {
+    #[default]
+    None,
+    Zlib,
+    Lz4,
+    Lzma,
+}
+
+impl Compressor {
+    /// The name in [`PlainTetrahedra::format`] and errors.
+    fn name(self) -> &'static str {
+        match self {
+            Compressor::None => "none",
+            Compressor::Zlib => "zlib",
+            Compressor::Lz4 => "lz4",
+            Compressor::Lzma => "lzma",
+        }
+    }
+
+    /// The kind of block, for errors.
+    fn block(self) -> &'static str {
+        match self {
+            Compressor::Zlib | Compressor::None => "a valid zlib stream",
+            Compressor::Lz4 => "a valid LZ4 block",
+            Compressor::Lzma => "a valid .xz stream",
+        }
+    }
+
+    /// How many times its blocks may give the bytes they hold, at most.
+    fn max_ratio(self) -> u64 {
+        match self {
+            Compressor::None | Compressor::Zlib => ZLIB_MAX_RATIO,
+            Compressor::Lz4 => LZ4_MAX_RATIO,
+            Compressor::Lzma => XZ_MAX_RATIO,
+        }
+    }
+
+    /// Decompresses a block into exactly `out.len()` bytes.
+    fn decompress(self, data: &[u8], out: &mut [u8]) -> std::result::Result<(), String> {
+        match self {
+            Compressor::None | Compressor::Zlib => inflate(data, out),
+            Compressor::Lz4 => unlz4(data, out),
+            Compressor::Lzma => unxz(data, out),
+        }
+    }
 }
 
 /// What the XML says: the file's settings, the Piece's counts, the arrays.
@@ -206,7 +298,7 @@ struct Array {
 struct Xml {
     little: bool,
     header64: bool,
-    zlib: bool,
+    compressor: Compressor,
     piece: Option<(usize, usize)>,
     points: Option<Array>,
     connectivity: Option<Array>,
@@ -234,12 +326,16 @@ impl Xml {
         let mut seen_file = false;
         let mut closed = false;
         let mut section = Section::None;
-        let mut reader = Reader::from_reader(bytes);
+        // quick-xml would take a byte-order mark for text before the root; positions stay
+        // the file's.
+        let skip = bom(bytes);
+        let mut reader = Reader::from_reader(&bytes[skip..]);
+        let pos = |r: &Reader<&[u8]>| r.buffer_position() as usize + skip;
         loop {
-            let at = reader.buffer_position() as usize;
+            let at = pos(&reader);
             let event = reader.read_event().map_err(|e| {
                 fail.byte(
-                    reader.error_position() as usize,
+                    reader.error_position() as usize + skip,
                     format!("the XML is not well formed: {e}"),
                 )
             })?;
@@ -282,7 +378,7 @@ impl Xml {
                         Some("PUnstructuredGrid") => {
                             return Err(fail.byte(
                                 at,
-                                "a parallel PUnstructuredGrid (.pvtu) only names its pieces' files: give halo4d a piece's .vtu",
+                                "a parallel PUnstructuredGrid (.pvtu) only names its pieces' files: read it by its path (halo4d check FILE.pvtu, import::read), which reads the pieces beside it",
                             ));
                         }
                         other => {
@@ -315,14 +411,16 @@ impl Xml {
                             ));
                         }
                     };
-                    x.zlib = match attr("compressor")?.as_deref() {
-                        None | Some("") => false,
-                        Some("vtkZLibDataCompressor") => true,
+                    x.compressor = match attr("compressor")?.as_deref() {
+                        None | Some("") => Compressor::None,
+                        Some("vtkZLibDataCompressor") => Compressor::Zlib,
+                        Some("vtkLZ4DataCompressor") => Compressor::Lz4,
+                        Some("vtkLZMADataCompressor") => Compressor::Lzma,
                         Some(c) => {
                             return Err(fail.byte(
                                 at,
                                 format!(
-                                    "compressor `{}`: halo4d reads vtkZLibDataCompressor or none; save the file with zlib or no compression",
+                                    "compressor `{}`: halo4d reads vtkZLibDataCompressor, vtkLZ4DataCompressor, vtkLZMADataCompressor or none; save the file with one of them",
                                     shorten(c)
                                 ),
                             ));
@@ -369,15 +467,17 @@ impl Xml {
                 }
                 b"DataArray" => {
                     let array = data_array(&attr, &fail, at)?;
+                    let text_at = pos(&reader);
                     let text = if empty {
-                        at..at
+                        Vec::new()
                     } else {
-                        let span = reader.read_to_end(e.name()).map_err(|err| {
-                            fail.byte(at, format!("the XML is not well formed: {err}"))
-                        })?;
-                        span.start as usize..span.end as usize
+                        own_text(&mut reader, skip, bytes, &fail, at, array.format)?
                     };
-                    let array = Array { text, ..array };
+                    let array = Array {
+                        text,
+                        text_at,
+                        ..array
+                    };
                     let slot = match section {
                         Section::Points => Some(&mut x.points),
                         Section::Cells => match attr("Name")?.as_deref() {
@@ -408,7 +508,7 @@ impl Xml {
                             ));
                         }
                     };
-                    let end = reader.buffer_position() as usize;
+                    let end = pos(&reader);
                     let rest = &bytes[end.min(bytes.len())..];
                     let skip = rest
                         .iter()
@@ -433,8 +533,88 @@ impl Xml {
     }
 }
 
+/// The own text of a DataArray whose start tag was just read, up to its end tag: the runs of
+/// text (and CDATA, and entity references, which no number or base64 text has and which are
+/// refused as such) directly inside it, as ranges of the file's bytes; what its children
+/// and comments hold is not its text. A child between two values (VTK writes its
+/// `InformationKey` after them) is read past; the text is read as XML gives it, the runs one
+/// after the other. One glued to an ascii value on both sides is an error: `1.5<a/>7` is
+/// `1.57` to XML and `1.5 7` to a reader of words, and no writer means either.
+fn own_text(
+    reader: &mut Reader<&[u8]>,
+    skip: usize,
+    bytes: &[u8],
+    fail: &Fail,
+    at: usize,
+    format: Format,
+) -> Result<Vec<Range<usize>>> {
+    let mut runs: Vec<Range<usize>> = Vec::new();
+    let mut depth = 0usize;
+    // Where markup (a child or a comment) began, if any came since the last run of text.
+    let mut cut: Option<usize> = None;
+    loop {
+        let from = reader.buffer_position() as usize + skip;
+        let event = reader.read_event().map_err(|e| {
+            fail.byte(
+                reader.error_position() as usize + skip,
+                format!("the XML is not well formed: {e}"),
+            )
+        })?;
+        let to = reader.buffer_position() as usize + skip;
+        let run = match event {
+            Event::Text(_) | Event::GeneralRef(_) if depth == 0 => from..to,
+            // `<![CDATA[` and `]]>` around it.
+            Event::CData(_) if depth == 0 => (from + 9).min(to)..to.saturating_sub(3).max(from),
+            Event::Start(_) => {
+                depth += 1;
+                cut = Some(from);
+                continue;
+            }
+            Event::End(_) if depth == 0 => return Ok(runs),
+            Event::End(_) => {
+                depth -= 1;
+                continue;
+            }
+            Event::Eof => {
+                return Err(fail.byte(
+                    at,
+                    "the file ends inside this DataArray, before its </DataArray>: it is truncated",
+                ));
+            }
+            _ => {
+                if depth == 0 {
+                    cut = Some(from);
+                }
+                continue;
+            }
+        };
+        match (runs.last_mut(), cut.take()) {
+            (Some(last), None) if last.end == run.start => last.end = run.end,
+            (Some(last), Some(markup)) => {
+                let glued = |b: Option<&u8>| b.is_some_and(|b| !b.is_ascii_whitespace());
+                if format == Format::Ascii
+                    && glued(bytes.get(last.end.wrapping_sub(1)))
+                    && glued(bytes.get(run.start))
+                {
+                    return Err(fail.byte(
+                        markup,
+                        "a child element or comment cuts a value of this ascii DataArray in two: put whitespace between the values and any element inside a DataArray",
+                    ));
+                }
+                runs.push(run);
+            }
+            _ => runs.push(run),
+        }
+    }
+}
+
 /// An attribute's value, if the element has it.
-fn attribute(e: &BytesStart, key: &str, fail: &Fail, at: usize) -> Result<Option<String>> {
+pub(super) fn attribute(
+    e: &BytesStart,
+    key: &str,
+    fail: &Fail,
+    at: usize,
+) -> Result<Option<String>> {
     match e.try_get_attribute(key) {
         Ok(a) => Ok(a.map(|a| String::from_utf8_lossy(&a.value).into_owned())),
         Err(err) => Err(fail.byte(at, format!("a malformed attribute: {err}"))),
@@ -495,8 +675,9 @@ fn data_array(
         ty,
         components,
         format,
-        text: 0..0,
+        text: Vec::new(),
         at,
+        text_at: at,
     })
 }
 
@@ -513,7 +694,7 @@ struct Decoder<'a> {
     fail: Fail,
     little: bool,
     header: usize,
-    zlib: bool,
+    compressor: Compressor,
     appended: Option<(bool, usize)>,
 }
 
@@ -524,7 +705,7 @@ impl<'a> Decoder<'a> {
             fail: Fail::new("VTU"),
             little: x.little,
             header: if x.header64 { 8 } else { 4 },
-            zlib: x.zlib,
+            compressor: x.compressor,
             appended: x.appended,
         }
     }
@@ -544,8 +725,9 @@ impl<'a> Decoder<'a> {
             }
         }
         if a.format != Format::Ascii {
-            if self.zlib {
-                s += " zlib";
+            if self.compressor != Compressor::None {
+                s += " ";
+                s += self.compressor.name();
             }
             if self.header == 8 {
                 s += " UInt64 headers";
@@ -653,10 +835,10 @@ impl<'a> Decoder<'a> {
 
     /// `count` values in text take at least `2 count - 1` bytes.
     fn ascii_count(&self, a: &Array, count: usize) -> Result<usize> {
-        let len = a.text.len();
+        let len = a.text_len();
         if count > len.div_ceil(2) {
             return Err(self.fail.byte(
-                a.text.start,
+                a.text_at,
                 format!(
                     "the DataArray must hold {count} values, but its text has only {len} bytes"
                 ),
@@ -665,39 +847,41 @@ impl<'a> Decoder<'a> {
         Ok(count)
     }
 
-    /// The words of an ascii array, exactly `count` of them.
+    /// The words of an ascii array's own text, exactly `count` of them.
     fn ascii(
         &self,
         a: &Array,
         count: usize,
         mut each: impl FnMut(usize, &[u8], usize) -> Result<()>,
     ) -> Result<()> {
-        let text = &self.bytes[a.text.clone()];
         let mut k = 0;
-        let mut i = 0;
-        while i < text.len() {
-            if text[i].is_ascii_whitespace() {
-                i += 1;
-                continue;
+        for run in &a.text {
+            let text = &self.bytes[run.clone()];
+            let mut i = 0;
+            while i < text.len() {
+                if text[i].is_ascii_whitespace() {
+                    i += 1;
+                    continue;
+                }
+                let start = i;
+                while i < text.len() && !text[i].is_ascii_whitespace() {
+                    i += 1;
+                }
+                if k == count {
+                    return Err(self.fail.byte(
+                        run.start + start,
+                        format!("the DataArray holds more than the {count} values it should"),
+                    ));
+                }
+                each(k, &text[start..i], run.start + start)?;
+                k += 1;
             }
-            let start = i;
-            while i < text.len() && !text[i].is_ascii_whitespace() {
-                i += 1;
-            }
-            if k == count {
-                return Err(self.fail.byte(
-                    a.text.start + start,
-                    format!("the DataArray holds more than the {count} values it should"),
-                ));
-            }
-            each(k, &text[start..i], a.text.start + start)?;
-            k += 1;
         }
         if k != count {
-            return Err(self.fail.byte(
-                a.text.end,
-                format!("the DataArray holds {k} values, not {count}"),
-            ));
+            let end = a.text.last().map_or(a.text_at, |r| r.end);
+            return Err(self
+                .fail
+                .byte(end, format!("the DataArray holds {k} values, not {count}")));
         }
         Ok(())
     }
@@ -710,13 +894,7 @@ impl<'a> Decoder<'a> {
             .filter(|&w| w <= isize::MAX as usize)
             .ok_or_else(|| self.fail.byte(a.at, format!("{count} values: too many")))?;
         let source = match a.format {
-            Format::Binary => {
-                let text = &self.bytes[a.text.clone()];
-                Source::Bytes(
-                    Cow::Owned(self.base64_all(text, a.text.start)?),
-                    a.text.start,
-                )
-            }
+            Format::Binary => Source::Bytes(Cow::Owned(self.base64_all(a)?), a.text_at),
             Format::Appended(offset) => {
                 let Some((base64, start)) = self.appended else {
                     return Err(self.fail.byte(
@@ -753,7 +931,7 @@ impl<'a> Decoder<'a> {
             Source::Bytes(_, at) | Source::Base64(_, at) => *at,
         };
         let hs = self.header;
-        if !self.zlib {
+        if self.compressor == Compressor::None {
             let head = self.get(&source, hs)?;
             let n = uint(&head[..hs], self.little);
             if n != want as u64 {
@@ -781,7 +959,7 @@ impl<'a> Decoder<'a> {
             };
             return Ok((data, at));
         }
-        // zlib: blocks, block size, last block's size, each block's compressed size.
+        // Compressed: blocks, block size, last block's size, each block's compressed size.
         let head = self.get(&source, 3 * hs)?;
         let [blocks, block, last] =
             [0, 1, 2].map(|i| uint(&head[i * hs..(i + 1) * hs], self.little));
@@ -818,11 +996,18 @@ impl<'a> Decoder<'a> {
                 ),
             ));
         }
-        if total > ZLIB_MAX_RATIO.saturating_mul(compressed) + 64 * blocks {
+        let c = self.compressor;
+        let most = c
+            .max_ratio()
+            .saturating_mul(compressed)
+            .saturating_add(BLOCK_SLACK.saturating_mul(blocks));
+        if total > most {
             return Err(self.fail.byte(
                 at,
                 format!(
-                    "the compressed array's header claims {total} bytes from {compressed} compressed ones, more than zlib can give"
+                    "the compressed array's header claims {total} bytes from {compressed} compressed ones, more than {} can give ({} times as many, at most): the header is wrong",
+                    c.name(),
+                    c.max_ratio()
                 ),
             ));
         }
@@ -848,11 +1033,12 @@ impl<'a> Decoder<'a> {
             .zip(ranges.par_iter())
             .enumerate()
             .try_for_each(|(k, (o, r))| {
-                inflate(&data[r.clone()], o).map_err(|why| {
+                c.decompress(&data[r.clone()], o).map_err(|why| {
                     self.fail.byte(
                         data_at(r),
                         format!(
-                            "block {k} of the compressed array is not a valid zlib stream: {why}"
+                            "block {k} of the compressed array is not {}: {why}",
+                            c.block()
                         ),
                     )
                 })
@@ -900,37 +1086,38 @@ impl<'a> Decoder<'a> {
         )
     }
 
-    /// A whole base64 text (whitespace allowed), decoded.
-    fn base64_all(&self, text: &[u8], at: usize) -> Result<Vec<u8>> {
-        if !text.iter().any(u8::is_ascii_whitespace) {
-            return self.base64_prefix(text, at, usize::MAX);
+    /// An inline array's own base64 text (whitespace allowed, and runs cut by child
+    /// elements, one after the other), decoded.
+    fn base64_all(&self, a: &Array) -> Result<Vec<u8>> {
+        let bytes = self.bytes;
+        let chars = || {
+            a.text
+                .iter()
+                .flat_map(|r| r.clone())
+                .filter(|&i| !bytes[i].is_ascii_whitespace())
+        };
+        if let [run] = &a.text[..]
+            && !bytes[run.clone()].iter().any(u8::is_ascii_whitespace)
+        {
+            return self.base64_prefix(&bytes[run.clone()], run.start, usize::MAX);
         }
-        let clean: Vec<u8> = text
-            .iter()
-            .copied()
-            .filter(|b| !b.is_ascii_whitespace())
-            .collect();
-        self.base64_prefix(&clean, at, usize::MAX).map_err(|e| {
+        let clean: Vec<u8> = chars().map(|i| bytes[i]).collect();
+        self.base64_prefix(&clean, 0, usize::MAX).map_err(|e| {
             // Name the byte of the file, not of the text without its whitespace.
             match e {
                 super::ImportError::Tetrahedra {
                     format,
-                    at: super::MeshFileLocation::Byte(b),
+                    at: super::MeshFileLocation::Byte(nth),
                     message,
-                } => {
-                    let nth = b - at;
-                    let original = text
-                        .iter()
-                        .enumerate()
-                        .filter(|(_, c)| !c.is_ascii_whitespace())
-                        .nth(nth)
-                        .map_or(text.len(), |(i, _)| i);
-                    super::ImportError::Tetrahedra {
-                        format,
-                        at: super::MeshFileLocation::Byte(at + original),
-                        message,
-                    }
-                }
+                } => super::ImportError::Tetrahedra {
+                    format,
+                    at: super::MeshFileLocation::Byte(
+                        chars()
+                            .nth(nth)
+                            .unwrap_or_else(|| a.text.last().map_or(a.text_at, |r| r.end)),
+                    ),
+                    message,
+                },
                 e => e,
             }
         })
@@ -986,6 +1173,50 @@ fn int_at(b: &[u8], little: bool, signed: bool) -> i64 {
         ((u << (64 - bits)) as i64) >> (64 - bits)
     } else {
         i64::try_from(u).unwrap_or(if signed { u as i64 } else { -1 })
+    }
+}
+
+/// Decompresses a raw LZ4 block (no frame, as `LZ4_compress_default` gives it) into exactly
+/// `out.len()` bytes.
+fn unlz4(data: &[u8], out: &mut [u8]) -> std::result::Result<(), String> {
+    match lz4_flex::block::decompress_into(data, out) {
+        Ok(n) if n == out.len() => Ok(()),
+        Ok(n) => Err(format!("it gives {n} bytes, the header says {}", out.len())),
+        Err(lz4_flex::block::DecompressError::OutputTooSmall { .. }) => Err(format!(
+            "it gives more than the {} bytes the header says",
+            out.len()
+        )),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// Decompresses an `.xz` stream (as `lzma_easy_buffer_encode` gives it) into exactly
+/// `out.len()` bytes, and checks its end (index, footer, checksum). The stream is decoded
+/// as it is read: nothing past `out.len() + 1` bytes is decoded, whatever it would give.
+fn unxz(data: &[u8], out: &mut [u8]) -> std::result::Result<(), String> {
+    let mut xz = lzma_rust2::XzReader::new(data, false);
+    let mut filled = 0;
+    while filled < out.len() {
+        match xz.read(&mut out[filled..]) {
+            Ok(0) => {
+                return Err(format!(
+                    "it gives {filled} bytes, the header says {}",
+                    out.len()
+                ));
+            }
+            Ok(n) => filled += n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e.to_string()),
+        }
+    }
+    let mut more = [0u8; 1];
+    match xz.read(&mut more) {
+        Ok(0) => Ok(()),
+        Ok(_) => Err(format!(
+            "it gives more than the {} bytes the header says",
+            out.len()
+        )),
+        Err(e) => Err(e.to_string()),
     }
 }
 
