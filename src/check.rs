@@ -136,9 +136,10 @@ impl CheckStats {
         self.failures().is_empty()
     }
 
-    /// What keeps the mesh from passing ([`Self::passes`]): each non-zero failure count as
-    /// `<count> <name>` (the conformity counts are [`Self::conforms`]'s, so a mesh that does
-    /// not conform always has one), and a volume defect above [`crate::limits::VOLUME_DEFECT`].
+    /// What keeps the mesh from passing ([`Self::passes`]): no tetrahedron at all, each
+    /// non-zero failure count as `<count> <name>` (the conformity counts are
+    /// [`Self::conforms`]'s, so a mesh that does not conform always has one), and a volume
+    /// defect above [`crate::limits::VOLUME_DEFECT`].
     pub fn failures(&self) -> Vec<String> {
         let counts = [
             ("inverted", self.inverted),
@@ -153,11 +154,17 @@ impl CheckStats {
             ("unexpected_boundary_faces", self.unexpected_boundary_faces),
             ("missing_surface_faces", self.missing_surface_faces),
         ];
-        let mut out: Vec<String> = counts
-            .iter()
-            .filter(|(_, c)| *c > 0)
-            .map(|(k, c)| format!("{c} {k}"))
-            .collect();
+        let mut out: Vec<String> = Vec::new();
+        // An empty mesh is vacuously valid, and almost surely not what was meant.
+        if self.tets == 0 {
+            out.push("0 tetrahedra (the file holds none to check)".into());
+        }
+        out.extend(
+            counts
+                .iter()
+                .filter(|(_, c)| *c > 0)
+                .map(|(k, c)| format!("{c} {k}")),
+        );
         // A NaN defect fails too.
         if self.volume_defect.is_nan() || self.volume_defect > VOLUME_DEFECT {
             out.push(format!(
@@ -248,37 +255,89 @@ const CHECK_RUN: usize = 1 << 14;
 /// number, where the exact arithmetic's assumption of no underflow holds.
 pub const SAFE_RANGE: f64 = 1e80;
 
-/// The positions scaled as a whole by the power of two that brings the largest coordinate
-/// into [0.5, 1) (exact: every orientation is kept, and `robust::orient3d` cannot overflow),
-/// the factor that scales volumes back, and which vertices have a coordinate too small for
-/// the predicates to stay exact ([`SAFE_RANGE`]).
-fn scaled<P: Copy + Into<[f64; 3]> + Sync>(positions: &[P]) -> (Vec<[f64; 3]>, f64, Vec<bool>) {
-    let largest = positions
-        .par_iter()
-        .map(|&p| {
-            Into::<[f64; 3]>::into(p)
-                .map(f64::abs)
-                .into_iter()
-                .fold(0.0, f64::max)
-        })
+/// The positions as the checker decides on them ([`scaled`]).
+struct Scaled {
+    /// Every vertex that a tetrahedron uses, scaled as a whole by the power of two that
+    /// brings the largest coordinate of those into [0.5, 1) (exact: every orientation is
+    /// kept, and `robust::orient3d` cannot overflow); the vertices no tetrahedron uses at
+    /// the origin, so that they take no part in the scaling.
+    positions: Vec<[f64; 3]>,
+    /// The factor that scales volumes back.
+    volume_scale: f64,
+    /// Which vertices have a coordinate too small for the predicates to stay exact
+    /// ([`SAFE_RANGE`]).
+    tiny: Vec<bool>,
+    /// The middle of the box of the used vertices (scaled): the origin volumes are summed
+    /// from, so that they do not cancel wherever the mesh stands.
+    centre: [f64; 3],
+}
+
+/// The positions the checker decides on ([`Scaled`]), with the vertices that `tets` use.
+fn scaled<P: Copy + Into<[f64; 3]> + Sync>(positions: &[P], tets: &[[u32; 4]]) -> Scaled {
+    use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
+    let marks: Vec<AtomicBool> = (0..positions.len())
+        .map(|_| AtomicBool::new(false))
+        .collect();
+    tets.par_iter().flatten().for_each(|&i| {
+        if let Some(u) = marks.get(i as usize) {
+            u.store(true, Relaxed);
+        }
+    });
+    let used: Vec<bool> = marks.into_iter().map(AtomicBool::into_inner).collect();
+    let at = |i: usize| -> [f64; 3] {
+        if used[i] {
+            positions[i].into()
+        } else {
+            [0.0; 3]
+        }
+    };
+    let largest = (0..positions.len())
+        .into_par_iter()
+        .map(|i| at(i).map(f64::abs).into_iter().fold(0.0, f64::max))
         .reduce(|| 0.0, f64::max);
-    if !(largest.is_finite() && largest > 0.0) {
-        let out = positions.iter().map(|&p| p.into()).collect();
-        return (out, 1.0, vec![false; positions.len()]);
-    }
-    // 2^-e with largest = m 2^e, m in [0.5, 1); in two steps, each a normal power of two.
-    let e = largest.log2().floor() as i32 + 1;
-    let (a, b) = (-e / 2, -e - (-e / 2));
-    let scale = |x: f64| x * 2f64.powi(a) * 2f64.powi(b);
-    let out: Vec<[f64; 3]> = positions
+    let (out, volume_scale, tiny): (Vec<[f64; 3]>, f64, Vec<bool>) =
+        if !(largest.is_finite() && largest > 0.0) {
+            let out = (0..positions.len()).map(at).collect();
+            (out, 1.0, vec![false; positions.len()])
+        } else {
+            // 2^-e with largest = m 2^e, m in [0.5, 1); in two steps, each a normal power of two.
+            let e = largest.log2().floor() as i32 + 1;
+            let (a, b) = (-e / 2, -e - (-e / 2));
+            let scale = |x: f64| x * 2f64.powi(a) * 2f64.powi(b);
+            let out: Vec<[f64; 3]> = (0..positions.len())
+                .into_par_iter()
+                .map(|i| at(i).map(scale))
+                .collect();
+            let tiny = out
+                .iter()
+                .map(|p| p.iter().any(|&x| x != 0.0 && x.abs() * SAFE_RANGE < 1.0))
+                .collect();
+            (out, 2f64.powi(3 * e), tiny)
+        };
+    let (lo, hi) = out
         .par_iter()
-        .map(|&p| Into::<[f64; 3]>::into(p).map(scale))
-        .collect();
-    let tiny = out
-        .iter()
-        .map(|p| p.iter().any(|&x| x != 0.0 && x.abs() * SAFE_RANGE < 1.0))
-        .collect();
-    (out, 2f64.powi(3 * e), tiny)
+        .zip(&used)
+        .filter(|(_, u)| **u)
+        .map(|(p, _)| (*p, *p))
+        .reduce(
+            || ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+            |(a, b), (c, d)| {
+                (
+                    [0, 1, 2].map(|k| a[k].min(c[k])),
+                    [0, 1, 2].map(|k| b[k].max(d[k])),
+                )
+            },
+        );
+    let centre = [0, 1, 2].map(|k| {
+        let m = 0.5 * lo[k] + 0.5 * hi[k];
+        if m.is_finite() { m } else { 0.0 }
+    });
+    Scaled {
+        positions: out,
+        volume_scale,
+        tiny,
+        centre,
+    }
 }
 
 /// A face (sorted vertex triple) with the vertex opposite it in its tetrahedron.
@@ -620,6 +679,9 @@ pub struct Examined {
     /// Which vertices have a coordinate too small, against the largest, for the exact
     /// predicates ([`SAFE_RANGE`]).
     pub tiny: Vec<bool>,
+    /// The middle of the box of the vertices the tetrahedra use (scaled): an origin near
+    /// the mesh, from which nothing summed over it cancels wherever the mesh stands.
+    pub centre: [f64; 3],
     /// Each tetrahedron's exact orientation as given: 1 positive, -1 inverted, 0 flat,
     /// degenerate or undecidable.
     pub orientation: Vec<i8>,
@@ -638,7 +700,12 @@ pub fn examine_tetrahedra<P: Copy + Into<[f64; 3]> + Sync>(
     let nv = positions.len();
     let (sorted, odd): (Vec<[u32; 4]>, Vec<bool>) =
         tets.par_iter().map(|&t| sorted_tet(t, nv)).unzip();
-    let (scaled, volume_scale, tiny) = scaled(positions);
+    let Scaled {
+        positions: scaled,
+        volume_scale,
+        tiny,
+        centre,
+    } = scaled(positions, tets);
     let (mut s, signs) = tet_stats(&sorted, &odd, &scaled, &tiny);
     let (_, faces) = face_uses(&sorted, &signs, nv);
     drop(sorted);
@@ -651,7 +718,11 @@ pub fn examine_tetrahedra<P: Copy + Into<[f64; 3]> + Sync>(
     s.boundary_volume = faces
         .boundary
         .par_chunks(CHECK_RUN)
-        .map(|part| part.iter().map(|&f| enclosed(f, &scaled)).sum::<f64>())
+        .map(|part| {
+            part.iter()
+                .map(|&f| enclosed(f, &scaled, centre))
+                .sum::<f64>()
+        })
         .collect::<Vec<f64>>()
         .iter()
         .sum();
@@ -660,6 +731,7 @@ pub fn examine_tetrahedra<P: Copy + Into<[f64; 3]> + Sync>(
         stats: s,
         scaled,
         tiny,
+        centre,
         orientation,
         boundary: faces.boundary,
         face_faults: faces.faults,
@@ -675,15 +747,16 @@ fn merge_faces(s: &mut CheckStats, faces: &Faces) {
     s.boundary_faces = faces.boundary.len();
 }
 
-/// A boundary face's share of the volume the boundary encloses (the divergence theorem),
-/// the face turned outward: away from its tetrahedron's fourth vertex.
-fn enclosed((face, opposite): Face, positions: &[[f64; 3]]) -> f64 {
+/// A boundary face's share of the volume the boundary encloses (the divergence theorem, from
+/// the origin `centre`, any point near the mesh: the shares of a mesh far from 0 then do
+/// not cancel), the face turned outward: away from its tetrahedron's fourth vertex.
+fn enclosed((face, opposite): Face, positions: &[[f64; 3]], centre: [f64; 3]) -> f64 {
     let mut f = face;
     let [pa, pb, pc, po] = [f[0], f[1], f[2], opposite].map(|i| c3(positions[i as usize]));
     if robust::orient3d(pa, pb, pc, po) > 0.0 {
         f.swap(1, 2);
     }
-    let [a, b, c] = f.map(|i| positions[i as usize]);
+    let [a, b, c] = f.map(|i| sub(positions[i as usize], centre));
     -dot(a, cross(b, c)) / 6.0
 }
 
@@ -715,7 +788,12 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
         .par_iter()
         .map(|t| sorted_tet(t.map(|i| layout.canon(i)), nv))
         .unzip();
-    let (scaled, volume_scale, tiny) = scaled(positions);
+    let Scaled {
+        positions: scaled,
+        volume_scale,
+        tiny,
+        centre,
+    } = scaled(positions, &tets);
     let (mut s, signs) = tet_stats(&tets, &odd, &scaled, &tiny);
     drop(odd);
     s.collapsed_vertices = layout.collapsed.iter().filter(|&&c| c).count();
@@ -727,7 +805,8 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
     merge_faces(&mut s, &faces);
     let boundary = faces.boundary;
 
-    let (boundary_volume, offset_faces, others) = classify_boundary(boundary, &scaled, &layout);
+    let (boundary_volume, offset_faces, others) =
+        classify_boundary(boundary, &scaled, centre, &layout);
     s.boundary_volume = boundary_volume;
     let offset_faces = bucket_sort(offset_faces, n, |f| f.0[0]);
     if !surface_triangles.is_empty() {
@@ -869,6 +948,7 @@ fn tet_stats(
 fn classify_boundary<P: Copy + Into<[f64; 3]> + Sync>(
     boundary: Vec<Face>,
     positions: &[[f64; 3]],
+    centre: [f64; 3],
     layout: &Layout<P>,
 ) -> (f64, Vec<OffsetFace>, Vec<[u32; 3]>) {
     let classified: Vec<(f64, Vec<OffsetFace>, Vec<[u32; 3]>)> = boundary
@@ -876,7 +956,7 @@ fn classify_boundary<P: Copy + Into<[f64; 3]> + Sync>(
         .map(|part| {
             let (mut volume, mut offset_faces, mut others) = (0.0, Vec::new(), Vec::new());
             for &(k, o) in part {
-                volume += enclosed((k, o), positions);
+                volume += enclosed((k, o), positions, centre);
                 match k.map(|i| layout.surface_vertex(i)) {
                     [Some(x), Some(y), Some(z)]
                         if x != y && y != z && x != z && k.iter().all(|&i| layout.offset(i)) =>

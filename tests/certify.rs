@@ -336,3 +336,90 @@ fn a_soup_of_ten_thousand_separate_tetrahedra_is_ten_thousand_components() {
     assert_eq!((c.boundary.components, c.boundary.cavities), (10_000, 0));
     assert!(c.boundary.windings.iter().all(|&w| w == Some(1)));
 }
+
+#[test]
+fn a_valid_mesh_gets_the_same_certificate_wherever_it_stands() {
+    // Integer coordinates moved by whole numbers (and halves) stay exact, so every mesh
+    // below is the cube itself, moved: its verdict, boundary, faults and volume are the
+    // cube's. The boundary's volume summed from the origin cancelled 300 units away.
+    let (p, t) = kuhn_cube(4);
+    let mut faulty = t.clone();
+    faulty[40].swap(2, 3);
+    for tets in [&t, &faulty] {
+        let reference = certify(&p, tets);
+        for by in [
+            [300.0, 300.0, 300.0],
+            [1e6, 1e6, 1e6],
+            [-1e6 - 0.5, 2e9, 0.25],
+            [2f64.powi(50), -3e15, 7e14],
+        ] {
+            let c = certify(&translated(&p, by), tets);
+            assert_eq!(c.failures(), reference.failures(), "{by:?}");
+            assert_eq!(c.boundary, reference.boundary, "{by:?}");
+            assert_eq!(c.faults, reference.faults, "{by:?}");
+            assert!(
+                (c.stats.volume - 64.0).abs() < 1e-9 && c.stats.volume_defect < 1e-12,
+                "{by:?}: volume {} defect {}",
+                c.stats.volume,
+                c.stats.volume_defect
+            );
+        }
+    }
+}
+
+#[test]
+fn vertices_no_tetrahedron_uses_take_no_part_in_the_certificate() {
+    // One vertex far away that no cell names made every tetrahedron undecidable (1e80) or
+    // every face one BVH box (1e308).
+    let (p, t) = kuhn_cube(4);
+    let reference = certify(&p, &t);
+    assert!(reference.failures().is_empty());
+    for extra in [[1e80, 0.0, 0.0], [1e308, -1e308, 1e308], [1e-300, 0.0, 0.0]] {
+        let mut q = p.clone();
+        q.insert(0, extra);
+        let shifted: Vec<[u32; 4]> = t.iter().map(|x| x.map(|i| i + 1)).collect();
+        let c = certify(&q, &shifted);
+        assert!(c.failures().is_empty(), "{extra:?}: {:?}", c.failures());
+        assert_eq!(c.boundary, reference.boundary, "{extra:?}");
+        assert_eq!(c.stats.volume, reference.stats.volume, "{extra:?}");
+    }
+}
+
+#[test]
+fn tetrahedra_beyond_the_exact_range_are_undecidable_and_nothing_else_is_claimed_of_them() {
+    // The cube beside one tetrahedron 1e100 times its size: the cube's coordinates are
+    // below what the exact predicates can take against the largest, so its tetrahedra are
+    // undecidable, said once as a count; no hanging vertex, crossing or misoriented edge
+    // is made up from the rounded coordinates.
+    let far = (
+        vec![
+            [1e100, 0.0, 0.0],
+            [2e100, 0.0, 0.0],
+            [1e100, 1e100, 0.0],
+            [1e100, 0.0, 1e100],
+        ],
+        vec![[0, 2, 1, 3]],
+    );
+    let (p, t) = joined(kuhn_cube(3), far);
+    let c = certify(&p, &t);
+    let b = &c.boundary;
+    assert_eq!(c.stats.undecidable, 162);
+    assert_eq!(
+        (
+            b.hanging_vertices,
+            b.self_intersections,
+            b.misoriented_edges,
+            b.nonmanifold_edges
+        ),
+        (0, 0, 0, 0),
+        "{b:?}"
+    );
+    assert_eq!(b.undecided_faces, 108);
+    assert!(c.stats.volume.is_finite() && c.stats.volume > 0.0);
+    assert_eq!(
+        names(&c),
+        ["undecidable", "undecided_windings"],
+        "{:?}",
+        c.failures()
+    );
+}

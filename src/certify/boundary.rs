@@ -45,6 +45,9 @@ pub struct Boundary {
     pub wrong_winding: usize,
     /// Components whose winding number could not be decided.
     pub undecided_windings: usize,
+    /// Faces with a vertex too small, against the mesh's largest coordinate, for the exact
+    /// predicates: no fault is claimed of them (their tetrahedra are `undecidable`).
+    pub undecided_faces: usize,
     /// The winding number of the whole boundary just inside each component (`None` where
     /// undecided), in the order of each component's first face.
     pub windings: Vec<Option<i64>>,
@@ -97,15 +100,39 @@ fn outward(faces: &[([u32; 3], u32)], positions: &[P]) -> Vec<[u32; 3]> {
         .collect()
 }
 
+/// A box around the points from `a` to `b`, as the BVH holds it: taken from `centre`, a
+/// point near the mesh, so that the f32 boxes of a mesh far from the origin still tell its
+/// faces apart, and rounded outward (no point of the box is left out: the difference is
+/// moved a step outward before f32 rounds it outward again).
+fn boxed(a: P, b: P, centre: P) -> Aabb {
+    let lo = [0, 1, 2].map(|k| (a[k].min(b[k]) - centre[k]).next_down());
+    let hi = [0, 1, 2].map(|k| (a[k].max(b[k]) - centre[k]).next_up());
+    broad::outward(glam::DVec3::from(lo), glam::DVec3::from(hi))
+}
+
 /// Judges the boundary faces (each a sorted vertex triple with the fourth vertex of its
-/// tetrahedron) on `positions` (scaled, as the checker's): the [`Boundary`] and each face's
-/// fault bits.
-pub fn judge(faces: &[([u32; 3], u32)], positions: &[P]) -> (Boundary, FaceMarks) {
+/// tetrahedron) on `positions` (scaled, as the checker's), with `centre` a point near them
+/// (the boxes' origin) and which vertices are too small to decide on (`tiny`, see
+/// [`crate::check::SAFE_RANGE`]): the [`Boundary`] and each face's fault bits. A face with
+/// such a vertex is *undecided*: no fault is claimed of it or of a pair it is in (its
+/// tetrahedron is counted `undecidable` already), and a winding number that would need it
+/// is left undecided.
+pub fn judge(
+    faces: &[([u32; 3], u32)],
+    positions: &[P],
+    centre: P,
+    tiny: &[bool],
+) -> (Boundary, FaceMarks) {
     use super::Fault;
     let at = |i: u32| positions[i as usize];
     let outward = outward(faces, positions);
+    let undecided: Vec<bool> = outward
+        .iter()
+        .map(|t| t.iter().any(|&i| tiny[i as usize]))
+        .collect();
     let mut b = Boundary {
         faces: faces.len(),
+        undecided_faces: undecided.iter().filter(|&&u| u).count(),
         ..Boundary::default()
     };
     let mut marks = vec![0u32; faces.len()];
@@ -125,7 +152,10 @@ pub fn judge(faces: &[([u32; 3], u32)], positions: &[P]) -> (Boundary, FaceMarks
     let mut sets = Sets::new(faces.len());
     for group in edges.chunk_by(|x, y| x.0 == y.0) {
         let fault = match group {
-            [(_, d1, _), (_, d2, _)] if d1 == d2 => {
+            // An undecided face's way along the edge is not known.
+            [(_, d1, f1), (_, d2, f2)]
+                if d1 == d2 && !undecided[*f1 as usize] && !undecided[*f2 as usize] =>
+            {
                 b.misoriented_edges += 1;
                 Fault::NONMANIFOLD
             }
@@ -175,13 +205,16 @@ pub fn judge(faces: &[([u32; 3], u32)], positions: &[P]) -> (Boundary, FaceMarks
     let tris: Vec<[P; 3]> = outward.iter().map(|t| t.map(at)).collect();
     let boxes: Vec<Aabb> = tris
         .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(glam::DVec3::from);
-            broad::outward(a.min(b).min(c), a.max(b).max(c))
+        .map(|&[a, b, c]| {
+            let lo = [0, 1, 2].map(|k| a[k].min(b[k]).min(c[k]));
+            let hi = [0, 1, 2].map(|k| a[k].max(b[k]).max(c[k]));
+            boxed(lo, hi, centre)
         })
         .collect();
     let bvh = broad::build(&boxes, 4);
     let shell = Shell {
+        centre,
+        undecided: &undecided,
         tris: &tris,
         component: &component,
         bvh: &bvh,
@@ -194,13 +227,16 @@ pub fn judge(faces: &[([u32; 3], u32)], positions: &[P]) -> (Boundary, FaceMarks
     vertices.dedup();
     let hanging: Vec<Vec<u32>> = vertices
         .par_iter()
+        .filter(|&&v| !tiny[v as usize])
         .filter_map(|&v| {
             let x = at(v);
             let on: Vec<u32> = shell
                 .near(x, x)
                 .into_iter()
                 .filter(|&f| {
-                    !outward[f as usize].contains(&v) && point_in_triangle(x, tris[f as usize])
+                    !undecided[f as usize]
+                        && !outward[f as usize].contains(&v)
+                        && point_in_triangle(x, tris[f as usize])
                 })
                 .collect();
             (!on.is_empty()).then_some(on)
@@ -214,7 +250,10 @@ pub fn judge(faces: &[([u32; 3], u32)], positions: &[P]) -> (Boundary, FaceMarks
     // Faces meeting beyond what they share.
     let crossing: Vec<Vec<(u32, u32)>> =
         broad::self_pairs_par(&bvh, &boxes, Vec::new, |out, f, g| {
-            if triangles_meet(outward[f as usize], outward[g as usize], positions) {
+            if !undecided[f as usize]
+                && !undecided[g as usize]
+                && triangles_meet(outward[f as usize], outward[g as usize], positions)
+            {
                 out.push((f, g));
             }
         });
@@ -227,7 +266,7 @@ pub fn judge(faces: &[([u32; 3], u32)], positions: &[P]) -> (Boundary, FaceMarks
     // The winding number just inside each component, and which are cavities.
     let mut firsts: Vec<Vec<u32>> = vec![Vec::new(); b.components];
     for (f, &c) in component.iter().enumerate() {
-        if firsts[c as usize].len() < WINDING_TRIES {
+        if firsts[c as usize].len() < WINDING_TRIES && !undecided[f] && !tiny[faces[f].1 as usize] {
             firsts[c as usize].push(f as u32);
         }
     }
@@ -279,6 +318,8 @@ fn fan_pieces(group: &[(u32, [u32; 2], u32)]) -> usize {
 /// The boundary faces as the winding number reads them: their corners, their components,
 /// and a BVH of their boxes.
 struct Shell<'a> {
+    centre: P,
+    undecided: &'a [bool],
     tris: &'a [[P; 3]],
     component: &'a [u32],
     bvh: &'a Bvh2,
@@ -288,9 +329,7 @@ struct Shell<'a> {
 impl Shell<'_> {
     /// The faces whose boxes meet the box of `a` and `b` (rounded outward: none is missed).
     fn near(&self, a: P, b: P) -> Vec<u32> {
-        let lo = glam::DVec3::new(a[0].min(b[0]), a[1].min(b[1]), a[2].min(b[2]));
-        let hi = glam::DVec3::new(a[0].max(b[0]), a[1].max(b[1]), a[2].max(b[2]));
-        let query = broad::outward(lo, hi);
+        let query = boxed(a, b, self.centre);
         let mut out = Vec::new();
         self.bvh.aabb_traverse(query, |bvh, node| {
             let node = &bvh.nodes[node as usize];
@@ -332,10 +371,10 @@ fn winding(f: usize, apex: u32, shell: &Shell, positions: &[P]) -> Option<(i64, 
         return None;
     }
     let g = mean(&[a, b, c]);
-    let blocked = shell
-        .near(p, g)
-        .into_iter()
-        .any(|j| j as usize != f && segment_meets_triangle(p, g, shell.tris[j as usize]));
+    let blocked = shell.near(p, g).into_iter().any(|j| {
+        j as usize != f
+            && (shell.undecided[j as usize] || segment_meets_triangle(p, g, shell.tris[j as usize]))
+    });
     if blocked {
         return None;
     }
@@ -353,6 +392,9 @@ fn winding(f: usize, apex: u32, shell: &Shell, positions: &[P]) -> Option<(i64, 
         q[axis] = 2.0 * sign;
         let (mut total, mut mine) = (0, 0);
         for j in shell.near(p, q) {
+            if shell.undecided[j as usize] {
+                continue 'rays;
+            }
             let t = shell.tris[j as usize];
             let (op, oq) = (orient(t[0], t[1], t[2], p), orient(t[0], t[1], t[2], q));
             if op * oq > 0 {
@@ -391,16 +433,15 @@ mod tests {
     use crate::certify::kuhn_cube;
     use crate::check::examine_tetrahedra;
 
-    /// Two Kuhn cubes, the second moved by `by`, as one mesh's boundary faces and scaled
-    /// positions.
-    fn two_cubes(by: [f64; 3]) -> (Vec<([u32; 3], u32)>, Vec<P>) {
+    /// Two Kuhn cubes, the second moved by `by`, as one mesh examined: its boundary faces,
+    /// scaled positions and centre.
+    fn two_cubes(by: [f64; 3]) -> crate::check::Examined {
         let (mut p, mut t) = kuhn_cube(3);
         let (q, s) = kuhn_cube(2);
         let n = p.len() as u32;
         p.extend(q.iter().map(|x| [x[0] + by[0], x[1] + by[1], x[2] + by[2]]));
         t.extend(s.iter().map(|x| x.map(|i| i + n)));
-        let e = examine_tetrahedra(&p, &t);
-        (e.boundary, e.scaled)
+        examine_tetrahedra(&p, &t)
     }
 
     /// The solid angle of triangle abc seen from x (Van Oosterom and Strackee), over 4 pi:
@@ -425,8 +466,9 @@ mod tests {
             [0.5, 0.5, 0.5],
             [10.0, 0.0, 0.0],
         ] {
-            let (faces, positions) = two_cubes(by);
-            let (b, _) = judge(&faces, &positions);
+            let e = two_cubes(by);
+            let (faces, positions, centre) = (e.boundary, e.scaled, e.centre);
+            let (b, _) = judge(&faces, &positions, centre, &vec![false; positions.len()]);
             let outward = outward(&faces, &positions);
             let mut all = 0;
             for i in 0..outward.len() {
@@ -446,8 +488,9 @@ mod tests {
         // Nested (the second cube inside the first), touching face to face, apart: at the
         // centroid of every boundary face's tetrahedron.
         for by in [[0.5, 0.5, 0.5], [3.0, 0.0, 0.0], [10.0, 0.0, 0.0]] {
-            let (faces, positions) = two_cubes(by);
-            let (b, _) = judge(&faces, &positions);
+            let e = two_cubes(by);
+            let (faces, positions, centre) = (e.boundary, e.scaled, e.centre);
+            let (b, _) = judge(&faces, &positions, centre, &vec![false; positions.len()]);
             assert_eq!(b.undecided_windings, 0);
             let mut seen = Vec::new();
             let out = outward(&faces, &positions);

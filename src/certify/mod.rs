@@ -121,16 +121,12 @@ pub struct Certificate {
 }
 
 impl Certificate {
-    /// What keeps the mesh from passing: [`CheckStats::failures`], a mesh without
-    /// tetrahedra, then each non-zero count of the boundary's faults as `<count> <name>`;
+    /// What keeps the mesh from passing: [`CheckStats::failures`] (a mesh without
+    /// tetrahedra among them), then each non-zero count of the boundary's faults as `<count> <name>`;
     /// empty when it passes.
     pub fn failures(&self) -> Vec<String> {
         let b = &self.boundary;
         let mut out = self.stats.failures();
-        // An empty mesh is vacuously valid, and almost surely not what was meant.
-        if self.stats.tets == 0 {
-            out.push("0 tetrahedra (the file holds none to check)".into());
-        }
         for (name, count, what) in [
             (
                 "nonmanifold_edges",
@@ -189,7 +185,12 @@ pub fn certify(positions: &[[f64; 3]], tets: &[[u32; 4]]) -> Certificate {
         examined = examine_tetrahedra(positions, tets);
         convention = Convention::Reversed;
     }
-    let (boundary, face_marks) = boundary::judge(&examined.boundary, &examined.scaled);
+    let (boundary, face_marks) = boundary::judge(
+        &examined.boundary,
+        &examined.scaled,
+        examined.centre,
+        &examined.tiny,
+    );
     let (quality, shapes) = quality::quality(&examined.scaled, tets);
 
     // Each tetrahedron's own faults, then those of its faces.
