@@ -3,7 +3,7 @@
 //! read the same; and malformed files, each an error that names its line or byte, never a
 //! panic.
 
-use crate::common::fixture;
+use crate::common::{fixture, halo4d};
 use halo4d::import::{FileTetrahedra, PlainTetrahedra, read, read_tetgen};
 use std::path::{Path, PathBuf};
 
@@ -973,11 +973,10 @@ fn a_pvtu_piece_without_cells_is_read_as_none() {
 </VTKFile>
 "#;
     let dir = tempfile::tempdir().unwrap();
-    // Alone, it holds no tetrahedron.
+    // Alone, it holds no tetrahedron: read, and its check fails as in every format.
     let alone = dir.path().join("empty.vtu");
     std::fs::write(&alone, empty).unwrap();
-    let e = read(&alone).unwrap_err().to_string();
-    assert!(e.contains("no tetrahedra"), "{e}");
+    assert_eq!(plain(&alone).tets.len(), 0);
     // Among pieces, it adds none.
     let mut pvtu = std::fs::read_to_string(path("cube-pieces.pvtu")).unwrap();
     for k in 0..3 {
@@ -1002,17 +1001,69 @@ fn a_pvtu_piece_without_cells_is_read_as_none() {
         m.format,
         "PVTU, 4 pieces (VTU binary zlib; VTU appended base64 zlib)"
     );
-    // Only empty pieces: no tetrahedra.
+    // Only empty pieces: no tetrahedra, read; the check fails.
     std::fs::write(
         &p,
         "<VTKFile type=\"PUnstructuredGrid\"><PUnstructuredGrid><Piece Source=\"empty.vtu\"/></PUnstructuredGrid></VTKFile>",
     )
     .unwrap();
-    let e = read(&p).unwrap_err().to_string();
-    assert!(
-        e.contains("none of its 1 pieces holds a tetrahedron"),
-        "{e}"
-    );
+    assert_eq!(plain(&p).tets.len(), 0);
+    for file in [&alone, &p] {
+        let checked = halo4d::check_file(file).unwrap();
+        assert_eq!(
+            checked.failures(),
+            ["0 tetrahedra (the file holds none to check)"],
+            "{}",
+            file.display()
+        );
+    }
+}
+
+#[test]
+fn a_mesh_without_tetrahedra_fails_its_check_alike_in_every_format() {
+    // A triangle and its points, and no tetrahedron: read in every format, and the check
+    // fails (exit status 1) with the same failure, not an error of the reader (2).
+    let dir = tempfile::tempdir().unwrap();
+    let files: [(&str, &[u8]); 6] = [
+        (
+            "empty.vtk",
+            b"# vtk DataFile Version 4.2\nno cells\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 3 double\n0 0 0\n1 0 0\n0 1 0\nCELLS 1 4\n3 0 1 2\nCELL_TYPES 1\n5\n",
+        ),
+        (
+            "empty.msh",
+            b"$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n$Elements\n1\n1 2 0 1 2 3\n$EndElements\n",
+        ),
+        (
+            "empty.mesh",
+            b"MeshVersionFormatted 2\nDimension 3\nVertices\n3\n0 0 0 0\n1 0 0 0\n0 1 0 0\nTriangles\n1\n1 2 3 0\nEnd\n",
+        ),
+        ("empty.node", b"3 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n"),
+        ("empty.ele", b"0 4 0\n"),
+        (
+            "empty.vtu",
+            b"<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=\"3\" NumberOfCells=\"0\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0 0 1 0</DataArray></Points><Cells><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\"></DataArray><DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\"></DataArray><DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\"></DataArray></Cells></Piece></UnstructuredGrid></VTKFile>",
+        ),
+    ];
+    for (name, bytes) in files {
+        std::fs::write(dir.path().join(name), bytes).unwrap();
+    }
+    for name in [
+        "empty.vtk",
+        "empty.msh",
+        "empty.mesh",
+        "empty.ele",
+        "empty.vtu",
+    ] {
+        let out = halo4d(&["check", name], dir.path());
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(
+            out.status.code(),
+            Some(1),
+            "{name}: {text}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(text.contains("FAILED 0 tetrahedra"), "{name}: {text}");
+    }
 }
 
 #[test]

@@ -13,10 +13,11 @@
 //!
 //! Guarantees: an error in a piece names the `.pvtu`, the piece's file and the byte in it;
 //! a missing piece is an error naming the file looked for; a piece may hold no cell (a
-//! process that had none), but the whole must hold a tetrahedron.
+//! process that had none), and the whole none either (its check then fails with `0
+//! tetrahedra`, as for any file).
 
 use super::tetfile::{Fail, Result, bom};
-use super::vtu::{attribute, read_vtu_piece};
+use super::vtu::{attribute, read_vtu};
 use super::{ImportError, MeshFileLocation, PlainTetrahedra};
 use crate::limits::shorten;
 use quick_xml::events::Event;
@@ -59,7 +60,7 @@ pub fn read_pvtu(path: &Path) -> Result<PlainTetrahedra> {
             let stem = Path::new(source)
                 .file_stem()
                 .map_or_else(|| source.clone(), |s| s.to_string_lossy().into_owned());
-            read_vtu_piece(&bytes, &stem, true).map_err(|e| in_piece(e, &file, source))
+            read_vtu(&bytes, &stem).map_err(|e| in_piece(e, &file, source))
         })
         .collect();
     let mut meshes = Vec::with_capacity(read.len());
@@ -218,12 +219,6 @@ fn weld(
         }
         tets.extend(m.tets.iter().map(|t| t.map(|i| index[i as usize])));
         piece_of.extend(std::iter::repeat_n(k as u32, m.tets.len()));
-    }
-    if tets.is_empty() {
-        return Err(fail.file(format!(
-            "none of its {} pieces holds a tetrahedron: halo4d checks tetrahedral meshes",
-            pieces.len()
-        )));
     }
     let format = format!(
         "PVTU, {} piece{} ({})",

@@ -412,21 +412,9 @@ impl Cells {
         }
     }
 
-    /// The tetrahedra, unless the file has other solids or no tetrahedron.
+    /// The tetrahedra, none or more, unless the file has other solids. A file without a
+    /// tetrahedron is read (its check fails with `0 tetrahedra`, in every format alike).
     pub fn finish(self, fail: &Fail) -> Result<Vec<[u32; 4]>> {
-        let skipped = self.skipped;
-        let tets = self.finish_allow_empty(fail)?;
-        if tets.is_empty() {
-            return Err(fail.file(format!(
-                "the mesh has no tetrahedra ({skipped} lower-dimensional cells skipped): halo4d checks tetrahedral meshes"
-            )));
-        }
-        Ok(tets)
-    }
-
-    /// The tetrahedra, none or more (a piece of a `.pvtu` may hold none), unless the file
-    /// has other solids.
-    pub fn finish_allow_empty(self, fail: &Fail) -> Result<Vec<[u32; 4]>> {
         if let Some(&(_, _, at)) = self.others.first() {
             let list: Vec<String> = self
                 .others

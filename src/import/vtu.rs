@@ -61,12 +61,6 @@ const BLOCK_SLACK: u64 = 64;
 /// (Lagrange and Bézier tetrahedra: their first four points, the corners) are read; cells
 /// of lower dimension are skipped; other solids are an error.
 pub fn read_vtu(bytes: &[u8], name: &str) -> Result<PlainTetrahedra> {
-    read_vtu_piece(bytes, name, false)
-}
-
-/// [`read_vtu`], or where `piece` (a piece of a `.pvtu`, which may hold no cell), one that
-/// may hold no tetrahedron.
-pub(super) fn read_vtu_piece(bytes: &[u8], name: &str, piece: bool) -> Result<PlainTetrahedra> {
     let xml = Xml::parse(bytes)?;
     let d = Decoder::new(bytes, &xml);
     let (np, nc) = xml
@@ -174,11 +168,7 @@ pub(super) fn read_vtu_piece(bytes: &[u8], name: &str, piece: bool) -> Result<Pl
         }
         start = end;
     }
-    let tets = if piece {
-        cells.finish_allow_empty(&d.fail)?
-    } else {
-        cells.finish(&d.fail)?
-    };
+    let tets = cells.finish(&d.fail)?;
     plain(name, &format, positions, tets)
 }
 
