@@ -423,3 +423,80 @@ fn tetrahedra_beyond_the_exact_range_are_undecidable_and_nothing_else_is_claimed
         c.failures()
     );
 }
+
+/// Kuhn's cube [0, 4]^3 as a `.pvtu` of two pieces (the cubes below x = 2, and the rest),
+/// each piece with its own points, in `dir`; `shift` moves the second piece's points on the
+/// cut along x. Returns the `.pvtu`'s path.
+fn two_pieces(dir: &std::path::Path, shift: f64) -> std::path::PathBuf {
+    use halo4d::export::write_tetrahedra_vtu;
+    use halo4d::internals::file_order;
+    let (p, t) = kuhn_cube(4);
+    for (k, below) in [(0, true), (1, false)] {
+        let tets: Vec<[u32; 4]> = t
+            .iter()
+            .filter(|q| (q.iter().map(|&i| p[i as usize][0]).sum::<f64>() < 8.0) == below)
+            .copied()
+            .collect();
+        let mut used: Vec<u32> = tets.iter().flatten().copied().collect();
+        used.sort_unstable();
+        used.dedup();
+        let local = |i: u32| used.binary_search(&i).unwrap() as u32;
+        let points: Vec<[f64; 3]> = used
+            .iter()
+            .map(|&i| {
+                let mut x = p[i as usize];
+                if k == 1 && x[0] == 2.0 {
+                    x[0] += shift;
+                }
+                x
+            })
+            .collect();
+        let tets: Vec<[u32; 4]> = tets.iter().map(|q| file_order(q.map(local))).collect();
+        write_tetrahedra_vtu(&dir.join(format!("cube_{k}.vtu")), &points, &tets, &[]).unwrap();
+    }
+    let pvtu = dir.join("cube.pvtu");
+    std::fs::write(
+        &pvtu,
+        r#"<?xml version="1.0"?>
+<VTKFile type="PUnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">
+  <PUnstructuredGrid GhostLevel="0">
+    <PPoints><PDataArray type="Float64" NumberOfComponents="3"/></PPoints>
+    <Piece Source="cube_0.vtu"/>
+    <Piece Source="cube_1.vtu"/>
+  </PUnstructuredGrid>
+</VTKFile>
+"#,
+    )
+    .unwrap();
+    pvtu
+}
+
+#[test]
+fn a_partitioned_mesh_is_certified_as_one_and_a_fault_between_pieces_names_both() {
+    let dir = tempfile::tempdir().unwrap();
+    let whole = halo4d::check_file(&two_pieces(dir.path(), 0.0)).unwrap();
+    assert!(whole.failures().is_empty(), "{:?}", whole.failures());
+    let c = whole.certificate.as_ref().unwrap();
+    // The points on the cut welded: the cube's 125, one boundary component.
+    assert_eq!((c.stats.vertices, c.stats.tets), (125, 384));
+    assert_eq!(c.boundary.components, 1);
+    let pieces = whole.pieces();
+    assert_eq!(
+        pieces
+            .iter()
+            .map(|p| (p.file.as_str(), p.tets))
+            .collect::<Vec<_>>(),
+        [("cube_0.vtu", 192), ("cube_1.vtu", 192)]
+    );
+    assert!(pieces.iter().all(|p| p.faulty == 0));
+
+    // The second piece's cut moved into the first: the pieces overlap, and both are named.
+    let overlap = halo4d::check_file(&two_pieces(dir.path(), -0.25)).unwrap();
+    assert!(!overlap.failures().is_empty());
+    let pieces = overlap.pieces();
+    assert!(pieces.iter().all(|p| p.faulty > 0), "{pieces:?}");
+    let text = overlap.text();
+    for file in ["cube_0.vtu", "cube_1.vtu"] {
+        assert!(text.contains(&format!("piece {file}: ")), "{text}");
+    }
+}

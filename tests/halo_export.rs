@@ -542,6 +542,49 @@ fn check_file_sees_every_prism_missing_from_a_halo() {
 }
 
 #[test]
+fn a_halo_file_without_its_surface_triangles_never_claims_the_coverage() {
+    // A halo .vtk of a halo4d that wrote no surface_triangles: read off the boundary alone,
+    // half a halo is a valid shell of what is left, and no tetrahedron at all is vacuously
+    // one. The check makes the checks that need no more, and says what it could not see.
+    let dir = tempfile::tempdir().unwrap();
+    let (_, vtk, _) = patches(dir.path());
+    let halo = read_vtk(&std::fs::read(&vtk).unwrap()).unwrap();
+    let total = halo.mesh.tets.len();
+    let mut expected_exit = Vec::new();
+    for (name, kept) in [("whole", total), ("half", total / 2), ("none", 0)] {
+        let mut h = halo.clone();
+        h.mesh.tets.truncate(kept);
+        h.mesh.surface_triangles.clear();
+        let file = format!("{name}.vtk");
+        let text = ascii_vtk(&h, true).replace("surface_triangles 3 0 int\n", "");
+        let text = text.replace("FIELD FieldData 4", "FIELD FieldData 3");
+        std::fs::write(dir.path().join(&file), text).unwrap();
+        let out = halo4d(&["check", &file], dir.path());
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stdout.contains("conform"), "{file}: {stdout}");
+        if kept > 0 {
+            assert!(
+                stdout.contains("NOT checked: the coverage of the surface")
+                    && stdout.contains("surface_triangles"),
+                "{file}: {stdout}"
+            );
+        }
+        let json = halo4d(&["check", &file, "--json"], dir.path());
+        if json.status.code() != Some(2) {
+            let v: Value = serde_json::from_slice(&json.stdout).unwrap();
+            assert_eq!(v["unchecked"].as_array().unwrap().len(), 1, "{file}: {v}");
+        }
+        expected_exit.push((name, out.status.code(), stderr.into_owned()));
+    }
+    // The whole halo and its first half pass what can be checked (exit 0, saying what is
+    // not); no tetrahedron at all is no pass.
+    assert_eq!(expected_exit[0].1, Some(0), "{expected_exit:?}");
+    assert_eq!(expected_exit[1].1, Some(0), "{expected_exit:?}");
+    assert_ne!(expected_exit[2].1, Some(0), "{expected_exit:?}");
+}
+
+#[test]
 fn unreadable_files_are_errors_of_the_cli_with_the_file_named() {
     let dir = tempfile::tempdir().unwrap();
     let (glb, _, _) = patches(dir.path());
