@@ -123,17 +123,25 @@ pub fn check_file(file: &Path) -> Result<Checked, InspectError> {
                 ..checked
             }
         }
-        FileTetrahedra::Plain(mesh) => {
-            let certificate = certify(&mesh.positions, &mesh.tets);
-            Checked {
-                halos: vec![(mesh.name.clone(), certificate.stats)],
-                plain: Some(mesh.why.clone()),
-                certificate: Some(certificate),
-                mesh: Some(mesh),
-                ..checked
-            }
-        }
+        FileTetrahedra::Plain(mesh) => check_mesh(file, mesh),
     })
+}
+
+/// Certifies a tetrahedral mesh without halo4d's layout, read from `file` or given in
+/// memory ([`PlainTetrahedra::from_arrays`]; `file` then names where it came from): what
+/// [`check_file`] gives for such a file.
+pub fn check_mesh(file: &Path, mesh: PlainTetrahedra) -> Checked {
+    let certificate = certify(&mesh.positions, &mesh.tets);
+    Checked {
+        file: file.to_path_buf(),
+        scene: None,
+        halos: vec![(mesh.name.clone(), certificate.stats)],
+        plain: Some(mesh.why.clone()),
+        certificate: Some(certificate),
+        mesh: Some(mesh),
+        verification: None,
+        unchecked: Vec::new(),
+    }
 }
 
 /// Checks a build's output folder: reads its one `.glb`, runs the checker on each halo,

@@ -99,7 +99,9 @@ pub use parts::{HaloIndex, HaloPart, Parts, SurfacePart};
 
 // The files: each written whole or not at all, and checked again.
 pub use export::write_atomic;
-pub use inspect::{Checked, InspectError, Piece, Unchecked, check_dir, check_file, verify_scene};
+pub use inspect::{
+    Checked, InspectError, Piece, Unchecked, check_dir, check_file, check_mesh, verify_scene,
+};
 
 /// What the tests and benches reach into beneath the API: stage internals with their own
 /// contracts, kept public so that they can be tested on their own, not for use.

@@ -12,7 +12,17 @@ A scene comes from a dict, a JSON string or a scene file (`halo4d.Scene(...)`), 
 the command line validates it (`halo4d.SceneError`, whose `field` names the field at fault).
 `scene.sample()` samples it in 4D once; `.build(view=...)` builds any number of 4D views of
 it. The work runs with the GIL released; Ctrl-C interrupts a call at once.
+
+`halo4d.check` certifies any tetrahedral mesh, from a file or from memory:
+
+>>> import pyvista, halo4d
+>>> grid = pyvista.read("ball.vtu")             # or a meshio.Mesh, or (points, cells)
+>>> result = halo4d.check(grid)
+>>> grid.cell_data["fault"] = result["cell_faults"]   # threshold on it in PyVista
 """
+
+import os
+from typing import Any
 
 from ._native import (
     BuildError,
@@ -25,8 +35,92 @@ from ._native import (
     Surface,
     __version__,
     catalogue,
-    check,
 )
+from ._native import certify_arrays as _certify
+from ._native import check as _check_path
+
+# VTK's cell types whose first four points are a tetrahedron's corners: linear, quadratic,
+# Lagrange and Bezier tetrahedra (VTK_TETRA, VTK_QUADRATIC_TETRA, VTK_LAGRANGE_TETRAHEDRON,
+# VTK_BEZIER_TETRAHEDRON).
+_VTK_TETRAHEDRA = (10, 24, 71, 78)
+# VTK's cell types of dimension 3 that are not tetrahedra (hexahedra, wedges, pyramids, ...).
+_VTK_OTHER_SOLIDS = {11: "voxel", 12: "hexahedron", 13: "wedge", 14: "pyramid", 15: "pentagonal prism",
+                     16: "hexagonal prism", 25: "quadratic hexahedron", 26: "quadratic wedge",
+                     27: "quadratic pyramid", 29: "triquadratic hexahedron", 32: "biquadratic quadratic wedge",
+                     33: "biquadratic quadratic hexahedron", 42: "polyhedron", 72: "Lagrange hexahedron",
+                     73: "Lagrange wedge", 74: "Lagrange pyramid", 79: "Bezier hexahedron", 80: "Bezier wedge",
+                     81: "Bezier pyramid"}
+# meshio's cell types: tetrahedra (their first four nodes the corners), and other solids.
+_MESHIO_TETRAHEDRA = ("tetra", "tetra10", "tetra20", "tetra35", "tetra56", "tetra84", "tetra120", "tetra165",
+                      "tetra220", "tetra286")
+_MESHIO_SOLIDS = ("hexahedron", "wedge", "pyramid", "polyhedron")
+
+
+def _refuse_solids(found: dict) -> None:
+    if found:
+        listed = ", ".join(f"{n} {kind}" for kind, n in found.items())
+        raise ValueError(f"the mesh has {listed} besides its tetrahedra: halo4d checks tetrahedral meshes "
+                         "only; split the other cells into tetrahedra first")
+
+
+def check(source: Any) -> dict[str, Any]:
+    """`halo4d check` on a file or folder (str or os.PathLike), or the certificate of a
+    tetrahedral mesh in memory, without writing a file: a PyVista `UnstructuredGrid`, a
+    meshio `Mesh`, or `(points, cells)` NumPy arrays ((n, 3) and (m, 4), in VTK's and
+    Gmsh's convention: a, b, c, d positive when det[b - a, c - a, d - a] > 0).
+
+    Gives a dict: `verified`, `failures`, `halos` (each mesh's statistics), `plain`,
+    `format`, `text` (what the command prints), `certificate` (for another program's mesh:
+    `convention`, `boundary`, `quality` and `faults`, each tetrahedron's fault bits as a
+    NumPy uint32 array), for a folder `curves` and `verification`, and for a mesh in
+    memory `cell_faults`: the fault bits of each of its cells (0 for the lower-dimensional
+    cells it skips), to set as cell data, the way PyVista's own `validate_mesh` gives a
+    status per cell. A file that cannot be read raises `OSError`; a mesh with other solids
+    than tetrahedra, indices out of range or non-finite points, `ValueError`.
+    """
+    if isinstance(source, (str, os.PathLike)):
+        return _check_path(source)
+    import numpy as np
+
+    if hasattr(source, "celltypes") and hasattr(source, "cell_connectivity"):
+        # A PyVista UnstructuredGrid.
+        types = np.asarray(source.celltypes)
+        # PyVista 0.49 names the cells' starts `cell_offsets` (`offset` before).
+        offsets = np.asarray(source.cell_offsets if hasattr(source, "cell_offsets") else source.offset,
+                             dtype=np.int64)
+        conn = np.asarray(source.cell_connectivity, dtype=np.int64)
+        _refuse_solids({name: int(np.count_nonzero(types == t)) for t, name in _VTK_OTHER_SOLIDS.items()
+                        if np.any(types == t)})
+        which = np.flatnonzero(np.isin(types, _VTK_TETRAHEDRA))
+        tets = conn[offsets[which][:, None] + np.arange(4)] if len(which) else np.zeros((0, 4), np.int64)
+        points, n_cells, fmt = np.asarray(source.points, dtype=np.float64), len(types), "a PyVista UnstructuredGrid"
+    elif hasattr(source, "points") and hasattr(source, "cells"):
+        # A meshio Mesh: its cell blocks one after the other.
+        blocks, which, start = [], [], 0
+        _refuse_solids({b.type: len(b.data) for b in source.cells if b.type.startswith(_MESHIO_SOLIDS)})
+        for b in source.cells:
+            if b.type in _MESHIO_TETRAHEDRA:
+                blocks.append(np.asarray(b.data, dtype=np.int64)[:, :4])
+                which.append(np.arange(start, start + len(b.data)))
+            start += len(b.data)
+        tets = np.vstack(blocks) if blocks else np.zeros((0, 4), np.int64)
+        which = np.concatenate(which) if which else np.zeros(0, np.int64)
+        points, n_cells, fmt = np.asarray(source.points, dtype=np.float64), start, "a meshio Mesh"
+    elif isinstance(source, tuple) and len(source) == 2:
+        points = np.asarray(source[0], dtype=np.float64)
+        tets = np.asarray(source[1], dtype=np.int64)
+        n_cells, which, fmt = len(tets), np.arange(len(tets)), "(points, cells) arrays"
+    else:
+        raise TypeError(f"halo4d.check takes a path, a PyVista UnstructuredGrid, a meshio Mesh or "
+                        f"(points, cells) arrays, not {type(source).__name__}")
+    if points.ndim != 2 or points.shape[1] != 3 or tets.ndim != 2 or tets.shape[1] != 4:
+        raise ValueError(f"points must be (n, 3) and cells (m, 4); got {points.shape} and {tets.shape}")
+    result = _certify(np.ascontiguousarray(points), np.ascontiguousarray(tets), "mesh", fmt)
+    cell_faults = np.zeros(n_cells, dtype=np.uint32)
+    cell_faults[which] = result["certificate"]["faults"]
+    result["cell_faults"] = cell_faults
+    return result
+
 
 __all__ = [
     "BuildError",

@@ -766,6 +766,56 @@ fn check<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
         }
     })?
     .map_err(|e| PyOSError::new_err(e.to_string()))?;
+    checked_dict(py, &checked)
+}
+
+/// The certificate of tetrahedra given as arrays (what `halo4d.check` makes of a PyVista
+/// grid, a meshio mesh or `(points, cells)`): `points` (n, 3) float64, `tets` (m, 4) int64
+/// in VTK's convention (a, b, c, d positive when det[b - a, c - a, d - a] > 0), `name` and
+/// `format` saying where they came from. The dict of `check`; indices out of range or
+/// non-finite points raise `ValueError`.
+#[pyfunction]
+fn certify_arrays<'py>(
+    py: Python<'py>,
+    points: numpy::PyReadonlyArray2<'py, f64>,
+    tets: numpy::PyReadonlyArray2<'py, i64>,
+    name: String,
+    format: String,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (p, t) = (points.as_array(), tets.as_array());
+    if p.ncols() != 3 || t.ncols() != 4 {
+        return Err(PyValueError::new_err(format!(
+            "points must be (n, 3) and tetrahedra (m, 4); got {:?} and {:?}",
+            p.shape(),
+            t.shape()
+        )));
+    }
+    let positions: Vec<[f64; 3]> = p.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect();
+    let n = positions.len();
+    let mut cells = Vec::with_capacity(t.nrows());
+    for (k, r) in t.rows().into_iter().enumerate() {
+        let mut c = [0u32; 4];
+        for (slot, &i) in c.iter_mut().zip(r.iter()) {
+            *slot = u32::try_from(i)
+                .ok()
+                .filter(|&i| (i as usize) < n)
+                .ok_or_else(|| {
+                    PyValueError::new_err(format!(
+                        "tetrahedron {k} names point {i}, but there are {n} points"
+                    ))
+                })?;
+        }
+        cells.push(c);
+    }
+    let mesh = halo4d::import::PlainTetrahedra::from_arrays(&name, &format, positions, &cells)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let label = PathBuf::from(&name);
+    let checked = run(py, move || halo4d::check_mesh(&label, mesh))?;
+    checked_dict(py, &checked)
+}
+
+/// What `check` gives for a `Checked`.
+fn checked_dict<'py>(py: Python<'py>, checked: &halo4d::Checked) -> PyResult<Bound<'py, PyAny>> {
     let out = PyDict::new(py);
     let failures = checked.failures();
     out.set_item("verified", failures.is_empty())?;
@@ -788,7 +838,7 @@ fn check<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
     out.set_item("plain", checked.plain.clone())?;
     if let Some(certificate) = &checked.certificate {
         let entry = to_python(py, certificate)?;
-        entry.set_item("faults", certificate.faults.clone())?;
+        entry.set_item("faults", PyArray1::from_slice(py, &certificate.faults))?;
         out.set_item("certificate", entry)?;
     }
     out.set_item("format", checked.mesh.as_ref().map(|m| m.format.clone()))?;
@@ -811,5 +861,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Curve>()?;
     m.add_function(wrap_pyfunction!(catalogue, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
+    m.add_function(wrap_pyfunction!(certify_arrays, m)?)?;
     Ok(())
 }

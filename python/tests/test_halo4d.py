@@ -371,3 +371,41 @@ def test_the_type_stubs_name_what_the_module_has():
         if issubclass(cls, Exception):
             own |= {"field", "file"} if name == "SceneError" else set()
         assert members == own, (name, members ^ own)
+
+
+def test_a_mesh_in_memory_is_certified_without_a_file_with_its_faults_per_cell():
+    import pyvista
+
+    faults = ROOT / "fixtures" / "tetmeshes" / "faults"
+    # The same mesh from a file, as a PyVista grid, as a meshio mesh and as arrays: the
+    # same certificate.
+    by_file = halo4d.check(faults / "nested-balls.vtk")
+    grid = pyvista.read(faults / "nested-balls.vtk")
+    mesh = meshio.read(faults / "nested-balls.vtk")
+    tets = mesh.cells_dict["tetra"]
+    for source in (grid, mesh, (mesh.points, tets)):
+        got = halo4d.check(source)
+        assert got["failures"] == by_file["failures"], type(source)
+        assert got["certificate"]["boundary"] == by_file["certificate"]["boundary"]
+        assert np.array_equal(got["certificate"]["faults"], by_file["certificate"]["faults"])
+        assert got["cell_faults"].dtype == np.uint32
+    # The bits per cell, to show in PyVista: every cell of the inner ball's boundary marked
+    # wrong winding (1024), none of the outer's interior.
+    result = halo4d.check(grid)
+    grid.cell_data["fault"] = result["cell_faults"]
+    assert grid.cell_data["fault"].shape == (grid.n_cells,)
+    assert np.count_nonzero(result["cell_faults"] & 1024) > 0
+    # A triangle among the cells is skipped (fault 0), the tetrahedra keep theirs.
+    points = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=float)
+    mixed = meshio.Mesh(points, [("triangle", np.array([[0, 1, 2]])), ("tetra", np.array([[0, 1, 2, 3]]))])
+    got = halo4d.check(mixed)
+    assert got["verified"] and list(got["cell_faults"]) == [0, 0], got["failures"]
+    flipped = halo4d.check((points, np.array([[0, 2, 1, 3], [0, 1, 2, 3]])))
+    assert not flipped["verified"]
+    # Bad input is a clear error, not a crash.
+    with pytest.raises(ValueError, match="names point 9"):
+        halo4d.check((points, np.array([[0, 1, 2, 9]])))
+    with pytest.raises(ValueError, match="hexahedron"):
+        halo4d.check(meshio.Mesh(np.zeros((8, 3)), [("hexahedron", np.arange(8)[None, :])]))
+    with pytest.raises(TypeError, match="PyVista UnstructuredGrid"):
+        halo4d.check(42)

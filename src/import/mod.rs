@@ -353,6 +353,32 @@ pub struct PlainTetrahedra {
 }
 
 impl PlainTetrahedra {
+    /// Another program's tetrahedra given in memory (a PyVista grid's, a meshio mesh's,
+    /// arrays), in VTK's and Gmsh's convention as the files have them (a, b, c, d positive
+    /// when det[b − a, c − a, d − a] > 0), converted to halo4d's (`convention`); `format`
+    /// says where they came from. Non-finite positions and indices out of range are an
+    /// [`ImportError::BadTetrahedra`].
+    pub fn from_arrays(
+        name: &str,
+        format: &str,
+        positions: Vec<[f64; 3]>,
+        tets: &[[u32; 4]],
+    ) -> Result<Self, ImportError> {
+        PlainTetrahedra {
+            name: name.to_string(),
+            positions,
+            tets: tets
+                .iter()
+                .map(|&t| crate::convention::file_order(t))
+                .collect(),
+            why: format!("{format}, which has no halo layout (another program's tetrahedra)"),
+            format: format.to_string(),
+            pieces: Vec::new(),
+            piece_of: Vec::new(),
+        }
+        .validate()
+    }
+
     /// Checks what the checker takes for granted: finite positions, indices in range, and
     /// for a mesh of pieces, a piece for each tetrahedron.
     fn validate(self) -> Result<Self, ImportError> {
