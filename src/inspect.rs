@@ -182,7 +182,7 @@ pub fn verify_scene(scene: &ImportedScene) -> (Curves, Verification) {
 }
 
 /// Each halo's checker statistics; and the halos whose files do not give the surface's
-/// triangles, certified as tetrahedral meshes.
+/// triangles, whose coverage of the surface is therefore unchecked.
 fn check_halos<'a>(
     halos: impl Iterator<Item = &'a ImportedHalo>,
 ) -> (Vec<(String, CheckStats)>, Vec<Unchecked>) {
