@@ -489,7 +489,7 @@ def transformed_runs(binary, folder, meshes):
                 print(f"{path.name}: exit {got[0]} {got[1]}, the original {want[1]}: the planted faults named in both")
             else:
                 failed.append(f"{path.name}: exit {got[0]} {got[1]}, the original exit {want[0]} {want[1]}")
-                print(f"{path.name}: {failed[-1]}")
+                print(failed[-1])
         rows.append((f"every mesh above {label} ({len(meshes)} files)", "the original's verdict",
                      f"{'same' if same == len(meshes) else 'DIFFERENT'} verdict {same}/{len(meshes)}, "
                      f"{ms(times)} in all (originals {ms(original)})", "", "", "", ""))
