@@ -27,7 +27,7 @@ fn certify_meshes(c: &mut Criterion) {
         );
         let file = dir.path().join(format!("kuhn-{n}.vtu"));
         let in_file: Vec<[u32; 4]> = tets.iter().map(|&t| file_order(t)).collect();
-        write_tetrahedra_vtu(&file, &positions, &in_file, &[]).expect("the .vtu is written");
+        write_tetrahedra_vtu(&file, &positions, &in_file, &[], &[]).expect("the .vtu is written");
         drop((positions, tets, in_file));
         group.bench_with_input(BenchmarkId::new("vtu_file", 6 * n.pow(3)), &file, |b, f| {
             b.iter(|| {

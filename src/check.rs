@@ -256,24 +256,27 @@ const CHECK_RUN: usize = 1 << 14;
 pub const SAFE_RANGE: f64 = 1e80;
 
 /// The positions as the checker decides on them ([`scaled`]).
-struct Scaled {
+pub(crate) struct Scaled {
     /// Every vertex that a tetrahedron uses, scaled as a whole by the power of two that
     /// brings the largest coordinate of those into [0.5, 1) (exact: every orientation is
     /// kept, and `robust::orient3d` cannot overflow); the vertices no tetrahedron uses at
     /// the origin, so that they take no part in the scaling.
-    positions: Vec<[f64; 3]>,
+    pub(crate) positions: Vec<[f64; 3]>,
     /// The factor that scales volumes back.
-    volume_scale: f64,
+    pub(crate) volume_scale: f64,
     /// Which vertices have a coordinate too small for the predicates to stay exact
     /// ([`SAFE_RANGE`]).
-    tiny: Vec<bool>,
+    pub(crate) tiny: Vec<bool>,
     /// The middle of the box of the used vertices (scaled): the origin volumes are summed
     /// from, so that they do not cancel wherever the mesh stands.
-    centre: [f64; 3],
+    pub(crate) centre: [f64; 3],
 }
 
 /// The positions the checker decides on ([`Scaled`]), with the vertices that `tets` use.
-fn scaled<P: Copy + Into<[f64; 3]> + Sync>(positions: &[P], tets: &[[u32; 4]]) -> Scaled {
+pub(crate) fn scaled<P: Copy + Into<[f64; 3]> + Sync>(
+    positions: &[P],
+    tets: &[[u32; 4]],
+) -> Scaled {
     use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
     let marks: Vec<AtomicBool> = (0..positions.len())
         .map(|_| AtomicBool::new(false))

@@ -11,7 +11,7 @@
 //! from the same library functions: [`CheckStats::verdict`], [`CurvesReport::failures`],
 //! [`Verification::failures`].
 
-use crate::certify::{Certificate, Fault, certify};
+use crate::certify::{Certificate, Fault, certify_cells};
 use crate::check::{CheckStats, HALO_ONLY, check};
 use crate::convention::file_order;
 use crate::export::{CellValues, write_tetrahedra_vtu};
@@ -68,7 +68,7 @@ pub struct Unchecked {
 pub struct Piece {
     /// Its file, as the `.pvtu` names it.
     pub file: String,
-    /// Its tetrahedra.
+    /// Its cells: its tetrahedra, and a mixed mesh's other cells.
     pub tets: usize,
     /// Those with a fault.
     pub faulty: usize,
@@ -131,7 +131,7 @@ pub fn check_file(file: &Path) -> Result<Checked, InspectError> {
 /// memory ([`PlainTetrahedra::from_arrays`]; `file` then names where it came from): what
 /// [`check_file`] gives for such a file.
 pub fn check_mesh(file: &Path, mesh: PlainTetrahedra) -> Checked {
-    let certificate = certify(&mesh.positions, &mesh.tets);
+    let certificate = certify_cells(&mesh.positions, &mesh.tets, &mesh.solids);
     Checked {
         file: file.to_path_buf(),
         scene: None,
@@ -244,13 +244,15 @@ impl Checked {
         if let Some(c) = &self.certificate {
             out += &certificate_text(c);
         }
+        let mesh_is_mixed = self.certificate.as_ref().is_some_and(|c| c.cells.is_some());
         for p in self.pieces().iter().filter(|p| p.faulty > 0) {
             let faults: Vec<String> = p.faults.iter().map(|(f, n)| format!("{n} {f}")).collect();
             out += &format!(
-                "piece {}: {} of its {} tetrahedra with a fault ({})\n",
+                "piece {}: {} of its {} {} with a fault ({})\n",
                 p.file,
                 p.faulty,
                 p.tets,
+                if mesh_is_mixed { "cells" } else { "tetrahedra" },
                 faults.join(", ")
             );
         }
@@ -273,7 +275,23 @@ impl Checked {
         for f in &failures {
             out += &format!("FAILED {f}\n");
         }
-        if let (true, Some(c)) = (failures.is_empty(), &self.certificate) {
+        if let (
+            true,
+            Some(Certificate {
+                cells: Some(_),
+                boundary: b,
+                ..
+            }),
+        ) = (failures.is_empty(), &self.certificate)
+        {
+            out += &format!(
+                "ok: a valid subdivision of the region its boundary encloses into its cells: every cell positive and star-shaped, every two meeting face to face or not at all (bent quadrilaterals only between two cells that both have them), the boundary manifold, not meeting itself and wound once around ({} {}, {} {})\n",
+                b.components,
+                plural(b.components, "component", "components"),
+                b.cavities,
+                plural(b.cavities, "cavity", "cavities"),
+            );
+        } else if let (true, Some(c)) = (failures.is_empty(), &self.certificate) {
             let b = &c.boundary;
             out += &format!(
                 "ok: a valid tetrahedralization of the region its boundary encloses: every tetrahedron positive, every two meeting face to face or not at all, the boundary manifold, not meeting itself and wound once around ({} {}, {} {})\n",
@@ -345,9 +363,10 @@ impl Checked {
     }
 
     /// Writes the checked mesh (one without halo4d's layout) to `path` as a `.vtu` with
-    /// each tetrahedron's faults as the cell field `fault` (the bits of [`Fault`]), and its
-    /// `min_dihedral_deg`, `max_dihedral_deg` and `radius_ratio`: to open in ParaView and
-    /// threshold on `fault`. The tetrahedra as the file gave them.
+    /// each cell's faults as the cell field `fault` (the bits of [`Fault`]), and its
+    /// `min_dihedral_deg`, `max_dihedral_deg` and `radius_ratio` (a mixed mesh's other cells:
+    /// the extremes over the tetrahedra they were certified as): to open in ParaView and
+    /// threshold on `fault`. The cells as the file gave them.
     pub fn write_marks(&self, path: &Path) -> Result<(), String> {
         let (Some(mesh), Some(c)) = (&self.mesh, &self.certificate) else {
             return Err(
@@ -355,14 +374,32 @@ impl Checked {
             );
         };
         let tets: Vec<[u32; 4]> = mesh.tets.iter().map(|&t| file_order(t)).collect();
-        let column = |k: usize| c.shapes.iter().map(|s| s[k]).collect::<Vec<f32>>();
+        let others: Vec<(u8, &[u32])> = mesh
+            .solids
+            .iter()
+            .map(|s| (s.kind.vtk_type(), s.used()))
+            .collect();
+        // Each cell's shape: a tetrahedron's own; another cell's extremes over its
+        // tetrahedra.
+        let mut shapes = c.shapes[..tets.len()].to_vec();
+        if let Some(cells) = &c.cells {
+            shapes.extend(cells.first_tet.windows(2).map(|w| {
+                c.shapes[w[0]..w[1]]
+                    .iter()
+                    .fold([f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY], |a, s| {
+                        [a[0].min(s[0]), a[1].max(s[1]), a[2].min(s[2])]
+                    })
+            }));
+        }
+        let column = |k: usize| shapes.iter().map(|s| s[k]).collect::<Vec<f32>>();
         let (lo, hi, ratio) = (column(0), column(1), column(2));
         write_tetrahedra_vtu(
             path,
             &mesh.positions,
             &tets,
+            &others,
             &[
-                ("fault", CellValues::U32(&c.faults)),
+                ("fault", CellValues::U32(c.cell_faults())),
                 ("min_dihedral_deg", CellValues::F32(&lo)),
                 ("max_dihedral_deg", CellValues::F32(&hi)),
                 ("radius_ratio", CellValues::F32(&ratio)),
@@ -389,7 +426,7 @@ impl Checked {
             })
             .collect();
         let mut counts = vec![[0usize; Fault::NAMES.len()]; out.len()];
-        for (&k, &bits) in mesh.piece_of.iter().zip(&c.faults) {
+        for (&k, &bits) in mesh.piece_of.iter().zip(c.cell_faults()) {
             let Some(piece) = out.get_mut(k as usize) else {
                 continue;
             };
@@ -413,14 +450,19 @@ impl Checked {
         out
     }
 
-    /// How many tetrahedra have each fault bit, for the line `--mark` prints.
+    /// How many cells have each fault bit, for the line `--mark` prints.
     pub fn marked(&self) -> Vec<(&'static str, usize)> {
         let Some(c) = &self.certificate else {
             return Vec::new();
         };
         Fault::NAMES
             .iter()
-            .map(|&(bit, name)| (name, c.faults.iter().filter(|&&f| f & bit != 0).count()))
+            .map(|&(bit, name)| {
+                (
+                    name,
+                    c.cell_faults().iter().filter(|&&f| f & bit != 0).count(),
+                )
+            })
             .filter(|&(_, n)| n > 0)
             .collect()
     }
@@ -466,6 +508,9 @@ fn certificate_text(c: &Certificate) -> String {
             },
         ),
     ];
+    if let Some(cells) = &c.cells {
+        out += &cells_text(cells);
+    }
     out += "\nboundary\n";
     for (k, v) in rows {
         let _ = writeln!(out, "  {k:<22}{v}");
@@ -493,11 +538,61 @@ fn certificate_text(c: &Certificate) -> String {
     }
     out += "  worst (smallest radius ratio)\n";
     for w in q.worst.iter().take(5) {
+        let of = match c.cells.as_ref().map(|cells| cells.cell_of(w.tet)) {
+            Some((kind, id)) if kind != "tetrahedron" => format!(" (of {kind} {id})"),
+            _ => String::new(),
+        };
         let _ = writeln!(
             out,
-            "    tetrahedron {:>10}: radius ratio {:.3e}, dihedral angles {:.4} to {:.4} degrees",
+            "    tetrahedron {:>10}{of}: radius ratio {:.3e}, dihedral angles {:.4} to {:.4} degrees",
             w.tet, w.radius_ratio, w.min_dihedral_deg, w.max_dihedral_deg
         );
+    }
+    out
+}
+
+/// A mixed mesh's cells, its quadrilaterals and its first faulty cells, as text.
+fn cells_text(c: &crate::certify::Cells) -> String {
+    let mut out = String::from("\ncells\n");
+    let rows = [
+        ("tetrahedra", c.tetrahedra.to_string()),
+        ("hexahedra", c.hexahedra.to_string()),
+        ("wedges", c.wedges.to_string()),
+        ("pyramids", c.pyramids.to_string()),
+        (
+            "certified as",
+            format!(
+                "{} tetrahedra (a hexahedron 12 and a wedge 8 around their corners' mean, a pyramid 2)",
+                c.certified_tetrahedra
+            ),
+        ),
+        ("quadrilaterals", c.quads.to_string()),
+        (
+            "nonplanar_quads",
+            if c.nonplanar_quads > 0 {
+                let w = c.max_warp_deg;
+                let w = if w < 1e-3 {
+                    format!("{w:.2e}")
+                } else {
+                    format!("{w:.4}")
+                };
+                format!("{} (the largest warp {w} degrees)", c.nonplanar_quads)
+            } else {
+                "0".into()
+            },
+        ),
+        ("nonconforming_quads", c.nonconforming_quads.to_string()),
+        ("undecided_quads", c.undecided_quads.to_string()),
+        ("cells with a fault", c.faulty_cells.to_string()),
+    ];
+    for (k, v) in rows {
+        let _ = writeln!(out, "  {k:<22}{v}");
+    }
+    for f in &c.faulty {
+        let _ = writeln!(out, "    {} {}: {}", f.kind, f.id, f.faults.join(", "));
+    }
+    if c.faulty_cells > c.faulty.len() {
+        let _ = writeln!(out, "    ... and {} more", c.faulty_cells - c.faulty.len());
     }
     out
 }

@@ -452,7 +452,7 @@ fn two_pieces(dir: &std::path::Path, shift: f64) -> std::path::PathBuf {
             })
             .collect();
         let tets: Vec<[u32; 4]> = tets.iter().map(|q| file_order(q.map(local))).collect();
-        write_tetrahedra_vtu(&dir.join(format!("cube_{k}.vtu")), &points, &tets, &[]).unwrap();
+        write_tetrahedra_vtu(&dir.join(format!("cube_{k}.vtu")), &points, &tets, &[], &[]).unwrap();
     }
     let pvtu = dir.join("cube.pvtu");
     std::fs::write(

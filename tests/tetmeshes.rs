@@ -592,8 +592,8 @@ fn indices_out_of_range_and_nan_coordinates_fail() {
 }
 
 #[test]
-fn other_solids_are_refused_by_name_and_count() {
-    // A Gmsh tetrahedron made a hexahedron (type 5, 8 nodes).
+fn solids_other_than_the_four_are_refused_by_name_and_count() {
+    // A Gmsh tetrahedron made a hexahedron (type 5, 8 nodes): read as one.
     let text = std::fs::read_to_string(path("cube-2.2-ascii.msh")).unwrap();
     let tet = text
         .lines()
@@ -601,12 +601,14 @@ fn other_solids_are_refused_by_name_and_count() {
         .unwrap();
     let w: Vec<&str> = tet.split_whitespace().collect();
     let hex = format!("{} 5 {} {}", w[0], w[2..].join(" "), w[5..9].join(" "));
-    fails(
-        "cube.msh",
-        text.replace(tet, &hex).as_bytes(),
-        true,
-        &["1 hexahedra", "11 tetrahedra", "tetrahedral meshes"],
-    );
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("cube.msh");
+    std::fs::write(&p, text.replace(tet, &hex)).unwrap();
+    let m = plain(&p);
+    assert_eq!((m.tets.len(), m.solids.len()), (11, 1));
+    assert_eq!(m.solids[0].id, w[0].parse::<u64>().unwrap());
+    // Medit's hexahedra and prisms are not read (their corner order is not VTK's or Gmsh's
+    // for certain).
     fails(
         "cube.mesh",
         &edit(
@@ -617,17 +619,139 @@ fn other_solids_are_refused_by_name_and_count() {
         true,
         &["2 hexahedra", "1 prisms", "12 tetrahedra"],
     );
-    // A VTU tetrahedron's type made 12 (hexahedron).
+    // A VTU tetrahedron's type made 16 (a hexagonal prism).
     let vtu = std::fs::read_to_string(path("cube-ascii.vtu")).unwrap();
     let types = vtu.find("Name=\"types\"").unwrap();
     let ten = types + vtu[types..].find("10").unwrap();
     let mut bad = vtu.clone();
-    bad.replace_range(ten..ten + 2, "12");
+    bad.replace_range(ten..ten + 2, "16");
     fails(
         "cube.vtu",
         bad.as_bytes(),
         true,
-        &["1 hexahedra", "tetrahedral meshes"],
+        &["1 hexagonal prisms", "four kinds of cell"],
+    );
+}
+
+/// The mixed mesh as Gmsh 4.15.2 and VTK 9.5.2 write it (`make.py`), each file's cells as
+/// the writer gave them.
+const MIXED: [&str; 5] = [
+    "mixed-4.1-ascii.msh",
+    "mixed-2.2-binary.msh",
+    "mixed-order2.msh",
+    "mixed.vtk",
+    "mixed-vtk9.vtu",
+];
+
+/// Each cell's corners' coordinates in VTK's order (to 1e-9: Gmsh's text keeps 16 digits,
+/// not every bit), the cells sorted: the same mesh whatever the numbering of its points and
+/// cells.
+fn mixed_corners(m: &PlainTetrahedra) -> Vec<Vec<[i64; 3]>> {
+    let at = |i: &u32| m.positions[*i as usize].map(|x| (x * 1e9).round() as i64);
+    let mut out: Vec<Vec<[i64; 3]>> = m
+        .tets
+        .iter()
+        .map(|t| t.iter().map(at).collect())
+        .chain(m.solids.iter().map(|s| s.used().iter().map(at).collect()))
+        .collect();
+    out.sort();
+    out
+}
+
+#[test]
+fn a_mixed_mesh_reads_the_same_from_gmsh_and_vtk_in_vtk_corner_order() {
+    let first = plain(&path(MIXED[0]));
+    let kinds = |m: &PlainTetrahedra| {
+        use halo4d::import::SolidKind::*;
+        [Hexahedron, Wedge, Pyramid].map(|k| m.solids.iter().filter(|s| s.kind == k).count())
+    };
+    assert_eq!((first.tets.len(), kinds(&first)), (133, [12, 24, 6]));
+    // Gmsh's prisms turn their first triangle towards the opposite one, VTK's wedges away
+    // from it: read from either, every wedge is VTK's.
+    for name in MIXED {
+        let m = plain(&path(name));
+        assert!(mixed_corners(&m) == mixed_corners(&first), "{name}");
+        let checked = halo4d::check_file(&path(name)).unwrap();
+        assert!(
+            checked.failures().is_empty(),
+            "{name}: {:?}",
+            checked.failures()
+        );
+        let c = checked.certificate.as_ref().unwrap();
+        let cells = c.cells.as_ref().unwrap();
+        assert_eq!(cells.certified_tetrahedra, 133 + 12 * 12 + 24 * 8 + 6 * 2);
+        assert_eq!((cells.quads, cells.nonplanar_quads), (94, 78), "{name}");
+        assert_eq!(c.convention, halo4d::certify::Convention::Positive);
+        // The twist turns each horizontal section rigidly: the volume is the box's within
+        // what the bent quadrilaterals' split moves.
+        assert!((c.stats.volume - 3.0).abs() < 0.01, "{}", c.stats.volume);
+        assert!(checked.text().contains("ok: a valid subdivision"), "{name}");
+    }
+}
+
+#[test]
+fn a_split_hexahedron_conforms_where_its_faces_are_planar_and_is_named_where_bent() {
+    let checked = halo4d::check_file(&path("mixed-untwisted-split-hex.vtu")).unwrap();
+    assert!(checked.failures().is_empty(), "{:?}", checked.failures());
+    let checked = halo4d::check_file(&path("mixed-split-hex.vtu")).unwrap();
+    assert_eq!(
+        checked.failures(),
+        ["2 nonconforming_quads (bent quadrilaterals against two triangles of other cells)"]
+    );
+    let cells = checked.certificate.as_ref().unwrap().cells.clone().unwrap();
+    // The two hexahedra whose bent faces meet the split one's tetrahedra.
+    assert_eq!(cells.faulty_cells, 2);
+    assert!(
+        cells
+            .faulty
+            .iter()
+            .all(|f| f.kind == "hexahedron" && f.faults == ["non-conforming quadrilateral"]),
+        "{:?}",
+        cells.faulty
+    );
+    let text = checked.text();
+    assert!(text.contains("nonconforming_quads   2"), "{text}");
+
+    let checked = halo4d::check_file(&path("mixed-inverted-wedge.vtu")).unwrap();
+    assert_eq!(checked.failures(), ["8 inverted"]);
+    let cells = checked.certificate.as_ref().unwrap().cells.clone().unwrap();
+    assert_eq!(cells.faulty_cells, 1);
+    assert_eq!(cells.faulty[0].kind, "wedge");
+    assert!(cells.faulty[0].faults.contains(&"inverted"));
+}
+
+#[test]
+fn mark_writes_a_mixed_mesh_as_its_cells_with_their_faults() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("marked.vtu");
+    let o = halo4d(
+        &[
+            "check",
+            path("mixed-split-hex.vtu").to_str().unwrap(),
+            "--mark",
+            out.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("2 non-conforming quadrilateral"),
+        "{stdout}"
+    );
+    // The marked file holds the same cells, and is certified alike.
+    let (a, b) = (plain(&out), plain(&path("mixed-split-hex.vtu")));
+    assert!(mixed_corners(&a) == mixed_corners(&b));
+    assert_eq!(
+        halo4d::check_file(&out).unwrap().failures(),
+        halo4d::check_file(&path("mixed-split-hex.vtu"))
+            .unwrap()
+            .failures()
     );
 }
 

@@ -28,11 +28,13 @@
 //! between it and the face's centroid. The winding number there is exact.
 
 mod boundary;
+mod cells;
 mod exact;
 mod grid;
 mod quality;
 
 pub use boundary::Boundary;
+pub use cells::{Cells, FaultyCell, certify_cells};
 pub use grid::kuhn_cube;
 pub use quality::{BINS, Bin, Cell, Quality, WORST};
 
@@ -71,9 +73,11 @@ impl Fault {
     pub const WINDING: u32 = 1 << 10;
     /// A boundary face of a cavity (not a fault: reported).
     pub const CAVITY: u32 = 1 << 11;
+    /// A cell with a bent quadrilateral against two triangles of other cells (mixed meshes).
+    pub const NONCONFORMING: u32 = 1 << 12;
 
     /// Every bit with its name, as `--mark`'s legend and the README give them.
-    pub const NAMES: [(u32, &'static str); 12] = [
+    pub const NAMES: [(u32, &'static str); 13] = [
         (Self::INVERTED, "inverted"),
         (Self::FLAT, "flat"),
         (Self::UNDECIDABLE, "undecidable"),
@@ -86,6 +90,7 @@ impl Fault {
         (Self::SELF_INTERSECTION, "self-intersecting boundary"),
         (Self::WINDING, "wrong winding"),
         (Self::CAVITY, "cavity (not a fault)"),
+        (Self::NONCONFORMING, "non-conforming quadrilateral"),
     ];
 }
 
@@ -118,9 +123,19 @@ pub struct Certificate {
     /// Each tetrahedron's smallest and largest dihedral angle (degrees) and radius ratio.
     #[serde(skip)]
     pub shapes: Vec<[f32; 3]>,
+    /// For a mixed mesh (hexahedra, wedges, pyramids): its cells and quadrilaterals
+    /// ([`certify_cells`]); the tetrahedra above are then those certified.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cells: Option<Cells>,
 }
 
 impl Certificate {
+    /// Each cell's [`Fault`] bits: each tetrahedron's, and for a mixed mesh then each other
+    /// cell's ([`Cells::faults`]).
+    pub fn cell_faults(&self) -> &[u32] {
+        self.cells.as_ref().map_or(&self.faults, |c| &c.faults)
+    }
+
     /// What keeps the mesh from passing: [`CheckStats::failures`] (a mesh without
     /// tetrahedra among them), then each non-zero count of the boundary's faults as `<count> <name>`;
     /// empty when it passes.
@@ -162,6 +177,11 @@ impl Certificate {
                 "undecided_windings",
                 b.undecided_windings,
                 "components whose winding number could not be decided",
+            ),
+            (
+                "nonconforming_quads",
+                self.cells.as_ref().map_or(0, |c| c.nonconforming_quads),
+                "bent quadrilaterals against two triangles of other cells",
             ),
         ] {
             if count > 0 {
@@ -266,5 +286,6 @@ pub fn certify(positions: &[[f64; 3]], tets: &[[u32; 4]]) -> Certificate {
         quality,
         faults,
         shapes,
+        cells: None,
     }
 }

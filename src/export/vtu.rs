@@ -1,12 +1,12 @@
-//! Tetrahedra with cell fields as a VTK XML unstructured grid (`.vtu`), its arrays raw in
-//! one appended block (little-endian, 64-bit block headers): ParaView, VTK and meshio read
-//! it, and a mesh of ten million tetrahedra is written without a text or base64 copy. What
-//! `halo4d check --mark` writes: the checked mesh with each tetrahedron's faults.
+//! Tetrahedra (and other cells) with cell fields as a VTK XML unstructured grid (`.vtu`), its
+//! arrays raw in one appended block (little-endian, 64-bit block headers): ParaView, VTK and
+//! meshio read it, and a mesh of ten million tetrahedra is written without a text or base64
+//! copy. What `halo4d check --mark` writes: the checked mesh with each cell's faults.
 
 use std::io::Write;
 use std::path::Path;
 
-/// A cell field's values, one per tetrahedron.
+/// A cell field's values, one per cell.
 #[derive(Clone, Copy, Debug)]
 pub enum CellValues<'a> {
     /// Unsigned 32-bit integers (bit sets, counts).
@@ -39,29 +39,32 @@ impl CellValues<'_> {
     }
 }
 
-/// Writes `positions` and `tets` (vertex indices in the file's order: VTK's positive
-/// orientation) with the named cell fields to `path`, atomically: a file that fails half
-/// way is not left behind. Every field must have one value per tetrahedron.
+/// Writes `positions`, `tets` (vertex indices in the file's order: VTK's positive
+/// orientation) and after them the `others` cells (each its VTK type and its points in
+/// VTK's order) with the named cell fields to `path`, atomically: a file that fails half
+/// way is not left behind. Every field must have one value per cell.
 pub fn write_tetrahedra_vtu(
     path: &Path,
     positions: &[[f64; 3]],
     tets: &[[u32; 4]],
+    others: &[(u8, &[u32])],
     fields: &[(&str, CellValues)],
 ) -> std::io::Result<()> {
+    let nc = tets.len() + others.len();
     for (name, values) in fields {
         let n = values.len();
-        if n != tets.len() {
+        if n != nc {
             return Err(std::io::Error::other(format!(
-                "cell field {name} has {n} values for {} tetrahedra",
-                tets.len()
+                "cell field {name} has {n} values for {nc} cells"
             )));
         }
     }
-    let (nv, nt) = (positions.len(), tets.len());
+    let nv = positions.len();
+    let points = 4 * tets.len() + others.iter().map(|o| o.1.len()).sum::<usize>();
     // Each array's byte size, in the order they are appended.
-    let mut sizes = vec![nv * 24, nt * 32, nt * 8, nt];
+    let mut sizes = vec![nv * 24, points * 8, nc * 8, nc];
     // Every cell field's values are 4 bytes wide.
-    sizes.extend(fields.iter().map(|_| nt * 4));
+    sizes.extend(fields.iter().map(|_| nc * 4));
     let mut offsets = Vec::with_capacity(sizes.len());
     let mut at = 0usize;
     for s in &sizes {
@@ -83,7 +86,7 @@ pub fn write_tetrahedra_vtu(
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <UnstructuredGrid>\n",
     );
     head +=
-        &format!("    <Piece NumberOfPoints=\"{nv}\" NumberOfCells=\"{nt}\">\n      <Points>\n");
+        &format!("    <Piece NumberOfPoints=\"{nv}\" NumberOfCells=\"{nc}\">\n      <Points>\n");
     head += &array("Float64", "Points", 3, offsets[0]);
     head += "      </Points>\n      <Cells>\n";
     head += &array("Int64", "connectivity", 1, offsets[1]);
@@ -104,18 +107,19 @@ pub fn write_tetrahedra_vtu(
             }
         }
         block(w, sizes[1])?;
-        for t in tets {
-            for &i in t {
-                w.write_all(&i64::from(i).to_le_bytes())?;
-            }
+        for &i in tets.iter().flatten().chain(others.iter().flat_map(|o| o.1)) {
+            w.write_all(&i64::from(i).to_le_bytes())?;
         }
         block(w, sizes[2])?;
-        for k in 1..=nt as i64 {
-            w.write_all(&(4 * k).to_le_bytes())?;
+        let mut end = 0i64;
+        for len in std::iter::repeat_n(4, tets.len()).chain(others.iter().map(|o| o.1.len())) {
+            end += len as i64;
+            w.write_all(&end.to_le_bytes())?;
         }
         block(w, sizes[3])?;
-        // VTK's tetrahedron.
-        w.write_all(&vec![10u8; nt])?;
+        // VTK's tetrahedron, then the other cells' types.
+        w.write_all(&vec![10u8; tets.len()])?;
+        w.write_all(&others.iter().map(|o| o.0).collect::<Vec<u8>>())?;
         for ((_, values), &size) in fields.iter().zip(&sizes[4..]) {
             block(w, size)?;
             values.write(w)?;

@@ -15,8 +15,10 @@
 //! tags. Every other section (`$PhysicalNames`, `$Entities`, `$NodeData`, `$Periodic`, ...)
 //! is skipped to its `$End` line. A UTF-8 byte-order mark before `$MeshFormat` is skipped.
 
-use super::tetfile::{Cells, Fail, Kind, Result, Scan, TagMap, Tagged, f64_at, non_finite, plain};
-use super::{MeshFileLocation, PlainTetrahedra};
+use super::tetfile::{
+    Cells, Fail, GMSH_PRISM, Kind, Result, SAME, Scan, TagMap, Tagged, f64_at, non_finite, plain,
+};
+use super::{MeshFileLocation, PlainTetrahedra, SolidKind};
 use crate::limits::shorten;
 
 /// Reads the tetrahedra of a Gmsh `.msh` file (2.2 or 4.1, ASCII or binary); `name` names
@@ -151,8 +153,7 @@ pub fn read_gmsh(bytes: &[u8], name: &str) -> Result<PlainTetrahedra> {
             .file("the file has no $Nodes section (nor, in MSH 2.2, $ParametricNodes)")
     })?;
     let cells = cells.ok_or_else(|| s.fail.file("the file has no $Elements section"))?;
-    let tets = cells.finish(&s.fail)?;
-    plain(name, &format, positions, tets)
+    plain(name, &format, positions, cells.finish(&s.fail)?)
 }
 
 /// The next word must be `end`.
@@ -191,11 +192,21 @@ fn skip_section(s: &mut Scan, name: &[u8]) -> Result<()> {
     Ok(())
 }
 
+/// How many of an element's first nodes the reader keeps: a tetrahedron's, hexahedron's,
+/// prism's or pyramid's corners; 0 for an element it skips or refuses.
+fn corners(kind: Kind) -> usize {
+    match kind {
+        Kind::Tet => 4,
+        Kind::Cell(solid, _) => solid.corners(),
+        Kind::Lower | Kind::Solid(_) => 0,
+    }
+}
+
 /// The number of nodes of a Gmsh element type and what the reader does with it.
 fn element_type(t: u64) -> Option<(usize, Kind)> {
-    const HEX: Kind = Kind::Solid("hexahedra");
-    const PRISM: Kind = Kind::Solid("prisms");
-    const PYRAMID: Kind = Kind::Solid("pyramids");
+    const HEX: Kind = Kind::Cell(SolidKind::Hexahedron, SAME);
+    const PRISM: Kind = Kind::Cell(SolidKind::Wedge, GMSH_PRISM);
+    const PYRAMID: Kind = Kind::Cell(SolidKind::Pyramid, SAME);
     Some(match t {
         4 => (4, Kind::Tet),
         11 => (10, Kind::Tet),
@@ -479,31 +490,29 @@ impl Elements<'_> {
         })
     }
 
-    /// One element of an ASCII file, its tag and tags read: its `n` nodes.
-    fn ascii_element(&self, s: &mut Scan, cells: &mut Cells, n: usize, kind: Kind) -> Result<()> {
+    /// One element of an ASCII file, its tag (`tag`) and tags read: its `n` nodes.
+    fn ascii_element(
+        &self,
+        s: &mut Scan,
+        cells: &mut Cells,
+        (n, kind): (usize, Kind),
+        tag: u64,
+    ) -> Result<()> {
+        let corners = corners(kind);
+        let at = s.here();
+        let mut nodes = [0u32; 8];
+        for slot in &mut nodes[..corners] {
+            let node = s.u64("a node tag")?;
+            *slot = self.node(node, &s.fail, s.here())?;
+        }
+        for _ in corners..n {
+            s.u64("a node tag")?;
+        }
         match kind {
-            Kind::Tet => {
-                let mut tet = [0u32; 4];
-                for slot in &mut tet {
-                    let tag = s.u64("a node tag")?;
-                    *slot = self.node(tag, &s.fail, s.here())?;
-                }
-                for _ in 4..n {
-                    s.word("a node tag")?;
-                }
-                cells.tet(tet);
-            }
-            Kind::Lower | Kind::Solid(_) => {
-                let at = s.here();
-                for _ in 0..n {
-                    s.word("a node tag")?;
-                }
-                if let Kind::Solid(name) = kind {
-                    cells.other(name, 1, at);
-                } else {
-                    cells.skipped += 1;
-                }
-            }
+            Kind::Tet => cells.tet([nodes[0], nodes[1], nodes[2], nodes[3]]),
+            Kind::Cell(solid, order) => cells.solid(solid, order, &nodes, tag),
+            Kind::Lower => cells.skipped += 1,
+            Kind::Solid(name) => cells.other(name, 1, at),
         }
         Ok(())
     }
@@ -513,14 +522,14 @@ impl Elements<'_> {
         let n = s.count("elements", 9)?;
         let mut cells = Cells::with_capacity(n);
         for _ in 0..n {
-            s.u64("an element tag")?;
+            let tag = s.u64("an element tag")?;
             let t = s.u64("an element type")?;
-            let (nodes, kind) = element_type(t).ok_or_else(|| s.err(unknown_type(t)))?;
+            let element = element_type(t).ok_or_else(|| s.err(unknown_type(t)))?;
             let tags = s.count("tags", 2)?;
             for _ in 0..tags {
                 s.word("a tag")?;
             }
-            self.ascii_element(s, &mut cells, nodes, kind)?;
+            self.ascii_element(s, &mut cells, element, tag)?;
         }
         Ok(cells)
     }
@@ -537,7 +546,7 @@ impl Elements<'_> {
             s.i64("the entity's tag")?;
             let t = s.u64("the element type")?;
             let n = s.count("elements in the block", 4)?;
-            let (nodes, kind) = element_type(t).ok_or_else(|| s.err(unknown_type(t)))?;
+            let element = element_type(t).ok_or_else(|| s.err(unknown_type(t)))?;
             if n > total - read {
                 return Err(s.err(format!(
                     "the blocks hold more elements than the {total} the section claims"
@@ -545,8 +554,8 @@ impl Elements<'_> {
             }
             read += n;
             for _ in 0..n {
-                s.u64("an element tag")?;
-                self.ascii_element(s, &mut cells, nodes, kind)?;
+                let tag = s.u64("an element tag")?;
+                self.ascii_element(s, &mut cells, element, tag)?;
             }
         }
         if read != total {
@@ -574,31 +583,38 @@ impl Elements<'_> {
         let count = s.check_count(count as u64, "elements in the block", per)?;
         let start = s.pos;
         let data = s.take(count * per, "the elements")?;
-        match kind {
-            Kind::Tet => {
-                cells.tets.reserve(count);
-                for (k, e) in data.chunks_exact(per).enumerate() {
-                    let mut tet = [0u32; 4];
-                    for (j, slot) in tet.iter_mut().enumerate() {
-                        let off = (skip + j) * size;
-                        let raw = super::tetfile::uint(&e[off..off + size], s.little);
-                        // 4-byte tags are signed ints: a negative one is no node.
-                        let tag = if size == 4 {
-                            raw as u32 as i32 as i64 as u64
-                        } else {
-                            raw
-                        };
-                        let at = MeshFileLocation::Byte(start + per * k + off);
-                        *slot = self.node(tag, &s.fail, at)?;
-                    }
-                    cells.tet(tet);
+        let corners = corners(kind);
+        if corners == 0 {
+            match kind {
+                Kind::Solid(name) if count > 0 => {
+                    cells.other(name, count, MeshFileLocation::Byte(start))
                 }
+                _ => cells.skipped += count,
             }
-            Kind::Lower => cells.skipped += count,
-            Kind::Solid(name) => {
-                if count > 0 {
-                    cells.other(name, count, MeshFileLocation::Byte(start));
-                }
+            return Ok(());
+        }
+        if kind == Kind::Tet {
+            cells.tets.reserve(count);
+        }
+        // 4-byte integers are signed: a negative node tag is no node.
+        let int = |b: &[u8]| {
+            let raw = super::tetfile::uint(b, s.little);
+            if size == 4 {
+                raw as u32 as i32 as i64 as u64
+            } else {
+                raw
+            }
+        };
+        for (k, e) in data.chunks_exact(per).enumerate() {
+            let mut nodes = [0u32; 8];
+            for (j, slot) in nodes[..corners].iter_mut().enumerate() {
+                let off = (skip + j) * size;
+                let at = MeshFileLocation::Byte(start + per * k + off);
+                *slot = self.node(int(&e[off..off + size]), &s.fail, at)?;
+            }
+            match kind {
+                Kind::Cell(solid, order) => cells.solid(solid, order, &nodes, int(&e[..size])),
+                _ => cells.tet([nodes[0], nodes[1], nodes[2], nodes[3]]),
             }
         }
         Ok(())

@@ -166,6 +166,5 @@ pub fn read_medit(bytes: &[u8], name: &str) -> Result<PlainTetrahedra> {
         }
     }
     let positions = positions.ok_or_else(|| s.fail.file("the file has no Vertices section"))?;
-    let tets = cells.finish(&s.fail)?;
-    plain(name, FORMAT, positions, tets)
+    plain(name, FORMAT, positions, cells.finish(&s.fail)?)
 }

@@ -347,9 +347,86 @@ pub struct PlainTetrahedra {
     /// The files of a `.pvtu`'s pieces, in its order, as it names them (relative to its
     /// folder); empty for a mesh of one file.
     pub pieces: Vec<String>,
-    /// For each tetrahedron, the index in [`PlainTetrahedra::pieces`] of the piece it came
-    /// from; empty for a mesh of one file (else as long as `tets`).
+    /// For each tetrahedron, then each of [`PlainTetrahedra::solids`], the index in
+    /// [`PlainTetrahedra::pieces`] of the piece it came from; empty for a mesh of one file
+    /// (else as long as `tets` and `solids` together).
     pub piece_of: Vec<u32>,
+    /// The hexahedra, wedges and pyramids of a mixed mesh, as the file gives them (their
+    /// corners in VTK's order); empty for a mesh of tetrahedra only.
+    pub solids: Vec<Solid>,
+}
+
+/// A kind of solid cell other than a tetrahedron that a mixed mesh may have.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SolidKind {
+    /// Eight corners: the quadrilateral 0 1 2 3, its normal (right-hand rule) towards the
+    /// opposite one 4 5 6 7, corner i + 4 above corner i.
+    Hexahedron,
+    /// Six corners: the triangle 0 1 2, its normal away from the opposite one 3 4 5, corner
+    /// i + 3 above corner i.
+    Wedge,
+    /// Five corners: the quadrilateral 0 1 2 3, its normal towards the apex 4.
+    Pyramid,
+}
+
+impl SolidKind {
+    /// How many corners.
+    pub fn corners(self) -> usize {
+        match self {
+            SolidKind::Hexahedron => 8,
+            SolidKind::Wedge => 6,
+            SolidKind::Pyramid => 5,
+        }
+    }
+
+    /// The name, singular.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolidKind::Hexahedron => "hexahedron",
+            SolidKind::Wedge => "wedge",
+            SolidKind::Pyramid => "pyramid",
+        }
+    }
+
+    /// The name, plural.
+    pub fn plural(self) -> &'static str {
+        match self {
+            SolidKind::Hexahedron => "hexahedra",
+            SolidKind::Wedge => "wedges",
+            SolidKind::Pyramid => "pyramids",
+        }
+    }
+
+    /// VTK's number for the linear cell of this kind.
+    pub fn vtk_type(self) -> u8 {
+        match self {
+            SolidKind::Hexahedron => 12,
+            SolidKind::Wedge => 13,
+            SolidKind::Pyramid => 14,
+        }
+    }
+}
+
+/// A hexahedron, wedge or pyramid of a mixed mesh: its corners in VTK's order (the readers
+/// convert Gmsh's prisms and VTK's voxels; a quadratic cell's corners, its other nodes
+/// left out).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Solid {
+    /// Which kind.
+    pub kind: SolidKind,
+    /// The corners, the first [`SolidKind::corners`] of them used (the rest 0).
+    pub corners: [u32; 8],
+    /// The cell's number in the file: its VTK cell id (counting every cell from 0), or its
+    /// Gmsh element tag.
+    pub id: u64,
+}
+
+impl Solid {
+    /// The corners used.
+    pub fn used(&self) -> &[u32] {
+        &self.corners[..self.kind.corners()]
+    }
 }
 
 impl PlainTetrahedra {
@@ -375,6 +452,7 @@ impl PlainTetrahedra {
             format: format.to_string(),
             pieces: Vec::new(),
             piece_of: Vec::new(),
+            solids: Vec::new(),
         }
         .validate()
     }
@@ -404,18 +482,27 @@ impl PlainTetrahedra {
                 )));
             }
         }
+        for s in &self.solids {
+            if let Some(&i) = s.used().iter().find(|&&i| i as usize >= nv) {
+                return Err(bad(format!(
+                    "{} {} names vertex {i}, but there are only {nv} vertices",
+                    s.kind.name(),
+                    s.id
+                )));
+            }
+        }
         if !self.pieces.is_empty() || !self.piece_of.is_empty() {
             let np = self.pieces.len();
-            if self.piece_of.len() != self.tets.len() {
+            if self.piece_of.len() != self.tets.len() + self.solids.len() {
                 return Err(bad(format!(
-                    "{} pieces recorded for {} tetrahedra",
+                    "{} pieces recorded for {} cells",
                     self.piece_of.len(),
-                    self.tets.len()
+                    self.tets.len() + self.solids.len()
                 )));
             }
             if let Some(k) = self.piece_of.iter().position(|&p| p as usize >= np) {
                 return Err(bad(format!(
-                    "tetrahedron {k} came from piece {}, but there are {np} pieces",
+                    "cell {k} came from piece {}, but there are {np} pieces",
                     self.piece_of[k]
                 )));
             }

@@ -18,7 +18,7 @@
 
 use super::tetfile::{Fail, Result, bom};
 use super::vtu::{attribute, read_vtu};
-use super::{ImportError, MeshFileLocation, PlainTetrahedra};
+use super::{ImportError, MeshFileLocation, PlainTetrahedra, Solid};
 use crate::limits::shorten;
 use quick_xml::events::Event;
 use quick_xml::reader::Reader;
@@ -188,7 +188,9 @@ fn weld(
 ) -> Result<PlainTetrahedra> {
     let mut positions: Vec<[f64; 3]> = Vec::new();
     let mut tets = Vec::with_capacity(meshes.iter().map(|m| m.tets.len()).sum());
-    let mut piece_of = Vec::with_capacity(tets.capacity());
+    let mut solids = Vec::with_capacity(meshes.iter().map(|m| m.solids.len()).sum());
+    let mut piece_of = Vec::with_capacity(tets.capacity() + solids.capacity());
+    let mut solid_piece_of = Vec::with_capacity(solids.capacity());
     // The points of the pieces before the current one, by their coordinates' bits.
     let mut earlier: HashMap<[u64; 3], u32> = HashMap::new();
     let mut formats: Vec<&str> = Vec::new();
@@ -221,7 +223,13 @@ fn weld(
         }
         tets.extend(m.tets.iter().map(|t| t.map(|i| index[i as usize])));
         piece_of.extend(std::iter::repeat_n(k as u32, m.tets.len()));
+        solids.extend(m.solids.iter().map(|s| Solid {
+            corners: s.corners.map(|i| index[i as usize]),
+            ..*s
+        }));
+        solid_piece_of.extend(std::iter::repeat_n(k as u32, m.solids.len()));
     }
+    piece_of.extend(solid_piece_of);
     let format = format!(
         "PVTU, {} piece{} ({})",
         pieces.len(),
@@ -236,6 +244,7 @@ fn weld(
         format,
         pieces,
         piece_of,
+        solids,
     }
     .validate()
 }

@@ -4,7 +4,7 @@
 //! skipped, other solids refused), node tags mapped to dense indices, and the
 //! [`PlainTetrahedra`] they give.
 
-use super::{ImportError, MeshFileLocation, PlainTetrahedra};
+use super::{ImportError, MeshFileLocation, PlainTetrahedra, Solid, SolidKind};
 use crate::convention::file_order;
 use crate::limits::shorten;
 
@@ -347,29 +347,32 @@ pub(super) enum Kind {
     Tet,
     /// A point, line, triangle, quadrilateral or other cell of dimension below 3: skipped.
     Lower,
-    /// A solid that is not a tetrahedron (hexahedron, prism, pyramid, ...), named in the
-    /// plural: refused.
+    /// A hexahedron, wedge or pyramid (linear or of higher order), read by its corners:
+    /// corner i in VTK's order is the file's node `order[i]`.
+    Cell(SolidKind, &'static [usize]),
+    /// Another solid (a polyhedron, a hexagonal prism, ...), named in the plural: refused.
     Solid(&'static str),
 }
+
+/// VTK's and Gmsh's corner order of a hexahedron or pyramid, and VTK's of a wedge.
+pub(super) const SAME: &[usize] = &[0, 1, 2, 3, 4, 5, 6, 7];
+/// A VTK voxel's corners (x fastest, then y, then z) in a hexahedron's order.
+const VOXEL: &[usize] = &[0, 1, 3, 2, 4, 5, 7, 6];
+/// A Gmsh prism's corners in VTK's wedge order: Gmsh's first triangle turns towards the
+/// opposite one, VTK's away from it.
+pub(super) const GMSH_PRISM: &[usize] = &[0, 2, 1, 3, 5, 4];
 
 /// The kind of a VTK cell type, or `None` where VTK defines no such type.
 pub(super) fn vtk_kind(t: u64) -> Option<Kind> {
     Some(match t {
         10 | 24 | 71 | 78 => Kind::Tet,
         0..=9 | 21..=23 | 28 | 30 | 34..=36 | 51..=54 | 60..=63 | 68..=70 | 75..=77 => Kind::Lower,
-        11 => Kind::Solid("voxels"),
-        12 => Kind::Solid("hexahedra"),
-        13 => Kind::Solid("wedges"),
-        14 => Kind::Solid("pyramids"),
+        11 => Kind::Cell(SolidKind::Hexahedron, VOXEL),
+        12 | 25 | 29 | 33 => Kind::Cell(SolidKind::Hexahedron, SAME),
+        13 | 26 | 31 | 32 => Kind::Cell(SolidKind::Wedge, SAME),
+        14 | 27 | 37 => Kind::Cell(SolidKind::Pyramid, SAME),
         15 => Kind::Solid("pentagonal prisms"),
         16 => Kind::Solid("hexagonal prisms"),
-        25 => Kind::Solid("quadratic hexahedra"),
-        26 => Kind::Solid("quadratic wedges"),
-        27 => Kind::Solid("quadratic pyramids"),
-        29 => Kind::Solid("triquadratic hexahedra"),
-        31 | 32 => Kind::Solid("quadratic wedges"),
-        33 => Kind::Solid("biquadratic-quadratic hexahedra"),
-        37 => Kind::Solid("triquadratic pyramids"),
         41 => Kind::Solid("convex point sets"),
         42 => Kind::Solid("polyhedra"),
         55 | 64 => Kind::Solid("parametric or higher-order tetrahedra (no corner order known)"),
@@ -380,11 +383,62 @@ pub(super) fn vtk_kind(t: u64) -> Option<Kind> {
     })
 }
 
-/// The cells read so far: the tetrahedra (in halo4d's orientation), how many lower-dimensional
-/// cells were skipped, and the other solids found.
+/// Whether a VTK cell of type `t` and kind `kind` (of [`vtk_kind`]) may have `len` points:
+/// a tetrahedron, hexahedron, wedge or pyramid has as many as its type says (at least its
+/// corners where the type does not fix them); the message after `cell N` if not.
+pub(super) fn vtk_cell_size(kind: Kind, t: u64, len: usize) -> std::result::Result<(), String> {
+    let least = match kind {
+        Kind::Tet => 4,
+        Kind::Cell(solid, _) => solid.corners(),
+        Kind::Lower | Kind::Solid(_) => return Ok(()),
+    };
+    match vtk_nodes(t) {
+        Some(n) if n != len => Err(format!("has {len} points, but a cell of type {t} has {n}")),
+        None if len < least => Err(format!(
+            "has {len} points, but a cell of type {t} has at least {least}"
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// The number of nodes of a VTK cell type where it has a fixed one (a tetrahedron, a
+/// hexahedron, a wedge or a pyramid, linear or of higher order).
+fn vtk_nodes(t: u64) -> Option<usize> {
+    Some(match t {
+        10 => 4,
+        24 => 10,
+        11 | 12 => 8,
+        25 => 20,
+        29 => 27,
+        33 => 24,
+        13 => 6,
+        26 => 15,
+        31 => 12,
+        32 => 18,
+        14 => 5,
+        27 => 13,
+        37 => 19,
+        _ => return None,
+    })
+}
+
+/// A hexahedron, wedge or pyramid whose nodes, as the file orders them, are `nodes` (at least
+/// its corners), its corner i in VTK's order being `nodes[order[i]]`; `id` its number in the
+/// file.
+pub(super) fn solid(kind: SolidKind, order: &[usize], nodes: &[u32], id: u64) -> Solid {
+    let mut corners = [0u32; 8];
+    for (c, &o) in corners.iter_mut().zip(&order[..kind.corners()]) {
+        *c = nodes[o];
+    }
+    Solid { kind, corners, id }
+}
+
+/// The cells read so far: the tetrahedra (in halo4d's orientation), the hexahedra, wedges and
+/// pyramids, how many lower-dimensional cells were skipped, and the other solids found.
 #[derive(Default)]
 pub(super) struct Cells {
     pub tets: Vec<[u32; 4]>,
+    pub solids: Vec<Solid>,
     pub skipped: usize,
     /// Each kind of other solid: its name, how many, where the first is.
     others: Vec<(&'static str, usize, MeshFileLocation)>,
@@ -404,7 +458,14 @@ impl Cells {
         self.tets.push(file_order(tet));
     }
 
-    /// `n` solids that are not tetrahedra, the first at `at`.
+    /// A hexahedron, wedge or pyramid whose nodes (as the file orders them, at least its
+    /// corners) are `nodes`, its corner i in VTK's order being `nodes[order[i]]`; `id` its
+    /// number in the file.
+    pub fn solid(&mut self, kind: SolidKind, order: &[usize], nodes: &[u32], id: u64) {
+        self.solids.push(solid(kind, order, nodes, id));
+    }
+
+    /// `n` solids that halo4d does not read, the first at `at`.
     pub fn other(&mut self, name: &'static str, n: usize, at: MeshFileLocation) {
         match self.others.iter_mut().find(|o| o.0 == name) {
             Some(o) => o.1 += n,
@@ -412,9 +473,10 @@ impl Cells {
         }
     }
 
-    /// The tetrahedra, none or more, unless the file has other solids. A file without a
-    /// tetrahedron is read (its check fails with `0 tetrahedra`, in every format alike).
-    pub fn finish(self, fail: &Fail) -> Result<Vec<[u32; 4]>> {
+    /// The tetrahedra and the hexahedra, wedges and pyramids, none or more, unless the file
+    /// has other solids. A file without a cell is read (its check fails with `0
+    /// tetrahedra`, in every format alike).
+    pub fn finish(self, fail: &Fail) -> Result<(Vec<[u32; 4]>, Vec<Solid>)> {
         if let Some(&(_, _, at)) = self.others.first() {
             let list: Vec<String> = self
                 .others
@@ -428,13 +490,14 @@ impl Cells {
             return Err(fail.at(
                 at,
                 format!(
-                    "the mesh has {} besides its {} tetrahedra: halo4d checks tetrahedral meshes only; split the other cells into tetrahedra first",
+                    "the mesh has {} besides its {} tetrahedra and {} hexahedra, wedges and pyramids: halo4d checks meshes of these four kinds of cell only; split the other cells into them first",
                     list.join(", "),
-                    self.tets.len()
+                    self.tets.len(),
+                    self.solids.len()
                 ),
             ));
         }
-        Ok(self.tets)
+        Ok((self.tets, self.solids))
     }
 }
 
@@ -517,13 +580,14 @@ impl Tagged {
     }
 }
 
-/// The tetrahedra of a file without halo4d's layout: `name` (the file's stem), `format` as
-/// [`PlainTetrahedra::format`] says it.
+/// The cells of a file without halo4d's layout: `name` (the file's stem), `format` as
+/// [`PlainTetrahedra::format`] says it, the tetrahedra and other solids of
+/// [`Cells::finish`].
 pub(super) fn plain(
     name: &str,
     format: &str,
     positions: Vec<[f64; 3]>,
-    tets: Vec<[u32; 4]>,
+    (tets, solids): (Vec<[u32; 4]>, Vec<Solid>),
 ) -> Result<PlainTetrahedra> {
     PlainTetrahedra {
         name: name.to_string(),
@@ -533,6 +597,7 @@ pub(super) fn plain(
         format: format.to_string(),
         pieces: Vec::new(),
         piece_of: Vec::new(),
+        solids,
     }
     .validate()
 }

@@ -113,7 +113,12 @@ fn nodes(bytes: &[u8], format: &str) -> Result<(Vec<[f64; 3]>, u64)> {
 }
 
 /// The tetrahedra of an `.ele` file, whose vertex indices count from `first`.
-fn elements(bytes: &[u8], format: &str, nv: usize, first: u64) -> Result<Vec<[u32; 4]>> {
+fn elements(
+    bytes: &[u8],
+    format: &str,
+    nv: usize,
+    first: u64,
+) -> Result<(Vec<[u32; 4]>, Vec<super::Solid>)> {
     let fail = Fail::new(format);
     let mut s = Scan::new(bytes, fail.clone());
     s.comments = true;

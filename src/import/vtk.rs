@@ -15,8 +15,8 @@
 //! halo4d's layout is read as tetrahedra alone for `halo4d check`
 //! ([`read_vtk_tetrahedra`]). A UTF-8 byte-order mark before the first line is skipped.
 
-use super::tetfile::{Kind, bom, vtk_kind};
-use super::{FileParams, FileTetrahedra, ImportError, ImportedHalo, PlainTetrahedra};
+use super::tetfile::{Kind, bom, solid, vtk_cell_size, vtk_kind};
+use super::{FileParams, FileTetrahedra, ImportError, ImportedHalo, PlainTetrahedra, Solid};
 use crate::check::TetMesh;
 use crate::convention::file_order;
 use crate::limits::shorten;
@@ -60,6 +60,7 @@ pub fn read_vtk_tetrahedra(bytes: &[u8]) -> Result<FileTetrahedra> {
         format,
         pieces: Vec::new(),
         piece_of: Vec::new(),
+        solids: grid.solids,
     }
     .validate()
     .map(FileTetrahedra::Plain)
@@ -77,6 +78,13 @@ fn name(title: &str) -> String {
 /// The halo of a grid whose FIELD data gives halo4d's layout.
 fn halo(grid: Grid, title: &str) -> Result<ImportedHalo> {
     let field = |key: &str| grid.field.get(key).and_then(|v| v.first().copied());
+    if let Some(s) = grid.solids.first() {
+        return Err(err(format!(
+            "its FIELD data gives halo4d's halo layout, but cell {} is a {}: a halo is built of tetrahedra only",
+            s.id,
+            s.kind.name()
+        )));
+    }
     let n = surface_vertices(&grid.field)?;
     for key in ["rho", "delta_d", "delta_t"] {
         if let Some(v) = field(key).filter(|v| !v.is_finite()) {
@@ -340,6 +348,8 @@ impl Type {
 struct Grid {
     points: Vec<[f64; 3]>,
     tets: Vec<[u32; 4]>,
+    /// Hexahedra, wedges and pyramids (a halo has none).
+    solids: Vec<Solid>,
     field: HashMap<String, Vec<f64>>,
     t: Option<Vec<f64>>,
     d_orig: Option<Vec<f64>>,
@@ -660,14 +670,13 @@ impl Reader<'_> {
             )));
         }
         g.tets = Vec::with_capacity(cells.spans.len());
-        // Each kind of solid other than a tetrahedron: how many, and the first's cell and type.
+        // Each kind of solid halo4d does not read: how many, and the first's cell and type.
         let mut others: Vec<(&str, usize, usize, f64)> = Vec::new();
         for (k, (&t, &(start, len))) in types.iter().zip(&cells.spans).enumerate() {
             let kind = (t >= 0.0 && t.fract() == 0.0)
                 .then(|| vtk_kind(t as u64))
                 .flatten()
                 .ok_or_else(|| err(format!("cell {k} has type {t}, which VTK does not define")))?;
-            let ids = &cells.ids[start..start + len];
             match kind {
                 Kind::Lower => continue,
                 Kind::Solid(name) => {
@@ -677,21 +686,16 @@ impl Reader<'_> {
                     }
                     continue;
                 }
-                Kind::Tet => {}
+                Kind::Tet | Kind::Cell(..) => {}
             }
-            let wanted = match t as u64 {
-                10 => Some(4),
-                24 => Some(10),
-                _ => None,
+            vtk_cell_size(kind, t as u64, len).map_err(|m| err(format!("cell {k} {m}")))?;
+            let mut nodes = [0u32; 8];
+            let used = if let Kind::Cell(solid, _) = kind {
+                solid.corners()
+            } else {
+                4
             };
-            if wanted.is_some_and(|w| w != len) || len < 4 {
-                return Err(err(format!(
-                    "cell {k} has {len} points, but a tetrahedron of type {t} has {}",
-                    wanted.unwrap_or(4)
-                )));
-            }
-            let mut tet = [0u32; 4];
-            for (slot, &id) in tet.iter_mut().zip(ids) {
+            for (slot, &id) in nodes[..used].iter_mut().zip(&cells.ids[start..start + len]) {
                 if !(id >= 0.0 && id.fract() == 0.0 && id < points as f64) {
                     return Err(err(format!(
                         "cell {k} names point {id}, but there are {points} points"
@@ -699,7 +703,12 @@ impl Reader<'_> {
                 }
                 *slot = id as u32;
             }
-            g.tets.push(file_order(tet));
+            match kind {
+                Kind::Cell(kind, order) => g.solids.push(solid(kind, order, &nodes, k as u64)),
+                _ => g
+                    .tets
+                    .push(file_order([nodes[0], nodes[1], nodes[2], nodes[3]])),
+            }
         }
         if let Some(&(_, _, k, t)) = others.first() {
             let list: Vec<String> = others
@@ -707,9 +716,10 @@ impl Reader<'_> {
                 .map(|(name, n, _, _)| format!("{n} {name}"))
                 .collect();
             return Err(err(format!(
-                "cell {k} has type {t}, not 10 (a tetrahedron): the mesh has {} besides its {} tetrahedra, and halo4d checks tetrahedral meshes only; split the other cells into tetrahedra first",
+                "cell {k} has type {t}: the mesh has {} besides its {} tetrahedra and {} hexahedra, wedges and pyramids, and halo4d checks meshes of these four kinds of cell only; split the other cells into them first",
                 list.join(", "),
-                g.tets.len()
+                g.tets.len(),
+                g.solids.len()
             )));
         }
         Ok(g)

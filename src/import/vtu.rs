@@ -20,7 +20,9 @@
 //! before the XML is skipped.
 
 use super::PlainTetrahedra;
-use super::tetfile::{Cells, Fail, Kind, Result, bom, parse_f64, parse_i64, plain, uint, vtk_kind};
+use super::tetfile::{
+    Cells, Fail, Kind, Result, bom, parse_f64, parse_i64, plain, uint, vtk_cell_size, vtk_kind,
+};
 use crate::limits::shorten;
 use base64::Engine;
 use base64::engine::{DecodePaddingMode, GeneralPurpose, GeneralPurposeConfig};
@@ -143,24 +145,12 @@ pub fn read_vtu(bytes: &[u8], name: &str) -> Result<PlainTetrahedra> {
     for (k, (&end, &(t, kind))) in ends.iter().zip(&kinds).enumerate() {
         let end = end as usize;
         let len = end - start;
+        vtk_cell_size(kind, u64::from(t), len)
+            .map_err(|m| d.fail.byte(offsets.at, format!("cell {k} {m}")))?;
+        let nodes = &ids[start..end];
         match kind {
-            Kind::Tet => {
-                let wanted = match t {
-                    10 => Some(4),
-                    24 => Some(10),
-                    _ => None,
-                };
-                if wanted.is_some_and(|w| w != len) || len < 4 {
-                    return Err(d.fail.byte(
-                        offsets.at,
-                        format!(
-                            "cell {k} has {len} points, but a tetrahedron of type {t} has {}",
-                            wanted.unwrap_or(4)
-                        ),
-                    ));
-                }
-                cells.tet([ids[start], ids[start + 1], ids[start + 2], ids[start + 3]]);
-            }
+            Kind::Tet => cells.tet([nodes[0], nodes[1], nodes[2], nodes[3]]),
+            Kind::Cell(solid, order) => cells.solid(solid, order, nodes, k as u64),
             Kind::Lower => cells.skipped += 1,
             Kind::Solid(name) => {
                 cells.other(name, 1, super::MeshFileLocation::Byte(types.at));
@@ -168,8 +158,7 @@ pub fn read_vtu(bytes: &[u8], name: &str) -> Result<PlainTetrahedra> {
         }
         start = end;
     }
-    let tets = cells.finish(&d.fail)?;
-    plain(name, &format, positions, tets)
+    plain(name, &format, positions, cells.finish(&d.fail)?)
 }
 
 /// A number type of VTK XML and its size.

@@ -421,7 +421,7 @@ pub fn check(args: CheckArgs) -> Outcome {
                 "wrote {} (cell field `fault`: {})",
                 mark.display(),
                 if marked.is_empty() {
-                    "no tetrahedron marked".to_string()
+                    "no cell marked".to_string()
                 } else {
                     marked.join(", ")
                 }
