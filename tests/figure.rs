@@ -95,9 +95,14 @@ fn the_glb_shows_the_picture_through_its_camera_with_the_halos_hidden() {
     assert_eq!(picture, ["surface", "curves", "camera"]);
     let halos: Vec<&str> = in_scene(1).into_iter().map(kind).collect();
     assert_eq!(halos, ["halo"]);
-    // halo4d's own reader still finds the halos there.
+    // halo4d's own reader still finds the halos there, and in a file whose scene leaves out
+    // `nodes`, as Blender's exporter writes the halos' emptied scene.
     let read = halo4d::import::read_glb(&glb).unwrap();
     assert_eq!(read.len(), 1);
+    let without = crate::common::with_json(&glb, |j| {
+        j["scenes"][1].as_object_mut().unwrap().remove("nodes");
+    });
+    assert_eq!(halo4d::import::read_glb(&without).unwrap().len(), 1);
 
     // The camera: where the picture's eye is, looking where it looks, and each point of the
     // surface lands on the same pixel through both.
