@@ -110,6 +110,7 @@ pub mod internals {
     pub use crate::render::camera::{Camera, Placement};
     pub use crate::render::compare::verdict_differs;
     pub use crate::render::overlay::{INK, OVER_BANDS, OVER_SHADE, curve_ink};
+    pub use crate::render::shade::colormap;
     pub use crate::render::stipple::{Drawn, tone};
     pub use crate::render::trace::{Hit, Primary, TraceSurface, Tracer};
     pub use crate::render::visible::curve_visibility;

@@ -104,6 +104,11 @@ pub struct Outputs {
     /// in their inks, broken edges of the sheets passing under), the same lines the PNG
     /// draws, scalable for papers and slides.
     pub svg: bool,
+    /// `<name>.html`: a page that shows the `.glb` in a web browser through the picture's
+    /// camera (turned with the mouse), the halos hidden, for sharing a figure; it holds
+    /// three.js and the `.glb`, so it opens from a file, offline. Needs `glb`.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub html: bool,
     /// Whether the halos are checked against the intersection curves. Always when a halo
     /// file is written (`glb`, `vtk`; the default then), and on request without one (the
     /// verdict in `report.json` and the exit status).
@@ -137,6 +142,12 @@ impl Outputs {
                 "halo files (glb, vtk) are always verified; remove `verify: false`, or set `glb` and `vtk` to false",
             ));
         }
+        if self.html && !self.glb {
+            return Err(FieldError::new(
+                "html",
+                "the page shows the scene's .glb, which it holds: set `glb` to true as well, or `html` to false",
+            ));
+        }
         TUBE_RADIUS.check("curve_radius", self.curve_radius)?;
         Ok(())
     }
@@ -153,6 +164,7 @@ impl Default for Outputs {
             report: true,
             png: true,
             svg: false,
+            html: false,
             curve_radius: CURVE_RADIUS,
             verify: None,
             stipples: false,

@@ -8,6 +8,7 @@ mod cli;
 mod common;
 mod curves_export;
 mod export;
+mod figure;
 mod fuzz;
 mod fuzz_build;
 mod gallery;

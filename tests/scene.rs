@@ -104,6 +104,10 @@ const BROKEN: &[(&str, &[&str])] = &[
     ("zero-rho.json", &["halo.rho", "1e-6 to 0.49"]),
     ("rho-below-f32.json", &["halo.rho", "1e-6 to 0.49", "f32"]),
     (
+        "html-without-glb.json",
+        &["outputs.html", "set `glb` to true as well"],
+    ),
+    (
         "curve-radius-too-large.json",
         &["outputs.curve_radius", "at most 0.05", "0.5"],
     ),

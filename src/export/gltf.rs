@@ -29,6 +29,29 @@
 //! "_W", "_DW", "_CURVE", "indices"}}}`; `indices` join consecutive points in pairs, and a
 //! closed curve's last point back to its first.
 //!
+//! The file has two glTF scenes. The first, the file's `scene`, is the picture: every surface,
+//! the curves, the stipples and, when the picture has one, its camera. The second, `halo4d
+//! halos`, holds the halos' nodes alone. That is how the halos are in the file but hidden
+//! where a reader shows the file's scene: Blender 4.5's own importer (`import_scene.gltf`)
+//! makes a collection of each scene and excludes all but the default's from the view layer
+//! (`io_scene_gltf2/blender/imp/scene.py`), three.js's GLTFLoader gives the default scene as
+//! `gltf.scene`. `KHR_node_visibility` would say it on the nodes themselves, but Blender 4.5's
+//! importer does not read it (the name occurs nowhere in its `io_scene_gltf2`), nor does
+//! three.js's GLTFLoader (r187). halo4d's own readers take the meshes by their extras, in
+//! whichever scene.
+//!
+//! Each surface has COLOR_0, the picture's colour of its w before shading (the scene's
+//! `render.colormap` over the w of all the surfaces' triangle vertices, linear RGB as glTF
+//! wants), and a white material, so that a viewer that multiplies the two (Blender's importer
+//! puts a Color Attribute node into the material of a primitive with COLOR_0, three.js turns
+//! on vertex colours) shows the picture's colours. The camera node is the picture's camera,
+//! its first eye: a perspective (or orthographic) camera at the eye, looking at the picture's
+//! centre (glTF's camera looks down its -z, +y up), with the picture's vertical field of view
+//! and aspect ratio and near and far planes around the surfaces' box; its extras give the
+//! picture's size and the point it looks at (glTF's frame), `{"picture": {"width", "height",
+//! "target"}}`: Blender's importer sets no render size (it is the user's), and an orbiting
+//! viewer turns about the target.
+//!
 //! Floats, because Blender 3.5+ imports float attributes and drops integer ones. Each
 //! attribute has its own tightly packed, 4-byte aligned buffer view. The asset's extras
 //! record the scene as parsed and the build's verdict: `{"halo4d": {"scene", "verified",
@@ -42,9 +65,12 @@ use crate::halo::Halo;
 use crate::intersect::{CurvePoint, Curves};
 use crate::motion::Polyline;
 use crate::render::diagram::PALETTE as STILLS;
+use crate::render::shade::colormap;
 use crate::render::stipple::Drawn;
+use crate::render::visible::PictureCamera;
+use crate::render::{CameraProjection, Colormap};
 use crate::view::area_normal_sums;
-use glam::{DVec3, Vec3};
+use glam::{DMat3, DQuat, DVec3, Vec3};
 use gltf_json as json;
 use json::validation::Checked::Valid;
 use json::validation::USize64;
@@ -52,7 +78,8 @@ use rayon::prelude::*;
 use serde_json::value::{RawValue, to_raw_value};
 use std::io::{self, Write};
 
-/// Base colours of the surfaces' materials, in turn.
+/// Base colours of the halos' translucent materials, in turn (a surface's material is white:
+/// its colours are its COLOR_0).
 const PALETTE: [[f32; 4]; 6] = [
     [0.85, 0.62, 0.25, 1.0],
     [0.30, 0.55, 0.85, 1.0],
@@ -64,6 +91,20 @@ const PALETTE: [[f32; 4]; 6] = [
 
 /// Base colour of the curves' tubes: the renderer's ink.
 const CURVE_COLOUR: [f32; 4] = [0.02, 0.02, 0.02, 1.0];
+
+/// The name of the file's second glTF scene, which holds the halos' nodes.
+pub const HALO_SCENE: &str = "halo4d halos";
+
+/// How the scene's picture shows it, which the `.glb` carries for programs that know nothing
+/// of halo4d's attributes: the surfaces' colours of w and the picture's camera.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Figure {
+    /// The picture's camera (its first eye), written as a camera node; none when the scene
+    /// has none (no triangle to frame, or an orthographic eye inside the box).
+    pub camera: Option<PictureCamera>,
+    /// The picture's colour map, which gives each surface vertex its COLOR_0.
+    pub colormap: Colormap,
+}
 
 /// Accumulates the binary chunk and the JSON objects that describe it.
 struct Builder {
@@ -88,20 +129,26 @@ impl Builder {
         })
     }
 
-    /// The document with its scene `name` of `nodes` and its one buffer: the JSON and the
-    /// binary chunk.
+    /// The document with its `scenes` (name, nodes), the first the file's `scene` and any
+    /// without nodes left out, and its one buffer: the JSON and the binary chunk.
     fn finish(
         mut self,
-        name: &str,
-        nodes: Vec<json::Index<json::Node>>,
+        scenes: Vec<(&str, Vec<json::Index<json::Node>>)>,
     ) -> Result<(Vec<u8>, Vec<u8>), String> {
-        let scene = self.root.push(json::Scene {
-            extensions: None,
-            extras: None,
-            name: Some(name.into()),
-            nodes,
-        });
-        self.root.scene = Some(scene);
+        for (k, (name, nodes)) in scenes.into_iter().enumerate() {
+            if k > 0 && nodes.is_empty() {
+                continue;
+            }
+            let scene = self.root.push(json::Scene {
+                extensions: None,
+                extras: None,
+                name: Some(name.into()),
+                nodes,
+            });
+            if k == 0 {
+                self.root.scene = Some(scene);
+            }
+        }
         self.root.push(json::Buffer {
             byte_length: USize64::from(self.bin.len()),
             name: None,
@@ -309,24 +356,40 @@ pub fn to_glb(
     curve_radius: f64,
     asset: &serde_json::Value,
 ) -> Result<Vec<u8>, String> {
-    let (text, bin) = glb_chunks(surfaces, curves, curve_radius, &[], asset)?;
+    let (text, bin) = glb_chunks(
+        surfaces,
+        curves,
+        curve_radius,
+        &[],
+        &Figure::default(),
+        asset,
+    )?;
     Ok(glb_container(text, bin))
 }
 
 /// The JSON and binary chunks of [`to_glb`]'s file, with the `stipples` of the scene's
-/// picture as a point cloud when there are any, for [`write_glb_container`] to write without
-/// a copy of the whole file in memory.
+/// picture as a point cloud when there are any and the `figure`'s colours and camera, for
+/// [`write_glb_container`] to write without a copy of the whole file in memory.
 pub fn glb_chunks(
     surfaces: &[SurfaceData],
     curves: &Curves,
     curve_radius: f64,
     stipples: &[Drawn],
+    figure: &Figure,
     asset: &serde_json::Value,
 ) -> Result<(Vec<u8>, Vec<u8>), String> {
     let mut b = Builder::new(asset)?;
     let mut nodes = Vec::new();
+    let mut halo_nodes = Vec::new();
+    let scale = w_scale(surfaces);
     for (k, s) in surfaces.iter().enumerate() {
-        let mesh = surface_mesh(&mut b, s, PALETTE[k % PALETTE.len()])?;
+        let colours: Vec<f32> = s
+            .projected
+            .w
+            .iter()
+            .flat_map(|&w| w_colour(figure.colormap, scale, w))
+            .collect();
+        let mesh = surface_mesh(&mut b, s, &colours)?;
         nodes.push(b.root.push(json::Node {
             mesh: Some(mesh),
             name: Some(s.name.to_string()),
@@ -334,7 +397,7 @@ pub fn glb_chunks(
         }));
         if !s.halo.tets.is_empty() {
             let halo_mesh = halo_mesh(&mut b, s, mesh, PALETTE[k % PALETTE.len()])?;
-            nodes.push(b.root.push(json::Node {
+            halo_nodes.push(b.root.push(json::Node {
                 mesh: Some(halo_mesh),
                 name: Some(format!("{}-halo", s.name)),
                 ..Default::default()
@@ -356,7 +419,131 @@ pub fn glb_chunks(
             ..Default::default()
         }));
     }
-    b.finish("halo4d", nodes)
+    if let Some(camera) = &figure.camera {
+        nodes.push(camera_node(&mut b, camera, surfaces)?);
+    }
+    b.finish(vec![("halo4d", nodes), (HALO_SCENE, halo_nodes)])
+}
+
+/// The picture's scale of w: the least and greatest w of the surfaces' triangle vertices, as
+/// the renderer takes it.
+fn w_scale(surfaces: &[SurfaceData]) -> (f64, f64) {
+    surfaces
+        .iter()
+        .flat_map(|s| {
+            let w = &s.projected.w;
+            s.mesh
+                .triangles
+                .iter()
+                .flatten()
+                .map(move |&v| w[v as usize])
+        })
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), w| {
+            (a.min(w), b.max(w))
+        })
+}
+
+/// The picture's colour of `w` before shading, linear RGB: the renderer's share of the scale
+/// `(w0, w1)` through `map` (a scale of one w, or none, gives every w the same colour).
+pub fn w_colour(map: Colormap, (w0, w1): (f64, f64), w: f64) -> [f32; 3] {
+    let span = if w1 > w0 { w1 - w0 } else { 1.0 };
+    colormap(map, (w - w0) / span).as_vec3().to_array()
+}
+
+/// Appends the picture's camera as a camera (perspective or orthographic, with the picture's
+/// aspect ratio) and its node in glTF's frame, with near and far planes around the box of the
+/// `surfaces`' vertices.
+fn camera_node(
+    b: &mut Builder,
+    c: &PictureCamera,
+    surfaces: &[SurfaceData],
+) -> Result<json::Index<json::Node>, String> {
+    let bad = || format!("the picture's camera cannot be written: {c:?}");
+    let (eye, target, up) = (DVec3::from(c.eye), DVec3::from(c.target), DVec3::from(c.up));
+    let forward = (target - eye).try_normalize().ok_or_else(bad)?;
+    let right = forward.cross(up).try_normalize().ok_or_else(bad)?;
+    let up = right.cross(forward);
+    // glTF's camera looks down its -z with +y up and +x right.
+    let axes = DMat3::from_cols(to_gltf(right), to_gltf(up), to_gltf(-forward));
+    let rotation = DQuat::from_mat3(&axes).normalize().as_quat().to_array();
+    let translation = to_gltf(eye).as_vec3().to_array();
+    // Near and far: the depths of the box's corners along the view, with room on either
+    // side; the near plane in front of the eye whatever the box.
+    let (lo, hi) = surfaces
+        .iter()
+        .flat_map(|s| &s.projected.positions)
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        });
+    let diagonal = (hi - lo).length();
+    let depths = (0..8).map(|k| {
+        let corner = DVec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        );
+        (corner - eye).dot(forward)
+    });
+    let (nearest, farthest) = depths.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, z), d| {
+        (a.min(d), z.max(d))
+    });
+    let znear = (0.5 * nearest).max(1e-3 * diagonal);
+    let zfar = (1.5 * farthest).max(2.0 * znear);
+    let aspect = f64::from(c.width) / f64::from(c.height);
+    let (perspective, orthographic, type_) = match (c.projection, c.fov_deg, c.half_height) {
+        (CameraProjection::Perspective, Some(fov), _) => (
+            Some(json::camera::Perspective {
+                aspect_ratio: Some(aspect as f32),
+                yfov: fov.to_radians() as f32,
+                zfar: Some(zfar as f32),
+                znear: znear as f32,
+                extensions: None,
+                extras: None,
+            }),
+            None,
+            json::camera::Type::Perspective,
+        ),
+        (CameraProjection::Orthographic, _, Some(half)) => (
+            None,
+            Some(json::camera::Orthographic {
+                xmag: (half * aspect) as f32,
+                ymag: half as f32,
+                zfar: zfar as f32,
+                znear: znear as f32,
+                extensions: None,
+                extras: None,
+            }),
+            json::camera::Type::Orthographic,
+        ),
+        _ => return Err(bad()),
+    };
+    let numbers = [znear, zfar, aspect, c.fov_deg.unwrap_or(1.0)];
+    let finite = numbers.iter().all(|x| x.is_finite())
+        && rotation.iter().chain(&translation).all(|x| x.is_finite());
+    if !finite || znear <= 0.0 || zfar <= znear {
+        return Err(bad());
+    }
+    let camera = b.root.push(json::Camera {
+        name: Some("camera".into()),
+        orthographic,
+        perspective,
+        type_: Valid(type_),
+        extensions: None,
+        extras: raw_extras(serde_json::json!({
+            "picture": {
+                "width": c.width,
+                "height": c.height,
+                "target": to_gltf(target).as_vec3().to_array(),
+            }
+        }))?,
+    });
+    Ok(b.root.push(json::Node {
+        camera: Some(camera),
+        name: Some("camera".into()),
+        rotation: Some(json::scene::UnitQuaternion(rotation)),
+        translation: Some(translation),
+        ..Default::default()
+    }))
 }
 
 /// A motion picture's stills as a `.glb`: one node per still, named `still-NN` with its
@@ -423,7 +610,7 @@ pub fn stills_glb(
             ..Default::default()
         }));
     }
-    let (text, bin) = b.finish("motion picture", nodes)?;
+    let (text, bin) = b.finish(vec![("motion picture", nodes)])?;
     Ok(glb_container(text, bin))
 }
 
@@ -450,12 +637,13 @@ fn material(
     })
 }
 
-/// Appends the mesh of surface `s`: its projected positions and normals, W, U, V and PATCH,
-/// the 4D mesh before the view, its triangles, and a material of base colour `colour`.
+/// Appends the mesh of surface `s`: its projected positions and normals, its `colours`
+/// (COLOR_0, RGB per vertex), W, U, V and PATCH, the 4D mesh before the view, its triangles,
+/// and a white material (which COLOR_0 colours).
 fn surface_mesh(
     b: &mut Builder,
     s: &SurfaceData,
-    colour: [f32; 4],
+    colours: &[f32],
 ) -> Result<json::Index<json::Mesh>, String> {
     let p = s.projected;
     let scalar = |f: &dyn Fn(usize) -> f64| {
@@ -468,6 +656,10 @@ fn surface_mesh(
     let mut attributes = vec![
         (Semantic::Positions, b.positions(&p.positions)),
         (Semantic::Normals, b.normals(&p.normals)),
+        (
+            Semantic::Colors(0),
+            b.floats(colours, json::accessor::Type::Vec3, None),
+        ),
         (
             Semantic::Extras("W".into()),
             b.floats(&scalar(&|i| p.w[i]), Scalar, None),
@@ -506,7 +698,7 @@ fn surface_mesh(
         name: Some(s.name.to_string()),
         double_sided: true,
         pbr_metallic_roughness: json::material::PbrMetallicRoughness {
-            base_color_factor: json::material::PbrBaseColorFactor(colour),
+            base_color_factor: json::material::PbrBaseColorFactor([1.0; 4]),
             metallic_factor: json::material::StrengthFactor(0.0),
             roughness_factor: json::material::StrengthFactor(0.6),
             ..Default::default()

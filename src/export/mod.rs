@@ -6,7 +6,8 @@
 //! `quality`, for MeshLab), `-curves.ply` (the intersection curves as PLY edges, with the
 //! depth gap dw as vertex `quality`, for MeshLab), `.obj` (Wavefront, positions and normals
 //! only), `.vtk` (legacy VTK unstructured grids of the halos' tetrahedra, for ParaView and
-//! meshio), `report.json`, and any tetrahedra with cell fields as `.vtu`
+//! meshio), `.html` (a page that shows the `.glb` in a web browser, three.js and the file
+//! inlined), `report.json`, and any tetrahedra with cell fields as `.vtu`
 //! ([`write_tetrahedra_vtu`], what `halo4d check --mark` writes). Guarantees: each file in its format's conventions
 //! (`convention`); every file is written to a temporary name and renamed into place,
 //! so a failure never leaves a half-written file, and a build's files move into place
@@ -14,6 +15,7 @@
 //! surfaces back.
 
 mod gltf;
+mod html;
 mod obj;
 mod off4;
 mod ply;
@@ -21,7 +23,11 @@ mod tubes;
 mod vtk;
 mod vtu;
 
-pub use gltf::{glb_chunks, glb_container, stills_glb, to_glb, write_glb_container};
+pub use gltf::{
+    Figure, HALO_SCENE, glb_chunks, glb_container, stills_glb, to_glb, w_colour,
+    write_glb_container,
+};
+pub use html::write_html;
 pub use obj::to_obj;
 pub use off4::to_4off;
 pub use ply::{segments, to_curves_ply, to_ply, to_still_ply, to_stipples_ply};

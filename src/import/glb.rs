@@ -179,6 +179,8 @@ fn attach_halo(
 
 /// The JSON chunk as `gltf-json`'s document; an error names the field.
 fn parse(json: &[u8]) -> Result<json::Root> {
+    let patched = scenes_with_nodes(json);
+    let json = patched.as_deref().unwrap_or(json);
     let mut de = serde_json::Deserializer::from_slice(json);
     serde_path_to_error::deserialize(&mut de).map_err(|e| {
         let path = e.path().to_string();
@@ -192,6 +194,28 @@ fn parse(json: &[u8]) -> Result<json::Root> {
             e.into_inner()
         ))
     })
+}
+
+/// The JSON chunk with `"nodes": []` in each scene that leaves it out, or `None` when none
+/// does (or it is not JSON, which [`parse`] reports). glTF's scenes may leave it out (Blender
+/// 4.5's exporter does, for the collection of a scene without objects, such as the hidden
+/// halos' after their objects moved), and `gltf-json` requires it.
+fn scenes_with_nodes(json: &[u8]) -> Option<Vec<u8>> {
+    let mut document: Value = serde_json::from_slice(json).ok()?;
+    let mut changed = false;
+    for scene in document.get_mut("scenes")?.as_array_mut()? {
+        if let Some(scene) = scene.as_object_mut()
+            && !scene.contains_key("nodes")
+        {
+            scene.insert("nodes".into(), Value::Array(Vec::new()));
+            changed = true;
+        }
+    }
+    if changed {
+        serde_json::to_vec(&document).ok()
+    } else {
+        None
+    }
 }
 
 /// An object's extras as JSON (null when it has none).

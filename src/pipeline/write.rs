@@ -59,8 +59,8 @@ pub fn report_of(scene: &Scene, built: &Built) -> Report {
     assemble_report(scene, built, timings, None, built.failures(), Vec::new())
 }
 
-/// Writes the mesh files the scene asks for (`.glb`, `.ply`, stipples, `.obj`, `.4off`,
-/// `.vtk`), staged, from the surfaces' `data`, the `stipples` and the build's verdict
+/// Writes the mesh files the scene asks for (`.glb`, `.html`, `.ply`, stipples, `.obj`,
+/// `.4off`, `.vtk`), staged, from the surfaces' `data`, the `stipples` and the build's verdict
 /// (`failures`); gives their names in the report's order.
 fn write_meshes(
     scene: &Scene,
@@ -85,6 +85,19 @@ fn write_meshes(
             let file = staged
                 .stream(format!("{name}.glb"), |w| {
                     export::write_glb_container(w, &text, &bin)
+                })
+                .map_err(staged_error)?;
+            Ok(vec![file])
+        }));
+    }
+    if scene.outputs.html {
+        // The page holds the same bytes as the `.glb`, made again on a core of its own.
+        jobs.push(Box::new(|| {
+            let (text, bin) = glb_chunks(scene, built, data, stipples, failures)?;
+            let glb = export::glb_container(text, bin);
+            let file = staged
+                .stream(format!("{name}.html"), |w| {
+                    export::write_html(w, name, &glb, scene.render.background)
                 })
                 .map_err(staged_error)?;
             Ok(vec![file])
@@ -290,9 +303,22 @@ fn glb_chunks(
         built.shown_curves(),
         scene.outputs.curve_radius * built.diagonal,
         stipples,
+        &figure(scene, built),
         &asset,
     )
     .map_err(internal)
+}
+
+/// What the `.glb` carries of the scene's picture: its colour map and its camera (none when
+/// the picture has none: no triangle to frame, or an orthographic eye inside the box, which
+/// the picture itself reports as an error when there is one).
+fn figure(scene: &Scene, built: &Built) -> export::Figure {
+    let parts = built.parts(&scene.halo);
+    let surfaces = parts.surfaces.iter().map(|s| (s.positions, s.triangles));
+    export::Figure {
+        camera: render::picture_camera(surfaces, &scene.render, &scene.camera).ok(),
+        colormap: scene.render.colormap,
+    }
 }
 
 /// The bytes of the `.glb` a build of `scene` writes (with its stipples when

@@ -814,6 +814,25 @@ pub fn picture_pixel_size<'a>(
     Ok(visible::pixel_size(&cam, depth, settings.height))
 }
 
+/// The camera of the picture of the projected surfaces (positions, triangles), its first eye
+/// (what the build's report gives as `picture.camera`), without rendering it: where the eye
+/// stands, what it looks at, its field of view and the picture's size. The settings are
+/// checked first.
+pub fn picture_camera<'a>(
+    surfaces: impl Iterator<Item = (&'a [DVec3], &'a [[u32; 3]])> + Clone,
+    settings: &RenderSettings,
+    camera: &CameraSettings,
+) -> Result<visible::PictureCamera, RenderError> {
+    let (placement, _) = place(surfaces, settings, camera)?;
+    let cam = first_camera(settings, camera, &placement)?;
+    Ok(visible::PictureCamera::of(
+        &cam,
+        placement.target,
+        settings.width,
+        settings.height,
+    ))
+}
+
 /// The box around every vertex of a triangle of the surfaces (positions, triangles), which
 /// the camera frames; `None` when there is no triangle.
 pub fn triangle_bounds<'a>(
