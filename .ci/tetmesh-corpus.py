@@ -57,6 +57,7 @@ import tetgen
 import vtk
 from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray, vtk_to_numpy
 
+import mixed_corpus
 import vtk_pieces
 
 # Gmsh's target edge length per shape: a few hundred to two thousand tetrahedra each.
@@ -945,12 +946,15 @@ def corpus(binary, out, table_path):
     more_rows, more_failed = transformed_runs(binary, out / "transformed", originals)
     rows += more_rows
     failed += more_failed
+    mixed_rows, mixed_failed, mixed_files = mixed_corpus.corpus(binary, out, run_halo4d, judge_halo4d, ms)
+    rows += mixed_rows
+    failed += mixed_failed
 
     header = ("mesh", "halo4d must", "halo4d", "vtkCellValidator", "vtkMeshQuality", "meshio", "TetGen")
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join(c.replace("|", "/") for c in row) + " |" for row in rows]
     table = "\n".join(lines) + "\n"
-    files = sum(len(g[2]) for g in groups) + len(fault_cases) + len(TRANSFORMS) * len(originals)
+    files = sum(len(g[2]) for g in groups) + len(fault_cases) + len(TRANSFORMS) * len(originals) + mixed_files
     print(f"{files} files")
     note = (f"\n{files} files. halo4d: {binary}; Gmsh {gmsh.__version__}, TetGen (tetgen {tetgen.__version__}), "
             f"meshio {meshio.__version__}, VTK {vtk.vtkVersion.GetVTKVersion()}, PyVista {pyvista.__version__}. TetGen's check (-C) runs "

@@ -104,6 +104,9 @@ pub struct CheckStats {
     pub collapsed_vertices: usize,
     /// Sum of the tetrahedra's absolute volumes.
     pub volume: f64,
+    /// The base-10 logarithm of `volume`, finite wherever the volume is positive, also where
+    /// it overflows an f64 (a mesh 1e300 across encloses about 1e900).
+    pub volume_log10: f64,
     /// Volume enclosed by the boundary faces.
     pub boundary_volume: f64,
     /// |volume - boundary_volume| / boundary_volume.
@@ -262,8 +265,9 @@ pub(crate) struct Scaled {
     /// kept, and `robust::orient3d` cannot overflow); the vertices no tetrahedron uses at
     /// the origin, so that they take no part in the scaling.
     pub(crate) positions: Vec<[f64; 3]>,
-    /// The factor that scales volumes back.
-    pub(crate) volume_scale: f64,
+    /// The power of two that scales volumes back (2^volume_exp2 may overflow an f64 where
+    /// the volumes it scales do not).
+    pub(crate) volume_exp2: i32,
     /// Which vertices have a coordinate too small for the predicates to stay exact
     /// ([`SAFE_RANGE`]).
     pub(crate) tiny: Vec<bool>,
@@ -298,10 +302,10 @@ pub(crate) fn scaled<P: Copy + Into<[f64; 3]> + Sync>(
         .into_par_iter()
         .map(|i| at(i).map(f64::abs).into_iter().fold(0.0, f64::max))
         .reduce(|| 0.0, f64::max);
-    let (out, volume_scale, tiny): (Vec<[f64; 3]>, f64, Vec<bool>) =
+    let (out, volume_exp2, tiny): (Vec<[f64; 3]>, i32, Vec<bool>) =
         if !(largest.is_finite() && largest > 0.0) {
             let out = (0..positions.len()).map(at).collect();
-            (out, 1.0, vec![false; positions.len()])
+            (out, 0, vec![false; positions.len()])
         } else {
             // 2^-e with largest = m 2^e, m in [0.5, 1); in two steps, each a normal power of two.
             let e = largest.log2().floor() as i32 + 1;
@@ -315,7 +319,7 @@ pub(crate) fn scaled<P: Copy + Into<[f64; 3]> + Sync>(
                 .iter()
                 .map(|p| p.iter().any(|&x| x != 0.0 && x.abs() * SAFE_RANGE < 1.0))
                 .collect();
-            (out, 2f64.powi(3 * e), tiny)
+            (out, 3 * e, tiny)
         };
     let (lo, hi) = out
         .par_iter()
@@ -337,7 +341,7 @@ pub(crate) fn scaled<P: Copy + Into<[f64; 3]> + Sync>(
     });
     Scaled {
         positions: out,
-        volume_scale,
+        volume_exp2,
         tiny,
         centre,
     }
@@ -705,7 +709,7 @@ pub fn examine_tetrahedra<P: Copy + Into<[f64; 3]> + Sync>(
         tets.par_iter().map(|&t| sorted_tet(t, nv)).unzip();
     let Scaled {
         positions: scaled,
-        volume_scale,
+        volume_exp2,
         tiny,
         centre,
     } = scaled(positions, tets);
@@ -729,7 +733,7 @@ pub fn examine_tetrahedra<P: Copy + Into<[f64; 3]> + Sync>(
         .collect::<Vec<f64>>()
         .iter()
         .sum();
-    finish_volumes(&mut s, volume_scale);
+    finish_volumes(&mut s, volume_exp2);
     Examined {
         stats: s,
         scaled,
@@ -793,7 +797,7 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
         .unzip();
     let Scaled {
         positions: scaled,
-        volume_scale,
+        volume_exp2,
         tiny,
         centre,
     } = scaled(positions, &tets);
@@ -824,7 +828,7 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
     let edges = surface_edges(&mut s, offset_faces, &layout, &incidence);
     let open = check_quads(&mut s, edges, &layout, &incidence);
     s.unexpected_boundary_faces = unexpected_boundary_faces(&others, &open, &layout);
-    finish_volumes(&mut s, volume_scale);
+    finish_volumes(&mut s, volume_exp2);
     s
 }
 
@@ -1175,10 +1179,12 @@ fn unexpected_boundary_faces<P: Copy + Into<[f64; 3]> + Sync>(
         .count()
 }
 
-/// The volume defect, then the volumes back in the mesh's own units (infinite or zero where
-/// they do not fit an f64) by `volume_scale`, the factor [`scaled`] gives.
-fn finish_volumes(s: &mut CheckStats, volume_scale: f64) {
+/// The volume defect, the volume's logarithm, then the volumes back in the mesh's own units
+/// (infinite or zero where they do not fit an f64) by 2^`volume_exp2`, the power [`scaled`]
+/// gives.
+fn finish_volumes(s: &mut CheckStats, volume_exp2: i32) {
     let boundary_volume = s.boundary_volume;
+    s.volume_log10 = s.volume.log10() + f64::from(volume_exp2) * std::f64::consts::LOG10_2;
     s.volume_defect = if boundary_volume.abs() > 0.0 {
         (s.volume - boundary_volume).abs() / boundary_volume.abs()
     } else if s.volume == 0.0 {
@@ -1192,6 +1198,8 @@ fn finish_volumes(s: &mut CheckStats, volume_scale: f64) {
         &mut s.min_volume,
         &mut s.max_volume,
     ] {
-        *v *= volume_scale;
+        // In two steps: each power of two stays finite where the product does.
+        let half = volume_exp2 / 2;
+        *v = *v * 2f64.powi(half) * 2f64.powi(volume_exp2 - half);
     }
 }

@@ -706,7 +706,14 @@ fn stat_rows(stats: &CheckStats) -> Vec<(String, String)> {
         .map(|r| r.0)
         .unwrap_or_default();
     rows.into_iter()
+        // The logarithm is the volume's own row where the volume overflows.
+        .filter(|(k, _)| k != "volume_log10")
         .map(|(k, v)| {
+            if k == "volume" && !stats.volume.is_finite() && stats.volume_log10.is_finite() {
+                // Beyond an f64: the decimal from the logarithm.
+                let (e, m) = (stats.volume_log10.floor(), stats.volume_log10.fract());
+                return (k, format!("{:.3}e{e} (beyond an f64)", 10f64.powf(m)));
+            }
             let text = match v {
                 serde_json::Value::Number(n) if n.is_u64() || n.is_i64() => n.to_string(),
                 serde_json::Value::Number(n) => {

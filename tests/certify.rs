@@ -255,6 +255,38 @@ fn a_mesh_scaled_by_powers_of_two_gets_the_same_certificate_and_1e150_is_still_e
 }
 
 #[test]
+fn a_volume_beyond_an_f64_is_given_by_its_logarithm() {
+    // Kuhn's cube scaled by 2^1000: its volume times 2^3000 overflows, its logarithm does
+    // not.
+    let (p, t) = kuhn_cube(3);
+    let at_one = certify(&p, &t).stats;
+    assert!((at_one.volume_log10 - at_one.volume.log10()).abs() < 1e-12);
+    let s = 2f64.powi(1000);
+    let scaled: Vec<[f64; 3]> = p.iter().map(|q| q.map(|x| x * s)).collect();
+    let c = certify(&scaled, &t);
+    assert!(c.failures().is_empty(), "{:?}", c.failures());
+    assert!(c.stats.volume.is_infinite());
+    let want = at_one.volume.log10() + 3000.0 * std::f64::consts::LOG10_2;
+    assert!(
+        (c.stats.volume_log10 - want).abs() < 1e-9,
+        "{}",
+        c.stats.volume_log10
+    );
+    // The command prints the decimal: one tetrahedron with legs of 1e300 encloses 1e900 / 6.
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("big.vtk");
+    std::fs::write(
+        &file,
+        "# vtk DataFile Version 4.2\nbig\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 4 double\n0 0 0\n1e300 0 0\n0 1e300 0\n0 0 1e300\nCELLS 1 5\n4 0 1 2 3\nCELL_TYPES 1\n10\n",
+    )
+    .unwrap();
+    let o = halo4d(&["check", file.to_str().unwrap()], dir.path());
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{out}");
+    assert!(out.contains("1.667e899 (beyond an f64)"), "{out}");
+}
+
+#[test]
 fn check_prints_json_and_marks_each_faulty_tetrahedron_in_a_vtu() {
     let dir = tempfile::tempdir().unwrap();
     let faults = fixture("tetmeshes/faults");

@@ -973,7 +973,7 @@ fn malformed_vtk_files_are_clear_errors() {
             &format!("CELL_TYPES {nt}\n12\n"),
         )
         .as_bytes(),
-        &["cell 0 has type 12", "tetrahedron"],
+        &["cell 0 has 4 points", "a cell of type 12 has 8"],
     );
     vtk_fails(
         replace(

@@ -752,8 +752,9 @@ fn catalogue<'py>(py: Python<'py>) -> PyResult<Vec<Bound<'py, PyAny>>> {
 /// folder the `curves` recomputed from its surfaces and the halos' `verification` against
 /// them, the `scene` the file records, `plain` (why a mesh is not read as a halo, or None),
 /// for another program's tetrahedral mesh (`.vtk`, `.vtu`, `.msh`, `.mesh`, `.node`/`.ele`)
-/// its `certificate` (`convention`, `boundary`, `quality`, and `faults`: each tetrahedron's
-/// fault bits) and `format`, and `text` (what the command prints). A file that cannot be
+/// its `certificate` (`convention`, `boundary`, `quality`, for a mixed mesh `cells`, and
+/// `faults`: each cell's fault bits, its tetrahedra first, then its hexahedra, wedges and
+/// pyramids in the file's order) and `format`, and `text` (what the command prints). A file that cannot be
 /// read raises `OSError`.
 #[pyfunction]
 fn check<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
@@ -838,7 +839,10 @@ fn checked_dict<'py>(py: Python<'py>, checked: &halo4d::Checked) -> PyResult<Bou
     out.set_item("plain", checked.plain.clone())?;
     if let Some(certificate) = &checked.certificate {
         let entry = to_python(py, certificate)?;
-        entry.set_item("faults", PyArray1::from_slice(py, &certificate.faults))?;
+        entry.set_item(
+            "faults",
+            PyArray1::from_slice(py, certificate.cell_faults()),
+        )?;
         out.set_item("certificate", entry)?;
     }
     out.set_item("format", checked.mesh.as_ref().map(|m| m.format.clone()))?;

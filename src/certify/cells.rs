@@ -31,9 +31,81 @@ use super::exact::orient;
 use super::{Certificate, Fault, certify};
 use crate::check::scaled;
 use crate::convention::file_order;
-use crate::import::{Solid, SolidKind};
 use rayon::prelude::*;
 use serde::Serialize;
+
+/// A kind of solid cell other than a tetrahedron that a mixed mesh may have.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SolidKind {
+    /// Eight corners: the quadrilateral 0 1 2 3, its normal (right-hand rule) towards the
+    /// opposite one 4 5 6 7, corner i + 4 above corner i.
+    Hexahedron,
+    /// Six corners: the triangle 0 1 2, its normal away from the opposite one 3 4 5, corner
+    /// i + 3 above corner i.
+    Wedge,
+    /// Five corners: the quadrilateral 0 1 2 3, its normal towards the apex 4.
+    Pyramid,
+}
+
+impl SolidKind {
+    /// How many corners.
+    pub fn corners(self) -> usize {
+        match self {
+            SolidKind::Hexahedron => 8,
+            SolidKind::Wedge => 6,
+            SolidKind::Pyramid => 5,
+        }
+    }
+
+    /// The name, singular.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolidKind::Hexahedron => "hexahedron",
+            SolidKind::Wedge => "wedge",
+            SolidKind::Pyramid => "pyramid",
+        }
+    }
+
+    /// The name, plural.
+    pub fn plural(self) -> &'static str {
+        match self {
+            SolidKind::Hexahedron => "hexahedra",
+            SolidKind::Wedge => "wedges",
+            SolidKind::Pyramid => "pyramids",
+        }
+    }
+
+    /// VTK's number for the linear cell of this kind.
+    pub fn vtk_type(self) -> u8 {
+        match self {
+            SolidKind::Hexahedron => 12,
+            SolidKind::Wedge => 13,
+            SolidKind::Pyramid => 14,
+        }
+    }
+}
+
+/// A hexahedron, wedge or pyramid of a mixed mesh: its corners in VTK's order (the readers
+/// convert Gmsh's prisms and VTK's voxels; a quadratic cell's corners, its other nodes
+/// left out).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Solid {
+    /// Which kind.
+    pub kind: SolidKind,
+    /// The corners, the first [`SolidKind::corners`] of them used (the rest 0).
+    pub corners: [u32; 8],
+    /// The cell's number in the file: its VTK cell id (counting every cell from 0), or its
+    /// Gmsh element tag.
+    pub id: u64,
+}
+
+impl Solid {
+    /// The corners used.
+    pub fn used(&self) -> &[u32] {
+        &self.corners[..self.kind.corners()]
+    }
+}
 
 /// A hexahedron's quadrilaterals, each turning counterclockwise seen from outside.
 const HEX_QUADS: [[usize; 4]; 6] = [

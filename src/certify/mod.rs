@@ -34,7 +34,7 @@ mod grid;
 mod quality;
 
 pub use boundary::Boundary;
-pub use cells::{Cells, FaultyCell, certify_cells};
+pub use cells::{Cells, FaultyCell, Solid, SolidKind, certify_cells};
 pub use grid::kuhn_cube;
 pub use quality::{BINS, Bin, Cell, Quality, WORST};
 
