@@ -275,26 +275,15 @@ impl Checked {
         for f in &failures {
             out += &format!("FAILED {f}\n");
         }
-        if let (
-            true,
-            Some(Certificate {
-                cells: Some(_),
-                boundary: b,
-                ..
-            }),
-        ) = (failures.is_empty(), &self.certificate)
-        {
-            out += &format!(
-                "ok: a valid subdivision of the region its boundary encloses into its cells: every cell positive and star-shaped, every two meeting face to face or not at all (bent quadrilaterals only between two cells that both have them), the boundary manifold, not meeting itself and wound once around ({} {}, {} {})\n",
-                b.components,
-                plural(b.components, "component", "components"),
-                b.cavities,
-                plural(b.cavities, "cavity", "cavities"),
-            );
-        } else if let (true, Some(c)) = (failures.is_empty(), &self.certificate) {
+        if let (true, Some(c)) = (failures.is_empty(), &self.certificate) {
             let b = &c.boundary;
+            let what = if c.cells.is_some() {
+                "a valid subdivision of the region its boundary encloses into its cells: every cell positive and star-shaped, every two meeting face to face or not at all (bent quadrilaterals only between two cells that both have them)"
+            } else {
+                "a valid tetrahedralization of the region its boundary encloses: every tetrahedron positive, every two meeting face to face or not at all"
+            };
             out += &format!(
-                "ok: a valid tetrahedralization of the region its boundary encloses: every tetrahedron positive, every two meeting face to face or not at all, the boundary manifold, not meeting itself and wound once around ({} {}, {} {})\n",
+                "ok: {what}, the boundary manifold, not meeting itself and wound once around ({} {}, {} {})\n",
                 b.components,
                 plural(b.components, "component", "components"),
                 b.cavities,
