@@ -770,25 +770,29 @@ fn check<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
     checked_dict(py, &checked)
 }
 
-/// The certificate of tetrahedra given as arrays (what `halo4d.check` makes of a PyVista
-/// grid, a meshio mesh or `(points, cells)`): `points` (n, 3) float64, `tets` (m, 4) int64
-/// in VTK's convention (a, b, c, d positive when det[b - a, c - a, d - a] > 0), `name` and
-/// `format` saying where they came from. The dict of `check`; indices out of range or
-/// non-finite points raise `ValueError`.
+/// The certificate of cells given as arrays (what `halo4d.check` makes of a PyVista grid, a
+/// meshio mesh or `(points, cells)`): `points` (n, 3) float64, `tets` (m, 4) int64 in VTK's
+/// convention (a, b, c, d positive when det[b - a, c - a, d - a] > 0), `solids` (k, 10)
+/// int64, a hexahedron's, wedge's or pyramid's VTK type (12, 13, 14), its number and its
+/// corners in VTK's order (padded with 0), `name` and `format` saying where they came from.
+/// The dict of `check`; indices out of range, unknown types or non-finite points raise
+/// `ValueError`.
 #[pyfunction]
 fn certify_arrays<'py>(
     py: Python<'py>,
     points: numpy::PyReadonlyArray2<'py, f64>,
     tets: numpy::PyReadonlyArray2<'py, i64>,
+    solids: numpy::PyReadonlyArray2<'py, i64>,
     name: String,
     format: String,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let (p, t) = (points.as_array(), tets.as_array());
-    if p.ncols() != 3 || t.ncols() != 4 {
+    let (p, t, s) = (points.as_array(), tets.as_array(), solids.as_array());
+    if p.ncols() != 3 || t.ncols() != 4 || s.ncols() != 10 {
         return Err(PyValueError::new_err(format!(
-            "points must be (n, 3) and tetrahedra (m, 4); got {:?} and {:?}",
+            "points must be (n, 3), tetrahedra (m, 4) and other cells (k, 10); got {:?}, {:?} and {:?}",
             p.shape(),
-            t.shape()
+            t.shape(),
+            s.shape()
         )));
     }
     let positions: Vec<[f64; 3]> = p.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect();
@@ -808,7 +812,31 @@ fn certify_arrays<'py>(
         }
         cells.push(c);
     }
+    use halo4d::import::{Solid, SolidKind};
+    let mut others = Vec::with_capacity(s.nrows());
+    for r in s.rows() {
+        let kind = match r[0] {
+            12 => SolidKind::Hexahedron,
+            13 => SolidKind::Wedge,
+            14 => SolidKind::Pyramid,
+            t => {
+                return Err(PyValueError::new_err(format!(
+                    "cell {} has VTK type {t}, not 12, 13 or 14 (a hexahedron, wedge or pyramid)",
+                    r[1]
+                )));
+            }
+        };
+        let mut corners = [0u32; 8];
+        for (slot, &i) in corners.iter_mut().zip(r.iter().skip(2)) {
+            *slot = u32::try_from(i).map_err(|_| {
+                PyValueError::new_err(format!("cell {} names point {i}, which is no point", r[1]))
+            })?;
+        }
+        let id = u64::try_from(r[1]).unwrap_or(0);
+        others.push(Solid { kind, corners, id });
+    }
     let mesh = halo4d::import::PlainTetrahedra::from_arrays(&name, &format, positions, &cells)
+        .and_then(|m| m.with_solids(others))
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     let label = PathBuf::from(&name);
     let checked = run(py, move || halo4d::check_mesh(&label, mesh))?;

@@ -405,7 +405,29 @@ def test_a_mesh_in_memory_is_certified_without_a_file_with_its_faults_per_cell()
     # Bad input is a clear error, not a crash.
     with pytest.raises(ValueError, match="names point 9"):
         halo4d.check((points, np.array([[0, 1, 2, 9]])))
-    with pytest.raises(ValueError, match="hexahedron"):
-        halo4d.check(meshio.Mesh(np.zeros((8, 3)), [("hexahedron", np.arange(8)[None, :])]))
+    prism = pyvista.UnstructuredGrid({16: np.arange(12)[None, :]}, np.random.default_rng(1).random((12, 3)))
+    with pytest.raises(ValueError, match="1 hexagonal prism"):
+        halo4d.check(prism)
     with pytest.raises(TypeError, match="PyVista UnstructuredGrid"):
         halo4d.check(42)
+
+
+def test_a_mixed_mesh_in_memory_gets_the_files_certificate_and_each_cells_faults():
+    import pyvista
+
+    here = ROOT / "fixtures" / "tetmeshes"
+    for name, failures in [("mixed-vtk9.vtu", []), ("mixed-split-hex.vtu", ["nonconforming_quads"]),
+                           ("mixed-inverted-wedge.vtu", ["inverted"])]:
+        by_file = halo4d.check(here / name)
+        grid = pyvista.read(here / name)
+        # meshio keeps wedges in Gmsh's corner order and turns them at the file: the same mesh.
+        mesh = meshio.read(here / name)
+        for source in (grid, mesh):
+            got = halo4d.check(source)
+            assert [f.split()[1] for f in got["failures"]] == failures, (name, type(source), got["failures"])
+            assert got["certificate"]["cells"] == by_file["certificate"]["cells"], (name, type(source))
+            assert sorted(got["cell_faults"]) == sorted(by_file["certificate"]["faults"]), (name, type(source))
+        # Each cell's bits where the grid has it: the faulty cells are the named kind.
+        faulty = np.flatnonzero(halo4d.check(grid)["cell_faults"])
+        kinds = {"mixed-vtk9.vtu": set(), "mixed-split-hex.vtu": {12}, "mixed-inverted-wedge.vtu": {13}}[name]
+        assert set(grid.celltypes[faulty]) == kinds, name

@@ -385,6 +385,13 @@ impl PlainTetrahedra {
         .validate()
     }
 
+    /// The mesh with `solids` (hexahedra, wedges, pyramids in VTK's corner order) beside its
+    /// tetrahedra; corners out of range are an [`ImportError::BadTetrahedra`].
+    pub fn with_solids(mut self, solids: Vec<Solid>) -> Result<Self, ImportError> {
+        self.solids = solids;
+        self.validate()
+    }
+
     /// Checks what the checker takes for granted: finite positions, indices in range, and
     /// for a mesh of pieces, a piece for each tetrahedron.
     fn validate(self) -> Result<Self, ImportError> {
