@@ -211,7 +211,7 @@ impl Cells {
 type QuadUse = ([u32; 4], u32, u8);
 
 /// How a quadrilateral is split, and whether it conforms.
-#[derive(Clone, Copy, Default)]
+#[derive(Clone, Copy)]
 struct Split {
     /// The diagonal it is split along: its two corners, the smaller first.
     diagonal: [u32; 2],
@@ -242,37 +242,7 @@ pub fn certify_cells(positions: &[[f64; 3]], tets: &[[u32; 4]], solids: &[Solid]
         let s = &solids[j as usize];
         quads(s.kind)[f as usize].map(|i| s.corners[i])
     };
-    // The triangles of the other cells that lie against a quadrilateral along a diagonal.
-    let halves = |q: [u32; 4]| {
-        let [a, b, c, d] = q;
-        [[a, b, c], [a, c, d], [a, b, d], [b, c, d]].map(sorted3)
-    };
-    let mut wanted: Vec<[u32; 3]> = uses
-        .par_iter()
-        .flat_map_iter(|&(_, j, f)| halves(corners(j, f)))
-        .collect();
-    wanted.par_sort_unstable();
-    wanted.dedup();
-    let fixed = tets
-        .par_iter()
-        .flat_map_iter(|t| {
-            [
-                [t[0], t[1], t[2]],
-                [t[0], t[1], t[3]],
-                [t[0], t[2], t[3]],
-                [t[1], t[2], t[3]],
-            ]
-        })
-        .chain(
-            solids
-                .par_iter()
-                .flat_map_iter(|s| triangles(s.kind).iter().map(|t| t.map(|i| s.corners[i]))),
-        )
-        .map(sorted3)
-        .filter(|k| wanted.binary_search(k).is_ok());
-    let mut present: Vec<[u32; 3]> = fixed.collect();
-    present.par_sort_unstable();
-    present.dedup();
+    let present = triangles_against(tets, solids, &uses, corners);
     let has = |k: [u32; 3]| present.binary_search(&k).is_ok();
 
     // Each distinct quadrilateral's split: along the diagonal of the triangles against it,
@@ -299,7 +269,7 @@ pub fn certify_cells(positions: &[[f64; 3]], tets: &[[u32; 4]], solids: &[Solid]
             (split, None, 0.0)
         })
         .collect();
-    // Each cell's faces' splits, by the cell and face.
+    // Each cell's faces' diagonals, by the cell and face.
     let mut first_quad = Vec::with_capacity(solids.len() + 1);
     let mut n = 0;
     for s in solids {
@@ -307,53 +277,14 @@ pub fn certify_cells(positions: &[[f64; 3]], tets: &[[u32; 4]], solids: &[Solid]
         n += quads(s.kind).len();
     }
     first_quad.push(n);
-    let mut splits = vec![Split::default(); n];
+    let mut diagonals = vec![[0u32; 2]; n];
     for (g, (split, _, _)) in groups.iter().zip(&judged) {
         for &(_, j, f) in *g {
-            splits[first_quad[j as usize] + f as usize] = *split;
+            diagonals[first_quad[j as usize] + f as usize] = split.diagonal;
         }
     }
-
-    // The tetrahedra: the mesh's, then each cell's.
-    let mut all_positions = positions.to_vec();
-    let mut all_tets = tets.to_vec();
-    let mut first_tet = Vec::with_capacity(solids.len() + 1);
-    for (j, s) in solids.iter().enumerate() {
-        first_tet.push(all_tets.len());
-        let c = |i: usize| s.corners[i];
-        let apex = match s.kind {
-            SolidKind::Pyramid => c(4),
-            SolidKind::Hexahedron | SolidKind::Wedge => {
-                // Each corner divided first: no sum overflows.
-                let k = s.kind.corners() as f64;
-                let mean = s.used().iter().fold([0.0; 3], |m, &i| {
-                    let p = positions[i as usize];
-                    [0, 1, 2].map(|a| m[a] + p[a] / k)
-                });
-                all_positions.push(mean);
-                (all_positions.len() - 1) as u32
-            }
-        };
-        // Each outward triangle (a, b, c) with the apex inside: (a, c, b, apex) is positive
-        // in the files' convention.
-        let mut cone = |[a, b, c]: [u32; 3]| all_tets.push(file_order([a, c, b, apex]));
-        for (f, q) in quads(s.kind).iter().enumerate() {
-            let [a, b, cc, d] = q.map(c);
-            if splits[first_quad[j] + f].diagonal == [a.min(cc), a.max(cc)] {
-                cone([a, b, cc]);
-                cone([a, cc, d]);
-            } else {
-                cone([a, b, d]);
-                cone([b, cc, d]);
-            }
-        }
-        if s.kind == SolidKind::Wedge {
-            for t in &WEDGE_TRIANGLES {
-                cone(t.map(c));
-            }
-        }
-    }
-    first_tet.push(all_tets.len());
+    let (all_positions, all_tets, first_tet) =
+        split_into_tetrahedra(positions, tets, solids, |j, f| diagonals[first_quad[j] + f]);
 
     // Each quadrilateral's planarity, exactly, on the coordinates the certificate decides
     // on; its warp where bent; against triangles and bent, it cannot conform.
@@ -398,29 +329,7 @@ pub fn certify_cells(positions: &[[f64; 3]], tets: &[[u32; 4]], solids: &[Solid]
     let count = |kind| solids.iter().filter(|s| s.kind == kind).count();
     let solid_ids: Vec<(SolidKind, u64)> = solids.iter().map(|s| (s.kind, s.id)).collect();
     let faulty_bits = |b: u32| b & !Fault::CAVITY != 0;
-    let faulty = faults
-        .iter()
-        .enumerate()
-        .filter(|(_, b)| faulty_bits(**b))
-        .take(NAMED)
-        .map(|(k, &b)| {
-            let (kind, id) = if k < nt {
-                ("tetrahedron", k as u64)
-            } else {
-                let (kind, id) = solid_ids[k - nt];
-                (kind.name(), id)
-            };
-            FaultyCell {
-                kind,
-                id,
-                faults: Fault::NAMES
-                    .iter()
-                    .filter(|(bit, _)| b & bit != 0 && *bit != Fault::CAVITY)
-                    .map(|&(_, name)| name)
-                    .collect(),
-            }
-        })
-        .collect();
+    let faulty = faulty_cells(&faults, nt, &solid_ids);
     certificate.cells = Some(Cells {
         tetrahedra: nt,
         hexahedra: count(SolidKind::Hexahedron),
@@ -439,6 +348,129 @@ pub fn certify_cells(positions: &[[f64; 3]], tets: &[[u32; 4]], solids: &[Solid]
         solids: solid_ids,
     });
     certificate
+}
+
+/// The triangles of other cells (the tetrahedra's faces, the pyramids' sides, the wedges'
+/// ends) that lie against a quadrilateral of `uses` along one of its diagonals, sorted.
+fn triangles_against(
+    tets: &[[u32; 4]],
+    solids: &[Solid],
+    uses: &[QuadUse],
+    corners: impl Fn(u32, u8) -> [u32; 4] + Sync,
+) -> Vec<[u32; 3]> {
+    let mut wanted: Vec<[u32; 3]> = uses
+        .par_iter()
+        .flat_map_iter(|&(_, j, f)| halves(corners(j, f)))
+        .collect();
+    wanted.par_sort_unstable();
+    wanted.dedup();
+    let fixed = tets
+        .par_iter()
+        .flat_map_iter(|t| {
+            [
+                [t[0], t[1], t[2]],
+                [t[0], t[1], t[3]],
+                [t[0], t[2], t[3]],
+                [t[1], t[2], t[3]],
+            ]
+        })
+        .chain(
+            solids
+                .par_iter()
+                .flat_map_iter(|s| triangles(s.kind).iter().map(|t| t.map(|i| s.corners[i]))),
+        )
+        .map(sorted3)
+        .filter(|k| wanted.binary_search(k).is_ok());
+    let mut present: Vec<[u32; 3]> = fixed.collect();
+    present.par_sort_unstable();
+    present.dedup();
+    present
+}
+
+/// A quadrilateral's triangles split along its diagonal from its first corner, then from its
+/// second, each sorted.
+fn halves([a, b, c, d]: [u32; 4]) -> [[u32; 3]; 4] {
+    [[a, b, c], [a, c, d], [a, b, d], [b, c, d]].map(sorted3)
+}
+
+/// The mesh's positions and tetrahedra with each cell's after them (its quadrilateral `f`
+/// split along `diagonal(j, f)` for cell j; a hexahedron's and a wedge's apex, the mean of
+/// their corners, a new vertex), and where each cell's tetrahedra begin (and the last end).
+fn split_into_tetrahedra(
+    positions: &[[f64; 3]],
+    tets: &[[u32; 4]],
+    solids: &[Solid],
+    diagonal: impl Fn(usize, usize) -> [u32; 2],
+) -> (Vec<[f64; 3]>, Vec<[u32; 4]>, Vec<usize>) {
+    // The tetrahedra: the mesh's, then each cell's.
+    let mut all_positions = positions.to_vec();
+    let mut all_tets = tets.to_vec();
+    let mut first_tet = Vec::with_capacity(solids.len() + 1);
+    for (j, s) in solids.iter().enumerate() {
+        first_tet.push(all_tets.len());
+        let c = |i: usize| s.corners[i];
+        let apex = match s.kind {
+            SolidKind::Pyramid => c(4),
+            SolidKind::Hexahedron | SolidKind::Wedge => {
+                // Each corner divided first: no sum overflows.
+                let k = s.kind.corners() as f64;
+                let mean = s.used().iter().fold([0.0; 3], |m, &i| {
+                    let p = positions[i as usize];
+                    [0, 1, 2].map(|a| m[a] + p[a] / k)
+                });
+                all_positions.push(mean);
+                (all_positions.len() - 1) as u32
+            }
+        };
+        // Each outward triangle (a, b, c) with the apex inside: (a, c, b, apex) is positive
+        // in the files' convention.
+        let mut cone = |[a, b, c]: [u32; 3]| all_tets.push(file_order([a, c, b, apex]));
+        for (f, q) in quads(s.kind).iter().enumerate() {
+            let [a, b, cc, d] = q.map(c);
+            if diagonal(j, f) == [a.min(cc), a.max(cc)] {
+                cone([a, b, cc]);
+                cone([a, cc, d]);
+            } else {
+                cone([a, b, d]);
+                cone([b, cc, d]);
+            }
+        }
+        if s.kind == SolidKind::Wedge {
+            for t in &WEDGE_TRIANGLES {
+                cone(t.map(c));
+            }
+        }
+    }
+    first_tet.push(all_tets.len());
+    (all_positions, all_tets, first_tet)
+}
+
+/// Up to [`NAMED`] cells with a fault, in the order of `faults` (the `nt` tetrahedra, then
+/// the cells of `solids`), with their faults' names.
+fn faulty_cells(faults: &[u32], nt: usize, solids: &[(SolidKind, u64)]) -> Vec<FaultyCell> {
+    faults
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| **b & !Fault::CAVITY != 0)
+        .take(NAMED)
+        .map(|(k, &b)| {
+            let (kind, id) = if k < nt {
+                ("tetrahedron", k as u64)
+            } else {
+                let (kind, id) = solids[k - nt];
+                (kind.name(), id)
+            };
+            FaultyCell {
+                kind,
+                id,
+                faults: Fault::NAMES
+                    .iter()
+                    .filter(|(bit, _)| b & bit != 0 && *bit != Fault::CAVITY)
+                    .map(|&(_, name)| name)
+                    .collect(),
+            }
+        })
+        .collect()
 }
 
 fn sorted3(mut k: [u32; 3]) -> [u32; 3] {
