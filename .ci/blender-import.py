@@ -31,11 +31,8 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-MIN_IOU = 0.95
-# How far (of 255, in any channel) a pixel of halo4d's picture must be from its background
-# to count as covered: the anti-aliased edge counts from about a tenth of its coverage on
-# the lightest surface colours.
-BACKGROUND_STEP = 8
+from silhouette import MIN_IOU, compare, covered
+
 SAMPLES = 32
 
 
@@ -128,18 +125,10 @@ def main():
 
     # The picture's background as its PNG stores it: the corner pixel, which the fitted
     # camera's margin leaves empty.
-    picture_background = picture[0, 0].astype(int)
-    covered_picture = (np.abs(picture.astype(int) - picture_background) > BACKGROUND_STEP).any(axis=2)
+    covered_picture = covered(picture)
     covered_blender = alpha[..., 0] >= 0.5
-    both = covered_picture & covered_blender
-    union = covered_picture | covered_blender
-    iou = both.sum() / max(union.sum(), 1)
-
-    diff = np.full((height, width, 3), 255, np.uint8)
-    diff[both] = (150, 150, 150)
-    diff[covered_picture & ~covered_blender] = (220, 30, 30)
-    diff[covered_blender & ~covered_picture] = (30, 60, 220)
-    Image.fromarray(np.concatenate([picture, blender, diff], axis=1)).save(out / "side-by-side.png")
+    iou, picture_only, blender_only = compare(picture, covered_picture, blender, covered_blender,
+                                              out / "side-by-side.png")
 
     record = {
         "glb": str(glb),
@@ -148,8 +137,8 @@ def main():
         "iou": float(iou),
         "picture_pixels": int(covered_picture.sum()),
         "blender_pixels": int(covered_blender.sum()),
-        "picture_only": int((covered_picture & ~covered_blender).sum()),
-        "blender_only": int((covered_blender & ~covered_picture).sum()),
+        "picture_only": picture_only,
+        "blender_only": blender_only,
         "min_iou": MIN_IOU,
         "samples": SAMPLES,
         "blender": bpy.app.version_string,

@@ -21,16 +21,11 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-MIN_IOU = 0.95
+from silhouette import MIN_IOU, compare, covered
+
 MIN_COVERED = 0.05
 MIN_INK = 200
 INK_LEVEL = 40
-BACKGROUND_STEP = 8
-
-
-def covered(image):
-    background = image[0, 0].astype(int)
-    return (np.abs(image.astype(int) - background) > BACKGROUND_STEP).any(axis=2)
 
 
 def main():
@@ -43,22 +38,17 @@ def main():
     if shot.shape != picture.shape:
         sys.exit(f"the screenshot is {shot.shape[1]}x{shot.shape[0]}, the picture {picture.shape[1]}x{picture.shape[0]}")
     a, b = covered(picture), covered(shot)
-    iou = (a & b).sum() / max((a | b).sum(), 1)
+    iou, picture_only, shot_only = compare(picture, a, shot, b, out / "browser-side-by-side.png")
     share = b.mean()
     ink = int((shot <= INK_LEVEL).all(axis=2).sum())
-    diff = np.full(shot.shape, 255, np.uint8)
-    diff[a & b] = (150, 150, 150)
-    diff[a & ~b] = (220, 30, 30)
-    diff[b & ~a] = (30, 60, 220)
-    Image.fromarray(np.concatenate([picture, shot, diff], axis=1)).save(out / "browser-side-by-side.png")
     record = {
         "shot": str(shot_path),
         "picture": str(picture_path),
         "iou": float(iou),
         "covered_share": float(share),
         "ink_pixels": ink,
-        "picture_only": int((a & ~b).sum()),
-        "shot_only": int((b & ~a).sum()),
+        "picture_only": picture_only,
+        "shot_only": shot_only,
         "min_iou": MIN_IOU,
     }
     (out / "browser-result.json").write_text(json.dumps(record, indent=2) + "\n")

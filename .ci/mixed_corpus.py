@@ -15,7 +15,8 @@ The meshes, all from Gmsh 4.15.2:
 and the twisted hybrid at order 2. Each is written by Gmsh (MSH 4.1 ASCII and binary, 2.2
 ASCII and binary, its legacy .vtk), by VTK 9.5.2's XML writer (ASCII, inline binary with
 zlib, appended with LZ4), its legacy writer (binary), its parallel writer (a .pvtu of three
-pieces) and by PyVista's `save`.
+pieces), by PyVista's `save`, and by meshio 5.3.5 from Gmsh's file (.vtu with zlib, .msh
+2.2 binary).
 
 The faults, planted in the twisted hybrid as VTK orders its cells: a hexahedron split into
 Kuhn's six tetrahedra (its bent faces against its neighbours' whole: non-conforming; the
@@ -28,6 +29,7 @@ import io
 from pathlib import Path
 
 import gmsh
+import meshio
 import numpy as np
 import pyvista
 import vtk
@@ -176,6 +178,15 @@ def make_clean(folder):
             gmsh.write(str(files[-1]))
             grids[name] = solids(files[-1])
             files += write_vtk_formats(folder, name, grids[name])
+            # meshio's conversion of Gmsh's file, as people convert meshes: its .vtu (VTK's
+            # wedge order) and its .msh 2.2 binary (Gmsh's again).
+            with contextlib.redirect_stderr(io.StringIO()):
+                converted = meshio.read(folder / f"{name}-gmsh-4.1-binary.msh")
+                converted = meshio.Mesh(converted.points, [c for c in converted.cells if c.dim == 3])
+                files.append(folder / f"{name}-meshio.vtu")
+                meshio.vtu.write(files[-1], converted, binary=True, compression="zlib")
+                files.append(folder / f"{name}-meshio-2.2-binary.msh")
+                meshio.gmsh.write(files[-1], converted, fmt_version="2.2", binary=True)
             if name == "hybrid-twisted":
                 gmsh.model.mesh.setOrder(2)
                 gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)

@@ -246,11 +246,11 @@ pub struct CheckArgs {
     /// instead of the tables.
     #[arg(long)]
     pub json: bool,
-    /// Write the checked mesh (one without halo4d's layout) to this .vtu, each tetrahedron
-    /// with its faults as the cell field `fault` (bits: 1 inverted, 2 flat, 4
-    /// undecidable, 8 degenerate, 16 duplicate, 32 overshared face, 64 folded face, 128
-    /// hanging vertex, 256 non-manifold boundary, 512 self-intersecting boundary, 1024
-    /// wrong winding, 2048 cavity), and its dihedral angles and radius ratio.
+    /// Write the checked mesh (one without halo4d's layout) to this .vtu, each cell with its
+    /// faults as the cell field `fault` (bits: 1 inverted, 2 flat, 4 undecidable, 8
+    /// degenerate, 16 duplicate, 32 overshared face, 64 folded face, 128 hanging vertex, 256
+    /// non-manifold boundary, 512 self-intersecting boundary, 1024 wrong winding, 2048
+    /// cavity, 4096 non-conforming quadrilateral), and its dihedral angles and radius ratio.
     #[arg(long, value_name = "OUT.vtu")]
     pub mark: Option<PathBuf>,
 }
