@@ -1,7 +1,9 @@
 //! The build at scale: the oblique flat torus (`fixtures/scenes/flat-torus.json`) on uniform
 //! grids of about 100k, 1M, 4M and 10M triangles, with every output but the picture (glb,
-//! vtk, ply, report). For each size: the wall time of each stage (from `report.json`), the
-//! peak resident memory of the build and the bytes it wrote, as a Markdown table.
+//! vtk, ply, report). For each size: the wall time of each stage and the total (from
+//! `report.json`) beside the wall time measured from outside, the estimated memory beside
+//! the peak the report read and the one `/usr/bin/time` measured (where it is installed),
+//! and the bytes written, as a Markdown table.
 //!
 //! `cargo bench --bench scale` runs 100k and 1M; `HALO4D_SCALE=100k,1M,4M,10M cargo bench
 //! --bench scale` chooses the sizes (a size beyond the machine's memory limit is refused by
@@ -52,21 +54,39 @@ fn main() {
     });
     let dir = tempfile::tempdir().expect("a temporary folder");
     println!(
-        "| triangles | sample | audit | view | halo | curves | verify | export | total (s) | peak memory (GB) | written (MB) |"
+        "| triangles | sample | audit | view | guards | halo | curves | verify | export | free | total (s) | wall (s) | estimate (GB) | peak (GB) | peak, time (GB) | written (MB) |"
     );
-    println!("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    println!(
+        "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+    );
+    let time = Path::new("/usr/bin/time");
     for size in sizes {
         let u = side(size);
         scene["sampling"] = serde_json::json!({"method": "uniform", "u": u, "v": u});
         let file = dir.path().join(format!("scale-{u}.json"));
         std::fs::write(&file, serde_json::to_vec(&scene).unwrap()).unwrap();
         let out = dir.path().join(format!("out-{u}"));
-        let run = Command::new(env!("CARGO_BIN_EXE_halo4d"))
+        let halo4d = env!("CARGO_BIN_EXE_halo4d");
+        let mut command = if time.exists() {
+            let mut c = Command::new(time);
+            c.args(["-f", "halo4d-peak-kb %M", halo4d]);
+            c
+        } else {
+            Command::new(halo4d)
+        };
+        let start = std::time::Instant::now();
+        let run = command
             .args(["build", "--quiet", "--out"])
             .arg(&out)
             .arg(&file)
             .output()
             .expect("halo4d runs");
+        let wall = start.elapsed().as_secs_f64();
+        let peak_outside = String::from_utf8_lossy(&run.stderr)
+            .lines()
+            .find_map(|l| l.strip_prefix("halo4d-peak-kb "))
+            .and_then(|kb| kb.trim().parse::<f64>().ok())
+            .map_or("-".to_string(), |kb| format!("{:.2}", kb * 1e3 / 1e9));
         let triangles = 2 * u as u64 * u as u64;
         if !run.status.success() {
             let err = String::from_utf8_lossy(&run.stderr);
@@ -80,17 +100,22 @@ fn main() {
             serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
         let t = &report["timings_ms"];
         let s = |k: &str| t[k].as_f64().unwrap_or(f64::NAN) / 1e3;
+        let memory = &report["memory"];
+        let gb = |k: &str| memory[k].as_f64().unwrap_or(f64::NAN);
         println!(
-            "| {triangles} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.0} |",
+            "| {triangles} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {wall:.2} | {:.2} | {:.2} | {peak_outside} | {:.0} |",
             s("sample"),
             s("audit"),
             s("view"),
+            s("guards"),
             s("halo"),
             s("curves"),
             s("verify"),
             s("export"),
+            s("free"),
             s("total"),
-            report["memory"]["peak_gb"].as_f64().unwrap_or(f64::NAN),
+            gb("estimate_gb"),
+            gb("peak_gb"),
             folder_bytes(&out) as f64 / 1e6
         );
         let h = &report["surfaces"][0]["halo"]["stage_ms"];

@@ -88,8 +88,8 @@ mod viewsearch;
 pub use error::Error;
 pub use pipeline::report;
 pub use pipeline::{
-    Built, Sampled, Stages, SurfaceProduct, build, glb_bytes, render_to, report_of, shown_curves,
-    write,
+    Built, Sampled, Stages, SurfaceProduct, build, build_since, glb_bytes, render_to, report_of,
+    shown_curves, write,
 };
 pub use scene::{DEFAULT_SCENE, Outputs, Scene, SceneError, SceneSurface};
 pub use viewsearch::{Found, SearchError, resolve as resolve_view, search as search_view};

@@ -482,18 +482,18 @@ pub const MIN_EXTENT: f64 = 1e-30;
 
 /// The most triangles whose boxes may hold a point of a surface, on average over points
 /// spread by area: what each ray of the picture and each candidate pair of the curves
-/// costs (`report.json`'s `crowding.triangles`). Well-shaped meshes have 2 to 6 on the
-/// fixtures, the sliver fixture 68 (a grid of 4 x 1024 cells); the Fermat quartic on a grid
-/// of 1024 x 8 cells, whose slivers fan out from the patches' common corners, 142, and its
+/// costs (`report.json`'s `crowding.triangles`). Well-shaped meshes have 1.6 to 4.4 on the
+/// fixtures, the sliver fixture 65 (a grid of 4 x 1024 cells); the Fermat quartic on a grid
+/// of 1024 x 8 cells, whose slivers fan out from the patches' common corners, 140, and its
 /// picture alone takes over a minute. A build whose surfaces pile up more is refused after
 /// the projection.
 pub const SURFACE_CROWDING: f64 = 100.0;
 
 /// The most halo tetrahedra whose boxes may hold a point of a surface, on average over
 /// points spread by area: what each query of the verification and of the picture costs
-/// (`report.json`'s `crowding.halos`). Sound halos have 11 to 31 on the fixtures (412 on
+/// (`report.json`'s `crowding.halos`). Sound halos have 9.6 to 23 on the fixtures (404 on
 /// the sliver fixture); halos that keep their folds (`halo.fold: report`) a fifth of the
-/// scene wide, 1148, and take 45 s to verify and draw. A build whose halos pile up more is
+/// scene wide, 955, and take 45 s to verify and draw. A build whose halos pile up more is
 /// refused before the curves.
 pub const HALO_CROWDING: f64 = 600.0;
 

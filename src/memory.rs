@@ -1,6 +1,6 @@
 //! The memory a command may use, and the checks that stages make before they allocate what
-//! grows with their input: the stages from the halos on, by their triangles
-//! ([`BUILD_BYTES_PER_TRIANGLE`]), and the renderer, by its pixels and, in `slices` mode,
+//! grows with their input: a build, by its triangles and the stages it runs
+//! ([`build_bytes`]), and the renderer, by its pixels and, in `slices` mode,
 //! its per-sample hits. The intersection stage streams its candidate pairs, so they add
 //! nothing that grows with their number.
 //!
@@ -12,12 +12,49 @@ use crate::limits::MAX_MEMORY;
 /// Bytes in a gigabyte, as the limit and the messages count them.
 pub const GB: f64 = 1e9;
 
-/// Peak resident bytes per triangle of a build from the halos on (two layers of
-/// tetrahedra, the checker's incidence, the curves, the verification's index, the `.glb`'s
-/// chunks while the files stream), with a margin: measured 830 bytes at 1,000,000 triangles,
-/// 750 at 4,000,000 and 730 at 10,000,000 (`report.json`'s `memory.peak_gb` of `cargo bench
-/// --bench scale`, the flat torus with glb, vtk, ply and report).
-pub const BUILD_BYTES_PER_TRIANGLE: f64 = 1100.0;
+/// What every build holds whatever its size (the program, the threads' stacks, the
+/// buffers of fixed size): 0.123 GB measured at 100,352 triangles with halos, of which
+/// 100,352 x [`BUILD_BYTES_PER_TRIANGLE`] is 0.085 GB.
+pub const BASE_BYTES: f64 = 40e6;
+
+/// Peak resident bytes per triangle of a build that makes halos (two layers of
+/// tetrahedra, the checker's incidence, the verification's indexes, the `.glb`'s chunks
+/// while the files stream), over [`BASE_BYTES`]: the flat torus with glb, vtk, ply and
+/// report peaks at 0.86 GB at 1,002,528 triangles and 3.11 GB at 3,998,792, the default
+/// scene at tolerance 1e-5 (1,327,286 triangles) at 1.05 GB (`/usr/bin/time` of `halo4d
+/// build`; `cargo bench --bench scale` compares them).
+pub const BUILD_BYTES_PER_TRIANGLE: f64 = 850.0;
+
+/// The same for a build that makes the curves but no halos: 0.37 GB at 1,002,528
+/// triangles.
+pub const CURVES_BYTES_PER_TRIANGLE: f64 = 360.0;
+
+/// The same for the sampling and projection alone, adaptive (spade's triangulations, the
+/// queue): 0.52 GB at 1,327,286 triangles.
+pub const ADAPTIVE_BYTES_PER_TRIANGLE: f64 = 400.0;
+
+/// The same on a uniform grid or from a mesh file: 0.19 GB at 1,002,528 triangles.
+pub const SAMPLE_BYTES_PER_TRIANGLE: f64 = 170.0;
+
+/// The estimated peak resident bytes of a build of `triangles` triangles, by its most
+/// demanding stage: the halos, else the curves, else the sampling (`adaptive` or not).
+/// Measured from outside, it is high by 0 to 12% from 100,000 to 4 million triangles.
+pub fn build_bytes(triangles: usize, adaptive: bool, curves: bool, halos: bool) -> f64 {
+    let per = if halos {
+        BUILD_BYTES_PER_TRIANGLE
+    } else if curves {
+        CURVES_BYTES_PER_TRIANGLE.max(if adaptive {
+            ADAPTIVE_BYTES_PER_TRIANGLE
+        } else {
+            SAMPLE_BYTES_PER_TRIANGLE
+        })
+    } else if adaptive {
+        ADAPTIVE_BYTES_PER_TRIANGLE
+    } else {
+        SAMPLE_BYTES_PER_TRIANGLE
+    };
+    BASE_BYTES + triangles as f64 * per
+}
 
 /// The limit in bytes, and where it comes from (for messages).
 pub fn limit() -> Result<(f64, &'static str), String> {

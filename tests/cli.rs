@@ -546,7 +546,7 @@ fn scenes_beyond_what_f32_and_the_predicates_hold_are_refused_and_the_rest_write
 
 #[test]
 fn a_build_beyond_the_memory_limit_is_refused_before_the_halos_and_writes_nothing() {
-    // The default scene's 13,000 triangles need more than 10 MB from the halos on: refused
+    // A build of the default scene's 13,000 triangles needs more than 10 MB: refused
     // under a limit of 10 MB with the estimate and what to change, built under 1 GB.
     let dir = tempfile::tempdir().unwrap();
     let out = halo4d_with(
@@ -575,6 +575,56 @@ fn a_build_beyond_the_memory_limit_is_refused_before_the_halos_and_writes_nothin
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(dir.path().join("out").join("report.json").exists());
+}
+
+#[test]
+fn the_report_s_timings_and_memory_agree_with_the_process_s() {
+    // The default scene with its picture, timed from outside: the report's total is the
+    // process's wall time but for its start and exit, its stages add up to the total, and
+    // the estimated memory is within 20% of the peak the system measured (VmHWM, what
+    // `/usr/bin/time` reports). `cargo bench --bench scale` compares them at 100k to 10M
+    // triangles.
+    let dir = tempfile::tempdir().unwrap();
+    let start = std::time::Instant::now();
+    let out = halo4d(&["build", "--quiet", "--out", "out"], dir.path());
+    let wall = start.elapsed().as_secs_f64() * 1e3;
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("out/report.json")).unwrap())
+            .unwrap();
+    let t = report["timings_ms"].as_object().unwrap();
+    let total = t["total"].as_f64().unwrap();
+    let stages: f64 = t
+        .iter()
+        .filter(|(k, _)| *k != "total")
+        .map(|(_, v)| v.as_f64().unwrap())
+        .sum();
+    for stage in ["setup", "guards", "free", "export", "render", "halo"] {
+        assert!(t.contains_key(stage), "no `{stage}` in {t:?}");
+    }
+    assert!(
+        stages <= total && stages >= 0.99 * total - 2.0,
+        "{stages} of {total} ms: {t:?}"
+    );
+    // Starting and ending a process takes milliseconds; other tests share the cores.
+    assert!(total < wall, "{total} ms reported, {wall} ms measured");
+    assert!(
+        wall - total < 0.02 * wall + 100.0,
+        "{total} ms reported, {wall} ms measured"
+    );
+    let memory = &report["memory"];
+    let (estimate, peak) = (
+        memory["estimate_gb"].as_f64().unwrap(),
+        memory["peak_gb"].as_f64().unwrap(),
+    );
+    assert!(
+        (peak - estimate).abs() < 0.2 * peak,
+        "estimate {estimate} GB, peak {peak} GB"
+    );
 }
 
 #[test]

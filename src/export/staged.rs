@@ -97,13 +97,27 @@ impl Staged {
         Ok(file)
     }
 
-    /// Moves every file written into place, then releases the lock.
-    pub fn commit(mut self) -> Result<(), StagedError> {
-        let files = std::mem::take(self.files.get_mut().unwrap_or_else(|e| e.into_inner()));
+    /// Moves the files written so far into place, keeping the lock for more; `stale`, a
+    /// file the build writes last, is removed from the folder first (so that the folder
+    /// never holds a former build's `report.json` beside the new files).
+    pub fn move_into_place(&self, stale: Option<&str>) -> Result<(), StagedError> {
+        if let Some(file) = stale {
+            let path = self.dir.join(file);
+            match std::fs::remove_file(&path) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(io(&path)(e)),
+                _ => {}
+            }
+        }
+        let files = std::mem::take(&mut *self.files.lock().unwrap_or_else(|e| e.into_inner()));
         for (tmp, path) in files {
             std::fs::rename(&tmp, &path).map_err(io(&path))?;
         }
         Ok(())
+    }
+
+    /// Moves every file written into place, then releases the lock.
+    pub fn commit(self) -> Result<(), StagedError> {
+        self.move_into_place(None)
     }
 }
 

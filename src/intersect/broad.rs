@@ -38,28 +38,6 @@ pub fn build(boxes: &[Aabb], leaf: u32) -> Bvh2 {
     bvh
 }
 
-/// The mean number of primitives a query at each of `probes` visits in `bvh` (those in the
-/// leaves whose boxes hold the point), each probe's count cut at `cap`: what a point query
-/// costs, and, at points on the primitives, how much their boxes overlap. Measured at no
-/// more than `cap` per probe, so it stays cheap where the boxes pile up.
-pub fn crowding(bvh: &Bvh2, probes: &[DVec3], cap: usize) -> f64 {
-    if probes.is_empty() {
-        return 0.0;
-    }
-    let total: usize = probes
-        .par_iter()
-        .map(|&x| {
-            let mut n = 0;
-            bvh.aabb_traverse(outward(x, x), |bvh, node| {
-                n += bvh.nodes[node as usize].prim_count as usize;
-                n < cap
-            });
-            n.min(cap)
-        })
-        .sum();
-    total as f64 / probes.len() as f64
-}
-
 /// Node pairs the parallel descent hands out as tasks, at least: enough for the
 /// work-stealing pool to balance uneven subtrees on many cores, few enough that each is worth
 /// a task. A constant, so that the tasks, and the order of the pairs, do not depend on the
@@ -263,32 +241,5 @@ mod tests {
             }
             assert_eq!(fast, slow, "leaf size {leaf}");
         }
-    }
-
-    #[test]
-    fn crowding_counts_the_boxes_holding_each_point() {
-        // Brute force: with one box per leaf, the count is the number of boxes that contain
-        // each probe; with more per leaf it is at least that; cut at `cap` it is at most cap.
-        let mut next = crate::intersect::lcg(11);
-        let boxes: Vec<Aabb> = (0..500)
-            .map(|_| {
-                let c = DVec3::new(next(), next(), next());
-                let h = DVec3::new(next(), next(), next()) * 0.2;
-                outward(c - h, c + h)
-            })
-            .collect();
-        let probes: Vec<DVec3> = (0..200)
-            .map(|_| DVec3::new(next(), next(), next()))
-            .collect();
-        let holding = |x: DVec3| {
-            let p = outward(x, x).min;
-            boxes.iter().filter(|b| b.contains_point(p)).count()
-        };
-        let exact = probes.iter().map(|&x| holding(x)).sum::<usize>() as f64 / 200.0;
-        assert!(exact > 2.0, "{exact}");
-        assert_eq!(crowding(&build(&boxes, 1), &probes, usize::MAX), exact);
-        assert!(crowding(&build(&boxes, 4), &probes, usize::MAX) >= exact);
-        assert!(crowding(&build(&boxes, 1), &probes, 3) <= 3.0);
-        assert_eq!(crowding(&build(&boxes, 1), &[], 3), 0.0);
     }
 }

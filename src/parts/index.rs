@@ -158,12 +158,6 @@ impl<'a> HaloIndex<'a> {
         });
     }
 
-    /// The mean number of tetrahedra a query at each of `probes` visits, each probe's
-    /// count cut at `cap` ([`broad::crowding`]).
-    pub(crate) fn crowding(&self, probes: &[DVec3], cap: usize) -> f64 {
-        broad::crowding(&self.bvh, probes, cap)
-    }
-
     /// The surface vertices tetrahedron `g` is built over.
     pub(crate) fn over(&self, g: u32) -> impl Iterator<Item = u32> + '_ {
         self.over[g as usize]

@@ -195,6 +195,8 @@ pub(super) fn in_view(
     }
     let mut timings = samples.timings;
     let projections = project(scene, samples.surfaces, &mut timings, bar)?;
+    bar.set_message("measuring the scene and how its triangles pile up");
+    let start = Instant::now();
     let scale = Scale::of(scene, &projections, stages)?;
     // Measured for the stages that query the triangles; a build of the report alone (an
     // adaptive mesh of millions of triangles, say) skips it.
@@ -207,6 +209,7 @@ pub(super) fn in_view(
     if !probes.is_empty() {
         crowding.triangles = work::surface_crowding(scene, &projections, &probes)?;
     }
+    timings.guards += ms(start);
     let Scale {
         diagonal,
         pixel,
@@ -218,7 +221,10 @@ pub(super) fn in_view(
         products.push(surface_product(scene, view, stages, rho, &mut timings, bar));
     }
     if stages.halos {
+        bar.set_message("measuring how the halos pile up");
+        let start = Instant::now();
         crowding.halos = work::halo_crowding(scene, &products, &probes, diagonal)?;
+        timings.guards += ms(start);
     }
     let mut curves = Curves::default();
     if stages.curves {
@@ -404,11 +410,16 @@ impl Scale {
             .iter()
             .map(|p| p.sample.mesh.triangles.len())
             .sum();
-        let needed = if stages.halos || stages.curves {
-            triangles as f64 * crate::memory::BUILD_BYTES_PER_TRIANGLE
+        let adaptive = projections
+            .iter()
+            .any(|p| p.sample.report.method == "adaptive");
+        let picture = if scene.outputs.png || scene.outputs.svg {
+            render::picture_bytes(&scene.render)
         } else {
             0.0
         };
+        // The picture is refused on its own, by the renderer, which knows its mode's needs.
+        let needed = crate::memory::build_bytes(triangles, adaptive, stages.curves, stages.halos);
         let (limit, source_of_limit) = crate::memory::limit().map_err(|message| Error::Scale {
             scene: scene.name.clone(),
             message,
@@ -417,9 +428,8 @@ impl Scale {
             return Err(Error::Scale {
                 scene: scene.name.clone(),
                 message: format!(
-                    "the halos, curves and verification of {triangles} triangles would need about {:.2} GB ({} bytes per triangle), more than the limit of {:.2} GB ({source_of_limit}); sample fewer triangles (sampling.tolerance, sampling.max_triangles or a coarser grid)",
+                    "the build of {triangles} triangles would need about {:.2} GB, more than the limit of {:.2} GB ({source_of_limit}); sample fewer triangles (sampling.tolerance, sampling.max_triangles or a coarser grid)",
                     needed / crate::memory::GB,
-                    crate::memory::BUILD_BYTES_PER_TRIANGLE,
                     limit / crate::memory::GB
                 ),
             });
@@ -429,7 +439,7 @@ impl Scale {
             pixel,
             rho,
             memory: MemoryReport {
-                estimate_gb: needed / crate::memory::GB,
+                estimate_gb: (needed + picture) / crate::memory::GB,
                 limit_gb: limit / crate::memory::GB,
                 peak_gb: None,
             },

@@ -203,12 +203,31 @@ fn run_stages<T>(
 
 /// Builds a scene into `out_dir`: runs the stages and writes the outputs the scene asks for.
 pub fn build(scene: &Scene, out_dir: &Path, quiet: bool) -> Result<Report, Error> {
+    build_since(scene, out_dir, quiet, Instant::now())
+}
+
+/// [`build`], for a program that started its work (reading the scene, finding its view)
+/// at `started`: the report's `setup` is the time until the build, and its `total` the wall
+/// time from `started` to `report.json` written. The build's memory is freed before the
+/// report is written, and its time is the report's `free`.
+pub fn build_since(
+    scene: &Scene,
+    out_dir: &Path,
+    quiet: bool,
+    started: Instant,
+) -> Result<Report, Error> {
+    let setup = ms(started);
     let last = if scene.outputs.png || scene.outputs.svg {
         "the picture and the files"
     } else {
         "the files"
     };
-    run_stages(scene, Stages::of(scene), quiet, last, |built| {
-        write(scene, &built, out_dir)
+    run_stages(scene, Stages::of(scene), quiet, last, |mut built| {
+        built.timings.setup = setup;
+        let (staged, mut report) = write::stage(scene, &built, out_dir)?;
+        let start = Instant::now();
+        drop(built);
+        report.timings_ms.free = ms(start);
+        write::finish(scene, staged, report, |_| ms(started))
     })
 }

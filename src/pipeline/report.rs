@@ -13,17 +13,18 @@ use crate::surfaces::Topology;
 use crate::verify::Verification;
 use serde::Serialize;
 
-/// `report.json`'s `memory`: what the stages from the halos on were estimated to need (1100
-/// bytes per triangle) against the limit (`HALO4D_MAX_MEMORY` gigabytes, or three quarters
-/// of the machine's memory), in GB. The picture is estimated on its own when it is made.
+/// `report.json`'s `memory`: the peak the build was estimated to need
+/// ([`crate::memory::build_bytes`]) against the limit (`HALO4D_MAX_MEMORY` gigabytes, or
+/// three quarters of the machine's memory), and the peak it reached, in GB. The picture is
+/// estimated on its own when it is made.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct MemoryReport {
-    /// Estimated peak of the stages from the halos on.
+    /// Estimated peak resident memory of the build.
     pub estimate_gb: f64,
     /// The limit a build refuses to go beyond.
     pub limit_gb: f64,
-    /// The process's peak resident memory when the files were made (null where the system
-    /// does not say).
+    /// The process's peak resident memory when `report.json` was written, the build's
+    /// memory freed (null where the system does not say).
     pub peak_gb: Option<f64>,
 }
 
@@ -155,15 +156,23 @@ pub(super) fn surface_warnings(surface: &str, source: &Source, stats: &MeshStats
     }
 }
 
-/// Milliseconds spent in each stage.
+/// Milliseconds spent in each stage. Every piece of work a build does is in one of them, so
+/// that they add up to `total`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct Timings {
+    /// Before the first stage: reading the scene and, when its view is `auto`, the view
+    /// search, from the moment `halo4d` started (0 where a program calls the library).
+    pub setup: f64,
     /// Sampling, all surfaces.
     pub sample: f64,
-    /// Auditing the samples, all surfaces.
+    /// Auditing the samples and validating their meshes, all surfaces.
     pub audit: f64,
     /// View (rotation, projection, normals), all surfaces.
     pub view: f64,
+    /// The checks before the slow stages: the scene's scale and the memory it needs, and
+    /// how the triangles' and the halos' boxes pile up (`crowding`).
+    pub guards: f64,
     /// Halos: thickening, tetrahedra, checking, all surfaces.
     pub halo: f64,
     /// Intersection curves, all surfaces together.
@@ -176,10 +185,42 @@ pub struct Timings {
     pub stipples: f64,
     /// Rendering the picture.
     pub render: f64,
-    /// Writing the outputs.
+    /// Writing the outputs and moving them into place (replacing a former build's files
+    /// is part of it).
     pub export: f64,
-    /// Sum of the stages.
+    /// Freeing the build's memory once its files are written.
+    pub free: f64,
+    /// The build's wall time, measured: from the start of `setup` to `report.json`
+    /// written, which is the process's wall time but for its start and exit. The stages
+    /// add up to it but for what lies between them (well under 1%). For the report of a
+    /// build made earlier ([`crate::write`]), the sum of the stages.
     pub total: f64,
+}
+
+impl Timings {
+    /// Each stage's name and milliseconds, in the order a build runs them.
+    pub fn stages(&self) -> [(&'static str, f64); 13] {
+        [
+            ("setup", self.setup),
+            ("sample", self.sample),
+            ("audit", self.audit),
+            ("view", self.view),
+            ("guards", self.guards),
+            ("halo", self.halo),
+            ("stipples", self.stipples),
+            ("curves", self.curves),
+            ("refine", self.refine),
+            ("verify", self.verify),
+            ("render", self.render),
+            ("export", self.export),
+            ("free", self.free),
+        ]
+    }
+
+    /// The sum of the stages.
+    pub fn sum(&self) -> f64 {
+        self.stages().iter().map(|(_, t)| t).sum()
+    }
 }
 
 /// Bounding box.
@@ -315,22 +356,16 @@ impl Report {
                 out += "halo verification: not run (no halo file written; `outputs.verify: true` asks for it)\n"
             }
         }
-        let t = self.timings_ms;
+        let stages: Vec<String> = (self.timings_ms.stages().iter())
+            .map(|(name, t)| format!("{name} {t:.1} ms"))
+            .collect();
         out += &format!(
-            "sample {:.1} ms, audit {:.1} ms, view {:.1} ms, halo {:.1} ms, curves {:.1} ms, refine {:.1} ms, verify {:.1} ms, export {:.1} ms, render {:.1} ms, total {:.1} ms\n",
-            t.sample,
-            t.audit,
-            t.view,
-            t.halo,
-            t.curves,
-            t.refine,
-            t.verify,
-            t.export,
-            t.render,
-            t.total
+            "{}, total {:.1} ms\n",
+            stages.join(", "),
+            self.timings_ms.total
         );
         out += &format!(
-            "memory: about {:.2} GB estimated from the halos on, limit {:.2} GB{}\n",
+            "memory: about {:.2} GB estimated, limit {:.2} GB{}\n",
             self.memory.estimate_gb,
             self.memory.limit_gb,
             self.memory

@@ -198,8 +198,10 @@ pub(super) fn sample_with(scene: &Scene, bar: &ProgressBar) -> Sampled {
         if let Some(w) = report.warning(&name) {
             bar.suspend(|| eprintln!("warning: {w}"));
         }
+        let start = Instant::now();
         let mesh = sampled.mesh;
         let stats = mesh.validate();
+        timings.audit += ms(start);
         for w in surface_warnings(&name, &entry.surface, &stats) {
             bar.suspend(|| eprintln!("warning: {w}"));
         }

@@ -1,9 +1,7 @@
 //! A build's files: written under temporary names side by side, moved into place together,
 //! with `report.json`.
 
-use super::report::{
-    MemoryReport, PictureReport, Report, Timings, surface_report, surface_warnings,
-};
+use super::report::{PictureReport, Report, Timings, surface_report, surface_warnings};
 use super::{Built, ms};
 use crate::error::Error;
 use crate::export::{self, SurfaceData};
@@ -17,46 +15,74 @@ use std::time::Instant;
 /// `out_dir`, and returns the report (also written as `report.json` when asked for). The
 /// export time is added to the build's timings, and the total is the sum of the stages.
 pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Error> {
+    let (staged, report) = stage(scene, built, out_dir)?;
+    finish(scene, staged, report, Timings::sum)
+}
+
+/// The report of a build that was not written (what [`write()`] reports, with no files and
+/// no picture), as the Python package gives it.
+pub fn report_of(scene: &Scene, built: &Built) -> Report {
+    let mut report = assemble_report(scene, built, built.timings, None, built.failures(), vec![]);
+    report.timings_ms.total = report.timings_ms.sum();
+    report.memory.peak_gb = crate::memory::peak_resident().map(|b| b / crate::memory::GB);
+    report
+}
+
+/// Writes every output but `report.json` under a temporary name (a failure leaves the
+/// folder as it was), and assembles the report, its total not yet set.
+pub(super) fn stage(
+    scene: &Scene,
+    built: &Built,
+    out_dir: &Path,
+) -> Result<(export::Staged, Report), Error> {
     let mut timings = built.timings;
     let export_start = Instant::now();
-    // Every file under a temporary name until all were made: a failure leaves the folder
-    // as it was.
     let staged = export::Staged::new(out_dir).map_err(staged_error)?;
     let data: Vec<SurfaceData> = built.surfaces.iter().map(|p| p.data(&scene.halo)).collect();
     let failures = built.failures();
     let stipples = file_stipples(scene, built)?;
     let mut files = write_meshes(scene, built, &staged, &data, &stipples, &failures)?;
-    timings.export = ms(export_start);
     let mut picture_report = None;
     if scene.outputs.png || scene.outputs.svg {
         let (picture, written) = write_picture(scene, built, &staged, &mut timings.render)?;
         files.extend(written);
         picture_report = Some(picture);
     }
+    // The picture's files (its PNG encoded, its SVG) are the export's.
+    timings.export = ms(export_start) - timings.render;
     if scene.outputs.report {
         files.push("report.json".into());
     }
-    timings.total = total(&timings);
     let report = assemble_report(scene, built, timings, picture_report, failures, files);
-    if scene.outputs.report {
+    Ok((staged, report))
+}
+
+/// Moves the staged files into place (its time added to the export's: replacing a former
+/// build's files of hundreds of megabytes takes a noticeable part of a second), then sets
+/// the report's peak memory and `total` (from its timings) and writes `report.json` last,
+/// when asked for. The former `report.json` is removed first, so the folder never holds a
+/// report beside files it does not describe.
+pub(super) fn finish(
+    scene: &Scene,
+    staged: export::Staged,
+    mut report: Report,
+    total: impl FnOnce(&Timings) -> f64,
+) -> Result<Report, Error> {
+    let start = Instant::now();
+    let last = scene.outputs.report.then_some("report.json");
+    staged.move_into_place(last).map_err(staged_error)?;
+    report.timings_ms.export += ms(start);
+    report.memory.peak_gb = crate::memory::peak_resident().map(|b| b / crate::memory::GB);
+    report.timings_ms.total = total(&report.timings_ms);
+    if let Some(file) = last {
         let text = serde_json::to_vec_pretty(&report).map_err(|e| Error::Internal {
             stage: "export",
             message: e.to_string(),
         })?;
-        staged
-            .write("report.json".into(), &text)
-            .map_err(staged_error)?;
+        staged.write(file.into(), &text).map_err(staged_error)?;
     }
     staged.commit().map_err(staged_error)?;
     Ok(report)
-}
-
-/// The report of a build that was not written (what [`write()`] reports, with no files and
-/// no picture), as the Python package gives it.
-pub fn report_of(scene: &Scene, built: &Built) -> Report {
-    let mut timings = built.timings;
-    timings.total = total(&timings);
-    assemble_report(scene, built, timings, None, built.failures(), Vec::new())
 }
 
 /// Writes the mesh files the scene asks for (`.glb`, `.html`, `.ply`, stipples, `.obj`,
@@ -195,22 +221,8 @@ fn write_picture(
     Ok((picture, files))
 }
 
-/// The sum of the stages' times, in the stages' order.
-fn total(timings: &Timings) -> f64 {
-    timings.sample
-        + timings.audit
-        + timings.view
-        + timings.halo
-        + timings.curves
-        + timings.refine
-        + timings.verify
-        + timings.stipples
-        + timings.render
-        + timings.export
-}
-
 /// The build's report: the scene, each surface, the stages that ran, the curves and the
-/// verification, the `timings`, the memory (with the peak so far), the warnings, the
+/// verification, the `timings`, the memory (its peak not yet measured), the warnings, the
 /// `picture`, the verdict (`failures`) and the `files` written.
 fn assemble_report(
     scene: &Scene,
@@ -235,10 +247,7 @@ fn assemble_report(
             .then(|| built.shown_curves().report.clone()),
         halo_verification: built.stages.verify.then(|| built.verification.clone()),
         timings_ms: timings,
-        memory: MemoryReport {
-            peak_gb: crate::memory::peak_resident().map(|b| b / crate::memory::GB),
-            ..built.memory
-        },
+        memory: built.memory,
         crowding: built.crowding.clone(),
         warnings: products
             .iter()

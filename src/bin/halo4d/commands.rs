@@ -33,6 +33,8 @@ fn load(scene: Option<PathBuf>, quiet: bool) -> Result<Scene, Box<dyn std::error
 
 /// `halo4d build`.
 pub fn build(args: BuildArgs) -> Outcome {
+    // Reading the scene and finding its view are part of the build's time (`setup`).
+    let started = std::time::Instant::now();
     let BuildArgs {
         scene,
         out,
@@ -41,7 +43,7 @@ pub fn build(args: BuildArgs) -> Outcome {
     } = args;
     let scene = load(scene, quiet)?;
     let out = out.unwrap_or_else(|| PathBuf::from("exports").join(&scene.name));
-    let report = halo4d::build(&scene, &out, quiet)?;
+    let report = halo4d::build_since(&scene, &out, quiet, started)?;
     eprint!("{}", report.summary());
     for f in &report.files {
         println!("{}", out.join(f).display());
