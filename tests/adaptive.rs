@@ -280,6 +280,33 @@ fn one_patch_refines_to_the_same_mesh_on_any_number_of_threads() {
 }
 
 #[test]
+fn a_patch_cut_into_tiles_conforms_and_is_the_same_on_any_number_of_threads() {
+    // Below 1e-4 of its extent the spun trefoil's one patch is refined as 16 tiles side by
+    // side: the seams conform (a closed sphere, no boundary or non-manifold edge, every
+    // triangle oriented alike), the tolerance holds at the audit's points, and the mesh is
+    // the same on one thread as on three.
+    let s = Surface::SpunTrefoil(SpunTrefoil::default());
+    let tol = 5e-5 * bounding_diagonal(&s);
+    let on = |threads| crate::common::on_threads(threads, || sample_adaptive(&s, tol, 4_000_000));
+    let one = on(1);
+    assert!(one.complete);
+    let stats = one.mesh.validate();
+    assert!(stats.triangles > 200_000, "{stats:?}");
+    assert!(stats.is_manifold(), "{stats:?}");
+    assert_eq!(
+        (
+            stats.boundary_edges,
+            stats.orientation_conflicts,
+            stats.euler_characteristic
+        ),
+        (0, 0, 2),
+        "{stats:?}"
+    );
+    assert!(audit(&s, &one.mesh).max_error <= tol);
+    assert!(one.mesh == on(3).mesh);
+}
+
+#[test]
 fn refinement_stops_at_the_shortest_edge_the_files_resolve() {
     // The 9-twist-spun trefoil is so tangled that refinement in the order of a plain queue
     // once piled 600,000 triangles onto points that f32 cannot tell apart, and the curves

@@ -29,18 +29,20 @@
 //! counted in factors of 4 above the tolerance (what halving its edges gains), and the
 //! refinement goes down the levels in rounds. So when the triangle budget stops it, every
 //! triangle left is within a factor of about 4 of the best error the budget allows, not
-//! fine in one place and coarse in another. Patches refine in parallel, each within a share
-//! of the budget in proportion to its failing triangles (the mesh does not depend on the
-//! number of threads); within a patch, the triangles queued unchecked are checked in
-//! batches on the cores, the splits staying in the queue's order (so the mesh is the same
-//! as one thread checking them in turn). Between rounds every new side point is inserted
-//! on the sides glued to it, so seams
-//! conform: side points are dyadic fractions of the side (the starting grids have powers of
-//! two of cells, and splits halve), and the glue maps (σ ↦ offset ± σ with offsets that are
-//! multiples of 1/2) send them to dyadic fractions exactly. At the end the patches are
-//! welded by the domain rules, as in the uniform sampler, and numbered for the stages after
-//! it: vertices along a Z curve of each patch's parameters, triangles by their smallest
-//! vertex.
+//! fine in one place and coarse in another. At tolerances below [`TILE_BELOW`] of the
+//! surface's extent each patch is cut into tiles (at least [`TILES`] per surface: a surface
+//! of one patch, like the spun knots, refines on 16 cores), and the tiles refine in parallel, each a triangulation of its own within a share of the
+//! budget in proportion to its failing triangles (the mesh does not depend on the number
+//! of threads); within a tile, the triangles queued unchecked are checked in batches on the
+//! cores, the splits staying in the queue's order (so the mesh is the same as one thread
+//! checking them in turn). The seams between tiles are glued sides like those between
+//! patches. Between rounds every new side point is inserted on the sides glued to it, so
+//! seams conform: side points are dyadic fractions of the side (the starting grids have
+//! powers of two of cells, tiles are powers of two per side, and splits halve), and the glue
+//! maps (σ ↦ offset ± σ with offsets that are multiples of 1/2) send them to dyadic
+//! fractions exactly. At the end the tiles are welded by the domain rules, as in the uniform
+//! sampler, and numbered for the stages after it: vertices along a Z curve of each patch's
+//! parameters, triangles by their smallest vertex.
 //!
 //! Guarantees: when `complete`, every triangle passes the audit's test at the tolerance;
 //! closed surfaces give closed manifold meshes, welded by rule, consistently oriented where
@@ -49,7 +51,7 @@
 
 use super::{AUDIT_POINTS, Classes, Mesh4};
 use crate::limits::MIN_EDGE;
-use crate::surfaces::{Domain, Side, SideRule, Surface};
+use crate::surfaces::{Domain, Glue, Side, SideRule, Surface};
 use glam::DVec4;
 use rayon::prelude::*;
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
@@ -71,8 +73,14 @@ pub struct AdaptiveMesh {
     pub failing: usize,
 }
 
-/// One patch being refined.
+/// One tile of a patch being refined (see [`tiles`]).
 struct Patch {
+    /// The surface's patch the tile is part of.
+    of: usize,
+    /// The tile's place in its patch: its lower corner in the patch's normalized
+    /// parameters, and the tiles per side.
+    tile: ([usize; 2], usize),
+    /// The tile's rectangle and its sides' rules (seams between tiles glued).
     domain: Domain,
     /// From normalized (s, t) to the triangulation's coordinates.
     warp: Warp,
@@ -108,7 +116,6 @@ impl Patch {
     fn insert(
         &mut self,
         surface: &Surface,
-        patch: usize,
         st: [f64; 2],
         near: Option<FixedVertexHandle>,
     ) -> Option<(FixedVertexHandle, bool)> {
@@ -127,7 +134,7 @@ impl Patch {
         }
         let [u, v] = self.uv(st);
         self.st.push(st);
-        self.p.push(surface.point(patch, u, v));
+        self.p.push(surface.point(self.of, u, v));
         Some((h, true))
     }
 
@@ -160,6 +167,13 @@ impl Patch {
             }
         }
         None
+    }
+
+    /// The patch's normalized parameters of the tile's `st`.
+    fn in_patch(&self, st: [f64; 2]) -> [f64; 2] {
+        let ([i, j], k) = self.tile;
+        let k = k as f64;
+        [(st[0] + i as f64) / k, (st[1] + j as f64) / k]
     }
 
     /// Whether the triangle has an edge on a pole side (the weld collapses it).
@@ -218,6 +232,146 @@ fn glued_images(domain: &Domain, side: Side, sigma: f64) -> Vec<(usize, Side, f6
             .collect(),
         SideRule::Open | SideRule::Pole => Vec::new(),
     }
+}
+
+/// Tiles per surface, at least, where it is cut: enough for the refinement of a surface of
+/// one patch (the spun knots) to keep 16 cores busy. Each patch is cut into k x k tiles, k
+/// a power of two with patches x k^2 at least this, the same k for every patch.
+const TILES: usize = 16;
+
+/// The relative tolerance (of the surface's bounding diagonal) below which a surface is cut
+/// into tiles: the catalogue's surfaces then sample into 40,000 to 175,000 triangles or
+/// more, and the seams cost nothing that shows. Above it a mesh samples in a fraction of
+/// a second on one core, and stays as it always was (the fixtures' meshes, at 1e-3).
+const TILE_BELOW: f64 = 1e-4;
+
+/// Triangles of the budget per tile, at least, for a surface to be cut: the tiles' starting
+/// grids (about 32 triangles each) must leave the budget to the refinement.
+const TILE_BUDGET: usize = 4096;
+
+/// A tile of a patch: its rectangle and side rules, its patch, its place in the patch (in
+/// tiles) and the tiles per side of the patch.
+struct Tile {
+    domain: Domain,
+    of: usize,
+    corner: [usize; 2],
+    k: usize,
+}
+
+/// The surface's patches cut into tiles refined side by side ([`Tile`]) where the
+/// tolerance is below [`TILE_BELOW`] of its extent and the budget allows. Tile
+/// (i, j) of patch p is number (p k + j) k + i. The seams between tiles are glued straight
+/// (σ to σ); a patch's glued sides are glued tile to tile, each piece's map σ ↦ offset ±
+/// σ carried onto the tiles' side coordinates (k σ - m) as k offset - m' ± m, exact since
+/// the offsets are multiples of 1/2 and k a power of two. Where a glue's image would not
+/// fall in one tile (an offset that is not a multiple of 1/k), the patches are not cut.
+/// The tiles' seams are sides like any other: their points are exchanged between rounds
+/// and welded at the end, so the mesh conforms across them and is the same on any number
+/// of threads (k does not depend on it).
+fn tiles(surface: &Surface, tolerance: f64, max_triangles: usize) -> Vec<Tile> {
+    let patches = surface.patch_count();
+    let domains: Vec<Domain> = (0..patches).map(|p| surface.domain(p)).collect();
+    let mut k = 1;
+    if tolerance < TILE_BELOW * super::bounding_diagonal(surface) {
+        while patches * k * k < TILES && patches * 4 * k * k * TILE_BUDGET <= max_triangles {
+            k *= 2;
+        }
+    }
+    cut(&domains, k).unwrap_or_else(|| cut(&domains, 1).expect("one tile per patch"))
+}
+
+/// [`tiles`] with k tiles per side, or `None` where a glue does not map tiles to tiles.
+fn cut(domains: &[Domain], k: usize) -> Option<Vec<Tile>> {
+    let index = |patch: usize, [i, j]: [usize; 2]| (patch * k + j) * k + i;
+    // The tile on `side` of a patch at place m along it.
+    let on_side = |side: Side, m: usize| match side {
+        Side::U0 => [0, m],
+        Side::U1 => [k - 1, m],
+        Side::V0 => [m, 0],
+        Side::V1 => [m, k - 1],
+    };
+    let kf = k as f64;
+    let part = |r: [f64; 2], a: usize| {
+        let at = |a: usize| {
+            if a == k {
+                r[1]
+            } else {
+                r[0] + (r[1] - r[0]) * (a as f64 / kf)
+            }
+        };
+        [at(a), at(a + 1)]
+    };
+    let mut out = Vec::with_capacity(domains.len() * k * k);
+    for (patch, domain) in domains.iter().enumerate() {
+        for j in 0..k {
+            for i in 0..k {
+                let mut sides = domain.sides.clone();
+                for side in Side::ALL {
+                    let (inside, neighbour, along) = match side {
+                        Side::U0 => (i > 0, [i.wrapping_sub(1), j], j),
+                        Side::U1 => (i + 1 < k, [i + 1, j], j),
+                        Side::V0 => (j > 0, [i, j.wrapping_sub(1)], i),
+                        Side::V1 => (j + 1 < k, [i, j + 1], i),
+                    };
+                    let opposite = match side {
+                        Side::U0 => Side::U1,
+                        Side::U1 => Side::U0,
+                        Side::V0 => Side::V1,
+                        Side::V1 => Side::V0,
+                    };
+                    sides[side as usize] = if inside {
+                        SideRule::Glued(vec![Glue::whole(index(patch, neighbour), opposite, false)])
+                    } else {
+                        match domain.side(side) {
+                            SideRule::Glued(pieces) => {
+                                let mut glued = Vec::new();
+                                let (a, b) = (along as f64 / kf, (along + 1) as f64 / kf);
+                                for g in pieces {
+                                    let (lo, hi) = (g.from.max(a), g.to.min(b));
+                                    if lo >= hi {
+                                        continue;
+                                    }
+                                    let (x, y) = (g.map(lo), g.map(hi));
+                                    let first = x.min(y);
+                                    let m = ((first * kf).floor().max(0.0) as usize).min(k - 1);
+                                    if x.max(y) > (m + 1) as f64 / kf || first < m as f64 / kf {
+                                        return None;
+                                    }
+                                    let shift = along as f64;
+                                    glued.push(Glue {
+                                        from: lo * kf - shift,
+                                        to: hi * kf - shift,
+                                        patch: index(g.patch, on_side(g.side, m)),
+                                        side: g.side,
+                                        offset: kf * g.offset - m as f64
+                                            + if g.reversed { -shift } else { shift },
+                                        reversed: g.reversed,
+                                    });
+                                }
+                                if glued.is_empty() {
+                                    SideRule::Open
+                                } else {
+                                    SideRule::Glued(glued)
+                                }
+                            }
+                            rule => rule.clone(),
+                        }
+                    };
+                }
+                out.push(Tile {
+                    domain: Domain {
+                        u: part(domain.u, i),
+                        v: part(domain.v, j),
+                        sides,
+                    },
+                    of: patch,
+                    corner: [i, j],
+                    k,
+                });
+            }
+        }
+    }
+    Some(out)
 }
 
 /// A monotone piecewise-linear map of [0, 1] onto [0, end], in equal pieces. It maps 0 to
@@ -435,7 +589,7 @@ fn level(score: f64, tolerance: f64) -> usize {
 /// R^4) of the surface at the audit points, stopping when the mesh would exceed
 /// `max_triangles` triangles. Patches are refined in parallel.
 pub fn sample_adaptive(surface: &Surface, tolerance: f64, max_triangles: usize) -> AdaptiveMesh {
-    let mut sampler = Sampler::new(surface, tolerance * (1.0 - 1e-9));
+    let mut sampler = Sampler::new(surface, tolerance * (1.0 - 1e-9), max_triangles);
     let complete = sampler.refine(max_triangles);
     let failing = if complete { 0 } else { sampler.count_failing() };
     AdaptiveMesh {
@@ -463,11 +617,11 @@ impl Patch {
     }
 
     /// Checks the new triangles and queues those that fail.
-    fn settle(&mut self, surface: &Surface, patch: usize, tolerance: f64) {
+    fn settle(&mut self, surface: &Surface, tolerance: f64) {
         let pending = std::mem::take(&mut self.pending);
         for &face in &pending {
             if self.alive(face) {
-                self.queue_checked(surface, patch, tolerance, face);
+                self.queue_checked(surface, tolerance, face);
             }
         }
         self.pending = pending;
@@ -475,9 +629,9 @@ impl Patch {
     }
 
     /// Checks a triangle and queues it on its level when it fails.
-    fn queue_checked(&mut self, surface: &Surface, patch: usize, tolerance: f64, face: Face) {
+    fn queue_checked(&mut self, surface: &Surface, tolerance: f64, face: Face) {
         let t = face.1.map(|h| h.index());
-        let check = Check::of(self.check(surface, patch, tolerance, t), tolerance);
+        let check = Check::of(self.check(surface, tolerance, t), tolerance);
         if let Check::Failed { level, .. } = check {
             self.queue[level].push_back(Queued { face, check });
         }
@@ -497,14 +651,8 @@ impl Patch {
 
     /// Inserts a point and queues its triangles; records it in the outbox when it is a new
     /// side point, for the sides glued to it. Returns whether the point is new.
-    fn add(
-        &mut self,
-        surface: &Surface,
-        patch: usize,
-        st: [f64; 2],
-        near: Option<FixedVertexHandle>,
-    ) -> bool {
-        match self.insert(surface, patch, st, near) {
+    fn add(&mut self, surface: &Surface, st: [f64; 2], near: Option<FixedVertexHandle>) -> bool {
+        match self.insert(surface, st, near) {
             Some((h, true)) => {
                 self.queue_around(h);
                 self.outbox.extend(sides_of_point(st));
@@ -527,7 +675,7 @@ impl Patch {
 
     /// Refines this patch, worst level first, until no triangle is queued above level
     /// `floor` (true) or the next split could take it past `share` more triangles (false).
-    fn refine(&mut self, patch: usize, cx: &Context, floor: usize, share: usize) -> bool {
+    fn refine(&mut self, cx: &Context, floor: usize, share: usize) -> bool {
         let mut used = 0usize;
         // The level worked on: nothing is queued above it again (new triangles go on it or
         // below), so it only goes down.
@@ -549,7 +697,7 @@ impl Patch {
             let split = match q.check {
                 Check::Due => {
                     self.queue[at].push_front(q);
-                    self.check_level(patch, cx, at);
+                    self.check_level(cx, at);
                     continue;
                 }
                 Check::Passed => continue,
@@ -579,7 +727,7 @@ impl Patch {
                 .collect();
             let mut added = false;
             for (a, b) in ends {
-                added |= self.split(cx.surface, patch, a, b, tri[0]);
+                added |= self.split(cx.surface, a, b, tri[0]);
             }
             used += self.cdt.num_inner_faces() - faces + 4 * (self.outbox.len() - sent);
             // A split elsewhere (an encroached side) may leave this triangle standing; one
@@ -598,7 +746,7 @@ impl Patch {
 
     /// Checks the unchecked triangles still standing among the first [`CHECK_BATCH`] of level
     /// `at`, on the cores.
-    fn check_level(&mut self, patch: usize, cx: &Context, at: usize) {
+    fn check_level(&mut self, cx: &Context, at: usize) {
         let mut queue = std::mem::take(&mut self.queue[at]);
         let this = &*self;
         queue
@@ -607,7 +755,7 @@ impl Patch {
             .filter(|q| matches!(q.check, Check::Due) && this.alive(q.face))
             .for_each(|q| {
                 let t = q.face.1.map(|h| h.index());
-                q.check = Check::of(this.check(cx.surface, patch, cx.tolerance, t), cx.tolerance);
+                q.check = Check::of(this.check(cx.surface, cx.tolerance, t), cx.tolerance);
             });
         self.queue[at] = queue;
     }
@@ -617,7 +765,6 @@ impl Patch {
     fn split(
         &mut self,
         surface: &Surface,
-        patch: usize,
         sa: [f64; 2],
         sb: [f64; 2],
         near: FixedVertexHandle,
@@ -634,11 +781,12 @@ impl Patch {
         } else {
             mid
         };
-        self.add(surface, patch, at, Some(near))
+        self.add(surface, at, Some(near))
     }
 
     /// Tests a triangle at the audit's edge and interior points.
-    fn check(&self, surface: &Surface, patch: usize, tolerance: f64, t: [usize; 3]) -> Verdict {
+    fn check(&self, surface: &Surface, tolerance: f64, t: [usize; 3]) -> Verdict {
+        let patch = self.of;
         if self.collapses(t) {
             return Verdict::Pass;
         }
@@ -717,20 +865,29 @@ struct Sampler<'a> {
 }
 
 impl<'a> Sampler<'a> {
-    /// Starts every patch from a coarse grid shaped like its warped rectangle, with the
-    /// rectangle's sides as constraint edges, and makes the glued sides conform.
-    fn new(surface: &'a Surface, tolerance: f64) -> Self {
+    /// Starts every tile of every patch ([`tiles`], within the budget of `max_triangles`)
+    /// from a coarse grid shaped like its
+    /// warped rectangle, with the rectangle's sides as constraint edges, and makes the
+    /// glued sides conform.
+    fn new(surface: &'a Surface, tolerance: f64, max_triangles: usize) -> Self {
         let [min_u, min_v] = surface.min_cells();
         let mut patches = Vec::new();
-        for patch in 0..surface.patch_count() {
-            let domain = surface.domain(patch);
-            let warp = patch_warp(surface, patch, &domain);
+        for Tile {
+            domain,
+            of,
+            corner,
+            k,
+        } in tiles(surface, tolerance, max_triangles)
+        {
+            let warp = patch_warp(surface, of, &domain);
             let pole = Side::ALL.map(|s| matches!(domain.side(s), SideRule::Pole));
             // About 16 cells, shaped like the warped rectangle.
             let aspect = warp.s.end() / warp.t.end();
-            let nu = grid_cells(4.0 * aspect.sqrt(), min_u);
-            let nv = grid_cells(4.0 / aspect.sqrt(), min_v);
+            let nu = grid_cells(4.0 * aspect.sqrt(), min_u.div_ceil(k));
+            let nv = grid_cells(4.0 / aspect.sqrt(), min_v.div_ceil(k));
             let mut p = Patch {
+                of,
+                tile: (corner, k),
                 domain,
                 warp,
                 cdt: Cdt::new(),
@@ -747,7 +904,7 @@ impl<'a> Sampler<'a> {
             for (j, row) in handles.iter_mut().enumerate() {
                 for (i, h) in row.iter_mut().enumerate() {
                     let st = [i as f64 / nu as f64, j as f64 / nv as f64];
-                    *h = p.insert(surface, patch, st, None).map(|(h, _)| h);
+                    *h = p.insert(surface, st, None).map(|(h, _)| h);
                     p.outbox.extend(sides_of_point(st));
                 }
             }
@@ -793,7 +950,7 @@ impl<'a> Sampler<'a> {
         }
         while let Some((patch, side, sigma)) = work.pop() {
             let p = &mut self.patches[patch];
-            if p.add(self.surface, patch, side_st(side, sigma), None) {
+            if p.add(self.surface, side_st(side, sigma), None) {
                 work.extend(glued_images(&p.domain, side, sigma));
             }
             p.outbox.clear();
@@ -801,8 +958,7 @@ impl<'a> Sampler<'a> {
         let (surface, tolerance) = (self.surface, self.tolerance);
         self.patches
             .par_iter_mut()
-            .enumerate()
-            .for_each(|(i, p)| p.settle(surface, i, tolerance));
+            .for_each(|p| p.settle(surface, tolerance));
     }
 
     /// Refines until every triangle passes (true), or the budget or floating point stops it
@@ -853,10 +1009,9 @@ impl<'a> Sampler<'a> {
                 .patches
                 .par_iter_mut()
                 .zip(work)
-                .enumerate()
-                .map(|(i, (p, w))| {
+                .map(|(p, w)| {
                     let share = (left * w as u128 / total as u128) as usize;
-                    p.refine(i, &cx, floor, share)
+                    p.refine(&cx, floor, share)
                 })
                 .collect();
             // The seams conform even when the budget stopped the round.
@@ -872,14 +1027,13 @@ impl<'a> Sampler<'a> {
     fn count_failing(&self) -> usize {
         self.patches
             .iter()
-            .enumerate()
-            .map(|(patch, p)| {
+            .map(|p| {
                 p.cdt
                     .inner_faces()
                     .filter(|f| {
                         let t = f.vertices().map(|v| v.fix().index());
                         matches!(
-                            p.check(self.surface, patch, self.tolerance, t),
+                            p.check(self.surface, self.tolerance, t),
                             Verdict::Split { .. }
                         )
                     })
@@ -950,7 +1104,8 @@ impl<'a> Sampler<'a> {
             .into_par_iter()
             .map(|id| {
                 let (patch, i) = locate(id);
-                (patch, z_order(self.patches[patch].st[i]), id)
+                let p = &self.patches[patch];
+                (p.of, z_order(p.in_patch(p.st[i])), id)
             })
             .collect();
         order.par_sort_unstable();
@@ -963,7 +1118,7 @@ impl<'a> Sampler<'a> {
                 let p = &self.patches[patch];
                 let [u, v] = p.uv(p.st[i]);
                 vertex_of[rep] = at.len() as u32;
-                at.push((patch, u, v));
+                at.push((p.of, u, v));
             }
             vertex_of[id] = vertex_of[rep];
         }
@@ -998,7 +1153,7 @@ impl<'a> Sampler<'a> {
         for k in sorted {
             let (t, patch, local) = faces[k as usize];
             let p = &self.patches[patch];
-            mesh.push_triangle(t, patch, local.map(|i| p.uv(p.st[i])));
+            mesh.push_triangle(t, p.of, local.map(|i| p.uv(p.st[i])));
         }
         mesh
     }
@@ -1016,4 +1171,59 @@ fn z_order(st: [f64; 2]) -> u64 {
         (x | x << 1) & 0x5555_5555_5555_5555
     };
     spread(st[0]) | spread(st[1]) << 1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tiles_glue_back_to_where_they_came_from() {
+        // Every catalogue surface cut into tiles: at least TILES of them, their rectangles
+        // covering each patch exactly, and every glued piece of a tile's side mapping its
+        // points onto a side of another tile whose own glue maps them back, the ends of
+        // each piece included.
+        for surface in Surface::catalogue() {
+            let fine = 1e-5 * crate::sample::bounding_diagonal(&surface);
+            assert_eq!(
+                tiles(&surface, 1e3 * fine, usize::MAX).len(),
+                surface.patch_count()
+            );
+            assert_eq!(tiles(&surface, fine, 1000).len(), surface.patch_count());
+            let tiles = tiles(&surface, fine, usize::MAX);
+            let name = surface.type_name();
+            assert!(tiles.len() >= TILES, "{name}: {} tiles", tiles.len());
+            let k = tiles[0].k;
+            assert_eq!(tiles.len(), surface.patch_count() * k * k, "{name}");
+            for (n, tile) in tiles.iter().enumerate() {
+                let domain = surface.domain(tile.of);
+                let [i, j] = tile.corner;
+                assert_eq!(n, (tile.of * k + j) * k + i, "{name}");
+                if i == 0 {
+                    assert_eq!(tile.domain.u[0], domain.u[0], "{name}");
+                }
+                if i + 1 == k {
+                    assert_eq!(tile.domain.u[1], domain.u[1], "{name}");
+                } else {
+                    assert_eq!(tile.domain.u[1], tiles[n + 1].domain.u[0], "{name}");
+                }
+                for side in Side::ALL {
+                    let SideRule::Glued(pieces) = tile.domain.side(side) else {
+                        continue;
+                    };
+                    for g in pieces {
+                        for sigma in [g.from, (g.from + g.to) / 2.0, g.to] {
+                            let image = g.map(sigma);
+                            assert!((0.0..=1.0).contains(&image), "{name}: {image}");
+                            let back: Vec<_> = glued_images(&tiles[g.patch].domain, g.side, image)
+                                .into_iter()
+                                .filter(|&(t, s, x)| t == n && s == side && x == sigma)
+                                .collect();
+                            assert_eq!(back.len(), 1, "{name}: tile {n} {side:?} at {sigma}");
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
