@@ -86,7 +86,7 @@ fn main() {
             .lines()
             .find_map(|l| l.strip_prefix("halo4d-peak-kb "))
             .and_then(|kb| kb.trim().parse::<f64>().ok())
-            .map_or("-".to_string(), |kb| format!("{:.2}", kb * 1e3 / 1e9));
+            .map_or("-".to_string(), |kib| format!("{:.2}", kib * 1024.0 / 1e9));
         let triangles = 2 * u as u64 * u as u64;
         if !run.status.success() {
             let err = String::from_utf8_lossy(&run.stderr);

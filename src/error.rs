@@ -33,7 +33,7 @@ pub enum Error {
     },
     /// The scene's numbers are finite but put its geometry where the files' f32 or the exact
     /// predicates cannot follow (too large or too small), or so many triangles that the
-    /// stages from the halos on would need more memory than the limit
+    /// build would need more memory than the limit
     /// (`HALO4D_MAX_MEMORY` gigabytes, or three quarters of the machine's memory).
     #[error("scene `{}`: {message}", shorten(.scene))]
     Scale {

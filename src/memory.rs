@@ -13,17 +13,18 @@ use crate::limits::MAX_MEMORY;
 pub const GB: f64 = 1e9;
 
 /// What every build holds whatever its size (the program, the threads' stacks, the
-/// buffers of fixed size): 0.123 GB measured at 100,352 triangles with halos, of which
+/// buffers of fixed size): 0.126 GB measured at 100,352 triangles with halos, of which
 /// 100,352 x [`BUILD_BYTES_PER_TRIANGLE`] is 0.085 GB.
-pub const BASE_BYTES: f64 = 40e6;
+pub const BASE_BYTES: f64 = 45e6;
 
 /// Peak resident bytes per triangle of a build that makes halos (two layers of
 /// tetrahedra, the checker's incidence, the verification's indexes, the `.glb`'s chunks
 /// while the files stream), over [`BASE_BYTES`]: the flat torus with glb, vtk, ply and
-/// report peaks at 0.86 GB at 1,002,528 triangles and 3.11 GB at 3,998,792, the default
-/// scene at tolerance 1e-5 (1,327,286 triangles) at 1.05 GB (`/usr/bin/time` of `halo4d
-/// build`; `cargo bench --bench scale` compares them).
-pub const BUILD_BYTES_PER_TRIANGLE: f64 = 850.0;
+/// report peaks at 0.12, 0.92, 3.18 and 7.69 GB at 100,352, 1,002,528, 3,998,792 and
+/// 9,999,392 triangles (`HALO4D_SCALE=100k,1M,4M,10M cargo bench --bench scale`), the
+/// default scene at tolerance 1e-5 (1,241,550 triangles) at 1.00 GB: this estimate is
+/// high by 3 to 18%.
+pub const BUILD_BYTES_PER_TRIANGLE: f64 = 900.0;
 
 /// The same for a build that makes the curves but no halos: 0.37 GB at 1,002,528
 /// triangles.
@@ -38,7 +39,7 @@ pub const SAMPLE_BYTES_PER_TRIANGLE: f64 = 170.0;
 
 /// The estimated peak resident bytes of a build of `triangles` triangles, by its most
 /// demanding stage: the halos, else the curves, else the sampling (`adaptive` or not).
-/// Measured from outside, it is high by 0 to 12% from 100,000 to 4 million triangles.
+/// Measured from outside, it is high by 3 to 18% from 100,000 to 10 million triangles.
 pub fn build_bytes(triangles: usize, adaptive: bool, curves: bool, halos: bool) -> f64 {
     let per = if halos {
         BUILD_BYTES_PER_TRIANGLE
@@ -72,8 +73,8 @@ pub fn limit() -> Result<(f64, &'static str), String> {
     }
     let total = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
         let line = m.lines().find(|l| l.starts_with("MemTotal:"))?;
-        let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-        Some(kb * 1e3)
+        let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+        Some(kib * 1024.0)
     });
     Ok(match total {
         Some(bytes) => (
@@ -92,6 +93,7 @@ pub fn limit() -> Result<(f64, &'static str), String> {
 pub fn peak_resident() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1e3)
+    // The kernel's "kB" are KiB, as `/usr/bin/time`'s %M.
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024.0)
 }

@@ -65,7 +65,7 @@ def medians_of(halo4d, scene, threads, runs):
             env = dict(os.environ, RAYON_NUM_THREADS=str(threads))
             start = time.monotonic()
             subprocess.run([halo4d, "build", "--quiet", "--out", out, scene], env=env,
-                           check=True, stdout=subprocess.DEVNULL)
+                           check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
             wall = time.monotonic() - start
             with open(os.path.join(out, "report.json")) as f:
                 timings = json.load(f)["timings_ms"]

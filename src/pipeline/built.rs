@@ -65,7 +65,7 @@ pub struct Built {
     pub pixel_size: f64,
     /// The halos' half-width asked for, in scene units (less where a halo was shrunk).
     pub rho: f64,
-    /// The memory the stages from the halos on were estimated to need, and the limit.
+    /// The memory the build was estimated to need, and the limit.
     pub memory: MemoryReport,
     /// How many boxes pile up at the surfaces' points, measured before the stages that
     /// query them.
@@ -362,7 +362,7 @@ fn project<'a>(
 }
 
 /// The scene's size in the view and what follows from it: the diagonal the halos' rho is a
-/// share of, a pixel's size, rho, and the memory the stages from the halos on need.
+/// share of, a pixel's size, rho, and the memory the build needs.
 struct Scale {
     diagonal: f64,
     pixel: f64,
