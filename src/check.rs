@@ -488,19 +488,51 @@ impl Incidence {
         for i in 0..vertices {
             starts[i + 1] += starts[i];
         }
-        let mut fill = starts.clone();
-        let mut others = vec![[0u32; 3]; starts[vertices]];
-        let mut signs = vec![0i8; starts[vertices]];
-        for (&[a, b, c, d], &sign) in tets.iter().zip(tet_signs) {
-            if [a, b, c, d] == DEGENERATE {
-                continue;
-            }
-            for (v, rest) in [(a, [b, c, d]), (b, [a, c, d])] {
-                others[fill[v as usize]] = rest;
-                signs[fill[v as usize]] = sign;
-                fill[v as usize] += 1;
-            }
+        let entries = starts[vertices];
+        let mut others = vec![[0u32; 3]; entries];
+        let mut signs = vec![0i8; entries];
+        // Filled on the cores: the vertices cut into one run per thread of about as many
+        // entries, each run's lists a slice of their own that its task fills in one pass
+        // over the tetrahedra, keeping those of its vertices. Every list is in the
+        // tetrahedra's order, as one core fills it, whatever the number of threads.
+        let runs = rayon::current_num_threads().max(1);
+        let mut cuts: Vec<usize> = (1..runs)
+            .map(|k| {
+                starts
+                    .partition_point(|&e| e * runs < k * entries)
+                    .min(vertices)
+            })
+            .collect();
+        cuts.insert(0, 0);
+        cuts.push(vertices);
+        cuts.dedup();
+        let mut slices = Vec::with_capacity(cuts.len());
+        let (mut o, mut g) = (others.as_mut_slice(), signs.as_mut_slice());
+        for w in cuts.windows(2) {
+            let len = starts[w[1]] - starts[w[0]];
+            let (here, rest) = std::mem::take(&mut o).split_at_mut(len);
+            let (here_signs, rest_signs) = std::mem::take(&mut g).split_at_mut(len);
+            slices.push((w[0]..w[1], here, here_signs));
+            (o, g) = (rest, rest_signs);
         }
+        slices.into_par_iter().for_each(|(run, others, signs)| {
+            let base = starts[run.start];
+            let mut fill: Vec<usize> = starts[run.clone()].iter().map(|s| s - base).collect();
+            for (&[a, b, c, d], &sign) in tets.iter().zip(tet_signs) {
+                if [a, b, c, d] == DEGENERATE {
+                    continue;
+                }
+                for (v, rest) in [(a, [b, c, d]), (b, [a, c, d])] {
+                    let v = v as usize;
+                    if run.contains(&v) {
+                        let at = &mut fill[v - run.start];
+                        others[*at] = rest;
+                        signs[*at] = sign;
+                        *at += 1;
+                    }
+                }
+            }
+        });
         Incidence {
             starts,
             others,
@@ -1205,5 +1237,56 @@ fn finish_volumes(s: &mut CheckStats, volume_exp2: i32) {
         // In two steps: each power of two stays finite where the product does.
         let half = volume_exp2 / 2;
         *v = *v * 2f64.powi(half) * 2f64.powi(volume_exp2 - half);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_incidence_is_the_same_on_any_number_of_threads() {
+        // Random tetrahedra over 500 vertices, some degenerate: every vertex's list in the
+        // tetrahedra's order, as one core fills it, whatever the threads' runs.
+        let mut next = crate::intersect::lcg(3);
+        let tets: Vec<[u32; 4]> = (0..20_000)
+            .map(|_| sorted_tet([0; 4].map(|_| (next() * 500.0) as u32), 500).0)
+            .collect();
+        let signs: Vec<i8> = (0..tets.len()).map(|i| [1, -1, 0][i % 3]).collect();
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| Incidence::new(&tets, &signs, 500))
+        };
+        let one = on(1);
+        assert!(tets.contains(&DEGENERATE));
+        assert_eq!(
+            one.starts[500],
+            2 * tets.iter().filter(|&&t| t != DEGENERATE).count()
+        );
+        for threads in [2, 3, 7] {
+            let many = on(threads);
+            assert_eq!(
+                (&many.starts, &many.others, &many.signs),
+                (&one.starts, &one.others, &one.signs),
+                "{threads} threads"
+            );
+        }
+        // Each list holds the tetrahedra whose smallest or second vertex it is, in order.
+        let v = 17;
+        let expected: Vec<[u32; 3]> = tets
+            .iter()
+            .filter(|&&t| t != DEGENERATE)
+            .flat_map(|&[a, b, c, d]| {
+                [(a, [b, c, d]), (b, [a, c, d])]
+                    .into_iter()
+                    .filter(|&(w, _)| w == v)
+                    .map(|(_, rest)| rest)
+            })
+            .collect();
+        assert!(!expected.is_empty());
+        assert_eq!(one.at(v), expected.as_slice());
     }
 }
