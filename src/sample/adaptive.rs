@@ -31,9 +31,10 @@
 //! triangle left is within a factor of about 4 of the best error the budget allows, not
 //! fine in one place and coarse in another. At tolerances below [`TILE_BELOW`] of the
 //! surface's extent each patch is cut into tiles (at least [`TILES`] per surface: a surface
-//! of one patch, like the spun knots, refines on 16 cores), and the tiles refine in parallel, each a triangulation of its own within a share of the
-//! budget in proportion to its failing triangles (the mesh does not depend on the number
-//! of threads); within a tile, the triangles queued unchecked are checked in batches on the
+//! of one patch, like the spun knots, refines on 16 cores); patches or tiles refine in
+//! parallel, each a triangulation of its own within a share of the budget in proportion
+//! to its failing triangles (the mesh does not depend on the number of threads); within
+//! one, the triangles queued unchecked are checked in batches on the
 //! cores, the splits staying in the queue's order (so the mesh is the same as one thread
 //! checking them in turn). The seams between tiles are glued sides like those between
 //! patches. Between rounds every new side point is inserted on the sides glued to it, so
@@ -77,8 +78,8 @@ pub struct AdaptiveMesh {
 struct Patch {
     /// The surface's patch the tile is part of.
     of: usize,
-    /// The tile's place in its patch: its lower corner in the patch's normalized
-    /// parameters, and the tiles per side.
+    /// The tile's place in its patch, counted in tiles along s and t, and the tiles per
+    /// side of the patch (1 for a patch refined whole).
     tile: ([usize; 2], usize),
     /// The tile's rectangle and its sides' rules (seams between tiles glued).
     domain: Domain,
