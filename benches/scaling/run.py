@@ -19,10 +19,6 @@ import subprocess
 import tempfile
 import time
 
-STAGES = ["setup", "sample", "audit", "view", "guards", "halo", "stipples", "curves",
-          "refine", "verify", "render", "export", "free", "total"]
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--halo4d", required=True, help="the halo4d binary")
@@ -33,13 +29,15 @@ def main():
     threads = [int(t) for t in args.threads.split(",")]
     for scene in args.scenes:
         medians = {t: medians_of(args.halo4d, scene, t, args.runs) for t in threads}
+        # The stages in the report's order, `total` last, then the wall time.
+        stages = list(medians[threads[0]])
         print(f"\n{os.path.basename(scene)}: medians of {args.runs} runs, seconds\n")
         head = ["stage"] + [f"{t} thr." for t in threads]
         head += [f"efficiency {t}" for t in threads[1:]]
         head += [f"serial fraction {t}" for t in threads[1:]]
         print("| " + " | ".join(head) + " |")
         print("| --- |" + " ---: |" * (len(head) - 1))
-        for stage in STAGES + ["wall"]:
+        for stage in stages:
             base = medians[threads[0]][stage]
             if stage not in ("total", "wall") and base < 0.0005:
                 continue
@@ -69,10 +67,10 @@ def medians_of(halo4d, scene, threads, runs):
             wall = time.monotonic() - start
             with open(os.path.join(out, "report.json")) as f:
                 timings = json.load(f)["timings_ms"]
-        record = {k: timings.get(k, 0.0) / 1e3 for k in STAGES}
+        record = {k: v / 1e3 for k, v in timings.items()}
         record["wall"] = wall
         records.append(record)
-    return {k: statistics.median(r[k] for r in records) for k in STAGES + ["wall"]}
+    return {k: statistics.median(r[k] for r in records) for k in records[0]}
 
 
 if __name__ == "__main__":

@@ -579,7 +579,7 @@ fn render_eyes(
     let mut depth = Vec::new();
     let (mut svg, mut seen) = (None, None);
     let (w, h) = (settings.width, settings.height);
-    scene.check_memory(&Camera::new(camera, &placement, w, h, eyes[0])?, eyes.len())?;
+    scene.check_memory(&Camera::new(camera, &placement, w, h, eyes[0])?)?;
     let mut rgb = vec![0u8; 3 * (w as usize * eyes.len()) * h as usize];
     for (e, &offset) in eyes.iter().enumerate() {
         let cam = Camera::new(camera, &placement, w, h, offset)?;
@@ -1022,11 +1022,10 @@ impl<'a> Scene<'a> {
     /// mode also every hit of every sample ([`slices::Probe`]) with its verdict, and a
     /// slice image per thread; the hits per ray are counted on a grid of up to 64 x 64 rays
     /// through the picture.
-    fn check_memory(&self, cam: &Camera, eyes: usize) -> Result<(), RenderError> {
+    fn check_memory(&self, cam: &Camera) -> Result<(), RenderError> {
         let s = self.settings;
         let pixels = f64::from(s.width) * f64::from(s.height);
         let mut needed = picture_bytes(s);
-        debug_assert_eq!(eyes, self::eyes(s).len());
         let mut what = format!("{} x {} pixels", s.width, s.height);
         if s.mode == RenderMode::Slices && self.halos.is_some() {
             let grid = 64.min(s.width).min(s.height);
