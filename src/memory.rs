@@ -12,18 +12,19 @@ use crate::limits::MAX_MEMORY;
 /// Bytes in a gigabyte, as the limit and the messages count them.
 pub const GB: f64 = 1e9;
 
-/// What every build holds whatever its size (the program, the threads' stacks, the
-/// buffers of fixed size): 0.126 GB measured at 100,352 triangles with halos, of which
-/// 100,352 x [`BUILD_BYTES_PER_TRIANGLE`] is 0.085 GB.
-pub const BASE_BYTES: f64 = 45e6;
+/// What every build holds whatever its size (the program, the threads' stacks and the
+/// allocator's arenas, the buffers of fixed size): 0.12 to 0.14 GB measured from one run to
+/// the next at 100,352 triangles with halos, of which 100,352 x
+/// [`BUILD_BYTES_PER_TRIANGLE`] is 0.09 GB.
+pub const BASE_BYTES: f64 = 55e6;
 
 /// Peak resident bytes per triangle of a build that makes halos (two layers of
 /// tetrahedra, the checker's incidence, the verification's indexes, the `.glb`'s chunks
 /// while the files stream), over [`BASE_BYTES`]: the flat torus with glb, vtk, ply and
-/// report peaks at 0.12, 0.92, 3.18 and 7.69 GB at 100,352, 1,002,528, 3,998,792 and
-/// 9,999,392 triangles (`HALO4D_SCALE=100k,1M,4M,10M cargo bench --bench scale`), the
+/// report peaks at 0.12 to 0.15, 0.88, 3.22 and 7.67 GB at 100,352, 1,002,528, 3,998,792
+/// and 9,999,392 triangles (`HALO4D_SCALE=100k,1M,4M,10M cargo bench --bench scale`), the
 /// default scene at tolerance 1e-5 (1,241,550 triangles) at 1.00 GB: this estimate is
-/// high by 8 to 18%.
+/// high by 0 to 18%.
 pub const BUILD_BYTES_PER_TRIANGLE: f64 = 900.0;
 
 /// The same for a build that makes the curves but no halos: 0.37 GB at 1,002,528
@@ -39,7 +40,7 @@ pub const SAMPLE_BYTES_PER_TRIANGLE: f64 = 170.0;
 
 /// The estimated peak resident bytes of a build of `triangles` triangles, by its most
 /// demanding stage: the halos, else the curves, else the sampling (`adaptive` or not).
-/// Measured from outside, it is high by 8 to 18% from 100,000 to 10 million triangles.
+/// Measured from outside, it is high by 0 to 18% from 100,000 to 10 million triangles.
 pub fn build_bytes(triangles: usize, adaptive: bool, curves: bool, halos: bool) -> f64 {
     let sampling = if adaptive {
         ADAPTIVE_BYTES_PER_TRIANGLE

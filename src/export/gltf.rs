@@ -160,18 +160,25 @@ impl Builder {
         Ok((text, self.bin))
     }
 
-    /// Appends a buffer view of 4-byte `words` (little-endian), written straight into the
-    /// binary chunk; `target` is `None` for data that no primitive reads (the tetrahedra).
-    fn view(
+    /// Appends a buffer view of 4-byte `words` (written little-endian, as glTF's binary
+    /// chunk is), copied straight into the binary chunk; `target` is `None` for data that no
+    /// primitive reads (the tetrahedra).
+    fn view<W: bytemuck::Pod>(
         &mut self,
-        words: impl ExactSizeIterator<Item = [u8; 4]>,
+        words: &[W],
         target: Option<json::buffer::Target>,
     ) -> json::Index<json::buffer::View> {
+        const { assert!(size_of::<W>() == 4) };
         debug_assert_eq!(self.bin.len() % 4, 0);
         let offset = self.bin.len();
-        self.bin.reserve(4 * words.len());
-        for w in words {
-            self.bin.extend_from_slice(&w);
+        let bytes: &[u8] = bytemuck::cast_slice(words);
+        if cfg!(target_endian = "little") {
+            self.bin.extend_from_slice(bytes);
+        } else {
+            self.bin.reserve(bytes.len());
+            for w in bytes.chunks_exact(4) {
+                self.bin.extend(w.iter().rev());
+            }
         }
         self.root.push(json::buffer::View {
             buffer: json::Index::new(0),
@@ -197,10 +204,7 @@ impl Builder {
         } else {
             1
         };
-        let view = self.view(
-            values.iter().map(|x| x.to_le_bytes()),
-            Some(json::buffer::Target::ArrayBuffer),
-        );
+        let view = self.view(values, Some(json::buffer::Target::ArrayBuffer));
         let (min, max) = match minmax {
             Some((lo, hi)) => (Some(serde_json::json!(lo)), Some(serde_json::json!(hi))),
             None => (None, None),
@@ -266,7 +270,7 @@ impl Builder {
         target: Option<json::buffer::Target>,
         name: Option<String>,
     ) -> json::Index<json::Accessor> {
-        let view = self.view(indices.iter().map(|i| i.to_le_bytes()), target);
+        let view = self.view(indices, target);
         self.root.push(json::Accessor {
             buffer_view: Some(view),
             byte_offset: None,

@@ -289,27 +289,25 @@ impl Mesh4 {
             ..MeshStats::default()
         };
         // Every directed edge as (low, high, direction), sorted so the uses of an undirected
-        // edge are adjacent.
-        let mut directed: Vec<(u32, u32, bool)> = Vec::with_capacity(3 * self.triangles.len());
+        // edge are adjacent; on the cores (the order is the same whatever the threads).
+        let mut directed: Vec<(u32, u32, bool)> = self
+            .triangles
+            .par_iter()
+            .flat_map_iter(|&[a, b, c]| {
+                [(a, b), (b, c), (c, a)].map(|(x, y)| (x.min(y), x.max(y), x > y))
+            })
+            .collect();
+        directed.par_sort_unstable();
+        stats.degenerate_triangles = self
+            .triangles
+            .par_iter()
+            .filter(|&&[a, b, c]| {
+                let [pa, pb, pc] = [a, b, c].map(|i| self.positions[i as usize]);
+                a == b || b == c || a == c || gram_area2(pb - pa, pc - pa) <= 0.0
+            })
+            .count();
+        // A vertex is used when an edge ends at it.
         let mut used = vec![false; self.positions.len()];
-        for t in &self.triangles {
-            let [a, b, c] = *t;
-            let (pa, pb, pc) = (
-                self.positions[a as usize],
-                self.positions[b as usize],
-                self.positions[c as usize],
-            );
-            if a == b || b == c || a == c || gram_area2(pb - pa, pc - pa) <= 0.0 {
-                stats.degenerate_triangles += 1;
-            }
-            for (x, y) in [(a, b), (b, c), (c, a)] {
-                directed.push((x.min(y), x.max(y), x > y));
-            }
-            for i in t {
-                used[*i as usize] = true;
-            }
-        }
-        directed.sort_unstable();
         for uses in directed.chunk_by(|p, q| (p.0, p.1) == (q.0, q.1)) {
             stats.edges += 1;
             match uses.len() {
@@ -317,10 +315,13 @@ impl Mesh4 {
                 2 => stats.orientation_conflicts += usize::from(uses[0].2 == uses[1].2),
                 _ => stats.non_manifold_edges += 1,
             }
+            used[uses[0].0 as usize] = true;
+            used[uses[0].1 as usize] = true;
         }
         stats.vertices = used.iter().filter(|u| **u).count();
         stats.unused_vertices = used.len() - stats.vertices;
         stats.non_finite_vertices = (0..self.positions.len())
+            .into_par_iter()
             .filter(|&i| {
                 !(self.positions[i].is_finite()
                     && self.tangent_u[i].is_finite()
