@@ -13,12 +13,14 @@
 
 mod formula;
 mod holomorphic;
+mod interval;
 mod jet;
 mod knots;
 mod simple;
 
 pub use formula::{Bound, Formula, FormulaEdge, FormulaSeam, FormulaSides, FormulaSource};
 pub use holomorphic::{Fermat, ProductPolynomial};
+pub use interval::Interval;
 pub use jet::{Jet, Real};
 pub use knots::{SpunTrefoil, TwistSpunTrefoil};
 pub use simple::{FlatTorus, KleinBottle, Patches, ProjectivePlane};

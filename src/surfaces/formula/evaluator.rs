@@ -1,12 +1,13 @@
-//! The evaluator: compiled formulas run over f64 (points) and over [`Jet`]s (points with
-//! their exact first and second derivatives), without recursion and without string work;
+//! The evaluator: compiled formulas run over f64 (points), over [`Jet`]s (points with
+//! their exact first and second derivatives) and over [`Interval`]s (enclosures of their
+//! values over boxes of parameters), without recursion and without string work;
 //! and, when a value is not finite, the instruction that made it so. Apart from the
 //! compiler: what runs once per point, against what runs once per formula.
 
 use super::compiler::{Fun, Node, Op, Program, Shared};
 use super::messages::failure;
 use crate::limits::shorten;
-use crate::surfaces::Jet;
+use crate::surfaces::{Interval, Jet};
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
 /// What a formula computes with: f64 for points, [`Jet`] for derivatives. Both take the
@@ -151,6 +152,65 @@ impl Number for Jet {
             Fun::Min => a.min(b),
             Fun::Max => a.max(b),
             _ => Jet::constant(f64::NAN),
+        }
+    }
+}
+
+/// Enclosures: the constants are the f64 values the compiler folded them to (`pi` the f64
+/// nearest π), and the formula over them is enclosed exactly as real arithmetic would
+/// compute it. What is undefined somewhere on a box (a logarithm reaching 0, `min`'s
+/// unused one-argument form) is the whole line there.
+impl Number for Interval {
+    fn constant(x: f64) -> Self {
+        Interval::point(x)
+    }
+    fn int_power(self, n: i32) -> Self {
+        self.powi(n)
+    }
+    fn real_power(self, k: f64) -> Self {
+        // An integral power is defined for negative bases, as f64's `powf` takes it.
+        if k.fract() == 0.0 && k.abs() <= f64::from(i32::MAX) {
+            self.powi(k as i32)
+        } else {
+            self.powf(k)
+        }
+    }
+    fn power(self, y: Self) -> Self {
+        self.pow(y)
+    }
+    fn scale(self, k: f64) -> Self {
+        self * Interval::point(k)
+    }
+    fn shift(self, k: f64) -> Self {
+        self + Interval::point(k)
+    }
+    fn over(self, k: f64) -> Self {
+        self / Interval::point(k)
+    }
+    fn call1(f: Fun, a: Self) -> Self {
+        match f {
+            Fun::Sin => a.sin(),
+            Fun::Cos => a.cos(),
+            Fun::Tan => a.tan(),
+            Fun::Asin => a.asin(),
+            Fun::Acos => a.acos(),
+            Fun::Atan => a.atan(),
+            Fun::Sinh => a.sinh(),
+            Fun::Cosh => a.cosh(),
+            Fun::Tanh => a.tanh(),
+            Fun::Exp => a.exp(),
+            Fun::Log => a.ln(),
+            Fun::Sqrt => a.sqrt(),
+            Fun::Abs => a.abs(),
+            Fun::Atan2 | Fun::Min | Fun::Max => Interval::ENTIRE,
+        }
+    }
+    fn call2(f: Fun, a: Self, b: Self) -> Self {
+        match f {
+            Fun::Atan2 => a.atan2(b),
+            Fun::Min => a.min(b),
+            Fun::Max => a.max(b),
+            _ => Interval::ENTIRE,
         }
     }
 }
@@ -354,6 +414,58 @@ mod tests {
         let p = Program::compile("2*pi*a + u", &params(&[("a", 0.5)]))
             .unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(p.ops, vec![Op::Const(PI), Op::U, Op::Add]);
+    }
+
+    #[test]
+    fn enclosures_hold_every_point_of_their_boxes() {
+        use crate::surfaces::Interval;
+        let texts = [
+            "sin(3*u) * cos(v) + u^2",
+            "exp(u - v) / (2 + cosh(v))",
+            "log(1 + u^2) * tan(v/4)",
+            "sqrt(u^2 + 1) - atan(u*v)",
+            "asin(v/3) + acos(u/4)",
+            "sinh(u) * tanh(v) + abs(u - v)",
+            "atan2(v + 5, u) + min(u, v) * max(u, v)",
+            "(u^2 + 1)^0.5 * (v^2 + 2)^v",
+            "u^3 - 1/(u^2 + 0.1) * v",
+        ];
+        // A number in [0, 1) from an index.
+        let unit = |i: u64| {
+            let z = (i + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            ((z ^ (z >> 29)).wrapping_mul(0xBF58_476D_1CE4_E5B9) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for text in texts {
+            let p = Program::compile(text, &params(&[])).unwrap_or_else(|e| panic!("{e}"));
+            for k in 0..60u64 {
+                // Boxes from a point to a third of the range, within u, v in [-2.9, 2.9].
+                let size = [0.0, 1e-6, 1e-3, 0.1, 1.0, 2.0][k as usize % 6];
+                let u0 = -2.9 + (5.8 - size) * unit(4 * k);
+                let v0 = -2.9 + (5.8 - size) * unit(4 * k + 1);
+                let (u, v) = (Interval::new(u0, u0 + size), Interval::new(v0, v0 + size));
+                let y = p.run(u, v);
+                for i in 0..=8 {
+                    for j in 0..=8 {
+                        let (a, b) = (u0 + size * i as f64 / 8.0, v0 + size * j as f64 / 8.0);
+                        let (a, b) = (a.min(u.hi()), b.min(v.hi()));
+                        let x = p.run(a, b);
+                        // The point's own rounding: a few units of its size.
+                        let slack = 1e-12 * x.abs().max(1.0);
+                        assert!(
+                            y.lo() - slack <= x && x <= y.hi() + slack,
+                            "{text} over u {u:?}, v {v:?} = {y:?} misses {x} at ({a}, {b})"
+                        );
+                    }
+                }
+                if size == 0.0 {
+                    let x = p.run(u0, v0);
+                    assert!(
+                        y.width() <= 1e-12 * x.abs().max(1.0),
+                        "{text}: {y:?} at a point"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

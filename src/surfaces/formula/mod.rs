@@ -39,7 +39,7 @@ mod messages;
 mod parser;
 mod sides;
 
-use super::{Domain, Eval4, Jet, Parametric, Topology};
+use super::{Domain, Eval4, Interval, Jet, Parametric, Topology};
 use crate::limits::{FINITE, FieldError, shorten};
 use compiler::{Op, Program, Shared, function};
 use glam::DVec4;
@@ -307,6 +307,13 @@ impl Formula {
 
     fn jets(&self, u: f64, v: f64) -> [Jet; 4] {
         self.shared.run(Jet::u(u), Jet::v(v))
+    }
+
+    /// Enclosures of the four coordinates over the box of parameters `u` x `v`: every
+    /// point the formula takes there (its constants as the compiler folded them) lies in
+    /// them, by interval arithmetic rounded outward.
+    pub fn enclose(&self, u: Interval, v: Interval) -> [Interval; 4] {
+        self.shared.run(u, v)
     }
 }
 
