@@ -11,10 +11,13 @@
 //! ([`write_tetrahedra_vtu`], what `halo4d check --mark` writes). Guarantees: each file in its format's conventions
 //! (`convention`); every file is written to a temporary name and renamed into place,
 //! so a failure never leaves a half-written file, and a build's files move into place
-//! together ([`Staged`]). The files are not synced to the disk (the operating system
+//! together ([`Staged`]). A build's files are not synced to the disk (the operating system
 //! writes them in its own time): a failed or killed build leaves none half-written, a
 //! power cut in the seconds after one may (syncing cost 0.5 to 1 s of a 1M-triangle
-//! build's 490 MB). [`crate::import`] reads the halos and surfaces back.
+//! build's 490 MB), and the build can be run again. The files of long runs that resume
+//! from what they find ([`write_atomic`]: an animation's frames, a gallery's pictures)
+//! are synced before they are renamed, so that a file found is whole. [`crate::import`]
+//! reads the halos and surfaces back.
 
 mod gltf;
 mod html;
@@ -68,7 +71,7 @@ pub struct SurfaceData<'a> {
 
 /// Writes `bytes` to `path` through a temporary file in the same folder and a rename.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let tmp = write_partial(path, |w| w.write_all(bytes))?;
+    let tmp = write_partial_as(path, "partial", Durable::Synced, |w| w.write_all(bytes))?;
     std::fs::rename(&tmp, path).inspect_err(|_| {
         let _ = std::fs::remove_file(&tmp);
     })
@@ -82,26 +85,37 @@ pub fn write_atomic_shared(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
-    let tmp = write_partial_as(path, &format!("{}.partial", std::process::id()), fill)?;
+    let suffix = format!("{}.partial", std::process::id());
+    let tmp = write_partial_as(path, &suffix, Durable::Synced, fill)?;
     std::fs::rename(&tmp, path).inspect_err(|_| {
         let _ = std::fs::remove_file(&tmp);
     })
 }
 
+/// Whether a file is synced to the disk before it is renamed into place.
+#[derive(Clone, Copy, PartialEq)]
+enum Durable {
+    /// Synced: a file found after a power cut is whole (what a resumed run relies on).
+    Synced,
+    /// Left to the operating system (a build's files, all made again by the next build).
+    Unsynced,
+}
+
 /// Writes what `fill` writes, buffered, to the temporary name of `path`
-/// (`.<file name>.partial` in its folder) and returns that name; on failure removes what it
-/// wrote.
+/// (`.<file name>.partial` in its folder), unsynced, and returns that name; on failure
+/// removes what it wrote.
 fn write_partial(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> std::io::Result<std::path::PathBuf> {
-    write_partial_as(path, "partial", fill)
+    write_partial_as(path, "partial", Durable::Unsynced, fill)
 }
 
-/// [`write_partial`] to `.<file name>.<suffix>`.
+/// [`write_partial`] to `.<file name>.<suffix>`, synced or not.
 fn write_partial_as(
     path: &Path,
     suffix: &str,
+    durable: Durable,
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> std::io::Result<std::path::PathBuf> {
     let name = path
@@ -113,7 +127,12 @@ fn write_partial_as(
         .and_then(|f| {
             let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
             fill(&mut w)?;
-            w.flush()
+            let f = w.into_inner().map_err(|e| e.into_error())?;
+            if durable == Durable::Synced {
+                f.sync_all()
+            } else {
+                Ok(())
+            }
         })
         .inspect_err(|_| {
             let _ = std::fs::remove_file(&tmp);
