@@ -99,6 +99,40 @@ impl Number for f64 {
     }
 }
 
+/// `call1` and `call2` of a [`Number`] whose functions are its methods of the same names
+/// (`ln` for `log`), with `undefined` for a function called with the wrong number of
+/// arguments (which the compiler refuses).
+macro_rules! calls {
+    ($undefined:expr) => {
+        fn call1(f: Fun, a: Self) -> Self {
+            match f {
+                Fun::Sin => a.sin(),
+                Fun::Cos => a.cos(),
+                Fun::Tan => a.tan(),
+                Fun::Asin => a.asin(),
+                Fun::Acos => a.acos(),
+                Fun::Atan => a.atan(),
+                Fun::Sinh => a.sinh(),
+                Fun::Cosh => a.cosh(),
+                Fun::Tanh => a.tanh(),
+                Fun::Exp => a.exp(),
+                Fun::Log => a.ln(),
+                Fun::Sqrt => a.sqrt(),
+                Fun::Abs => a.abs(),
+                Fun::Atan2 | Fun::Min | Fun::Max => $undefined,
+            }
+        }
+        fn call2(f: Fun, a: Self, b: Self) -> Self {
+            match f {
+                Fun::Atan2 => a.atan2(b),
+                Fun::Min => a.min(b),
+                Fun::Max => a.max(b),
+                _ => $undefined,
+            }
+        }
+    };
+}
+
 impl Number for Jet {
     fn constant(x: f64) -> Self {
         Jet::constant(x)
@@ -128,32 +162,7 @@ impl Number for Jet {
             dvv: self.dvv / k,
         }
     }
-    fn call1(f: Fun, a: Self) -> Self {
-        match f {
-            Fun::Sin => a.sin(),
-            Fun::Cos => a.cos(),
-            Fun::Tan => a.tan(),
-            Fun::Asin => a.asin(),
-            Fun::Acos => a.acos(),
-            Fun::Atan => a.atan(),
-            Fun::Sinh => a.sinh(),
-            Fun::Cosh => a.cosh(),
-            Fun::Tanh => a.tanh(),
-            Fun::Exp => a.exp(),
-            Fun::Log => a.ln(),
-            Fun::Sqrt => a.sqrt(),
-            Fun::Abs => a.abs(),
-            Fun::Atan2 | Fun::Min | Fun::Max => Jet::constant(f64::NAN),
-        }
-    }
-    fn call2(f: Fun, a: Self, b: Self) -> Self {
-        match f {
-            Fun::Atan2 => a.atan2(b),
-            Fun::Min => a.min(b),
-            Fun::Max => a.max(b),
-            _ => Jet::constant(f64::NAN),
-        }
-    }
+    calls!(Jet::constant(f64::NAN));
 }
 
 /// Enclosures: the constants are the f64 values the compiler folded them to (`pi` the f64
@@ -187,32 +196,7 @@ impl Number for Interval {
     fn over(self, k: f64) -> Self {
         self / Interval::point(k)
     }
-    fn call1(f: Fun, a: Self) -> Self {
-        match f {
-            Fun::Sin => a.sin(),
-            Fun::Cos => a.cos(),
-            Fun::Tan => a.tan(),
-            Fun::Asin => a.asin(),
-            Fun::Acos => a.acos(),
-            Fun::Atan => a.atan(),
-            Fun::Sinh => a.sinh(),
-            Fun::Cosh => a.cosh(),
-            Fun::Tanh => a.tanh(),
-            Fun::Exp => a.exp(),
-            Fun::Log => a.ln(),
-            Fun::Sqrt => a.sqrt(),
-            Fun::Abs => a.abs(),
-            Fun::Atan2 | Fun::Min | Fun::Max => Interval::ENTIRE,
-        }
-    }
-    fn call2(f: Fun, a: Self, b: Self) -> Self {
-        match f {
-            Fun::Atan2 => a.atan2(b),
-            Fun::Min => a.min(b),
-            Fun::Max => a.max(b),
-            _ => Interval::ENTIRE,
-        }
-    }
+    calls!(Interval::ENTIRE);
 }
 
 /// Runs one instruction on the stack `s` whose first `sp` entries are live.
