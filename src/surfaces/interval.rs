@@ -46,8 +46,8 @@ const LN2: Interval = Interval {
     hi: 0.693_147_180_559_945_4,
 };
 
-/// π/2: the nearest f64 is below it (1.5707963267948966192..., π/2 = 1.5707963267948966192313...
-/// and the f64 is 1.5707963267948965579...).
+/// π/2: the nearest f64 is below it (0x3FF921FB54442D18 = 1.570796326794896557...,
+/// π/2 = 1.570796326794896619...).
 const HALF_PI: Interval = Interval {
     lo: FRAC_PI_2,
     hi: 1.570_796_326_794_896_8,
@@ -116,11 +116,6 @@ impl Interval {
         Interval::new(down(lo), up(hi))
     }
 
-    /// The least interval holding both.
-    pub fn join(self, o: Interval) -> Interval {
-        Interval::new(self.lo.min(o.lo), self.hi.max(o.hi))
-    }
-
     /// x^2 (tighter than x * x where the interval holds 0).
     pub fn sqr(self) -> Interval {
         let (a, b) = (self.lo * self.lo, self.hi * self.hi);
@@ -136,11 +131,18 @@ impl Interval {
         if n < 0 {
             return Interval::point(1.0) / self.powi(n.saturating_neg());
         }
-        // Even powers from |x| (whose powers are monotone), odd ones from x by the sign.
-        let base = if n % 2 == 0 { self.abs() } else { self };
-        let mut out = Interval::point(1.0);
-        for _ in 0..n {
-            out = out * base;
+        // By squaring (as many steps as n has bits): x^n = x^(n mod 2) (x^2)^(n / 2), each
+        // square from `sqr`; an even power is not below 0 (which the products' outward
+        // rounding of an exact 0 would give).
+        let (mut out, mut square, mut e) = (Interval::point(1.0), self, n.unsigned_abs());
+        while e > 0 {
+            if e & 1 == 1 {
+                out = out * square;
+            }
+            e >>= 1;
+            if e > 0 {
+                square = square.sqr();
+            }
         }
         if n % 2 == 0 {
             Interval::new(out.lo.max(0.0), out.hi)
@@ -294,7 +296,8 @@ impl Interval {
     /// tanh, as 1 - 2 / (e^(2x) + 1) at each end (tanh is increasing), within [-1, 1].
     pub fn tanh(self) -> Interval {
         let at = |x: f64| {
-            // tanh(-x) = -tanh(x): from the side where e^(2x) does not overflow to 0 error.
+            // For x >= 0, e^(2x) >= 1 keeps the division away from 0; tanh(-x) = -tanh(x)
+            // for the rest.
             let t = |x: f64| {
                 let e = (Interval::point(2.0) * Interval::point(x)).exp();
                 Interval::point(1.0) - Interval::point(2.0) / (e + Interval::point(1.0))
@@ -386,27 +389,43 @@ fn pow_up(r: f64, n: u32) -> f64 {
     (0..n).fold(1.0, |p, _| up(p * r))
 }
 
-/// Σ x^k / d_k for k < N, by Horner's rule in interval arithmetic (an enclosure of the
-/// polynomial over all of x), the terms of odd k negated when `alternate`.
-fn horner<const N: usize>(x: Interval, divisors: [Interval; N], alternate: bool) -> Interval {
-    let one = Interval::point(1.0);
-    (0..N).rev().fold(Interval::point(0.0), |out, k| {
-        let c = one / divisors[k];
-        out * x + if alternate && k % 2 == 1 { -c } else { c }
-    })
+/// Σ c_k x^k over the `coefficients` c_k, by Horner's rule in interval arithmetic (an
+/// enclosure of the polynomial over all of x).
+fn horner(x: Interval, coefficients: &[Interval]) -> Interval {
+    coefficients
+        .iter()
+        .rev()
+        .fold(Interval::point(0.0), |out, &c| out * x + c)
 }
 
 /// An enclosure of n! (exact as an f64 up to 22!, and an interval around it beyond).
-fn factorial(n: u32) -> Interval {
-    (1..=n).fold(Interval::point(1.0), |p, k| {
-        p * Interval::point(f64::from(k))
-    })
+fn factorial(n: usize) -> Interval {
+    (1..=n).fold(Interval::point(1.0), |p, k| p * Interval::point(k as f64))
 }
 
-/// The odd numbers 1, 3, 5, ... as intervals.
-fn odd<const N: usize>() -> [Interval; N] {
-    std::array::from_fn(|n| Interval::point((2 * n + 1) as f64))
+/// Enclosures of the series' coefficients, made once: 1 / k! for e^x; (-1)^n / (2n+1)!
+/// and (-1)^n / (2n)! for sin and cos (in powers of x^2); 1 / (2n+1) for atanh and
+/// (-1)^n / (2n+1) for atan (in powers of x^2).
+struct Series {
+    exp: [Interval; 25],
+    sin: [Interval; 13],
+    cos: [Interval; 13],
+    atanh: [Interval; 20],
+    atan: [Interval; 20],
 }
+
+static SERIES: std::sync::LazyLock<Series> = std::sync::LazyLock::new(|| {
+    let one = Interval::point(1.0);
+    let sign = |n: usize, c: Interval| if n % 2 == 1 { -c } else { c };
+    let odd = |n: usize| Interval::point((2 * n + 1) as f64);
+    Series {
+        exp: std::array::from_fn(|k| one / factorial(k)),
+        sin: std::array::from_fn(|n| sign(n, one / factorial(2 * n + 1))),
+        cos: std::array::from_fn(|n| sign(n, one / factorial(2 * n))),
+        atanh: std::array::from_fn(|n| one / odd(n)),
+        atan: std::array::from_fn(|n| sign(n, one / odd(n))),
+    }
+});
 
 /// An enclosure of e^x at the point x.
 fn exp_point(x: f64) -> Interval {
@@ -426,7 +445,7 @@ fn exp_point(x: f64) -> Interval {
     let r = Interval::point(x) - Interval::point(k) * LN2;
     // e^r = Σ r^n / n! for n <= 24, and the rest below |r|^25 / 25! e^|r| (< 2 |r|^25 / 25!).
     const TERMS: u32 = 25;
-    let series = horner::<25>(r, std::array::from_fn(|k| factorial(k as u32)), false);
+    let series = horner(r, &SERIES.exp);
     let rest = 2.0 * remainder(r.mag(), TERMS);
     let e = series + Interval::new(-rest, rest);
     // 2^k in two steps, each exact, so that 2^k itself need not be a normal number.
@@ -453,7 +472,7 @@ fn ln_point(x: f64) -> Interval {
     // n < 20, the rest below 2 |s|^41 / (41 (1 - s^2)) < 3 |s|^41 / 41.
     let s =
         (Interval::point(m) - Interval::point(1.0)) / (Interval::point(m) + Interval::point(1.0));
-    let series = s * horner(s.sqr(), odd::<20>(), false);
+    let series = s * horner(s.sqr(), &SERIES.atanh);
     let rest = up(up(3.0 * pow_up(s.mag(), 41)) / 41.0);
     Interval::point(f64::from(e)) * LN2
         + Interval::point(2.0) * (series + Interval::new(-rest, rest))
@@ -470,7 +489,8 @@ enum Trig {
 /// hold a maximum and -1 where it may hold a minimum.
 fn trig(x: Interval, which: Trig) -> Interval {
     let full = Interval::new(-1.0, 1.0);
-    if !x.is_bounded() || x.width() >= 6.0 {
+    // Beyond 1e15 the reduction by π/2 tells nothing (and the multiples would not fit).
+    if !x.is_bounded() || x.width() >= 6.0 || x.mag() > 1e15 {
         return full;
     }
     let at = |t: f64| trig_point(t, which);
@@ -504,12 +524,8 @@ fn trig_point(t: f64, which: Trig) -> Interval {
     // sin r = r Σ (-1)^n r^2n / (2n+1)!, cos r = Σ (-1)^n r^2n / (2n)!, for n < 13; the
     // rest below |r|^27 / 27! and |r|^26 / 26! (each derivative at most 1).
     let r2 = r.sqr();
-    let sin = r * horner::<13>(
-        r2,
-        std::array::from_fn(|n| factorial(2 * n as u32 + 1)),
-        true,
-    );
-    let cos = horner::<13>(r2, std::array::from_fn(|n| factorial(2 * n as u32)), true);
+    let sin = r * horner(r2, &SERIES.sin);
+    let cos = horner(r2, &SERIES.cos);
     let (s_rest, c_rest) = (remainder(m, 27), remainder(m, 26));
     let sin = sin + Interval::new(-s_rest, s_rest);
     let cos = cos + Interval::new(-c_rest, c_rest);
@@ -549,7 +565,7 @@ fn atan_small(t: Interval) -> Interval {
     let one = Interval::point(1.0);
     let half = |t: Interval| t / (one + (one + t.sqr()).sqrt());
     let s = half(half(t));
-    let series = s * horner(s.sqr(), odd::<20>(), true);
+    let series = s * horner(s.sqr(), &SERIES.atan);
     let rest = up(pow_up(s.mag(), 41) / 41.0);
     Interval::point(4.0) * (series + Interval::new(-rest, rest))
 }
@@ -632,6 +648,8 @@ mod tests {
         encloses("sqrt", Interval::sqrt, f64::sqrt, 0.0, 9.0);
         encloses("sqr", Interval::sqr, |x| x * x, -3.0, 2.0);
         encloses("cube", |x| x.powi(3), |x| x.powi(3), -3.0, 2.0);
+        encloses("x^7", |x| x.powi(7), |x| x.powi(7), -3.0, 2.0);
+        encloses("x^8", |x| x.powi(8), |x| x.powi(8), -3.0, 2.0);
         encloses("x^-2", |x| x.powi(-2), |x| x.powi(-2), 0.5, 3.0);
         encloses("x^2.5", |x| x.powf(2.5), |x| x.powf(2.5), 0.0, 3.0);
         encloses("abs", Interval::abs, f64::abs, -3.0, 2.0);
@@ -679,6 +697,20 @@ mod tests {
     }
 
     #[test]
+    fn large_powers_take_as_many_steps_as_their_bits() {
+        // (1 + 1e-9)^1e9 = e^(1e9 ln(1 + 1e-9)) = 2.7182818270...: a billion multiplications
+        // one by one would take seconds. Each squaring doubles the relative width.
+        let x = 1.0 + 1e-9;
+        let p = Interval::point(x).powi(1_000_000_000);
+        let e = (1e9 * x.ln()).exp();
+        assert!(p.contains(e) && p.width() < 1e-5, "{p:?} against {e}");
+        assert!(Interval::point(1.0).powi(i32::MAX).contains(1.0));
+        assert_eq!(Interval::new(-1.0, 0.5).powi(i32::MIN), Interval::ENTIRE);
+        // Even powers of an interval around 0 never go below 0.
+        assert_eq!(Interval::new(-2.0, 1.0).powi(6).lo(), 0.0);
+    }
+
+    #[test]
     fn what_is_undefined_somewhere_claims_nothing() {
         let around_zero = Interval::new(-1.0, 1.0);
         assert_eq!(Interval::point(1.0) / around_zero, Interval::ENTIRE);
@@ -693,6 +725,7 @@ mod tests {
         assert!(big.hi.is_infinite() && big.lo > 1e307);
         assert!(Interval::point(-800.0).exp().contains(0.0));
         assert_eq!(Interval::point(1e300).sin(), Interval::new(-1.0, 1.0));
+        assert_eq!(Interval::new(1e300, 1e300).cos(), Interval::new(-1.0, 1.0));
     }
 
     #[test]
