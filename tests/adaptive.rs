@@ -374,6 +374,7 @@ fn scene_sampling_takes_relative_and_absolute_tolerances() {
             tolerance: None,
             absolute_tolerance: Some(0.01),
             max_triangles: 100_000,
+            bound: halo4d::sample::ErrorBound::Audited,
         },
     );
     assert_eq!(abs.tolerance, Some(0.01));

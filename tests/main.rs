@@ -18,6 +18,7 @@ mod intersect;
 mod lines;
 mod motion;
 mod own;
+mod proven;
 mod readme;
 mod refine;
 mod refused;

@@ -113,6 +113,10 @@ def test_write_gives_the_files_and_the_report_of_halo4d_build(cli_build, tmp_pat
     out, built = cli_build
     report = built.write(tmp_path)
     assert report["verified"] is True
+    # The proven bound beside the audited one: never below it.
+    sampling = report["surfaces"][0]["sampling"]
+    assert sampling["max_error"] <= sampling["proven_max_error"], sampling
+    assert sampling["unproven_triangles"] == 0, sampling
     for f in report["files"]:
         assert (tmp_path / f).is_file(), f
     # The same bytes as the command line's, but for the timings the report holds.

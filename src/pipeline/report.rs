@@ -6,7 +6,7 @@ use super::built::SurfaceProduct;
 use crate::halo::HaloReport;
 use crate::intersect::CurvesReport;
 use crate::render;
-use crate::sample::{self, Audit, MeshStats, Sampling, Source};
+use crate::sample::{self, Audit, MeshStats, Proof, Sampling, Source};
 use crate::scene::Scene;
 use crate::stipple::Stipples;
 use crate::surfaces::Topology;
@@ -72,6 +72,20 @@ pub struct SamplingReport {
     pub max_error_relative: f64,
     /// `rms_error / diagonal`.
     pub rms_error_relative: f64,
+    /// Proven largest distance, triangle to surface, in R^4, at every point of every
+    /// triangle (interval arithmetic: [`sample::triangle_bound`]); absent for a mesh file,
+    /// and `null` when some triangle has no finite bound (`unproven_triangles`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub proven_max_error: Option<Option<f64>>,
+    /// `proven_max_error / diagonal`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub proven_max_error_relative: Option<Option<f64>>,
+    /// Triangles without a finite proven bound (a formula undefined on part of one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unproven_triangles: Option<usize>,
+    /// The bound the adaptive sampler held the triangles to: `audited` or `proven`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bound: Option<sample::ErrorBound>,
     /// Whether the sampler met its tolerance everywhere (false when its triangle budget
     /// stopped it).
     pub complete: bool,
@@ -83,6 +97,8 @@ pub struct SamplingReport {
     pub ms: f64,
     /// Milliseconds spent auditing (with the uniform grid of `uniform_max_error`).
     pub audit_ms: f64,
+    /// Milliseconds spent proving `proven_max_error`.
+    pub proven_ms: f64,
 }
 
 impl SamplingReport {
@@ -91,9 +107,9 @@ impl SamplingReport {
         sampling: &Sampling,
         sampled: &sample::Sampled,
         audit: &Audit,
+        proof: Option<&Proof>,
         uniform_max_error: Option<f64>,
-        ms: f64,
-        audit_ms: f64,
+        [ms, audit_ms, proven_ms]: [f64; 3],
     ) -> Self {
         let (max_rel, rms_rel) = audit.relative(sampled.diagonal);
         SamplingReport {
@@ -113,10 +129,18 @@ impl SamplingReport {
             rms_error: audit.rms_error,
             max_error_relative: max_rel,
             rms_error_relative: rms_rel,
+            proven_max_error: proof.map(|p| p.max_error),
+            proven_max_error_relative: proof.map(|p| p.max_error.map(|m| m / sampled.diagonal)),
+            unproven_triangles: proof.map(|p| p.unproven),
+            bound: match *sampling {
+                Sampling::Adaptive { bound, .. } if method == "adaptive" => Some(bound),
+                _ => None,
+            },
             complete: sampled.complete,
             uniform_max_error,
             ms,
             audit_ms,
+            proven_ms,
         }
     }
 

@@ -192,8 +192,21 @@ pub(super) fn sample_with(scene: &Scene, bar: &ProgressBar) -> Sampled {
         };
         let audit_ms = ms(start);
         timings.audit += audit_ms;
+        let start = Instant::now();
+        let proof = entry
+            .surface
+            .parametric()
+            .map(|surface| sample::prove(surface, &sampled.mesh));
+        let proven_ms = ms(start);
+        timings.audit += proven_ms;
         let report = SamplingReport::new(
-            method, sampling, &sampled, &audited, uniform, sample_ms, audit_ms,
+            method,
+            sampling,
+            &sampled,
+            &audited,
+            proof.as_ref(),
+            uniform,
+            [sample_ms, audit_ms, proven_ms],
         );
         if let Some(w) = report.warning(&name) {
             bar.suspend(|| eprintln!("warning: {w}"));

@@ -50,7 +50,7 @@
 //! the surface is orientable. When the triangle budget stops the refinement, the mesh is
 //! still a valid mesh, only coarser than asked.
 
-use super::{AUDIT_POINTS, Classes, Mesh4};
+use super::{AUDIT_POINTS, Classes, ErrorBound, Mesh4, corner_error, triangle_bound};
 use crate::limits::MIN_EDGE;
 use crate::surfaces::{Domain, Glue, Side, SideRule, Surface};
 use glam::DVec4;
@@ -90,6 +90,10 @@ struct Patch {
     st: Vec<[f64; 2]>,
     /// The surface point of each point.
     p: Vec<DVec4>,
+    /// Whether triangles are held to their proven bound ([`ErrorBound::Proven`]).
+    proven: bool,
+    /// Each point's own rounding ([`corner_error`]), when `proven`.
+    error: Vec<f64>,
     /// Which sides are poles.
     pole: [bool; 4],
     /// The side coordinates of the points on each side (as bits: non-negative floats sort
@@ -134,8 +138,12 @@ impl Patch {
             self.sides[side as usize].insert(sigma.to_bits());
         }
         let [u, v] = self.uv(st);
+        let p = surface.point(self.of, u, v);
         self.st.push(st);
-        self.p.push(surface.point(self.of, u, v));
+        self.p.push(p);
+        if self.proven {
+            self.error.push(corner_error(surface, self.of, [u, v], p));
+        }
         Some((h, true))
     }
 
@@ -590,7 +598,18 @@ fn level(score: f64, tolerance: f64) -> usize {
 /// R^4) of the surface at the audit points, stopping when the mesh would exceed
 /// `max_triangles` triangles. Patches are refined in parallel.
 pub fn sample_adaptive(surface: &Surface, tolerance: f64, max_triangles: usize) -> AdaptiveMesh {
-    let mut sampler = Sampler::new(surface, tolerance * (1.0 - 1e-9), max_triangles);
+    sample_adaptive_to(surface, tolerance, ErrorBound::Audited, max_triangles)
+}
+
+/// [`sample_adaptive`], holding every triangle to the `bound` of its error: the audit's
+/// points, or the proven bound over the whole triangle ([`triangle_bound`]).
+pub fn sample_adaptive_to(
+    surface: &Surface,
+    tolerance: f64,
+    bound: ErrorBound,
+    max_triangles: usize,
+) -> AdaptiveMesh {
+    let mut sampler = Sampler::new(surface, tolerance * (1.0 - 1e-9), bound, max_triangles);
     let complete = sampler.refine(max_triangles);
     let failing = if complete { 0 } else { sampler.count_failing() };
     AdaptiveMesh {
@@ -807,6 +826,10 @@ impl Patch {
                 edge_error[k - 3] = d;
             }
         }
+        if self.proven {
+            let bound = triangle_bound(surface, patch, uv, corners, t.map(|i| self.error[i]));
+            worst = worst.max(bound);
+        }
         // The warp is curved, so a triangle counter-clockwise in the warped plane can be
         // folded over in (u, v); refinement straightens the warp until it is not.
         let [a, b, c] = t.map(|i| {
@@ -870,7 +893,7 @@ impl<'a> Sampler<'a> {
     /// from a coarse grid shaped like its
     /// warped rectangle, with the rectangle's sides as constraint edges, and makes the
     /// glued sides conform.
-    fn new(surface: &'a Surface, tolerance: f64, max_triangles: usize) -> Self {
+    fn new(surface: &'a Surface, tolerance: f64, bound: ErrorBound, max_triangles: usize) -> Self {
         let [min_u, min_v] = surface.min_cells();
         let mut patches = Vec::new();
         for Tile {
@@ -894,6 +917,8 @@ impl<'a> Sampler<'a> {
                 cdt: Cdt::new(),
                 st: Vec::new(),
                 p: Vec::new(),
+                proven: bound == ErrorBound::Proven,
+                error: Vec::new(),
                 pole,
                 sides: Default::default(),
                 pending: Vec::new(),

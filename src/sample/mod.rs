@@ -16,11 +16,13 @@
 
 mod adaptive;
 mod audit;
+mod proven;
 mod source;
 mod uniform;
 
-pub use adaptive::{metric_aspect, sample_adaptive};
+pub use adaptive::{metric_aspect, sample_adaptive, sample_adaptive_to};
 pub use audit::{AUDIT_POINTS, Audit, audit};
+pub use proven::{Proof, corner_error, prove, triangle_bound};
 pub use source::{MeshData4, MeshSurface, Source, mesh_from_data, mesh_tangents, mesh_topology};
 pub use uniform::sample_uniform;
 
@@ -47,6 +49,11 @@ pub enum Sampling {
         /// the mesh exceeds this many triangles.
         #[serde(default = "default_max_triangles")]
         max_triangles: usize,
+        /// Which bound of each triangle's error is held to the tolerance: `audited` (the
+        /// default: at the audit's points) or `proven` (at every point, by interval
+        /// arithmetic: [`triangle_bound`]).
+        #[serde(default, skip_serializing_if = "ErrorBound::is_audited")]
+        bound: ErrorBound,
     },
     /// A uniform grid of `u` by `v` cells on every patch.
     Uniform {
@@ -55,6 +62,27 @@ pub enum Sampling {
         /// Cells along v per patch (even, within [`crate::limits::GRID_CELLS`]).
         v: usize,
     },
+}
+
+/// Which bound of a triangle's distance from its surface the adaptive sampler holds to the
+/// tolerance.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ErrorBound {
+    /// The distance measured at the audit's points ([`AUDIT_POINTS`]): strong evidence,
+    /// and the cheaper.
+    #[default]
+    Audited,
+    /// The bound proven over the whole triangle by interval arithmetic
+    /// ([`triangle_bound`]): the triangles' distance from the true surface is at most the
+    /// tolerance everywhere.
+    Proven,
+}
+
+impl ErrorBound {
+    fn is_audited(&self) -> bool {
+        *self == ErrorBound::Audited
+    }
 }
 
 /// Relative tolerance of an adaptive sampling that gives none.
@@ -80,6 +108,7 @@ impl Sampling {
             tolerance: Some(relative),
             absolute_tolerance: None,
             max_triangles: DEFAULT_MAX_TRIANGLES,
+            bound: ErrorBound::Audited,
         }
     }
 
@@ -106,6 +135,7 @@ impl Sampling {
                 tolerance,
                 absolute_tolerance,
                 max_triangles,
+                ..
             } => {
                 if tolerance.is_some() && absolute_tolerance.is_some() {
                     return Err(FieldError::new(
@@ -166,10 +196,11 @@ pub fn sample(surface: &Surface, sampling: &Sampling) -> Sampled {
             tolerance,
             absolute_tolerance,
             max_triangles,
+            bound,
         } => {
             let tolerance =
                 absolute_tolerance.unwrap_or(tolerance.unwrap_or(DEFAULT_TOLERANCE) * diagonal);
-            let out = sample_adaptive(surface, tolerance, max_triangles);
+            let out = sample_adaptive_to(surface, tolerance, bound, max_triangles);
             Sampled {
                 mesh: out.mesh,
                 tolerance: Some(tolerance),

@@ -5,39 +5,159 @@
 //! f'' by the Cauchy-Riemann equations: ∂u f = f', ∂v f = i f', ∂uu f = f'', ∂uv f = i f'',
 //! ∂vv f = -f''.
 
-use super::{Domain, Eval4, Glue, Jet, Parametric, Side, SideRule, Topology};
+use super::{Domain, Eval4, Glue, Interval, Jet, Parametric, Scalar, Side, SideRule, Topology};
 use crate::limits::{FERMAT_N, FERMAT_Y_RANGE, FieldError, PRODUCT_U_RANGE};
 use glam::DVec4;
 use num_complex::Complex64 as C64;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, TAU};
+use std::ops::{Add, Div, Mul, Neg};
 
-/// Real and imaginary part of a holomorphic function of ζ = u + iv as jets in (u, v).
-fn holomorphic(f: C64, f1: C64, f2: C64) -> (Jet, Jet) {
+/// Real and imaginary part of a holomorphic function of ζ = u + iv as jets in (u, v), from
+/// f, f' and f'' as (re, im) pairs.
+fn holomorphic<S: Scalar>(f: [S; 2], f1: [S; 2], f2: [S; 2]) -> (Jet<S>, Jet<S>) {
     let re = Jet {
-        v: f.re,
-        du: f1.re,
-        dv: -f1.im,
-        duu: f2.re,
-        duv: -f2.im,
-        dvv: -f2.re,
+        v: f[0],
+        du: f1[0],
+        dv: -f1[1],
+        duu: f2[0],
+        duv: -f2[1],
+        dvv: -f2[0],
     };
     let im = Jet {
-        v: f.im,
-        du: f1.im,
-        dv: f1.re,
-        duu: f2.im,
-        duv: f2.re,
-        dvv: -f2.im,
+        v: f[1],
+        du: f1[1],
+        dv: f1[0],
+        duu: f2[1],
+        duv: f2[0],
+        dvv: -f2[1],
     };
     (re, im)
 }
 
+/// The jets of the point (Re z1, Re z2, Im z1, Im z2) from z1 and z2 with their first and
+/// second derivatives in ζ.
+fn jets<S: Scalar>(z1: [[S; 2]; 3], z2: [[S; 2]; 3]) -> [Jet<S>; 4] {
+    let (r1, i1) = holomorphic(z1[0], z1[1], z1[2]);
+    let (r2, i2) = holomorphic(z2[0], z2[1], z2[2]);
+    [r1, r2, i1, i2]
+}
+
 /// Builds the point (Re z1, Re z2, Im z1, Im z2) from the jets of z1 and z2.
 fn point(z1: (C64, C64, C64), z2: (C64, C64, C64)) -> Eval4 {
-    let (r1, i1) = holomorphic(z1.0, z1.1, z1.2);
-    let (r2, i2) = holomorphic(z2.0, z2.1, z2.2);
-    Eval4::from_jets([r1, r2, i1, i2])
+    let pair = |(a, b, c): (C64, C64, C64)| [a, b, c].map(|z| [z.re, z.im]);
+    Eval4::from_jets(jets(pair(z1), pair(z2)))
+}
+
+/// A rectangle of complex numbers, for the enclosures: the arithmetic of [`Interval`]s on
+/// the real and imaginary parts.
+#[derive(Clone, Copy, Debug)]
+struct Cx {
+    re: Interval,
+    im: Interval,
+}
+
+impl Cx {
+    fn new(re: Interval, im: Interval) -> Cx {
+        Cx { re, im }
+    }
+
+    /// e^{iθ}.
+    fn unit(theta: Interval) -> Cx {
+        let (sin, cos) = theta.sin_cos();
+        Cx::new(cos, sin)
+    }
+
+    /// The exact e^{2πi k/n} enclosed, for n up to 6, made once.
+    fn root(k: usize, n: usize) -> Cx {
+        static ROOTS: std::sync::LazyLock<[[Cx; 6]; 7]> = std::sync::LazyLock::new(|| {
+            std::array::from_fn(|n| {
+                std::array::from_fn(|k| {
+                    let turn = Interval::point(2.0 * k as f64) / Interval::point(n.max(1) as f64);
+                    Cx::unit(Interval::PI * turn)
+                })
+            })
+        });
+        ROOTS[n][k % n]
+    }
+
+    fn pair(self) -> [Interval; 2] {
+        [self.re, self.im]
+    }
+
+    fn entire() -> Cx {
+        Cx::new(Interval::ENTIRE, Interval::ENTIRE)
+    }
+
+    /// The principal power g^p, 0 < p < 1, with its derivatives from g's: g^p is analytic
+    /// where g stays off the negative real axis and 0 (the patches keep Re g >= 0). Where
+    /// the rectangle of g holds 0, |g^p| <= |g|^p still bounds the value, and the
+    /// derivatives are unbounded (a branch point).
+    fn power(p: f64, g: Cx, g1: Cx, g2: Cx) -> [Cx; 3] {
+        let norm2 = g.re.sqr() + g.im.sqr();
+        if norm2.lo() <= 0.0 {
+            let r = Interval::point(norm2.hi()).powf(p / 2.0).hi();
+            let disc = Interval::new(-r, r);
+            return [Cx::new(disc, disc), Cx::entire(), Cx::entire()];
+        }
+        let modulus = norm2.powf(p / 2.0);
+        let h = Cx::unit(g.im.atan2(g.re) * Interval::point(p)) * modulus;
+        let hm1 = h / g;
+        let hm2 = hm1 / g;
+        let p = Interval::point(p);
+        [
+            h,
+            hm1 * g1 * p,
+            hm2 * g1 * g1 * (p * (p - Interval::point(1.0))) + hm1 * g2 * p,
+        ]
+    }
+}
+
+impl Add for Cx {
+    type Output = Cx;
+    fn add(self, o: Cx) -> Cx {
+        Cx::new(self.re + o.re, self.im + o.im)
+    }
+}
+
+impl Neg for Cx {
+    type Output = Cx;
+    fn neg(self) -> Cx {
+        Cx::new(-self.re, -self.im)
+    }
+}
+
+impl Mul for Cx {
+    type Output = Cx;
+    fn mul(self, o: Cx) -> Cx {
+        Cx::new(
+            self.re * o.re - self.im * o.im,
+            self.re * o.im + self.im * o.re,
+        )
+    }
+}
+
+impl Mul<Interval> for Cx {
+    type Output = Cx;
+    fn mul(self, k: Interval) -> Cx {
+        Cx::new(self.re * k, self.im * k)
+    }
+}
+
+impl Div for Cx {
+    type Output = Cx;
+    fn div(self, o: Cx) -> Cx {
+        let d = o.re.sqr() + o.im.sqr();
+        Cx::new(
+            (self.re * o.re + self.im * o.im) / d,
+            (self.im * o.re - self.re * o.im) / d,
+        )
+    }
+}
+
+/// The enclosures' jets from the rectangles of z1 and z2 with their derivatives.
+fn enclosure(z1: [Cx; 3], z2: [Cx; 3]) -> [Jet<Interval>; 4] {
+    jets(z1.map(Cx::pair), z2.map(Cx::pair))
 }
 
 /// g^p with its first and second derivatives, given g, g', g'' (principal branch). Where
@@ -173,6 +293,24 @@ impl Parametric for Fermat {
             scale(power(p, s, c, -s), phase(k2)),
         )
     }
+    /// The same closed forms over rectangles, with the exact roots of unity (π enclosed).
+    fn enclose(&self, patch: usize, u: Interval, v: Interval) -> [Jet<Interval>; 4] {
+        let n = self.n as usize;
+        let (k1, k2) = (patch / n, patch % n);
+        let (sin_u, cos_u) = u.sin_cos();
+        let (sinh, cosh) = (v.sinh(), v.cosh());
+        let c = Cx::new(cos_u * cosh, -(sin_u * sinh));
+        let s = Cx::new(sin_u * cosh, cos_u * sinh);
+        let power = |g: Cx, g1: Cx, g2: Cx| {
+            if n == 2 {
+                [g, g1, g2]
+            } else {
+                Cx::power(2.0 / n as f64, g, g1, g2)
+            }
+        };
+        let turn = |z: [Cx; 3], k: usize| z.map(|z| z * Cx::root(k, n));
+        enclosure(turn(power(c, -s, -c), k1), turn(power(s, c, -s), k2))
+    }
     fn point(&self, patch: usize, u: f64, v: f64) -> DVec4 {
         let n = self.n as usize;
         let (k1, k2) = (patch / n, patch % n);
@@ -236,6 +374,12 @@ impl Parametric for ProductPolynomial {
         let e = C64::new(u, v).exp();
         let f = C64::new(-u, -v).exp() * if patch == 0 { 1.0 } else { -1.0 };
         point((e, e, e), (f, -f, f))
+    }
+    fn enclose(&self, patch: usize, u: Interval, v: Interval) -> [Jet<Interval>; 4] {
+        let sign = Interval::point(if patch == 0 { 1.0 } else { -1.0 });
+        let e = Cx::unit(v) * u.exp();
+        let f = Cx::unit(-v) * ((-u).exp() * sign);
+        enclosure([e, e, e], [f, -f, f])
     }
     fn topology(&self) -> Topology {
         Topology {

@@ -54,6 +54,12 @@ const HALF_PI: Interval = Interval {
 };
 
 impl Interval {
+    /// π: the nearest f64 and the one above it.
+    pub const PI: Interval = Interval {
+        lo: std::f64::consts::PI,
+        hi: 3.141_592_653_589_793_6,
+    };
+
     /// Every real.
     pub const ENTIRE: Interval = Interval {
         lo: f64::NEG_INFINITY,
@@ -79,6 +85,11 @@ impl Interval {
     /// The least interval holding a and b.
     pub fn hull(a: f64, b: f64) -> Interval {
         Interval::new(a.min(b), a.max(b))
+    }
+
+    /// The least interval holding both.
+    pub fn union(self, o: Interval) -> Interval {
+        Interval::new(self.lo.min(o.lo), self.hi.max(o.hi))
     }
 
     /// The lower bound.
@@ -112,6 +123,7 @@ impl Interval {
     }
 
     /// The bounds moved one unit outward.
+    #[inline]
     fn widened(lo: f64, hi: f64) -> Interval {
         Interval::new(down(lo), up(hi))
     }
@@ -182,7 +194,8 @@ impl Interval {
 
     /// e^x.
     pub fn exp(self) -> Interval {
-        Interval::new(exp_point(self.lo).lo.max(0.0), exp_point(self.hi).hi)
+        let (lo, hi) = ends(self, exp_point);
+        Interval::new(lo.lo.max(0.0), hi.hi)
     }
 
     /// The natural logarithm; the whole line where the interval reaches 0 or below.
@@ -190,7 +203,8 @@ impl Interval {
         if self.lo <= 0.0 {
             return Interval::ENTIRE;
         }
-        Interval::new(ln_point(self.lo).lo, ln_point(self.hi).hi)
+        let (lo, hi) = ends(self, ln_point);
+        Interval::new(lo.lo, hi.hi)
     }
 
     /// x^k for a real k, as e^(k ln x): x > 0, or x >= 0 for k > 0; the whole line
@@ -223,12 +237,17 @@ impl Interval {
 
     /// sin.
     pub fn sin(self) -> Interval {
-        trig(self, Trig::Sin)
+        sin_cos(self).0
     }
 
     /// cos.
     pub fn cos(self) -> Interval {
-        trig(self, Trig::Cos)
+        sin_cos(self).1
+    }
+
+    /// sin and cos, from one reduction.
+    pub fn sin_cos(self) -> (Interval, Interval) {
+        sin_cos(self)
     }
 
     /// tan, as sin / cos; the whole line where the interval may hold a pole.
@@ -238,7 +257,8 @@ impl Interval {
 
     /// atan.
     pub fn atan(self) -> Interval {
-        Interval::new(atan_point(self.lo).lo, atan_point(self.hi).hi)
+        let (lo, hi) = ends(self, atan_point);
+        Interval::new(lo.lo, hi.hi)
     }
 
     /// asin; the whole line where the interval leaves [-1, 1].
@@ -246,7 +266,8 @@ impl Interval {
         if self.lo < -1.0 || self.hi > 1.0 {
             return Interval::ENTIRE;
         }
-        Interval::new(asin_point(self.lo).lo, asin_point(self.hi).hi)
+        let (lo, hi) = ends(self, asin_point);
+        Interval::new(lo.lo, hi.hi)
     }
 
     /// acos, as π/2 - asin; the whole line where the interval leaves [-1, 1].
@@ -280,7 +301,8 @@ impl Interval {
             let x = Interval::point(x);
             (x.exp() - (-x).exp()) * Interval::point(0.5)
         };
-        Interval::new(at(self.lo).lo, at(self.hi).hi)
+        let (lo, hi) = ends(self, at);
+        Interval::new(lo.lo, hi.hi)
     }
 
     /// cosh, as (e^x + e^-x) / 2 at the end farther from 0, at least 1.
@@ -290,7 +312,8 @@ impl Interval {
             (x.exp() + (-x).exp()) * Interval::point(0.5)
         };
         let a = self.abs();
-        Interval::new(at(a.lo).lo.max(1.0), at(a.hi).hi)
+        let (lo, hi) = ends(a, at);
+        Interval::new(lo.lo.max(1.0), hi.hi)
     }
 
     /// tanh, as 1 - 2 / (e^(2x) + 1) at each end (tanh is increasing), within [-1, 1].
@@ -304,7 +327,8 @@ impl Interval {
             };
             if x < 0.0 { -t(-x) } else { t(x) }
         };
-        Interval::new(at(self.lo).lo.max(-1.0), at(self.hi).hi.min(1.0))
+        let (lo, hi) = ends(self, at);
+        Interval::new(lo.lo.max(-1.0), hi.hi.min(1.0))
     }
 }
 
@@ -316,6 +340,7 @@ impl From<f64> for Interval {
 
 impl Add for Interval {
     type Output = Interval;
+    #[inline]
     fn add(self, o: Interval) -> Interval {
         Interval::widened(self.lo + o.lo, self.hi + o.hi)
     }
@@ -323,6 +348,7 @@ impl Add for Interval {
 
 impl Sub for Interval {
     type Output = Interval;
+    #[inline]
     fn sub(self, o: Interval) -> Interval {
         Interval::widened(self.lo - o.hi, self.hi - o.lo)
     }
@@ -330,6 +356,7 @@ impl Sub for Interval {
 
 impl Neg for Interval {
     type Output = Interval;
+    #[inline]
     fn neg(self) -> Interval {
         Interval::new(-self.hi, -self.lo)
     }
@@ -337,7 +364,20 @@ impl Neg for Interval {
 
 impl Mul for Interval {
     type Output = Interval;
+    #[inline]
     fn mul(self, o: Interval) -> Interval {
+        // One factor not below 0 (most products in the series): two products decide.
+        if o.lo >= 0.0 {
+            let lo = self.lo * if self.lo >= 0.0 { o.lo } else { o.hi };
+            let hi = self.hi * if self.hi >= 0.0 { o.hi } else { o.lo };
+            // 0 times infinity is NaN, and the whole line.
+            return Interval::widened(lo, hi);
+        }
+        if self.lo >= 0.0 {
+            let lo = o.lo * if o.lo >= 0.0 { self.lo } else { self.hi };
+            let hi = o.hi * if o.hi >= 0.0 { self.hi } else { self.lo };
+            return Interval::widened(lo, hi);
+        }
         let p = [
             self.lo * o.lo,
             self.lo * o.hi,
@@ -375,18 +415,31 @@ impl Div for Interval {
     }
 }
 
+/// A function's enclosures at the two ends of `x`, computed once for a point.
+fn ends(x: Interval, at: impl Fn(f64) -> Interval) -> (Interval, Interval) {
+    let lo = at(x.lo);
+    (lo, if x.hi == x.lo { lo } else { at(x.hi) })
+}
+
 /// An upper bound of |r|^n / n! for the series' remainders, rounded up at each step.
 fn remainder(r: f64, n: u32) -> f64 {
-    let mut out = 1.0f64;
-    for k in 1..=n {
-        out = up(up(out * r) / f64::from(k));
-    }
-    out
+    up(pow_up(r, n) * SERIES.inverse_factorial[n as usize])
 }
 
 /// An upper bound of r^n for r >= 0, rounded up at each step.
 fn pow_up(r: f64, n: u32) -> f64 {
-    (0..n).fold(1.0, |p, _| up(p * r))
+    // By squaring, each product of numbers >= 0 rounded up: a short chain of steps.
+    let (mut out, mut square, mut e) = (1.0f64, r, n);
+    while e > 0 {
+        if e & 1 == 1 {
+            out = up(out * square);
+        }
+        e >>= 1;
+        if e > 0 {
+            square = up(square * square);
+        }
+    }
+    out
 }
 
 /// Σ c_k x^k over the `coefficients` c_k, by Horner's rule in interval arithmetic (an
@@ -407,12 +460,21 @@ fn factorial(n: usize) -> Interval {
 /// and (-1)^n / (2n)! for sin and cos (in powers of x^2); 1 / (2n+1) for atanh and
 /// (-1)^n / (2n+1) for atan (in powers of x^2).
 struct Series {
-    exp: [Interval; 25],
-    sin: [Interval; 13],
-    cos: [Interval; 13],
-    atanh: [Interval; 20],
-    atan: [Interval; 20],
+    exp: [Interval; EXP_TERMS as usize],
+    sin: [Interval; TRIG_TERMS as usize],
+    cos: [Interval; TRIG_TERMS as usize],
+    atanh: [Interval; ODD_TERMS as usize],
+    atan: [Interval; ODD_TERMS as usize],
+    /// Upper bounds of 1 / n!, for the remainders.
+    inverse_factorial: [f64; 2 * TRIG_TERMS as usize + 2],
 }
+
+/// Terms of the series: each leaves a remainder below 1e-19 of 1 at the largest argument
+/// its reduction leaves (|r| <= ln 2 / 2 for e^r, π/4 for sin and cos, 0.2 for atan and
+/// atanh), far below the unit in the last place that the enclosures' rounding adds.
+const EXP_TERMS: u32 = 17;
+const TRIG_TERMS: u32 = 10;
+const ODD_TERMS: u32 = 13;
 
 static SERIES: std::sync::LazyLock<Series> = std::sync::LazyLock::new(|| {
     let one = Interval::point(1.0);
@@ -424,6 +486,7 @@ static SERIES: std::sync::LazyLock<Series> = std::sync::LazyLock::new(|| {
         cos: std::array::from_fn(|n| sign(n, one / factorial(2 * n))),
         atanh: std::array::from_fn(|n| one / odd(n)),
         atan: std::array::from_fn(|n| sign(n, one / odd(n))),
+        inverse_factorial: std::array::from_fn(|n| (one / factorial(n)).hi),
     }
 });
 
@@ -443,10 +506,10 @@ fn exp_point(x: f64) -> Interval {
     // x = k ln 2 + r, |r| <= ln 2 / 2 (a little more from the rounding of k).
     let k = (x / LN_2).round();
     let r = Interval::point(x) - Interval::point(k) * LN2;
-    // e^r = Σ r^n / n! for n <= 24, and the rest below |r|^25 / 25! e^|r| (< 2 |r|^25 / 25!).
-    const TERMS: u32 = 25;
+    // e^r = Σ r^n / n! for n < EXP_TERMS, and the rest below |r|^N / N! e^|r| (< 2 |r|^N /
+    // N!, N = EXP_TERMS).
     let series = horner(r, &SERIES.exp);
-    let rest = 2.0 * remainder(r.mag(), TERMS);
+    let rest = 2.0 * remainder(r.mag(), EXP_TERMS);
     let e = series + Interval::new(-rest, rest);
     // 2^k in two steps, each exact, so that 2^k itself need not be a normal number.
     let half = (k / 2.0).trunc();
@@ -469,72 +532,79 @@ fn ln_point(x: f64) -> Interval {
         e += 1;
     }
     // ln m = 2 atanh s, s = (m - 1) / (m + 1), |s| < 0.172: 2 Σ s^(2n+1) / (2n+1) for
-    // n < 20, the rest below 2 |s|^41 / (41 (1 - s^2)) < 3 |s|^41 / 41.
+    // n < N = ODD_TERMS, the rest below 2 |s|^(2N+1) / ((2N+1) (1 - s^2)) < 3 |s|^(2N+1) /
+    // (2N+1).
     let s =
         (Interval::point(m) - Interval::point(1.0)) / (Interval::point(m) + Interval::point(1.0));
     let series = s * horner(s.sqr(), &SERIES.atanh);
-    let rest = up(up(3.0 * pow_up(s.mag(), 41)) / 41.0);
+    let odd = 2 * ODD_TERMS + 1;
+    let rest = up(up(3.0 * pow_up(s.mag(), odd)) / f64::from(odd));
     Interval::point(f64::from(e)) * LN2
         + Interval::point(2.0) * (series + Interval::new(-rest, rest))
 }
 
-/// Which of the two.
-#[derive(Clone, Copy, PartialEq)]
-enum Trig {
-    Sin,
-    Cos,
-}
-
-/// sin or cos over an interval: the hull of the values at its ends, with 1 where it may
-/// hold a maximum and -1 where it may hold a minimum.
-fn trig(x: Interval, which: Trig) -> Interval {
+/// sin and cos over an interval: for each, the hull of the values at its ends, with 1
+/// where it may hold a maximum and -1 where it may hold a minimum. One reduction serves
+/// both.
+fn sin_cos(x: Interval) -> (Interval, Interval) {
     let full = Interval::new(-1.0, 1.0);
     // Beyond 1e15 the reduction by π/2 tells nothing (and the multiples would not fit).
     if !x.is_bounded() || x.width() >= 6.0 || x.mag() > 1e15 {
-        return full;
+        return (full, full);
     }
-    let at = |t: f64| trig_point(t, which);
-    let (a, b) = (at(x.lo), at(x.hi));
-    let (mut lo, mut hi) = (a.lo.min(b.lo), a.hi.max(b.hi));
+    let (a, b) = ends2(x, trig_point);
+    let mut out = [0, 1].map(|i| (a[i].lo.min(b[i].lo), a[i].hi.max(b[i].hi)));
     // The multiples of π/2 the interval may hold (an enclosure of x / (π/2), so that an
     // extremum inside x is found, and one just outside may be too: a looser bound).
     let q = x / HALF_PI;
     let (first, last) = (q.lo.ceil() as i64, q.hi.floor() as i64);
     for n in first..=last {
         // sin: 1 at 1 mod 4, -1 at 3 mod 4; cos: 1 at 0 mod 4, -1 at 2 mod 4.
-        let phase = (n + if which == Trig::Cos { 1 } else { 0 }).rem_euclid(4);
-        if phase == 1 {
-            hi = 1.0;
-        } else if phase == 3 {
-            lo = -1.0;
+        for (i, (lo, hi)) in out.iter_mut().enumerate() {
+            match (n + i as i64).rem_euclid(4) {
+                1 => *hi = 1.0,
+                3 => *lo = -1.0,
+                _ => {}
+            }
         }
     }
-    Interval::new(lo.max(-1.0), hi.min(1.0))
+    let [s, c] = out.map(|(lo, hi)| Interval::new(lo.max(-1.0), hi.min(1.0)));
+    (s, c)
 }
 
-/// An enclosure of sin or cos at the point t.
-fn trig_point(t: f64, which: Trig) -> Interval {
+/// [`ends`] of a function with two values.
+fn ends2(x: Interval, at: impl Fn(f64) -> [Interval; 2]) -> ([Interval; 2], [Interval; 2]) {
+    let lo = at(x.lo);
+    (lo, if x.hi == x.lo { lo } else { at(x.hi) })
+}
+
+/// Enclosures of sin and cos at the point t.
+fn trig_point(t: f64) -> [Interval; 2] {
     if !t.is_finite() || t.abs() > 1e15 {
-        return Interval::new(-1.0, 1.0);
+        return [Interval::new(-1.0, 1.0); 2];
     }
     // t = k π/2 + r, |r| <= π/4 (a little more from the rounding of k).
     let k = (t / FRAC_PI_2).round();
     let r = Interval::point(t) - Interval::point(k) * HALF_PI;
     let m = r.mag();
-    // sin r = r Σ (-1)^n r^2n / (2n+1)!, cos r = Σ (-1)^n r^2n / (2n)!, for n < 13; the
-    // rest below |r|^27 / 27! and |r|^26 / 26! (each derivative at most 1).
+    // sin r = r Σ (-1)^n r^2n / (2n+1)!, cos r = Σ (-1)^n r^2n / (2n)!, for n < N =
+    // TRIG_TERMS; the rest below |r|^(2N+1) / (2N+1)! and |r|^2N / (2N)! (each derivative
+    // at most 1).
     let r2 = r.sqr();
     let sin = r * horner(r2, &SERIES.sin);
     let cos = horner(r2, &SERIES.cos);
-    let (s_rest, c_rest) = (remainder(m, 27), remainder(m, 26));
+    let (s_rest, c_rest) = (
+        remainder(m, 2 * TRIG_TERMS + 1),
+        remainder(m, 2 * TRIG_TERMS),
+    );
     let sin = sin + Interval::new(-s_rest, s_rest);
     let cos = cos + Interval::new(-c_rest, c_rest);
-    let quadrant = (k as i64 + if which == Trig::Cos { 1 } else { 0 }).rem_euclid(4);
-    match quadrant {
-        0 => sin,
-        1 => cos,
-        2 => -sin,
-        _ => -cos,
+    // sin and cos of r + k π/2.
+    match (k as i64).rem_euclid(4) {
+        0 => [sin, cos],
+        1 => [cos, -sin],
+        2 => [-sin, -cos],
+        _ => [-cos, sin],
     }
 }
 
@@ -559,14 +629,15 @@ fn atan_point(t: f64) -> Interval {
 }
 
 /// atan over an interval within [-1, 1]: halved twice (atan t = 2 atan(t / (1 + √(1 +
-/// t^2)))) to |t| <= tan(π/16) < 0.2, then Σ (-1)^n t^(2n+1) / (2n+1) for n < 20, the rest
-/// below |t|^41 / 41.
+/// t^2)))) to |t| <= tan(π/16) < 0.2, then Σ (-1)^n t^(2n+1) / (2n+1) for n < N =
+/// ODD_TERMS, the rest below |t|^(2N+1) / (2N+1).
 fn atan_small(t: Interval) -> Interval {
     let one = Interval::point(1.0);
     let half = |t: Interval| t / (one + (one + t.sqr()).sqrt());
     let s = half(half(t));
     let series = s * horner(s.sqr(), &SERIES.atan);
-    let rest = up(pow_up(s.mag(), 41) / 41.0);
+    let odd = 2 * ODD_TERMS + 1;
+    let rest = up(pow_up(s.mag(), odd) / f64::from(odd));
     Interval::point(4.0) * (series + Interval::new(-rest, rest))
 }
 

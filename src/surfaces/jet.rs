@@ -4,66 +4,207 @@
 //! with respect to the surface parameters (u, v). Arithmetic and the elementary functions
 //! propagate them by the chain rule, so every catalogue surface gets exact derivatives from
 //! the same code that evaluates its points: no finite differences anywhere.
+//!
+//! A jet is written over a [`Scalar`]: `f64` (a point with its derivatives) or
+//! [`Interval`] (a box of parameters, and enclosures of the point and of its derivatives
+//! over the whole box, which the proven tolerance and the certified curves rest on). The
+//! chain rule is the same for both; where a function has a kink or a jump (`abs`, `min`,
+//! `max`, `atan2` across its cut), an interval jet whose box reaches it has unbounded
+//! derivatives, since no bound holds there.
 
+use super::Interval;
+use std::fmt::Debug;
 use std::ops::{Add, Div, Mul, Neg, Sub};
+
+/// The numbers a [`Jet`] is made of: `f64`, or [`Interval`] for enclosures over a box.
+pub trait Scalar:
+    Copy
+    + Debug
+    + PartialEq
+    + From<f64>
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// sin and cos.
+    fn sin_cos(self) -> (Self, Self);
+    /// tan.
+    fn tan(self) -> Self;
+    /// asin.
+    fn asin(self) -> Self;
+    /// acos.
+    fn acos(self) -> Self;
+    /// atan.
+    fn atan(self) -> Self;
+    /// sinh.
+    fn sinh(self) -> Self;
+    /// cosh.
+    fn cosh(self) -> Self;
+    /// tanh.
+    fn tanh(self) -> Self;
+    /// e^x.
+    fn exp(self) -> Self;
+    /// The natural logarithm.
+    fn ln(self) -> Self;
+    /// The square root.
+    fn sqrt(self) -> Self;
+    /// An integer power.
+    fn powi(self, n: i32) -> Self;
+    /// A real power.
+    fn powf(self, k: f64) -> Self;
+}
+
+/// Each operation is `f64`'s own, so that a jet's value is the same bits as the plain
+/// evaluation's.
+impl Scalar for f64 {
+    fn sin_cos(self) -> (Self, Self) {
+        f64::sin_cos(self)
+    }
+    fn tan(self) -> Self {
+        f64::tan(self)
+    }
+    fn asin(self) -> Self {
+        f64::asin(self)
+    }
+    fn acos(self) -> Self {
+        f64::acos(self)
+    }
+    fn atan(self) -> Self {
+        f64::atan(self)
+    }
+    fn sinh(self) -> Self {
+        f64::sinh(self)
+    }
+    fn cosh(self) -> Self {
+        f64::cosh(self)
+    }
+    fn tanh(self) -> Self {
+        f64::tanh(self)
+    }
+    fn exp(self) -> Self {
+        f64::exp(self)
+    }
+    fn ln(self) -> Self {
+        f64::ln(self)
+    }
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    fn powi(self, n: i32) -> Self {
+        f64::powi(self, n)
+    }
+    fn powf(self, k: f64) -> Self {
+        f64::powf(self, k)
+    }
+}
+
+impl Scalar for Interval {
+    fn sin_cos(self) -> (Self, Self) {
+        Interval::sin_cos(self)
+    }
+    fn tan(self) -> Self {
+        Interval::tan(self)
+    }
+    fn asin(self) -> Self {
+        Interval::asin(self)
+    }
+    fn acos(self) -> Self {
+        Interval::acos(self)
+    }
+    fn atan(self) -> Self {
+        Interval::atan(self)
+    }
+    fn sinh(self) -> Self {
+        Interval::sinh(self)
+    }
+    fn cosh(self) -> Self {
+        Interval::cosh(self)
+    }
+    fn tanh(self) -> Self {
+        Interval::tanh(self)
+    }
+    fn exp(self) -> Self {
+        Interval::exp(self)
+    }
+    fn ln(self) -> Self {
+        Interval::ln(self)
+    }
+    fn sqrt(self) -> Self {
+        Interval::sqrt(self)
+    }
+    fn powi(self, n: i32) -> Self {
+        Interval::powi(self, n)
+    }
+    fn powf(self, k: f64) -> Self {
+        Interval::powf(self, k)
+    }
+}
 
 /// A value with its first and second partial derivatives in (u, v).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Jet {
+pub struct Jet<S = f64> {
     /// The value.
-    pub v: f64,
+    pub v: S,
     /// ∂/∂u.
-    pub du: f64,
+    pub du: S,
     /// ∂/∂v.
-    pub dv: f64,
+    pub dv: S,
     /// ∂²/∂u².
-    pub duu: f64,
+    pub duu: S,
     /// ∂²/∂u∂v.
-    pub duv: f64,
+    pub duv: S,
     /// ∂²/∂v².
-    pub dvv: f64,
+    pub dvv: S,
 }
 
-impl Jet {
+impl<S: Scalar> Jet<S> {
     /// A constant: all derivatives zero.
-    pub const fn constant(v: f64) -> Self {
+    pub fn constant(v: S) -> Self {
+        let z = S::from(0.0);
         Jet {
             v,
-            du: 0.0,
-            dv: 0.0,
-            duu: 0.0,
-            duv: 0.0,
-            dvv: 0.0,
+            du: z,
+            dv: z,
+            duu: z,
+            duv: z,
+            dvv: z,
         }
     }
 
     /// The parameter u itself.
-    pub const fn u(u: f64) -> Self {
+    pub fn u(u: S) -> Self {
         Jet {
-            v: u,
-            du: 1.0,
-            dv: 0.0,
-            duu: 0.0,
-            duv: 0.0,
-            dvv: 0.0,
+            du: S::from(1.0),
+            ..Jet::constant(u)
         }
     }
 
     /// The parameter v itself.
-    pub const fn v(v: f64) -> Self {
+    pub fn v(v: S) -> Self {
+        Jet {
+            dv: S::from(1.0),
+            ..Jet::constant(v)
+        }
+    }
+
+    /// A value with unbounded derivatives: what a function with a kink or a jump inside an
+    /// interval jet's box gives.
+    fn unbounded(v: S, entire: S) -> Self {
         Jet {
             v,
-            du: 0.0,
-            dv: 1.0,
-            duu: 0.0,
-            duv: 0.0,
-            dvv: 0.0,
+            du: entire,
+            dv: entire,
+            duu: entire,
+            duv: entire,
+            dvv: entire,
         }
     }
 
     /// Applies a scalar function with value `f`, derivative `f1` and second derivative `f2`
     /// (all taken at `self.v`) by the chain rule.
-    pub fn chain(self, f: f64, f1: f64, f2: f64) -> Self {
+    pub fn chain(self, f: S, f1: S, f2: S) -> Self {
         Jet {
             v: f,
             du: f1 * self.du,
@@ -98,6 +239,7 @@ impl Jet {
 
     /// Multiplies by a constant.
     pub fn scale(self, k: f64) -> Self {
+        let k = S::from(k);
         Jet {
             v: k * self.v,
             du: k * self.du,
@@ -108,17 +250,30 @@ impl Jet {
         }
     }
 
+    /// Divides by a constant.
+    pub fn over(self, k: f64) -> Self {
+        let k = S::from(k);
+        Jet {
+            v: self.v / k,
+            du: self.du / k,
+            dv: self.dv / k,
+            duu: self.duu / k,
+            duv: self.duv / k,
+            dvv: self.dvv / k,
+        }
+    }
+
     /// Reciprocal 1 / x.
     pub fn recip(self) -> Self {
-        let r = 1.0 / self.v;
-        self.chain(r, -r * r, 2.0 * r * r * r)
+        let r = S::from(1.0) / self.v;
+        self.chain(r, -r * r, S::from(2.0) * r * r * r)
     }
 
     /// Applies a function of two variables `f(self, o)` with value `f`, gradient `g` and
     /// Hessian `h = [f_aa, f_ab, f_bb]` (taken at `(self.v, o.v)`) by the chain rule.
-    pub fn chain2(self, o: Jet, f: f64, g: [f64; 2], h: [f64; 3]) -> Self {
+    pub fn chain2(self, o: Jet<S>, f: S, g: [S; 2], h: [S; 3]) -> Self {
         let (a, b) = (self, o);
-        let second = |ai: f64, aj: f64, bi: f64, bj: f64, aij: f64, bij: f64| {
+        let second = |ai: S, aj: S, bi: S, bj: S, aij: S, bij: S| {
             h[0] * ai * aj + h[1] * (ai * bj + bi * aj) + h[2] * bi * bj + g[0] * aij + g[1] * bij
         };
         Jet {
@@ -134,45 +289,45 @@ impl Jet {
     /// tan.
     pub fn tan(self) -> Self {
         let t = self.v.tan();
-        let d = 1.0 + t * t;
-        self.chain(t, d, 2.0 * t * d)
+        let d = S::from(1.0) + t * t;
+        self.chain(t, d, S::from(2.0) * t * d)
     }
 
     /// asin (NaN outside [-1, 1], infinite derivatives at ±1).
     pub fn asin(self) -> Self {
         let x = self.v;
-        let q = 1.0 - x * x;
-        let d = 1.0 / q.sqrt();
+        let q = S::from(1.0) - x * x;
+        let d = S::from(1.0) / q.sqrt();
         self.chain(x.asin(), d, x * d / q)
     }
 
     /// acos (NaN outside [-1, 1], infinite derivatives at ±1).
     pub fn acos(self) -> Self {
         let x = self.v;
-        let q = 1.0 - x * x;
-        let d = 1.0 / q.sqrt();
+        let q = S::from(1.0) - x * x;
+        let d = S::from(1.0) / q.sqrt();
         self.chain(x.acos(), -d, -x * d / q)
     }
 
     /// atan.
     pub fn atan(self) -> Self {
         let x = self.v;
-        let d = 1.0 / (1.0 + x * x);
-        self.chain(x.atan(), d, -2.0 * x * d * d)
+        let d = S::from(1.0) / (S::from(1.0) + x * x);
+        self.chain(x.atan(), d, S::from(-2.0) * x * d * d)
     }
 
-    /// The angle of the point (x, y) = (`x`, `self`), in (-π, π], as `f64::atan2`. Its
-    /// derivatives are those of the angle, smooth away from the origin (the jump across the
-    /// negative x axis is not seen by derivatives).
-    pub fn atan2(self, x: Jet) -> Self {
+    /// The derivatives of the angle of (x, y) = (`x`, `self`) applied to `angle`, its
+    /// value.
+    fn angle(self, x: Jet<S>, angle: S) -> Self {
         let (a, b) = (self.v, x.v);
         let r2 = a * a + b * b;
-        let q = 1.0 / (r2 * r2);
+        let q = S::from(1.0) / (r2 * r2);
+        let two = S::from(2.0);
         self.chain2(
             x,
-            a.atan2(b),
+            angle,
             [b / r2, -a / r2],
-            [-2.0 * a * b * q, (a * a - b * b) * q, 2.0 * a * b * q],
+            [-two * a * b * q, (a * a - b * b) * q, two * a * b * q],
         )
     }
 
@@ -191,8 +346,8 @@ impl Jet {
     /// tanh.
     pub fn tanh(self) -> Self {
         let t = self.v.tanh();
-        let d = 1.0 - t * t;
-        self.chain(t, d, -2.0 * t * d)
+        let d = S::from(1.0) - t * t;
+        self.chain(t, d, S::from(-2.0) * t * d)
     }
 
     /// exp.
@@ -203,15 +358,63 @@ impl Jet {
 
     /// The natural logarithm (NaN for negative numbers, -∞ at 0).
     pub fn ln(self) -> Self {
-        let r = 1.0 / self.v;
+        let r = S::from(1.0) / self.v;
         self.chain(self.v.ln(), r, -r * r)
     }
 
     /// Square root (NaN for negative numbers, infinite derivatives at 0).
     pub fn sqrt(self) -> Self {
         let s = self.v.sqrt();
-        let d = 0.5 / s;
-        self.chain(s, d, -0.5 * d / self.v)
+        let d = S::from(0.5) / s;
+        self.chain(s, d, S::from(-0.5) * d / self.v)
+    }
+
+    /// An integer power (any base, negative ones included; 0 to a negative power is
+    /// infinite).
+    pub fn powi(self, n: i32) -> Self {
+        let x = self.v;
+        let k = f64::from(n);
+        // A zero coefficient stays zero where the power beside it is infinite (x^1 at 0).
+        let term = |c: f64, e: i32| {
+            if c == 0.0 {
+                S::from(0.0)
+            } else {
+                S::from(c) * x.powi(e)
+            }
+        };
+        self.chain(
+            x.powi(n),
+            term(k, n.saturating_sub(1)),
+            term(k * (k - 1.0), n.saturating_sub(2)),
+        )
+    }
+
+    /// A constant real power x^k (NaN for negative x unless k is an integer: use
+    /// [`Jet::powi`] for those).
+    pub fn powf(self, k: f64) -> Self {
+        let x = self.v;
+        let term = |c: f64, e: f64| {
+            if c == 0.0 {
+                S::from(0.0)
+            } else {
+                S::from(c) * x.powf(e)
+            }
+        };
+        self.chain(x.powf(k), term(k, k - 1.0), term(k * (k - 1.0), k - 2.0))
+    }
+
+    /// A power with a varying exponent, exp(y ln x): defined for positive bases.
+    pub fn pow(self, y: Jet<S>) -> Self {
+        (y * self.ln()).exp()
+    }
+}
+
+impl Jet<f64> {
+    /// The angle of the point (x, y) = (`x`, `self`), in (-π, π], as `f64::atan2`. Its
+    /// derivatives are those of the angle, smooth away from the origin (the jump across the
+    /// negative x axis is not seen by derivatives).
+    pub fn atan2(self, x: Jet) -> Self {
+        self.angle(x, self.v.atan2(x.v))
     }
 
     /// Absolute value; at 0 the derivatives are those of the identity (one-sided).
@@ -228,39 +431,73 @@ impl Jet {
     pub fn max(self, o: Jet) -> Self {
         if o.v > self.v { o } else { self }
     }
+}
 
-    /// An integer power (any base, negative ones included; 0 to a negative power is
-    /// infinite).
-    pub fn powi(self, n: i32) -> Self {
-        let x = self.v;
-        let k = f64::from(n);
-        // A zero coefficient stays zero where the power beside it is infinite (x^1 at 0).
-        let term = |c: f64, e: i32| if c == 0.0 { 0.0 } else { c * x.powi(e) };
-        self.chain(
-            x.powi(n),
-            term(k, n.saturating_sub(1)),
-            term(k * (k - 1.0), n.saturating_sub(2)),
-        )
+/// Over a box, the functions with a kink or a jump keep their derivatives only where the
+/// box stays on one side of it.
+impl Jet<Interval> {
+    /// The angle of (x, y) = (`x`, `self`): unbounded derivatives where the box of (x, y)
+    /// reaches the origin or the cut along the negative x axis, where the angle jumps.
+    pub fn atan2(self, x: Jet<Interval>) -> Self {
+        let angle = self.v.atan2(x.v);
+        if x.v.lo() > 0.0 || !self.v.contains(0.0) {
+            self.angle(x, angle)
+        } else {
+            Jet::unbounded(angle, Interval::ENTIRE)
+        }
     }
 
-    /// A constant real power x^k (NaN for negative x unless k is an integer: use
-    /// [`Jet::powi`] for those).
-    pub fn powf(self, k: f64) -> Self {
-        let x = self.v;
-        let term = |c: f64, e: f64| if c == 0.0 { 0.0 } else { c * x.powf(e) };
-        self.chain(x.powf(k), term(k, k - 1.0), term(k * (k - 1.0), k - 2.0))
+    /// |x|: unbounded derivatives where the box holds a point where x changes sign.
+    pub fn abs(self) -> Self {
+        if self.v.lo() >= 0.0 {
+            self
+        } else if self.v.hi() <= 0.0 {
+            -self
+        } else {
+            Jet::unbounded(self.v.abs(), Interval::ENTIRE)
+        }
     }
 
-    /// A power with a varying exponent, exp(y ln x): defined for positive bases.
-    pub fn pow(self, y: Jet) -> Self {
-        (y * self.ln()).exp()
+    /// The smaller: unbounded derivatives where either may be the smaller.
+    pub fn min(self, o: Jet<Interval>) -> Self {
+        if self.v.hi() <= o.v.lo() {
+            self
+        } else if o.v.hi() <= self.v.lo() {
+            o
+        } else {
+            Jet::unbounded(self.v.min(o.v), Interval::ENTIRE)
+        }
+    }
+
+    /// The larger: unbounded derivatives where either may be the larger.
+    pub fn max(self, o: Jet<Interval>) -> Self {
+        if self.v.lo() >= o.v.hi() {
+            self
+        } else if o.v.lo() >= self.v.hi() {
+            o
+        } else {
+            Jet::unbounded(self.v.max(o.v), Interval::ENTIRE)
+        }
+    }
+
+    /// The least jet holding both (each part the hull of the two).
+    pub fn union(self, o: Jet<Interval>) -> Self {
+        Jet {
+            v: self.v.union(o.v),
+            du: self.du.union(o.du),
+            dv: self.dv.union(o.dv),
+            duu: self.duu.union(o.duu),
+            duv: self.duv.union(o.duv),
+            dvv: self.dvv.union(o.dvv),
+        }
     }
 }
 
-/// The numbers a surface's formula is written over once and evaluated twice: as plain
-/// values (`f64`, for a point alone, which the samplers and the audit ask for millions of
-/// times) and as [`Jet`]s (for a point with its derivatives). Each operation computes the
-/// value the same way in both, so a point is the same bits either way.
+/// The numbers a surface's formula is written over once and evaluated in several ways: as
+/// plain values (`f64`, for a point alone, which the samplers and the audit ask for
+/// millions of times), as [`Jet`]s (for a point with its derivatives) and as jets of
+/// intervals (enclosures over a box). Each operation computes the value the same way in
+/// the first two, so a point is the same bits either way.
 pub trait Real:
     Copy
     + Add<Output = Self>
@@ -273,8 +510,6 @@ pub trait Real:
 {
     /// A constant.
     fn constant(v: f64) -> Self;
-    /// The value.
-    fn value(self) -> f64;
     /// sin and cos, from one evaluation.
     fn sin_cos(self) -> (Self, Self);
     /// Square.
@@ -287,9 +522,6 @@ impl Real for f64 {
     fn constant(v: f64) -> Self {
         v
     }
-    fn value(self) -> f64 {
-        self
-    }
     fn sin_cos(self) -> (Self, Self) {
         f64::sin_cos(self)
     }
@@ -301,12 +533,9 @@ impl Real for f64 {
     }
 }
 
-impl Real for Jet {
+impl<S: Scalar> Real for Jet<S> {
     fn constant(v: f64) -> Self {
-        Jet::constant(v)
-    }
-    fn value(self) -> f64 {
-        self.v
+        Jet::constant(S::from(v))
     }
     fn sin_cos(self) -> (Self, Self) {
         let (s, c) = self.v.sin_cos();
@@ -320,15 +549,15 @@ impl Real for Jet {
     }
 }
 
-impl From<f64> for Jet {
+impl<S: Scalar> From<f64> for Jet<S> {
     fn from(v: f64) -> Self {
-        Jet::constant(v)
+        Jet::constant(S::from(v))
     }
 }
 
-impl Add for Jet {
-    type Output = Jet;
-    fn add(self, o: Jet) -> Jet {
+impl<S: Scalar> Add for Jet<S> {
+    type Output = Jet<S>;
+    fn add(self, o: Jet<S>) -> Jet<S> {
         Jet {
             v: self.v + o.v,
             du: self.du + o.du,
@@ -340,82 +569,83 @@ impl Add for Jet {
     }
 }
 
-impl Sub for Jet {
-    type Output = Jet;
-    fn sub(self, o: Jet) -> Jet {
+impl<S: Scalar> Sub for Jet<S> {
+    type Output = Jet<S>;
+    fn sub(self, o: Jet<S>) -> Jet<S> {
         self + (-o)
     }
 }
 
-impl Neg for Jet {
-    type Output = Jet;
-    fn neg(self) -> Jet {
+impl<S: Scalar> Neg for Jet<S> {
+    type Output = Jet<S>;
+    fn neg(self) -> Jet<S> {
         self.scale(-1.0)
     }
 }
 
-impl Mul for Jet {
-    type Output = Jet;
-    fn mul(self, o: Jet) -> Jet {
+impl<S: Scalar> Mul for Jet<S> {
+    type Output = Jet<S>;
+    fn mul(self, o: Jet<S>) -> Jet<S> {
+        let two = S::from(2.0);
         Jet {
             v: self.v * o.v,
             du: self.du * o.v + self.v * o.du,
             dv: self.dv * o.v + self.v * o.dv,
-            duu: self.duu * o.v + 2.0 * self.du * o.du + self.v * o.duu,
+            duu: self.duu * o.v + two * self.du * o.du + self.v * o.duu,
             duv: self.duv * o.v + self.du * o.dv + self.dv * o.du + self.v * o.duv,
-            dvv: self.dvv * o.v + 2.0 * self.dv * o.dv + self.v * o.dvv,
+            dvv: self.dvv * o.v + two * self.dv * o.dv + self.v * o.dvv,
         }
     }
 }
 
-impl Div for Jet {
-    type Output = Jet;
+impl<S: Scalar> Div for Jet<S> {
+    type Output = Jet<S>;
     #[allow(clippy::suspicious_arithmetic_impl)]
-    fn div(self, o: Jet) -> Jet {
+    fn div(self, o: Jet<S>) -> Jet<S> {
         self * o.recip()
     }
 }
 
-impl Add<f64> for Jet {
-    type Output = Jet;
-    fn add(mut self, k: f64) -> Jet {
-        self.v += k;
+impl<S: Scalar> Add<f64> for Jet<S> {
+    type Output = Jet<S>;
+    fn add(mut self, k: f64) -> Jet<S> {
+        self.v = self.v + S::from(k);
         self
     }
 }
 
-impl Sub<f64> for Jet {
-    type Output = Jet;
-    fn sub(mut self, k: f64) -> Jet {
-        self.v -= k;
+impl<S: Scalar> Sub<f64> for Jet<S> {
+    type Output = Jet<S>;
+    fn sub(mut self, k: f64) -> Jet<S> {
+        self.v = self.v - S::from(k);
         self
     }
 }
 
-impl Mul<f64> for Jet {
-    type Output = Jet;
-    fn mul(self, k: f64) -> Jet {
+impl<S: Scalar> Mul<f64> for Jet<S> {
+    type Output = Jet<S>;
+    fn mul(self, k: f64) -> Jet<S> {
         self.scale(k)
     }
 }
 
-impl Add<Jet> for f64 {
-    type Output = Jet;
-    fn add(self, j: Jet) -> Jet {
+impl<S: Scalar> Add<Jet<S>> for f64 {
+    type Output = Jet<S>;
+    fn add(self, j: Jet<S>) -> Jet<S> {
         j + self
     }
 }
 
-impl Sub<Jet> for f64 {
-    type Output = Jet;
-    fn sub(self, j: Jet) -> Jet {
+impl<S: Scalar> Sub<Jet<S>> for f64 {
+    type Output = Jet<S>;
+    fn sub(self, j: Jet<S>) -> Jet<S> {
         -j + self
     }
 }
 
-impl Mul<Jet> for f64 {
-    type Output = Jet;
-    fn mul(self, j: Jet) -> Jet {
+impl<S: Scalar> Mul<Jet<S>> for f64 {
+    type Output = Jet<S>;
+    fn mul(self, j: Jet<S>) -> Jet<S> {
         j.scale(self)
     }
 }
@@ -489,8 +719,8 @@ mod tests {
             x,
             [x.sqrt(), 0.5 / x.sqrt(), -0.25 * x.powf(-1.5)],
         );
-        against("abs", Jet::abs, -x, [x, -1.0, 0.0]);
-        against("abs", Jet::abs, x, [x, 1.0, 0.0]);
+        against("abs", Jet::<f64>::abs, -x, [x, -1.0, 0.0]);
+        against("abs", Jet::<f64>::abs, x, [x, 1.0, 0.0]);
         against(
             "powi",
             |j| j.powi(3),
@@ -572,5 +802,31 @@ mod tests {
         assert!(close(f.duu, -s / 2.0));
         assert!(close(f.duv, -c / 4.0));
         assert!(close(f.dvv, 2.0 * s / 8.0));
+    }
+
+    #[test]
+    fn interval_jets_lose_their_derivatives_only_across_a_kink() {
+        let x = |lo: f64, hi: f64| Jet::u(Interval::new(lo, hi));
+        let y = |lo: f64, hi: f64| Jet::v(Interval::new(lo, hi));
+        // On one side: the identity's jet (or its negative), exactly.
+        assert_eq!(x(0.0, 1.0).abs(), x(0.0, 1.0));
+        assert_eq!(x(-1.0, -0.5).abs(), -x(-1.0, -0.5));
+        assert_eq!(x(0.0, 1.0).min(y(2.0, 3.0)), x(0.0, 1.0));
+        assert_eq!(x(0.0, 1.0).max(y(2.0, 3.0)), y(2.0, 3.0));
+        assert!(x(1.0, 2.0).atan2(y(1.0, 2.0)).duu.is_bounded());
+        // Across: the value still enclosed, the derivatives unbounded.
+        let across = [
+            x(-1.0, 1.0).abs(),
+            x(0.0, 1.0).min(y(0.5, 3.0)),
+            x(0.0, 1.0).max(y(0.5, 3.0)),
+            // The angle of (x, y) = (-1, [-0.1, 0.1]) jumps across its cut.
+            y(-0.1, 0.1).atan2(Jet::constant(Interval::point(-1.0))),
+        ];
+        for j in across {
+            assert!(
+                j.v.is_bounded() && !j.du.is_bounded() && !j.duu.is_bounded(),
+                "{j:?}"
+            );
+        }
     }
 }

@@ -20,7 +20,7 @@
 //! on that line, and the pieces meet it vertically to second order, so the turned arc stays
 //! embedded and the surface stays twice differentiable.
 
-use super::{Domain, Eval4, Jet, Parametric, Real, Side, SideRule, Topology};
+use super::{Domain, Eval4, Interval, Jet, Parametric, Real, Side, SideRule, Topology};
 use crate::limits::{FieldError, SURFACE_LENGTH, TWISTS};
 use glam::DVec4;
 use serde::{Deserialize, Serialize};
@@ -73,19 +73,29 @@ fn smoothstep<T: Real>(t: T) -> T {
     t.cube() * ((t * 6.0 - 15.0) * t + 10.0)
 }
 
-/// The knotted arc at s in [0, 1]: (x, y, c), and whether the point belongs to the knotted
-/// part that the twist turns.
-fn arc<T: Real>(s: T) -> ([T; 3], bool) {
+/// The piece of the arc that s in [0, 1] lies on (the first of two at a join).
+fn piece_at(s: f64) -> usize {
     let g = s * total();
     let mut start = 0.0;
-    let mut piece = PIECES.len() - 1;
     for (i, len) in PIECES.iter().enumerate() {
-        if g.value() <= start + len || i == PIECES.len() - 1 {
-            piece = i;
-            break;
+        if g <= start + len {
+            return i;
         }
         start += len;
     }
+    PIECES.len() - 1
+}
+
+/// Where a piece starts along the arc, in the units of [`PIECES`].
+fn piece_start(piece: usize) -> f64 {
+    PIECES[..piece].iter().fold(0.0, |a, b| a + b)
+}
+
+/// The knotted arc at s in [0, 1] by the formula of `piece`: (x, y, c), and whether the
+/// point belongs to the knotted part that the twist turns.
+fn arc<T: Real>(piece: usize, s: T) -> ([T; 3], bool) {
+    let g = s * total();
+    let start = piece_start(piece);
     let t = (g - start) * (1.0 / PIECES[piece]);
     let c = T::constant;
     let braid = || smoothstep(t) * (3.0 * PI);
@@ -116,8 +126,8 @@ fn arc<T: Real>(s: T) -> ([T; 3], bool) {
 /// Spins the arc: s in [0, 1] along the arc (u), θ in [0, 2π] around the plane (v), with the
 /// knotted part turned by `twists` θ about the line x = -d. Over `f64` it gives the point,
 /// over [`Jet`]s the point with its derivatives.
-fn spin<T: Real>(scale: f64, twists: u32, s: T, theta: T) -> [T; 4] {
-    let ([mut x, mut y, c], knotted) = arc(s);
+fn spin<T: Real>(scale: f64, twists: u32, piece: usize, s: T, theta: T) -> [T; 4] {
+    let ([mut x, mut y, c], knotted) = arc(piece, s);
     if knotted && twists > 0 {
         let (sin, cos) = (theta * twists as f64).sin_cos();
         let dx = x + D;
@@ -135,12 +145,53 @@ fn spin<T: Real>(scale: f64, twists: u32, s: T, theta: T) -> [T; 4] {
 
 /// [`spin`] with its derivatives in (u, v) = (s, θ).
 fn spin_eval(scale: f64, twists: u32, s: f64, theta: f64) -> Eval4 {
-    Eval4::from_jets(spin(scale, twists, Jet::u(s), Jet::v(theta)))
+    Eval4::from_jets(spin(scale, twists, piece_at(s), Jet::u(s), Jet::v(theta)))
+}
+
+/// Enclosures of [`spin`] and its derivatives over a box: each piece of the arc that the
+/// box of s meets, over its part of the box, joined. The arc is twice differentiable
+/// across the joins, so the join of the pieces' second derivatives holds the arc's over
+/// the whole box.
+fn spin_enclose(scale: f64, twists: u32, s: Interval, theta: Interval) -> [Jet<Interval>; 4] {
+    // Each part reaches a little past its join, so that the parts cover the box whatever
+    // the rounding of the joins: a piece's formula is smooth past its ends, and what it
+    // gives there only widens the enclosure.
+    const PAST: f64 = 1e-9;
+    let last = PIECES.len() - 1;
+    let mut out: Option<[Jet<Interval>; 4]> = None;
+    for piece in 0..=last {
+        let from = if piece == 0 {
+            f64::NEG_INFINITY
+        } else {
+            piece_start(piece) / total() - PAST
+        };
+        let to = if piece == last {
+            f64::INFINITY
+        } else {
+            piece_start(piece + 1) / total() + PAST
+        };
+        let (lo, hi) = (s.lo().max(from), s.hi().min(to));
+        if lo > hi {
+            continue;
+        }
+        let part = spin(
+            scale,
+            twists,
+            piece,
+            Jet::u(Interval::new(lo, hi)),
+            Jet::v(theta),
+        );
+        out = Some(match out {
+            None => part,
+            Some(o) => std::array::from_fn(|k| o[k].union(part[k])),
+        });
+    }
+    out.unwrap_or([Jet::constant(Interval::ENTIRE); 4])
 }
 
 /// [`spin`]'s point alone.
 fn spin_point(scale: f64, twists: u32, s: f64, theta: f64) -> DVec4 {
-    DVec4::from_array(spin(scale, twists, s, theta))
+    DVec4::from_array(spin(scale, twists, piece_at(s), s, theta))
 }
 
 fn sphere_domain() -> Domain {
@@ -192,6 +243,9 @@ impl Parametric for SpunTrefoil {
     fn point(&self, _: usize, u: f64, v: f64) -> DVec4 {
         spin_point(self.scale, 0, u, v)
     }
+    fn enclose(&self, _: usize, u: Interval, v: Interval) -> [Jet<Interval>; 4] {
+        spin_enclose(self.scale, 0, u, v)
+    }
     fn topology(&self) -> Topology {
         SPHERE
     }
@@ -232,6 +286,9 @@ impl Parametric for TwistSpunTrefoil {
     }
     fn point(&self, _: usize, u: f64, v: f64) -> DVec4 {
         spin_point(self.scale, self.twists, u, v)
+    }
+    fn enclose(&self, _: usize, u: Interval, v: Interval) -> [Jet<Interval>; 4] {
+        spin_enclose(self.scale, self.twists, u, v)
     }
     fn topology(&self) -> Topology {
         SPHERE
@@ -323,8 +380,8 @@ mod tests {
     #[test]
     fn arc_is_twice_differentiable_at_the_joins() {
         for s in joins() {
-            let (a, _) = arc(Jet::u(s - 1e-12));
-            let (b, _) = arc(Jet::u(s + 1e-12));
+            let (a, _) = arc(piece_at(s - 1e-12), Jet::u(s - 1e-12));
+            let (b, _) = arc(piece_at(s + 1e-12), Jet::u(s + 1e-12));
             for i in 0..3 {
                 assert!((a[i].v - b[i].v).abs() < 1e-9);
                 assert!(

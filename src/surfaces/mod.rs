@@ -21,7 +21,7 @@ mod simple;
 pub use formula::{Bound, Formula, FormulaEdge, FormulaSeam, FormulaSides, FormulaSource};
 pub use holomorphic::{Fermat, ProductPolynomial};
 pub use interval::Interval;
-pub use jet::{Jet, Real};
+pub use jet::{Jet, Real, Scalar};
 pub use knots::{SpunTrefoil, TwistSpunTrefoil};
 pub use simple::{FlatTorus, KleinBottle, Patches, ProjectivePlane};
 
@@ -312,6 +312,9 @@ pub(crate) trait Parametric {
     fn patch_count(&self) -> usize;
     fn domain(&self, patch: usize) -> Domain;
     fn eval(&self, patch: usize, u: f64, v: f64) -> Eval4;
+    /// Enclosures of the point and of its derivatives over the box `u` x `v` of a patch:
+    /// what the surface takes at every point of the box lies in them.
+    fn enclose(&self, patch: usize, u: Interval, v: Interval) -> [Jet<Interval>; 4];
     /// The point alone (the samplers' and the audit's hot path); surfaces with a cheaper
     /// way than [`Parametric::eval`] override it.
     fn point(&self, patch: usize, u: f64, v: f64) -> DVec4 {
@@ -440,6 +443,15 @@ impl Surface {
     /// The point and its exact derivatives at (u, v) of a patch.
     pub fn eval(&self, patch: usize, u: f64, v: f64) -> Eval4 {
         dispatch!(self, s => s.eval(patch, u, v))
+    }
+
+    /// Enclosures of the point and of its first and second derivatives over the box of
+    /// parameters `u` x `v` of a patch, by interval arithmetic rounded outward: every
+    /// value the surface and its derivatives take on the box lies in them. Where the
+    /// surface has a kink or its parametrization a singularity inside the box, the
+    /// derivatives' enclosures are unbounded.
+    pub fn enclose(&self, patch: usize, u: Interval, v: Interval) -> [Jet<Interval>; 4] {
+        dispatch!(self, s => s.enclose(patch, u, v))
     }
 
     /// The point at (u, v) of a patch, without derivatives: the same as `eval(..).p`, faster

@@ -1,7 +1,9 @@
 //! The classical closed surfaces of Fourphront (paper 001) and the planar test scene of
 //! paper 000 fig. 1.
 
-use super::{Domain, Eval4, Glue, Jet, Parametric, Side, SideRule, Topology};
+use super::{
+    Domain, Eval4, Glue, Interval, Jet, Parametric, Real, Scalar, Side, SideRule, Topology,
+};
 use crate::limits::{Bound, FieldError, PATCH_COUNT, SURFACE_LENGTH};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, TAU};
@@ -23,6 +25,18 @@ impl Default for FlatTorus {
     }
 }
 
+impl FlatTorus {
+    fn jets<S: Scalar>(&self, _: usize, s: Jet<S>, t: Jet<S>) -> [Jet<S>; 4] {
+        let ((sin_s, cos_s), (sin_t, cos_t)) = (s.sin_cos(), t.sin_cos());
+        [
+            cos_s * self.r1,
+            sin_s * self.r1,
+            cos_t * self.r2,
+            sin_t * self.r2,
+        ]
+    }
+}
+
 impl Parametric for FlatTorus {
     fn patch_count(&self) -> usize {
         1
@@ -32,14 +46,11 @@ impl Parametric for FlatTorus {
             .glue_u(0, false)
             .glue_v(0)
     }
-    fn eval(&self, _: usize, u: f64, v: f64) -> Eval4 {
-        let (s, t) = (Jet::u(u), Jet::v(v));
-        Eval4::from_jets([
-            s.cos() * self.r1,
-            s.sin() * self.r1,
-            t.cos() * self.r2,
-            t.sin() * self.r2,
-        ])
+    fn eval(&self, patch: usize, u: f64, v: f64) -> Eval4 {
+        Eval4::from_jets(self.jets(patch, Jet::u(u), Jet::v(v)))
+    }
+    fn enclose(&self, patch: usize, u: Interval, v: Interval) -> [Jet<Interval>; 4] {
+        self.jets(patch, Jet::u(u), Jet::v(v))
     }
     fn topology(&self) -> Topology {
         Topology {
@@ -75,6 +86,16 @@ impl Default for KleinBottle {
     }
 }
 
+impl KleinBottle {
+    fn jets<S: Scalar>(&self, _: usize, u: Jet<S>, v: Jet<S>) -> [Jet<S>; 4] {
+        let ((sin_u, cos_u), (sin_v, cos_v)) = (u.sin_cos(), v.sin_cos());
+        let (sin_half, cos_half) = (u * 0.5).sin_cos();
+        let ring = cos_v * self.minor_radius + self.major_radius;
+        let lift = sin_v * self.minor_radius;
+        [ring * cos_u, ring * sin_u, lift * cos_half, lift * sin_half]
+    }
+}
+
 impl Parametric for KleinBottle {
     fn patch_count(&self) -> usize {
         1
@@ -84,17 +105,11 @@ impl Parametric for KleinBottle {
             .glue_u(0, true)
             .glue_v(0)
     }
-    fn eval(&self, _: usize, u: f64, v: f64) -> Eval4 {
-        let (u, v) = (Jet::u(u), Jet::v(v));
-        let ring = v.cos() * self.minor_radius + self.major_radius;
-        let lift = v.sin() * self.minor_radius;
-        let half = u * 0.5;
-        Eval4::from_jets([
-            ring * u.cos(),
-            ring * u.sin(),
-            lift * half.cos(),
-            lift * half.sin(),
-        ])
+    fn eval(&self, patch: usize, u: f64, v: f64) -> Eval4 {
+        Eval4::from_jets(self.jets(patch, Jet::u(u), Jet::v(v)))
+    }
+    fn enclose(&self, patch: usize, u: Interval, v: Interval) -> [Jet<Interval>; 4] {
+        self.jets(patch, Jet::u(u), Jet::v(v))
     }
     fn topology(&self) -> Topology {
         Topology {
@@ -132,6 +147,21 @@ impl Default for ProjectivePlane {
     }
 }
 
+impl ProjectivePlane {
+    fn jets<S: Scalar>(&self, _: usize, theta: Jet<S>, phi: Jet<S>) -> [Jet<S>; 4] {
+        let ((sin_t, x), (sin_p, cos_p)) = (theta.sin_cos(), phi.sin_cos());
+        let y = sin_t * cos_p;
+        let z = sin_t * sin_p;
+        let r = self.radius;
+        [
+            x * y * r,
+            x * z * r,
+            (y.sqr() - z.sqr()) * r,
+            y * z * (2.0 * r),
+        ]
+    }
+}
+
 impl Parametric for ProjectivePlane {
     fn patch_count(&self) -> usize {
         1
@@ -153,18 +183,11 @@ impl Parametric for ProjectivePlane {
                 SideRule::Glued(vec![half_turn(0.0, 0.5), half_turn(0.5, -0.5)]),
             )
     }
-    fn eval(&self, _: usize, u: f64, v: f64) -> Eval4 {
-        let (theta, phi) = (Jet::u(u), Jet::v(v));
-        let x = theta.cos();
-        let y = theta.sin() * phi.cos();
-        let z = theta.sin() * phi.sin();
-        let r = self.radius;
-        Eval4::from_jets([
-            x * y * r,
-            x * z * r,
-            (y.sqr() - z.sqr()) * r,
-            y * z * (2.0 * r),
-        ])
+    fn eval(&self, patch: usize, u: f64, v: f64) -> Eval4 {
+        Eval4::from_jets(self.jets(patch, Jet::u(u), Jet::v(v)))
+    }
+    fn enclose(&self, patch: usize, u: Interval, v: Interval) -> [Jet<Interval>; 4] {
+        self.jets(patch, Jet::u(u), Jet::v(v))
     }
     fn topology(&self) -> Topology {
         Topology {
@@ -224,18 +247,11 @@ impl Patches {
     }
 }
 
-impl Parametric for Patches {
-    fn patch_count(&self) -> usize {
-        self.count + 1
-    }
-    fn domain(&self, _: usize) -> Domain {
-        Domain::open([-1.0, 1.0], [-1.0, 1.0])
-    }
-    fn eval(&self, patch: usize, u: f64, v: f64) -> Eval4 {
-        let (u, v) = (Jet::u(u), Jet::v(v));
+impl Patches {
+    fn jets<S: Scalar>(&self, patch: usize, u: Jet<S>, v: Jet<S>) -> [Jet<S>; 4] {
         let s = self.size;
-        let c = Jet::constant;
-        Eval4::from_jets(if patch == 0 {
+        let c = |x: f64| Jet::from(x);
+        if patch == 0 {
             [u * s, v * s, c(0.0), c(0.0)]
         } else {
             [
@@ -244,7 +260,22 @@ impl Parametric for Patches {
                 v * (0.6 * s),
                 c(self.depth(patch)),
             ]
-        })
+        }
+    }
+}
+
+impl Parametric for Patches {
+    fn patch_count(&self) -> usize {
+        self.count + 1
+    }
+    fn domain(&self, _: usize) -> Domain {
+        Domain::open([-1.0, 1.0], [-1.0, 1.0])
+    }
+    fn eval(&self, patch: usize, u: f64, v: f64) -> Eval4 {
+        Eval4::from_jets(self.jets(patch, Jet::u(u), Jet::v(v)))
+    }
+    fn enclose(&self, patch: usize, u: Interval, v: Interval) -> [Jet<Interval>; 4] {
+        self.jets(patch, Jet::u(u), Jet::v(v))
     }
     fn topology(&self) -> Topology {
         Topology {

@@ -1,6 +1,7 @@
 //! The evaluator: compiled formulas run over f64 (points), over [`Jet`]s (points with
-//! their exact first and second derivatives) and over [`Interval`]s (enclosures of their
-//! values over boxes of parameters), without recursion and without string work;
+//! their exact first and second derivatives), over [`Interval`]s (enclosures of their
+//! values over boxes of parameters) and over jets of intervals (enclosures of their values
+//! and derivatives), without recursion and without string work;
 //! and, when a value is not finite, the instruction that made it so. Apart from the
 //! compiler: what runs once per point, against what runs once per formula.
 
@@ -10,8 +11,9 @@ use crate::limits::shorten;
 use crate::surfaces::{Interval, Jet};
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-/// What a formula computes with: f64 for points, [`Jet`] for derivatives. Both take the
-/// same steps, so that a point is bit for bit the value of its jet.
+/// What a formula computes with: f64 for points, [`Jet`] for derivatives, [`Interval`]
+/// and jets of them for enclosures. The first two take the same steps, so that a point is
+/// bit for bit the value of its jet.
 pub(super) trait Number:
     Copy
     + Add<Output = Self>
@@ -133,36 +135,49 @@ macro_rules! calls {
     };
 }
 
-impl Number for Jet {
-    fn constant(x: f64) -> Self {
-        Jet::constant(x)
-    }
-    fn int_power(self, n: i32) -> Self {
-        self.powi(n)
-    }
-    fn real_power(self, k: f64) -> Self {
-        self.powf(k)
-    }
-    fn power(self, y: Self) -> Self {
-        self.pow(y)
-    }
-    fn scale(self, k: f64) -> Self {
-        Jet::scale(self, k)
-    }
-    fn shift(self, k: f64) -> Self {
-        self + k
-    }
-    fn over(self, k: f64) -> Self {
-        Jet {
-            v: self.v / k,
-            du: self.du / k,
-            dv: self.dv / k,
-            duu: self.duu / k,
-            duv: self.duv / k,
-            dvv: self.dvv / k,
+/// A [`Number`] of jets over the scalar `$s`, whose undefined value is `$undefined` and
+/// whose constant real powers are `$real_power`.
+macro_rules! jets {
+    ($s:ty, $undefined:expr, $real_power:expr) => {
+        impl Number for Jet<$s> {
+            fn constant(x: f64) -> Self {
+                Jet::from(x)
+            }
+            fn int_power(self, n: i32) -> Self {
+                self.powi(n)
+            }
+            fn real_power(self, k: f64) -> Self {
+                $real_power(self, k)
+            }
+            fn power(self, y: Self) -> Self {
+                self.pow(y)
+            }
+            fn scale(self, k: f64) -> Self {
+                Jet::scale(self, k)
+            }
+            fn shift(self, k: f64) -> Self {
+                self + k
+            }
+            fn over(self, k: f64) -> Self {
+                Jet::over(self, k)
+            }
+            calls!(Jet::constant($undefined));
         }
+    };
+}
+
+jets!(f64, f64::NAN, Jet::powf);
+jets!(Interval, Interval::ENTIRE, |x: Jet<Interval>, k: f64| {
+    // As for intervals: an integral power is defined for negative bases.
+    match integral(k) {
+        Some(n) => x.powi(n),
+        None => x.powf(k),
     }
-    calls!(Jet::constant(f64::NAN));
+});
+
+/// `k` as an i32 where it is one (what f64's `powf` takes as an integer power).
+fn integral(k: f64) -> Option<i32> {
+    (k.fract() == 0.0 && k.abs() <= f64::from(i32::MAX)).then_some(k as i32)
 }
 
 /// Enclosures: the constants are the f64 values the compiler folded them to (`pi` the f64
@@ -178,10 +193,9 @@ impl Number for Interval {
     }
     fn real_power(self, k: f64) -> Self {
         // An integral power is defined for negative bases, as f64's `powf` takes it.
-        if k.fract() == 0.0 && k.abs() <= f64::from(i32::MAX) {
-            self.powi(k as i32)
-        } else {
-            self.powf(k)
+        match integral(k) {
+            Some(n) => self.powi(n),
+            None => self.powf(k),
         }
     }
     fn power(self, y: Self) -> Self {

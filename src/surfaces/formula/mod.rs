@@ -308,13 +308,6 @@ impl Formula {
     fn jets(&self, u: f64, v: f64) -> [Jet; 4] {
         self.shared.run(Jet::u(u), Jet::v(v))
     }
-
-    /// Enclosures of the four coordinates over the box of parameters `u` x `v`: every
-    /// point the formula takes there (its constants as the compiler folded them) lies in
-    /// them, by interval arithmetic rounded outward.
-    pub fn enclose(&self, u: Interval, v: Interval) -> [Interval; 4] {
-        self.shared.run(u, v)
-    }
 }
 
 impl Parametric for Formula {
@@ -332,6 +325,10 @@ impl Parametric for Formula {
 
     fn point(&self, _: usize, u: f64, v: f64) -> DVec4 {
         DVec4::from_array(self.shared.run(u, v))
+    }
+
+    fn enclose(&self, _: usize, u: Interval, v: Interval) -> [Jet<Interval>; 4] {
+        self.shared.run(Jet::u(u), Jet::v(v))
     }
 
     fn topology(&self) -> Topology {
