@@ -54,10 +54,10 @@ fn main() {
     });
     let dir = tempfile::tempdir().expect("a temporary folder");
     println!(
-        "| triangles | sample | audit | view | guards | halo | curves | verify | export | free | total (s) | wall (s) | estimate (GB) | peak (GB) | peak, time (GB) | written (MB) |"
+        "| triangles | sample | audit | prove | view | guards | halo | curves | verify | export | free | total (s) | wall (s) | estimate (GB) | peak (GB) | peak, time (GB) | written (MB) |"
     );
     println!(
-        "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+        "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
     );
     let time = Path::new("/usr/bin/time");
     for size in sizes {
@@ -103,9 +103,10 @@ fn main() {
         let memory = &report["memory"];
         let gb = |k: &str| memory[k].as_f64().unwrap_or(f64::NAN);
         println!(
-            "| {triangles} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {wall:.2} | {:.2} | {:.2} | {peak_outside} | {:.0} |",
+            "| {triangles} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {wall:.2} | {:.2} | {:.2} | {peak_outside} | {:.0} |",
             s("sample"),
             s("audit"),
+            s("prove"),
             s("view"),
             s("guards"),
             s("halo"),

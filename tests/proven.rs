@@ -245,6 +245,13 @@ fn a_vertex_moved_off_the_surface_raises_the_proof() {
     assert!(corner_error(&s, 0, mesh.uv[v], mesh.positions[v]) >= 1e-3 * (1.0 - 1e-12));
     let after = prove(&s, &mesh).max_error.unwrap();
     assert!(after >= 1e-3, "{before:e} -> {after:e}");
+    // A mesh without its triangles' parameters proves nothing, and says so.
+    mesh.triangle_uv.clear();
+    let proof = prove(&s, &mesh);
+    assert_eq!(
+        (proof.max_error, proof.unproven),
+        (None, mesh.triangles.len())
+    );
 }
 
 #[test]
@@ -357,4 +364,32 @@ fn the_report_carries_the_proof_beside_the_audit() {
         !out.status.success() && err.contains("proved") && err.contains("proven"),
         "{err}"
     );
+}
+
+#[test]
+fn outputs_prove_false_leaves_the_proof_out_unless_the_sampler_aims_at_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = serde_json::json!({
+        "name": "unproven",
+        "surfaces": [
+            { "surface": { "type": "klein_bottle" } },
+            { "surface": { "type": "flat_torus" },
+              "sampling": { "method": "adaptive", "tolerance": 1e-2, "bound": "proven" } }
+        ],
+        "sampling": { "method": "adaptive", "tolerance": 1e-2 },
+        "outputs": { "glb": false, "ply": false, "vtk": false, "png": false, "prove": false }
+    });
+    std::fs::write(dir.path().join("s.json"), scene.to_string()).unwrap();
+    let out = crate::common::halo4d(&["build", "s.json", "--out", "o", "-q"], dir.path());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("o/report.json")).unwrap()).unwrap();
+    let [klein, torus] = [0, 1].map(|i| &report["surfaces"][i]["sampling"]);
+    assert!(klein.get("proven_max_error").is_none(), "{klein}");
+    assert!(torus["proven_max_error"].as_f64().is_some(), "{torus}");
+    assert!(report["timings_ms"]["prove"].as_f64().unwrap() > 0.0);
 }

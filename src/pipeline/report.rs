@@ -192,6 +192,9 @@ pub struct Timings {
     pub sample: f64,
     /// Auditing the samples and validating their meshes, all surfaces.
     pub audit: f64,
+    /// Proving the bound of every triangle's distance from its surface (interval
+    /// arithmetic), all surfaces.
+    pub prove: f64,
     /// View (rotation, projection, normals), all surfaces.
     pub view: f64,
     /// The checks before the slow stages: the scene's scale and the memory it needs, and
@@ -223,11 +226,12 @@ pub struct Timings {
 
 impl Timings {
     /// Each stage's name and milliseconds, in the order a build runs them.
-    pub fn stages(&self) -> [(&'static str, f64); 13] {
+    pub fn stages(&self) -> [(&'static str, f64); 14] {
         [
             ("setup", self.setup),
             ("sample", self.sample),
             ("audit", self.audit),
+            ("prove", self.prove),
             ("view", self.view),
             ("guards", self.guards),
             ("halo", self.halo),

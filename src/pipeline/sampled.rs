@@ -5,7 +5,7 @@ use super::report::{SamplingReport, Timings, surface_warnings};
 use super::{Built, Stages, built::in_view, ms};
 use crate::error::Error;
 use crate::intersect::{self, Curves, Sheet};
-use crate::sample::{self, Audit, Mesh4, MeshStats, Source, audit};
+use crate::sample::{self, Audit, ErrorBound, Mesh4, MeshStats, Sampling, Source, audit};
 use crate::scene::Scene;
 use crate::stipple::Stipples;
 use glam::DVec3;
@@ -90,9 +90,9 @@ impl Sampled {
         self.surfaces.iter().map(|s| s.mesh.triangles.len()).sum()
     }
 
-    /// Milliseconds spent sampling and auditing.
+    /// Milliseconds spent sampling, auditing and proving.
     pub fn ms(&self) -> f64 {
-        self.timings.sample + self.timings.audit
+        self.timings.sample + self.timings.audit + self.timings.prove
     }
 }
 
@@ -193,12 +193,20 @@ pub(super) fn sample_with(scene: &Scene, bar: &ProgressBar) -> Sampled {
         let audit_ms = ms(start);
         timings.audit += audit_ms;
         let start = Instant::now();
+        let aimed = matches!(
+            sampling,
+            Sampling::Adaptive {
+                bound: ErrorBound::Proven,
+                ..
+            }
+        );
         let proof = entry
             .surface
             .parametric()
+            .filter(|_| scene.outputs.prove || aimed)
             .map(|surface| sample::prove(surface, &sampled.mesh));
         let proven_ms = ms(start);
-        timings.audit += proven_ms;
+        timings.prove += proven_ms;
         let report = SamplingReport::new(
             method,
             sampling,

@@ -826,7 +826,9 @@ impl Patch {
                 edge_error[k - 3] = d;
             }
         }
-        if self.proven {
+        // The proof is only worth its enclosure where the audit's points pass: a triangle
+        // failing them is split either way, waiting on the level of its measured error.
+        if self.proven && worst <= tolerance {
             let bound = triangle_bound(surface, patch, uv, corners, t.map(|i| self.error[i]));
             worst = worst.max(bound);
         }

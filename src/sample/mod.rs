@@ -8,7 +8,8 @@
 //!
 //! Guarantees: the adaptive sampler, when it reports `complete`, leaves every triangle within
 //! the tolerance of the surface as [`audit`] measures it (the audit shares no code with the
-//! sampler but the list of points it checks); seams and poles are welded by the domain rules
+//! sampler but the list of points it checks), and with [`ErrorBound::Proven`] as [`prove`]
+//! bounds it at every point, by interval arithmetic; seams and poles are welded by the domain rules
 //! of the surface, never by distance; closed surfaces give closed manifold meshes (every edge
 //! in exactly two triangles) with the surface's Euler characteristic; orientable surfaces
 //! give consistently oriented meshes; no triangle repeats a vertex or folds over in (u, v).

@@ -48,8 +48,22 @@ pub struct Proof {
 }
 
 /// Proves a bound for every triangle of `mesh` (see the module documentation), on every
-/// core. The mesh must carry its triangles' parameters (a sampled mesh does).
+/// core. A mesh without its triangles' and vertices' parameters (a sampled mesh has them;
+/// one read back from a file may not) has no triangle proven.
 pub fn prove(surface: &Surface, mesh: &Mesh4) -> Proof {
+    let n = mesh.triangles.len();
+    let v = mesh.positions.len();
+    if mesh.triangle_uv.len() != n
+        || mesh.triangle_patch.len() != n
+        || mesh.uv.len() != v
+        || mesh.patch.len() != v
+    {
+        return Proof {
+            max_error: if n == 0 { Some(0.0) } else { None },
+            worst_triangle: (n > 0).then_some(0),
+            unproven: n,
+        };
+    }
     // Each vertex's own rounding once, for the corners that stand at its own parameters
     // (all but those across a seam or at a pole, computed where they are met).
     let vertex_error: Vec<f64> = (0..mesh.positions.len())
