@@ -312,6 +312,18 @@ fn the_sampler_aiming_at_the_proof_meets_it_on_every_catalogue_fixture() {
     }
 }
 
+/// `halo4d build` of `scene` in `dir`: its report.
+fn built_report(dir: &std::path::Path, scene: &serde_json::Value) -> serde_json::Value {
+    std::fs::write(dir.join("s.json"), scene.to_string()).unwrap();
+    let out = crate::common::halo4d(&["build", "s.json", "--out", "o", "-q"], dir);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&std::fs::read(dir.join("o/report.json")).unwrap()).unwrap()
+}
+
 #[test]
 fn the_report_carries_the_proof_beside_the_audit() {
     // One surface held to its audit and one to its proof, in one scene: each report's
@@ -329,15 +341,7 @@ fn the_report_carries_the_proof_beside_the_audit() {
         ],
         "outputs": { "glb": false, "ply": false, "vtk": false, "png": false, "report": true }
     });
-    std::fs::write(dir.path().join("s.json"), scene.to_string()).unwrap();
-    let out = crate::common::halo4d(&["build", "s.json", "--out", "o", "-q"], dir.path());
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.path().join("o/report.json")).unwrap()).unwrap();
+    let report = built_report(dir.path(), &scene);
     let surfaces = report["surfaces"].as_array().unwrap();
     for (s, bound) in surfaces.iter().zip([Some("audited"), Some("proven"), None]) {
         let sampling = &s["sampling"];
@@ -379,15 +383,7 @@ fn outputs_prove_false_leaves_the_proof_out_unless_the_sampler_aims_at_it() {
         "sampling": { "method": "adaptive", "tolerance": 1e-2 },
         "outputs": { "glb": false, "ply": false, "vtk": false, "png": false, "prove": false }
     });
-    std::fs::write(dir.path().join("s.json"), scene.to_string()).unwrap();
-    let out = crate::common::halo4d(&["build", "s.json", "--out", "o", "-q"], dir.path());
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.path().join("o/report.json")).unwrap()).unwrap();
+    let report = built_report(dir.path(), &scene);
     let [klein, torus] = [0, 1].map(|i| &report["surfaces"][i]["sampling"]);
     assert!(klein.get("proven_max_error").is_none(), "{klein}");
     assert!(torus["proven_max_error"].as_f64().is_some(), "{torus}");
