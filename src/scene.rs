@@ -124,7 +124,7 @@ pub struct Outputs {
     /// scene's diagonal (as `halo.rho`).
     pub curve_radius: f64,
     /// The proven bound of every triangle's distance from its surface in `report.json`
-    /// (`sampling.proven_max_error`): on by default; `false` saves its time (2 to 14 µs a
+    /// (`sampling.proven_max_error`): on by default; `false` saves its time (2 to 11 µs a
     /// triangle on two cores) where the audit is enough. A surface sampled with `"bound":
     /// "proven"` is proven either way.
     #[serde(skip_serializing_if = "is_true")]

@@ -122,6 +122,16 @@ impl Interval {
         self.lo.is_finite() && self.hi.is_finite()
     }
 
+    /// The bounds of a sum or a difference moved one unit outward, but for an exact 0: a
+    /// sum of two f64 that rounds to 0 is 0 (a nonzero one is at least the least
+    /// subnormal, and sums that small are exact), so that 1 - 1 stays 0 and a square root
+    /// of it stays defined.
+    #[inline]
+    fn summed(lo: f64, hi: f64) -> Interval {
+        let exact = |x: f64, out: fn(f64) -> f64| if x == 0.0 { 0.0 } else { out(x) };
+        Interval::new(exact(lo, down), exact(hi, up))
+    }
+
     /// The bounds moved one unit outward.
     #[inline]
     fn widened(lo: f64, hi: f64) -> Interval {
@@ -342,7 +352,7 @@ impl Add for Interval {
     type Output = Interval;
     #[inline]
     fn add(self, o: Interval) -> Interval {
-        Interval::widened(self.lo + o.lo, self.hi + o.hi)
+        Interval::summed(self.lo + o.lo, self.hi + o.hi)
     }
 }
 
@@ -350,7 +360,7 @@ impl Sub for Interval {
     type Output = Interval;
     #[inline]
     fn sub(self, o: Interval) -> Interval {
-        Interval::widened(self.lo - o.hi, self.hi - o.lo)
+        Interval::summed(self.lo - o.hi, self.hi - o.lo)
     }
 }
 
@@ -824,5 +834,23 @@ mod tests {
         // Across the cut: all of [-π, π].
         let a = Interval::new(-0.1, 0.1).atan2(Interval::new(-2.0, -1.0));
         assert!(a.contains(-std::f64::consts::PI) && a.contains(std::f64::consts::PI));
+    }
+
+    #[test]
+    fn sums_keep_an_exact_zero() {
+        let zero = Interval::point(-1.0) + Interval::point(1.0);
+        assert_eq!(zero, Interval::point(0.0));
+        let root = zero.sqrt();
+        assert!(
+            root.lo() == 0.0 && root.hi() <= f64::from_bits(1),
+            "{root:?}"
+        );
+        assert_eq!(
+            Interval::point(0.5) - Interval::point(0.5),
+            Interval::point(0.0)
+        );
+        // An inexact sum is still widened.
+        let third = Interval::point(0.1) + Interval::point(0.2);
+        assert!(third.lo() < 0.1 + 0.2 && 0.1 + 0.2 < third.hi());
     }
 }
