@@ -56,91 +56,33 @@ pub trait Scalar:
     fn powf(self, k: f64) -> Self;
 }
 
-/// Each operation is `f64`'s own, so that a jet's value is the same bits as the plain
-/// evaluation's.
-impl Scalar for f64 {
-    fn sin_cos(self) -> (Self, Self) {
-        f64::sin_cos(self)
-    }
-    fn tan(self) -> Self {
-        f64::tan(self)
-    }
-    fn asin(self) -> Self {
-        f64::asin(self)
-    }
-    fn acos(self) -> Self {
-        f64::acos(self)
-    }
-    fn atan(self) -> Self {
-        f64::atan(self)
-    }
-    fn sinh(self) -> Self {
-        f64::sinh(self)
-    }
-    fn cosh(self) -> Self {
-        f64::cosh(self)
-    }
-    fn tanh(self) -> Self {
-        f64::tanh(self)
-    }
-    fn exp(self) -> Self {
-        f64::exp(self)
-    }
-    fn ln(self) -> Self {
-        f64::ln(self)
-    }
-    fn sqrt(self) -> Self {
-        f64::sqrt(self)
-    }
-    fn powi(self, n: i32) -> Self {
-        f64::powi(self, n)
-    }
-    fn powf(self, k: f64) -> Self {
-        f64::powf(self, k)
-    }
+/// [`Scalar`] for a type whose own methods of the same names do the work.
+macro_rules! scalar {
+    ($t:ty) => {
+        impl Scalar for $t {
+            fn sin_cos(self) -> (Self, Self) {
+                <$t>::sin_cos(self)
+            }
+            scalar!(@unary $t: tan asin acos atan sinh cosh tanh exp ln sqrt);
+            fn powi(self, n: i32) -> Self {
+                <$t>::powi(self, n)
+            }
+            fn powf(self, k: f64) -> Self {
+                <$t>::powf(self, k)
+            }
+        }
+    };
+    (@unary $t:ty: $($f:ident)*) => {
+        $(fn $f(self) -> Self {
+            <$t>::$f(self)
+        })*
+    };
 }
 
-impl Scalar for Interval {
-    fn sin_cos(self) -> (Self, Self) {
-        Interval::sin_cos(self)
-    }
-    fn tan(self) -> Self {
-        Interval::tan(self)
-    }
-    fn asin(self) -> Self {
-        Interval::asin(self)
-    }
-    fn acos(self) -> Self {
-        Interval::acos(self)
-    }
-    fn atan(self) -> Self {
-        Interval::atan(self)
-    }
-    fn sinh(self) -> Self {
-        Interval::sinh(self)
-    }
-    fn cosh(self) -> Self {
-        Interval::cosh(self)
-    }
-    fn tanh(self) -> Self {
-        Interval::tanh(self)
-    }
-    fn exp(self) -> Self {
-        Interval::exp(self)
-    }
-    fn ln(self) -> Self {
-        Interval::ln(self)
-    }
-    fn sqrt(self) -> Self {
-        Interval::sqrt(self)
-    }
-    fn powi(self, n: i32) -> Self {
-        Interval::powi(self, n)
-    }
-    fn powf(self, k: f64) -> Self {
-        Interval::powf(self, k)
-    }
-}
+// Each operation of f64 is its own, so that a jet's value is the same bits as the plain
+// evaluation's; each of Interval's encloses its value.
+scalar!(f64);
+scalar!(Interval);
 
 /// A value with its first and second partial derivatives in (u, v).
 #[derive(Clone, Copy, Debug, PartialEq)]
