@@ -31,13 +31,13 @@ pub struct Checked {
     /// The scene's name, when the file records it.
     pub scene: Option<String>,
     /// Each halo's name and the checker's statistics (for a file without halo4d's layout,
-    /// its tetrahedra's, from [`certify`]).
+    /// its tetrahedra's, from [`crate::certify`]).
     pub halos: Vec<(String, CheckStats)>,
     /// For a mesh without halo4d's layout: why it is not read as a halo. Its tetrahedra
     /// are certified instead ([`Self::certificate`]); the halo's own checks (offset faces,
     /// quads, surface faces) cannot be made.
     pub plain: Option<String>,
-    /// For a mesh without halo4d's layout: what [`certify`] found.
+    /// For a mesh without halo4d's layout: what [`crate::certify`] found.
     pub certificate: Option<Certificate>,
     /// For a mesh without halo4d's layout: its tetrahedra as read, for
     /// [`Self::write_marks`].
@@ -160,7 +160,8 @@ pub fn check_dir(dir: &Path) -> Result<Checked, InspectError> {
             source,
         })?;
     let (halos, unchecked) = check_halos(scene.surfaces.iter().filter_map(|s| s.halo.as_ref()));
-    let (curves, verification) = verify_scene(&scene);
+    let (mut curves, verification) = verify_scene(&scene);
+    curves.report.certified = recertify(&scene);
     Ok(Checked {
         file,
         scene: scene.name.clone(),
@@ -179,6 +180,21 @@ pub fn verify_scene(scene: &ImportedScene) -> (Curves, Verification) {
     let curves = intersect::curves(&scene.parts(&Curves::default()).sheets());
     let verification = verify::verify(&scene.parts(&curves));
     (curves, verification)
+}
+
+/// The certificate of the double curves of the scene recorded in the file, derived again
+/// from its analytic surfaces and view, when that scene asked for one (`curves.certify`).
+fn recertify(scene: &ImportedScene) -> Option<intersect::certified::Certificate> {
+    let recorded: crate::scene::Scene = serde_json::from_value(scene.scene.clone()?).ok()?;
+    if !recorded.curves.certify {
+        return None;
+    }
+    let surfaces: Vec<_> = recorded
+        .surfaces
+        .iter()
+        .map(|s| s.surface.parametric())
+        .collect();
+    Some(intersect::certified::certify(&surfaces, &recorded.view))
 }
 
 /// Each halo's checker statistics; and the halos whose files do not give the surface's

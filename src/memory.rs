@@ -24,7 +24,7 @@ pub const BASE_BYTES: f64 = 55e6;
 /// report peaks at 0.12 to 0.15, 0.88, 3.22 and 7.67 GB at 100,352, 1,002,528, 3,998,792
 /// and 9,999,392 triangles (`HALO4D_SCALE=100k,1M,4M,10M cargo bench --bench scale`), the
 /// default scene at tolerance 1e-5 (1,241,550 triangles) at 1.00 GB: this estimate is
-/// high by 0 to 18%.
+/// high by 0 to 25% (the most at 100,000, whose peak moves by 15% between runs).
 pub const BUILD_BYTES_PER_TRIANGLE: f64 = 900.0;
 
 /// The same for a build that makes the curves but no halos: 0.37 GB at 1,002,528
@@ -40,7 +40,7 @@ pub const SAMPLE_BYTES_PER_TRIANGLE: f64 = 170.0;
 
 /// The estimated peak resident bytes of a build of `triangles` triangles, by its most
 /// demanding stage: the halos, else the curves, else the sampling (`adaptive` or not).
-/// Measured from outside, it is high by 0 to 18% from 100,000 to 10 million triangles.
+/// Measured from outside, it is high by 0 to 25% from 100,000 to 10 million triangles.
 pub fn build_bytes(triangles: usize, adaptive: bool, curves: bool, halos: bool) -> f64 {
     let sampling = if adaptive {
         ADAPTIVE_BYTES_PER_TRIANGLE

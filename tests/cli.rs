@@ -114,6 +114,43 @@ fn a_budget_too_small_for_the_tolerance_warns_and_reports_incomplete() {
 }
 
 #[test]
+fn sweep_rows_say_whether_their_curves_are_the_certified_ones() {
+    // A paraboloid z = u² + v² over a square has no double curve, and the certificate
+    // proves it: every row's mesh agrees (`=`), and the table says what the certificate
+    // cost.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("square.json"),
+        r#"{ "name": "square", "surfaces": [ { "name": "square", "surface": { "type": "formula",
+             "x": "u", "y": "v", "z": "u*u + v*v", "w": "0", "u": [-1, 1], "v": [-1, 1] } } ] }"#,
+    )
+    .unwrap();
+    let out = halo4d(
+        &["sweep", "square.json", "--tolerances", "1e-2,1e-3", "-q"],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        table.contains("certified: 0 closed and 0 open curves, in"),
+        "{table}"
+    );
+    let rows: Vec<&str> = table.lines().filter(|l| l.starts_with("square ")).collect();
+    assert_eq!(rows.len(), 3, "{table}");
+    assert!(rows[..2].iter().all(|l| l.ends_with(" =")), "{table}");
+    let csv =
+        std::fs::read_to_string(dir.path().join("exports/reports/speed_vs_error.csv")).unwrap();
+    for line in csv.lines().skip(1) {
+        let r: Vec<&str> = line.split(',').collect();
+        assert_eq!(&r[15..19], ["0", "0", "0", "0"], "{csv}");
+    }
+}
+
+#[test]
 fn sweep_writes_csv_and_plot_for_a_scene() {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("two.json");
@@ -140,12 +177,13 @@ fn sweep_writes_csv_and_plot_for_a_scene() {
     assert_eq!(
         lines.next().unwrap(),
         "surface,method,tolerance,triangles,ms,max_error,rms_error,met,grid,\
-         curve_ms,refine_ms,curve_error,refined_residual,curve_points,not_converged"
+         curve_ms,refine_ms,curve_error,refined_residual,curve_points,not_converged,closed,open,\
+         certified_closed,certified_open,certify_ms"
     );
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 2 * 2 * 2, "{csv}");
     for r in &rows {
-        assert_eq!(r.len(), 15, "{csv}");
+        assert_eq!(r.len(), 20, "{csv}");
         let (tol, max): (f64, f64) = (r[2].parse().unwrap(), r[5].parse().unwrap());
         assert_eq!(r[7], "true", "{csv}");
         assert!(max <= tol && max > 0.0, "{csv}");
@@ -236,6 +274,14 @@ fn sweep_measures_the_curves_of_every_mesh_of_the_flat_torus() {
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 2 * 3, "{csv}");
     let number = |r: &[&str], name: &str| -> f64 { r[column(name)].parse().unwrap() };
+    // The certificate is the true surface's, whatever the mesh: the same on every row, and
+    // its time too.
+    let certified: Vec<[&str; 3]> = rows
+        .iter()
+        .map(|r| ["certified_closed", "certified_open", "certify_ms"].map(|c| r[column(c)]))
+        .collect();
+    assert!(certified.windows(2).all(|w| w[0] == w[1]), "{csv}");
+    assert!(number(&rows[0], "certify_ms") > 0.0, "{csv}");
     for method in ["adaptive", "uniform"] {
         let mine: Vec<&Vec<&str>> = rows.iter().filter(|r| r[1] == method).collect();
         let errors: Vec<f64> = mine.iter().map(|r| number(r, "curve_error")).collect();
@@ -581,8 +627,10 @@ fn a_build_beyond_the_memory_limit_is_refused_before_the_halos_and_writes_nothin
 fn the_report_s_timings_and_memory_agree_with_the_process_s() {
     // The default scene with its picture, timed from outside: the report's total is the
     // process's wall time but for its start and exit, its stages add up to the total, and
-    // the estimated memory is within 20% of the peak the system measured (VmHWM, what
-    // `/usr/bin/time` reports). `cargo bench --bench scale` compares them at 100k to 10M
+    // the estimated memory is a guard that does not fall short of the peak the system
+    // measured (VmHWM, what `/usr/bin/time` reports) and is not far above it: at this size
+    // the peak moves by 5% between runs and the estimate is high by 15 to 25%
+    // (docs/PERFORMANCE.md). `cargo bench --bench scale` compares them at 100k to 10M
     // triangles.
     let dir = tempfile::tempdir().unwrap();
     let start = std::time::Instant::now();
@@ -622,7 +670,7 @@ fn the_report_s_timings_and_memory_agree_with_the_process_s() {
         memory["peak_gb"].as_f64().unwrap(),
     );
     assert!(
-        (peak - estimate).abs() < 0.2 * peak,
+        peak <= 1.05 * estimate && estimate <= 1.35 * peak,
         "estimate {estimate} GB, peak {peak} GB"
     );
 }

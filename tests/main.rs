@@ -3,6 +3,7 @@
 mod adaptive;
 mod animate;
 mod architecture;
+mod certified;
 mod certify;
 mod cli;
 mod common;

@@ -20,6 +20,7 @@
 //! anything that could not be resolved.
 
 pub(crate) mod broad;
+pub mod certified;
 mod chain;
 pub(crate) mod exact;
 pub(crate) mod refine;
@@ -183,19 +184,45 @@ pub struct CurvesReport {
     /// What moving the points onto the analytic surfaces did ([`refine()`](fn@refine)), when it ran.
     #[serde(flatten)]
     pub refinement: Option<Refinement>,
+    /// The double curves certified on the true surfaces ([`certified::certify`]), when the
+    /// scene asks (`curves.certify`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub certified: Option<certified::Certificate>,
 }
 
 impl CurvesReport {
     /// The verdict of a build and of `halo4d check DIR` on the curves the halos are
     /// verified against: nothing unresolved.
     pub fn failures(&self) -> Vec<String> {
-        if self.unresolved == 0 {
-            return Vec::new();
+        let mut out = Vec::new();
+        if self.unresolved > 0 {
+            out.push(format!(
+                "curves: {} unresolved (more than two segments meet at a point)",
+                self.unresolved
+            ));
         }
-        vec![format!(
-            "curves: {} unresolved (more than two segments meet at a point)",
-            self.unresolved
-        )]
+        if let Some(c) = self
+            .certified
+            .as_ref()
+            .filter(|c| c.complete && (c.closed, c.open) != (self.closed, self.open))
+        {
+            let through = c
+                .components
+                .iter()
+                .find_map(|k| k.points.first())
+                .map(|p| {
+                    format!(
+                        " (a certified curve passes through ({:.6}, {:.6}, {:.6}))",
+                        p[0], p[1], p[2]
+                    )
+                })
+                .unwrap_or_default();
+            out.push(format!(
+                "curves: the true surfaces cross in {} closed and {} open curves (certified), the meshes in {} closed and {} open: sample finer where they differ{through}",
+                c.closed, c.open, self.closed, self.open
+            ));
+        }
+        out
     }
 
     /// The summary `halo4d build` and `halo4d check DIR` print: one line, and one more on
@@ -205,6 +232,9 @@ impl CurvesReport {
             "curves: {} ({} closed, {} open), {} points, {} triple points, {} unresolved",
             self.count, self.closed, self.open, self.points, self.triple_points, self.unresolved
         );
+        if let Some(c) = &self.certified {
+            out += &format!("\ncurves certified: {}", c.summary());
+        }
         if let Some(r) = &self.refinement {
             out += &format!(
                 "\ncurves refined onto the surfaces: {} points ({} cross-caps, {} trimmed beyond them), {} not converged, {} pole ends kept; max residual {:.1e}, max shift {:.1e}; triple points {} refined, {} not",

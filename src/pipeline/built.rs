@@ -236,7 +236,7 @@ pub(super) fn in_view(
         timings.curves = ms(start);
     }
     bar.inc(1);
-    let refined = (stages.curves && scene.curves.refine).then(|| {
+    let mut refined = (stages.curves && scene.curves.refine).then(|| {
         bar.set_message("refining the curves");
         let start = Instant::now();
         let none = Curves::default();
@@ -246,6 +246,17 @@ pub(super) fn in_view(
         timings.refine = ms(start);
         refined
     });
+    if stages.curves && scene.curves.certify {
+        bar.set_message("certifying the curves");
+        let start = Instant::now();
+        let surfaces: Vec<_> = products.iter().map(|p| p.surface.parametric()).collect();
+        let certificate = crate::intersect::certified::certify(&surfaces, &scene.view);
+        timings.certify = ms(start);
+        curves.report.certified = Some(certificate.clone());
+        if let Some(r) = &mut refined {
+            r.report.certified = Some(certificate);
+        }
+    }
     let mut verification = Verification::default();
     if stages.verify {
         bar.set_message("verifying halos");

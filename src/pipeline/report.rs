@@ -14,7 +14,7 @@ use crate::verify::Verification;
 use serde::Serialize;
 
 /// `report.json`'s `memory`: the peak the build was estimated to need
-/// ([`crate::memory::build_bytes`]) against the limit (`HALO4D_MAX_MEMORY` gigabytes, or
+/// (`crate::memory::build_bytes`) against the limit (`HALO4D_MAX_MEMORY` gigabytes, or
 /// three quarters of the machine's memory), and the peak it reached, in GB. The picture is
 /// estimated on its own when it is made.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -206,6 +206,8 @@ pub struct Timings {
     pub curves: f64,
     /// Moving the curves onto the analytic surfaces.
     pub refine: f64,
+    /// Certifying the double curves of the true surfaces (`curves.certify`).
+    pub certify: f64,
     /// Verifying the halos against the curves.
     pub verify: f64,
     /// Ranking the stipples, all surfaces.
@@ -226,7 +228,7 @@ pub struct Timings {
 
 impl Timings {
     /// Each stage's name and milliseconds, in the order a build runs them.
-    pub fn stages(&self) -> [(&'static str, f64); 14] {
+    pub fn stages(&self) -> [(&'static str, f64); 15] {
         [
             ("setup", self.setup),
             ("sample", self.sample),
@@ -238,6 +240,7 @@ impl Timings {
             ("stipples", self.stipples),
             ("curves", self.curves),
             ("refine", self.refine),
+            ("certify", self.certify),
             ("verify", self.verify),
             ("render", self.render),
             ("export", self.export),

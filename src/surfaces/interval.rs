@@ -117,6 +117,44 @@ impl Interval {
         self.lo <= x && x <= self.hi
     }
 
+    /// The midpoint (a finite point of the interval, 0 for the whole line).
+    pub fn mid(self) -> f64 {
+        match (self.lo.is_finite(), self.hi.is_finite()) {
+            (true, true) => {
+                let m = self.lo + 0.5 * (self.hi - self.lo);
+                if m.is_finite() {
+                    m.clamp(self.lo, self.hi)
+                } else {
+                    0.5 * self.lo + 0.5 * self.hi
+                }
+            }
+            (true, false) => self.lo.max(0.0),
+            (false, true) => self.hi.min(0.0),
+            (false, false) => 0.0,
+        }
+    }
+
+    /// The common part, if any.
+    pub fn intersect(self, o: Interval) -> Option<Interval> {
+        let (lo, hi) = (self.lo.max(o.lo), self.hi.min(o.hi));
+        (lo <= hi).then_some(Interval { lo, hi })
+    }
+
+    /// Whether the two share a point.
+    pub fn meets(self, o: Interval) -> bool {
+        self.lo <= o.hi && o.lo <= self.hi
+    }
+
+    /// Whether `o` lies in the interior of this interval (strictly inside both bounds).
+    pub fn holds_inside(self, o: Interval) -> bool {
+        self.lo < o.lo && o.hi < self.hi
+    }
+
+    /// Whether `o` lies in this interval (bounds included).
+    pub fn holds(self, o: Interval) -> bool {
+        self.lo <= o.lo && o.hi <= self.hi
+    }
+
     /// Whether both bounds are finite.
     pub fn is_bounded(self) -> bool {
         self.lo.is_finite() && self.hi.is_finite()
@@ -339,6 +377,13 @@ impl Interval {
         };
         let (lo, hi) = ends(self, at);
         Interval::new(lo.lo.max(-1.0), hi.hi.min(1.0))
+    }
+}
+
+/// Written as `[lo, hi]`.
+impl serde::Serialize for Interval {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        [self.lo, self.hi].serialize(serializer)
     }
 }
 

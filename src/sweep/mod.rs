@@ -80,6 +80,14 @@ pub struct Row {
     /// Curve points the refinement kept where the mesh put them (Newton did not converge
     /// there: the refinement's `not_converged`); they count in neither error.
     pub not_converged: usize,
+    /// The mesh's curves: closed, open.
+    pub curves: [usize; 2],
+    /// The true surface's double curves in the same view, certified
+    /// ([`crate::intersect::certified`]): closed, open; `None` where the certificate is not
+    /// complete. The same on every row of a surface: it does not depend on the mesh.
+    pub certified: Option<[usize; 2]>,
+    /// Milliseconds the certificate took (once per surface, the same on its rows).
+    pub certify_ms: f64,
 }
 
 /// Settings of a sweep.
@@ -180,6 +188,14 @@ pub fn sweep_surface(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Vec<Row>, SweepError> {
     let diagonal = bounding_diagonal(surface);
+    progress(&format!("{name}: certifying its double curves"));
+    let certificate = intersect::certified::certify(&[Some(surface)], &settings.view);
+    let truth = Truth {
+        certified: certificate
+            .complete
+            .then_some([certificate.closed, certificate.open]),
+        certify_ms: certificate.ms,
+    };
     let mut rows = Vec::new();
     let mut grids = GridSearch::new(surface, diagonal, settings.max_triangles);
     let curves = |mesh: &Mesh4| {
@@ -215,6 +231,9 @@ pub fn sweep_surface(
             refined_residual: c.refined_residual,
             curve_points: c.curve_points,
             not_converged: c.not_converged,
+            curves: c.curves,
+            certified: truth.certified,
+            certify_ms: truth.certify_ms,
         });
         drop(out);
         progress(&format!("{name}: uniform grids at {tolerance:.0e}"));
@@ -242,14 +261,24 @@ pub fn sweep_surface(
             refined_residual: c.refined_residual,
             curve_points: c.curve_points,
             not_converged: c.not_converged,
+            curves: c.curves,
+            certified: truth.certified,
+            certify_ms: truth.certify_ms,
         });
     }
     Ok(rows)
 }
 
+/// A surface's certified curves, for its rows ([`Row::certified`], [`Row::certify_ms`]).
+struct Truth {
+    certified: Option<[usize; 2]>,
+    certify_ms: f64,
+}
+
 /// What a mesh's curves cost and how far they are from the surface's: [`Row`]'s curve
 /// columns.
 struct MeshCurves {
+    curves: [usize; 2],
     curve_ms: f64,
     refine_ms: f64,
     curve_error: f64,
@@ -285,6 +314,7 @@ fn mesh_curves(surface: &Surface, mesh: &Mesh4, view: &View) -> Result<MeshCurve
     let r = refined.report.refinement.unwrap_or_default();
     let relative = |x: f64| if diagonal > 0.0 { x / diagonal } else { 0.0 };
     Ok(MeshCurves {
+        curves: [curves.report.closed, curves.report.open],
         curve_ms: curves.report.ms,
         refine_ms: r.refine_ms,
         curve_error: relative(r.max_shift),
@@ -453,16 +483,21 @@ impl<'a> GridSearch<'a> {
 
 /// The columns of [`to_csv`], in order.
 pub const CSV_HEADER: &str = "surface,method,tolerance,triangles,ms,max_error,rms_error,met,grid,\
-curve_ms,refine_ms,curve_error,refined_residual,curve_points,not_converged";
+curve_ms,refine_ms,curve_error,refined_residual,curve_points,not_converged,closed,open,\
+certified_closed,certified_open,certify_ms";
 
 /// The rows as CSV, the columns of [`CSV_HEADER`]: a [`Row`]'s fields in order, `grid` as
-/// `UxV` (empty for adaptive rows).
+/// `UxV` (empty for adaptive rows), `curves` as `closed,open` and `certified` as
+/// `certified_closed,certified_open` (empty where the certificate is not complete).
 pub fn to_csv(rows: &[Row]) -> String {
     let mut out = format!("{CSV_HEADER}\n");
     for r in rows {
         let grid = r.grid.map_or(String::new(), |[u, v]| format!("{u}x{v}"));
+        let certified = r
+            .certified
+            .map_or(",".to_string(), |[c, o]| format!("{c},{o}"));
         out.push_str(&format!(
-            "{},{},{:e},{},{:.3},{:.6e},{:.6e},{},{},{:.3},{:.3},{:.6e},{:.6e},{},{}\n",
+            "{},{},{:e},{},{:.3},{:.6e},{:.6e},{},{},{:.3},{:.3},{:.6e},{:.6e},{},{},{},{},{},{:.3}\n",
             r.surface,
             r.method,
             r.tolerance,
@@ -477,7 +512,11 @@ pub fn to_csv(rows: &[Row]) -> String {
             r.curve_error,
             r.refined_residual,
             r.curve_points,
-            r.not_converged
+            r.not_converged,
+            r.curves[0],
+            r.curves[1],
+            certified,
+            r.certify_ms
         ));
     }
     out
@@ -526,10 +565,12 @@ pub fn ratio(rows: &[Row], a: &Row) -> Ratio {
 /// A table for the terminal: per surface and tolerance, both methods and their ratio, then
 /// the adaptive mesh's curves: points, the mesh curve's error and the refined curve's
 /// residual (relative to the projected diagonal; `no curve` where the projection does not
-/// cross itself).
+/// cross itself), and whether its curves are the certified ones (`=`, else its closed/open
+/// counts; `?` where the certificate is not complete); after each surface, its certificate
+/// and what it cost against the curve stage.
 pub fn table(rows: &[Row]) -> String {
     let mut out = format!(
-        "{:<22} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>7} {:>8} {:>9} {:>9}\n",
+        "{:<22} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>7} {:>8} {:>9} {:>9} {:>6}\n",
         "surface",
         "tolerance",
         "adaptive",
@@ -541,7 +582,8 @@ pub fn table(rows: &[Row]) -> String {
         "ratio",
         "crv pts",
         "crv err",
-        "refined"
+        "refined",
+        "truth"
     );
     for a in rows.iter().filter(|r| r.method == "adaptive") {
         let u = rows.iter().find(|r| {
@@ -559,8 +601,13 @@ pub fn table(rows: &[Row]) -> String {
                 format!("{:.1e}", a.refined_residual),
             )
         };
+        let truth = match a.certified {
+            None => "?".to_string(),
+            Some(c) if c == a.curves => "=".to_string(),
+            Some(_) => format!("{}/{}", a.curves[0], a.curves[1]),
+        };
         out.push_str(&format!(
-            "{:<22} {:>9.0e} {:>10} {:>10.1} {:>9.2e}{} {:>10} {:>10.1} {:>9.2e}{} {:>7} {:>8} {:>9} {:>9}\n",
+            "{:<22} {:>9.0e} {:>10} {:>10.1} {:>9.2e}{} {:>10} {:>10.1} {:>9.2e}{} {:>7} {:>8} {:>9} {:>9} {:>6}\n",
             a.surface,
             a.tolerance,
             a.triangles,
@@ -575,9 +622,27 @@ pub fn table(rows: &[Row]) -> String {
             a.curve_points,
             err,
             residual,
+            truth,
         ));
+        let last = rows
+            .iter()
+            .rfind(|r| r.method == "adaptive" && r.surface == a.surface);
+        if last == Some(a) {
+            let curve_ms = a.curve_ms + a.refine_ms;
+            let certified = a.certified.map_or("not complete".to_string(), |[c, o]| {
+                format!("{c} closed and {o} open curves")
+            });
+            out.push_str(&format!(
+                "{:<22} certified: {certified}, in {:.0} ms ({:.1}x the curves and their \
+                 refinement on the adaptive mesh at {:.0e})\n",
+                a.surface,
+                a.certify_ms,
+                a.certify_ms / curve_ms.max(1e-3),
+                a.tolerance
+            ));
+        }
     }
-    out.push_str("(! = tolerance not met within the triangle budget; crv = the adaptive mesh's curves: points, error and refined residual relative to the projected diagonal)\n");
+    out.push_str("(! = tolerance not met within the triangle budget; crv = the adaptive mesh's curves: points, error and refined residual relative to the projected diagonal; truth = its curves those certified on the true surface (=), else its closed/open counts, ? = not certified)\n");
     out
 }
 
@@ -673,6 +738,20 @@ mod tests {
             );
         }
         assert!(table(&rows).contains("no curve"), "{}", table(&rows));
+        // The certificate is the true surface's: the same on both rows. Around the torus's
+        // seams it is not complete here, and the table says so.
+        assert_eq!(rows[0].certified, rows[1].certified);
+        assert_eq!(rows[0].certify_ms, rows[1].certify_ms);
+        assert!(rows.iter().all(|r| r.curves == [0, 0]));
+        let table = table(&rows);
+        let line = table.lines().find(|l| l.contains("certified:")).unwrap();
+        match rows[0].certified {
+            Some(c) => assert!(line.contains(&format!("{} closed", c[0])), "{table}"),
+            None => assert!(
+                line.contains("not complete") && table.contains(" ?"),
+                "{table}"
+            ),
+        }
     }
 
     #[test]
