@@ -12,11 +12,19 @@ if ! command -v Xvfb >/dev/null || ! command -v xdotool >/dev/null; then
 fi
 # A key held 1.5 s repeats twice (after 300 ms, then every second), so the check below can tell
 # one step from a step per repeat whatever the machine's load.
-Xvfb :97 -screen 0 1280x1024x24 -ardelay 300 -arinterval 1000 >/dev/null 2>&1 &
+# Xvfb picks a free display and writes its number once it accepts connections (-displayfd), so
+# a busy machine or a display left over by another run cannot make the viewer start too early.
+displayfile=$(mktemp)
+Xvfb -displayfd 3 -screen 0 1280x1024x24 -ardelay 300 -arinterval 1000 3>"$displayfile" >/dev/null 2>&1 &
 xvfb=$!
-trap 'kill "$xvfb" 2>/dev/null || true' EXIT
-export DISPLAY=:97
-sleep 1
+trap 'kill "$xvfb" 2>/dev/null || true; rm -f "$displayfile"' EXIT
+for _ in $(seq 1 300); do
+  [ -s "$displayfile" ] && break
+  kill -0 "$xvfb" 2>/dev/null || { echo "Xvfb exited before it opened a display"; exit 1; }
+  sleep 0.1
+done
+[ -s "$displayfile" ] || { echo "Xvfb opened no display in 30 s"; exit 1; }
+export DISPLAY=":$(head -n 1 "$displayfile")"
 # Waits for a window of the viewer ($1: its pid) and gives it the keyboard.
 w=
 find_window() {

@@ -13,8 +13,9 @@ use crate::motion::{self, MotionPicture, Polyline, Shape, Slicing};
 use crate::pipeline::Sampled;
 use crate::render::diagram;
 use crate::render::text::compact;
-use crate::sample::Source;
+use crate::sample::{ErrorBound, Mesh4, Sampling, Source};
 use crate::scene::Scene;
+use crate::surfaces::Surface;
 use glam::DVec4;
 use serde::Serialize;
 use std::path::Path;
@@ -29,10 +30,26 @@ const FILM_LINE: f64 = 3.0;
 const FILM_FPS: u32 = 24;
 
 /// Relative tolerances (of the surface's 4D diagonal) at which a catalogue or formula
-/// surface is sampled again, in turn, while its motion picture fails a check that a finer
-/// mesh can pass: a coarse mesh has pairs of critical vertices where the surface has none,
-/// and critical vertices in another order than the surface's critical levels.
+/// surface is sampled again through its critical points, in turn after its own tolerance,
+/// while its motion picture fails a check that a finer mesh can pass: a coarse mesh makes
+/// pairs of critical vertices beside the surface's points that cross other critical levels.
 const FINER: [f64; 3] = [2.5e-4, 6.25e-5, 1.5625e-5];
+
+/// The samplings of a surface whose bounding diagonal is `diagonal`, as (absolute
+/// tolerance, bound, triangle budget), that its motion picture tries in turn while it fails:
+/// the scene's own `sampling` (when adaptive; a mesh through the critical points has its
+/// slices change at the surface's critical levels), then the [`FINER`] tolerances below it.
+fn rungs(sampling: &Sampling, diagonal: f64) -> Vec<(f64, ErrorBound, usize)> {
+    let own = sampling.absolute_tolerance(diagonal).map(|t| {
+        let budget = sampling.max_triangles(1).min(FINER_TRIANGLES);
+        (t, sampling.bound(), budget)
+    });
+    let finer = FINER
+        .iter()
+        .map(|r| (r * diagonal, ErrorBound::Audited, FINER_TRIANGLES))
+        .filter(|f| own.is_none_or(|o| f.0 < o.0));
+    own.into_iter().chain(finer).collect()
+}
 
 /// The most triangles of a surface sampled again.
 const FINER_TRIANGLES: usize = 4_000_000;
@@ -57,15 +74,22 @@ pub struct SurfaceMotion {
     pub direction: DVec4,
     /// The hyperplanes' frame: the stills' x, y and z axes in 4D.
     pub frame: [DVec4; 3],
-    /// The Euler characteristic checked against (`None`: the surface has a boundary and
-    /// nothing is checked).
+    /// The Euler characteristic checked against (`None`: a mesh that is not a manifold,
+    /// whose counts are not checked).
     pub euler: Option<i64>,
-    /// (minima, saddles, maxima, degenerate).
+    /// Whether the surface is closed (else its boundary's critical points count too).
+    pub closed: bool,
+    /// (minima, saddles, maxima, degenerate) inside the surface.
     pub counts: [usize; 4],
+    /// (births, deaths, joins, splits) on its boundary.
+    pub boundary_counts: [usize; 4],
     /// The critical points, by level.
     pub critical_points: Vec<motion::CriticalPoint>,
     /// Critical vertices of the mesh that Newton's method found no critical point from.
     pub not_refined: usize,
+    /// The critical points proven on the surface by interval arithmetic (`None` for a
+    /// mesh read from a file).
+    pub proven: Option<motion::ProvenCritical>,
     /// The slice's components in each interval between critical levels.
     pub components: Vec<usize>,
     /// The stills.
@@ -93,13 +117,16 @@ pub struct FilmFrame {
     pub crossings: usize,
 }
 
-/// A surface sampled again, finer, for its motion picture.
+/// A surface sampled again for its motion picture, through the critical points found on
+/// the mesh before.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct Resampled {
     /// The adaptive sampler's tolerance, relative to the surface's 4D diagonal.
     pub relative_tolerance: f64,
     /// Its triangles.
     pub triangles: usize,
+    /// The critical points it was sampled through.
+    pub through: usize,
 }
 
 /// A still as `motion.json` records it.
@@ -149,11 +176,16 @@ impl Motion {
         let mut out = String::new();
         for s in &self.surfaces {
             let [min, saddle, max, degenerate] = s.counts;
-            let euler = s
-                .euler
-                .map_or("a surface with boundary: not checked".to_string(), |e| {
-                    format!("χ = {e}")
-                });
+            let euler = s.euler.map_or(
+                "χ unknown, a mesh that is not a manifold: not counted".to_string(),
+                |e| format!("χ = {e}"),
+            );
+            let boundary = match s.boundary_counts {
+                [0, 0, 0, 0] if s.closed => String::new(),
+                [b, d, j, k] => {
+                    format!("; on the boundary {b} births, {d} deaths, {j} joins, {k} splits")
+                }
+            };
             if let Some(r) = s.resampled {
                 out += &format!(
                     "{}: sampled again at {:e} of its diagonal ({} triangles) for the checks\n",
@@ -161,7 +193,7 @@ impl Motion {
                 );
             }
             out += &format!(
-                "{}: {min} births, {saddle} saddles, {max} deaths{} ({euler}); components per interval {:?}\n",
+                "{}: {min} births, {saddle} saddles, {max} deaths{}{boundary} ({euler}); components per interval {:?}\n",
                 s.name,
                 if degenerate > 0 {
                     format!(", {degenerate} degenerate")
@@ -184,6 +216,74 @@ impl Motion {
     }
 }
 
+/// The motion picture of `mesh` (sampled from `surface`, where it has one, as `sampling`
+/// says) along `n` with its hyperplanes' `frame`, its surface's `shape` and `extra` evenly
+/// spaced stills ([`motion::motion_picture`]); while it fails a check that a mesh through the
+/// critical points can pass, made again on the surface sampled through those it found, at
+/// the scene's own tolerance (when adaptive), then 2.5e-4, 6.25e-5 and 1.5625e-5 of its
+/// diagonal below it, in turn. Gives the last picture, and the mesh it was made of where
+/// that is not `mesh`; `say` hears each time why the surface is sampled again.
+pub fn motion_through(
+    mesh: &Mesh4,
+    surface: Option<&Surface>,
+    sampling: &Sampling,
+    (n, frame, shape, extra): (DVec4, [DVec4; 3], Shape, usize),
+    say: &mut dyn FnMut(String),
+) -> Result<(MotionPicture, Option<(Resampled, Mesh4)>), FieldError> {
+    let cut = |mesh: &Mesh4, proven| {
+        motion::motion_picture_proven(mesh, surface, proven, n, frame, shape, extra)
+    };
+    let mut picture = cut(mesh, None)?;
+    let mut last = None;
+    let Some(s) = surface else {
+        return Ok((picture, last));
+    };
+    let diagonal = crate::sample::bounding_diagonal(s);
+    for (tolerance, bound, budget) in rungs(sampling, diagonal) {
+        // A degenerate direction stays degenerate on any mesh.
+        if picture.failures.is_empty() || picture.critical.counts()[3] > 0 {
+            break;
+        }
+        let (points, through) = motion::through_points(s, &picture, diagonal);
+        let relative = tolerance / diagonal;
+        say(format!(
+            "{}; sampling again at {relative:.3e} of its diagonal through its {points} \
+             critical points",
+            picture.failures[0],
+        ));
+        let again = crate::sample::sample_adaptive_through(s, tolerance, bound, budget, &through);
+        picture = cut(&again.mesh, picture.proven.take())?;
+        let resampled = Resampled {
+            relative_tolerance: relative,
+            triangles: again.mesh.triangles.len(),
+            through: points,
+        };
+        last = Some((resampled, again.mesh));
+    }
+    Ok((picture, last))
+}
+
+/// The analytic surface of a scene's surface `source` where `mesh` has its parameters (a
+/// scene's own sampling; a mesh read from a file has none), and the topology its motion
+/// picture is checked against: the surface's, else the mesh's (its Euler characteristic
+/// where it is a manifold).
+pub fn surface_shape<'a>(source: &'a Source, mesh: &Mesh4) -> (Option<&'a Surface>, Shape) {
+    match source {
+        Source::Parametric(s) if mesh.triangle_uv.len() == mesh.triangles.len() => {
+            (Some(s), s.topology().into())
+        }
+        _ => {
+            let stats = mesh.validate();
+            let shape = Shape {
+                euler: stats.is_manifold().then_some(stats.euler_characteristic),
+                closed: stats.boundary_edges == 0,
+                orientable: stats.orientation_conflicts == 0,
+            };
+            (None, shape)
+        }
+    }
+}
+
 /// Makes the motion pictures of every surface of `scene` along `slicing` (the scene's
 /// `slicing`, or other settings) into `out` (files written under temporary names and moved
 /// into place together); unless `quiet`, says on stderr when a surface is sampled again
@@ -202,71 +302,25 @@ pub fn slice_scene(
     let staged = Staged::new(out).map_err(staged_error)?;
     let mut surfaces = Vec::new();
     let mut files = Vec::new();
-    for ((name, mesh), entry) in sampled.meshes().zip(&scene.surfaces) {
-        let (surface, shape) = match &entry.surface {
-            Source::Parametric(s) => {
-                let t = s.topology();
-                let euler = if t.closed {
-                    t.euler_characteristic
-                } else {
-                    None
-                };
-                (
-                    Some(s),
-                    Shape {
-                        euler,
-                        orientable: t.orientable,
-                    },
-                )
-            }
-            Source::Mesh(_) => {
-                let stats = mesh.validate();
-                let closed = stats.boundary_edges == 0 && stats.is_manifold();
-                (
-                    None,
-                    Shape {
-                        euler: closed.then_some(stats.euler_characteristic),
-                        orientable: stats.orientation_conflicts == 0,
-                    },
-                )
+    for (index, ((name, mesh), entry)) in sampled.meshes().zip(&scene.surfaces).enumerate() {
+        let (surface, shape) = surface_shape(&entry.surface, mesh);
+        let sampling = scene.surface_sampling(index);
+        let mut say = |m: String| {
+            if !quiet {
+                eprintln!("{name}: {m}");
             }
         };
-        let cut = |mesh: &crate::sample::Mesh4| {
-            motion::motion_picture(mesh, surface, n, frame, shape, slicing.levels)
-                .map_err(SliceError::Setting)
-        };
-        let mut picture = cut(mesh)?;
-        // The finer mesh made, with its relative tolerance, once the scene's fails.
-        let mut finest: Option<(f64, crate::sample::Mesh4)> = None;
-        if let Some(s) = surface {
-            let diagonal = crate::sample::bounding_diagonal(s);
-            for relative in FINER {
-                // A degenerate direction stays degenerate on any mesh.
-                if picture.failures.is_empty() || picture.critical.counts()[3] > 0 {
-                    break;
-                }
-                if !quiet {
-                    eprintln!(
-                        "{name}: {}; sampling again at {relative:e} of its diagonal",
-                        picture.failures[0]
-                    );
-                }
-                let finer = crate::sample::sample_adaptive(s, relative * diagonal, FINER_TRIANGLES);
-                let current = finest.as_ref().map_or(mesh, |f| &f.1);
-                // A scene sampled finer already keeps its mesh.
-                if finer.mesh.triangles.len() <= current.triangles.len() {
-                    continue;
-                }
-                picture = cut(&finer.mesh)?;
-                finest = Some((relative, finer.mesh));
-            }
-        }
+        let (picture, finest) = motion_through(
+            mesh,
+            surface,
+            sampling,
+            (n, frame, shape, slicing.levels),
+            &mut say,
+        )
+        .map_err(SliceError::Setting)?;
         let (mut record, written) = write_surface(scene, name, &picture, shape, &staged)?;
         files.extend(written);
-        record.resampled = finest.as_ref().map(|(relative_tolerance, m)| Resampled {
-            relative_tolerance: *relative_tolerance,
-            triangles: m.triangles.len(),
-        });
+        record.resampled = finest.as_ref().map(|f| f.0);
         if slicing.film > 0 {
             let mesh = finest.as_ref().map_or(mesh, |f| &f.1);
             let (frames, failures, file) =
@@ -374,9 +428,12 @@ fn write_surface(
         direction: critical.direction,
         frame: picture.frame,
         euler: shape.euler,
+        closed: shape.closed,
         counts: critical.counts(),
+        boundary_counts: critical.boundary_counts(),
         critical_points: critical.points.clone(),
         not_refined: critical.not_converged.len(),
+        proven: picture.proven.clone(),
         components: picture.components.clone(),
         stills,
         failures: picture.failures.clone(),

@@ -382,3 +382,53 @@ fn scene_sampling_takes_relative_and_absolute_tolerances() {
     let grid = sample(&s, &Sampling::Uniform { u: 8, v: 6 });
     assert_eq!((grid.tolerance, grid.mesh.triangles.len()), (None, 96));
 }
+
+#[test]
+fn a_mesh_sampled_through_points_has_a_vertex_at_each_and_keeps_its_topology() {
+    // Points inside the spun trefoil's tiles (at a tolerance that cuts it into tiles, and at
+    // one that does not), one on a side (left out): each point inside is a vertex at its
+    // surface point, the tolerance is still met, and the mesh stays a closed sphere.
+    use halo4d::sample::{ErrorBound, sample_adaptive_through};
+    let surface = Surface::SpunTrefoil(SpunTrefoil::default());
+    let d = bounding_diagonal(&surface);
+    let domain = surface.domain(0);
+    let at = |s: f64, t: f64| {
+        let u = domain.u[0] + (domain.u[1] - domain.u[0]) * s;
+        let v = domain.v[0] + (domain.v[1] - domain.v[0]) * t;
+        (0usize, [u, v])
+    };
+    let inside = [at(0.123, 0.456), at(0.71, 0.29), at(0.5001, 0.9)];
+    for relative in [1e-3, 5e-5] {
+        let through: Vec<_> = inside.iter().copied().chain([at(0.0, 0.3)]).collect();
+        let out = sample_adaptive_through(
+            &surface,
+            relative * d,
+            ErrorBound::Audited,
+            2_000_000,
+            &through,
+        );
+        assert!(out.complete, "at {relative}");
+        let stats = out.mesh.validate();
+        assert!(
+            stats.is_manifold() && stats.boundary_edges == 0,
+            "at {relative}"
+        );
+        assert_eq!(stats.euler_characteristic, 2, "at {relative}");
+        assert_eq!(stats.orientation_conflicts, 0, "at {relative}");
+        for &(patch, [u, v]) in &inside {
+            let p = surface.point(patch, u, v);
+            let nearest = out
+                .mesh
+                .positions
+                .iter()
+                .map(|q| q.distance(p))
+                .fold(f64::INFINITY, f64::min);
+            assert!(nearest <= 1e-12 * d, "at {relative}: {nearest}");
+        }
+        // The same without the points has no vertex there.
+        let plain = sample_adaptive(&surface, relative * d, 2_000_000).mesh;
+        let (patch, [u, v]) = inside[0];
+        let p = surface.point(patch, u, v);
+        assert!(plain.positions.iter().all(|q| q.distance(p) > 1e-9 * d));
+    }
+}

@@ -258,7 +258,18 @@ fn the_explorer_shows_the_slices_halo4d_slice_makes_over_the_surfaces() {
     let motion =
         halo4d::slicing::slice_scene(&scene, scene.slicing.unwrap(), dir.path(), true).unwrap();
     let surface = &motion.surfaces[0];
-    assert!(surface.resampled.is_none(), "made on the scene's own mesh");
+    // The scene's mesh changes its slices off the surface's critical levels: both cut the
+    // surface sampled again through its critical points, and the explorer says so.
+    let again = surface
+        .resampled
+        .expect("sampled again through its critical points");
+    assert_eq!(
+        plane.notes,
+        [format!(
+            "spun_trefoil sliced as sampled again at {:.3e} of its diagonal ({} triangles)",
+            again.relative_tolerance, again.triangles
+        )]
+    );
     assert!((plane.direction - surface.direction).length() < 1e-15);
     let levels = |points: &[halo4d::motion::CriticalPoint]| -> Vec<(String, f64)> {
         points
@@ -269,7 +280,7 @@ fn the_explorer_shows_the_slices_halo4d_slice_makes_over_the_surfaces() {
     assert_eq!(levels(&plane.critical), levels(&surface.critical_points));
     assert!(surface.stills.len() >= 5);
     for still in &surface.stills {
-        plane.move_to(&model, still.level);
+        plane.move_to(still.level);
         let curves: usize = plane.slices.iter().map(|s| s.curves.len()).sum();
         assert_eq!(curves, still.curves, "at level {}", still.level);
         assert!(plane.slices.iter().all(|s| s.max_residual <= 1e-12));
@@ -288,7 +299,7 @@ fn the_explorer_shows_the_slices_halo4d_slice_makes_over_the_surfaces() {
         "{title}"
     );
     let middle = plane.level;
-    plane.step(&model, 10.0);
+    plane.step(10.0);
     assert_eq!(plane.level, plane.range.1);
     assert!(
         plane
@@ -298,7 +309,7 @@ fn the_explorer_shows_the_slices_halo4d_slice_makes_over_the_surfaces() {
         plane.describe()
     );
     assert!(plane.describe().ends_with("above: nothing"));
-    plane.move_to(&model, middle);
+    plane.move_to(middle);
     // Drawn: every pixel the slice changes lies on a projected slice curve, and there are
     // many, in the slice's magenta.
     let view = scene.view;

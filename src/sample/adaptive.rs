@@ -609,7 +609,25 @@ pub fn sample_adaptive_to(
     bound: ErrorBound,
     max_triangles: usize,
 ) -> AdaptiveMesh {
+    sample_adaptive_through(surface, tolerance, bound, max_triangles, &[])
+}
+
+/// [`sample_adaptive_to`] with a vertex at each of the points `through` (a patch and its
+/// parameters) that lies inside a tile or on an open side: inserted into the starting
+/// grids, so that the refinement grades the mesh around them. A point on a glued side of a
+/// tile (a seam, a pole) or at a corner is left out: a side point off the sides' dyadic
+/// fractions would not weld.
+/// The motion pictures sample through the critical points of their heights, so that the
+/// mesh's slices change at the surface's critical levels.
+pub fn sample_adaptive_through(
+    surface: &Surface,
+    tolerance: f64,
+    bound: ErrorBound,
+    max_triangles: usize,
+    through: &[(usize, [f64; 2])],
+) -> AdaptiveMesh {
     let mut sampler = Sampler::new(surface, tolerance * (1.0 - 1e-9), bound, max_triangles);
+    sampler.insert_through(through);
     let complete = sampler.refine(max_triangles);
     let failing = if complete { 0 } else { sampler.count_failing() };
     AdaptiveMesh {
@@ -965,6 +983,37 @@ impl<'a> Sampler<'a> {
 
     fn triangles(&self) -> usize {
         self.patches.iter().map(|p| p.cdt.num_inner_faces()).sum()
+    }
+
+    /// Inserts each of the points `through` that lies strictly inside a tile
+    /// ([`sample_adaptive_through`]), and checks the triangles around it.
+    fn insert_through(&mut self, through: &[(usize, [f64; 2])]) {
+        if through.is_empty() {
+            return;
+        }
+        for &(patch, [u, v]) in through {
+            let inside = |r: [f64; 2], x: f64| (x - r[0]) / (r[1] - r[0]);
+            let tile = self.patches.iter_mut().find_map(|p| {
+                let st = [inside(p.domain.u, u), inside(p.domain.v, v)];
+                // Strictly inside, or on an open side (which welds to nothing) and
+                // strictly inside along it.
+                let open = |s: Side| matches!(p.domain.side(s), SideRule::Open);
+                let within = |x: f64| x > 0.0 && x < 1.0;
+                let on = |x: f64, low: Side, high: Side| {
+                    within(x) || (x == 0.0 && open(low)) || (x == 1.0 && open(high))
+                };
+                let fits = (within(st[0]) && on(st[1], Side::V0, Side::V1))
+                    || (within(st[1]) && on(st[0], Side::U0, Side::U1));
+                (p.of == patch && fits).then_some((p, st))
+            });
+            if let Some((p, st)) = tile {
+                p.add(self.surface, st, None);
+            }
+        }
+        let (surface, tolerance) = (self.surface, self.tolerance);
+        self.patches
+            .par_iter_mut()
+            .for_each(|p| p.settle(surface, tolerance));
     }
 
     /// Empties the outboxes: inserts the images of every new side point on the sides glued

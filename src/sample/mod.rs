@@ -21,7 +21,7 @@ mod proven;
 mod source;
 mod uniform;
 
-pub use adaptive::{metric_aspect, sample_adaptive, sample_adaptive_to};
+pub use adaptive::{metric_aspect, sample_adaptive, sample_adaptive_through, sample_adaptive_to};
 pub use audit::{AUDIT_POINTS, Audit, audit};
 pub use proven::{Proof, corner_error, prove, triangle_bound};
 pub use source::{MeshData4, MeshSurface, Source, mesh_from_data, mesh_tangents, mesh_topology};
@@ -121,6 +121,27 @@ impl Sampling {
         }
     }
 
+    /// The absolute tolerance of an adaptive sampling of a surface whose bounding diagonal
+    /// is `diagonal`; `None` for a grid.
+    pub fn absolute_tolerance(&self, diagonal: f64) -> Option<f64> {
+        match *self {
+            Sampling::Adaptive {
+                tolerance,
+                absolute_tolerance,
+                ..
+            } => Some(absolute(tolerance, absolute_tolerance, diagonal)),
+            Sampling::Uniform { .. } => None,
+        }
+    }
+
+    /// The bound an adaptive sampling holds its triangles to (a grid's is audited).
+    pub fn bound(&self) -> ErrorBound {
+        match *self {
+            Sampling::Adaptive { bound, .. } => bound,
+            Sampling::Uniform { .. } => ErrorBound::Audited,
+        }
+    }
+
     /// The most triangles a surface of `patches` patches can get.
     pub fn max_triangles(&self, patches: usize) -> usize {
         match *self {
@@ -183,6 +204,12 @@ pub struct Sampled {
     pub complete: bool,
 }
 
+/// The absolute tolerance of an adaptive sampling's settings: `absolute` where given, else
+/// `relative` (or [`DEFAULT_TOLERANCE`]) of the surface's `diagonal`.
+fn absolute(relative: Option<f64>, absolute: Option<f64>, diagonal: f64) -> f64 {
+    absolute.unwrap_or(relative.unwrap_or(DEFAULT_TOLERANCE) * diagonal)
+}
+
 /// Samples a surface as `sampling` says.
 pub fn sample(surface: &Surface, sampling: &Sampling) -> Sampled {
     let diagonal = bounding_diagonal(surface);
@@ -199,8 +226,7 @@ pub fn sample(surface: &Surface, sampling: &Sampling) -> Sampled {
             max_triangles,
             bound,
         } => {
-            let tolerance =
-                absolute_tolerance.unwrap_or(tolerance.unwrap_or(DEFAULT_TOLERANCE) * diagonal);
+            let tolerance = absolute(tolerance, absolute_tolerance, diagonal);
             let out = sample_adaptive_to(surface, tolerance, bound, max_triangles);
             Sampled {
                 mesh: out.mesh,

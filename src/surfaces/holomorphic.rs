@@ -331,11 +331,15 @@ impl Parametric for Fermat {
         let z2 = power(s) * unit_root(k2, n);
         DVec4::new(z1.re, z2.re, z1.im, z2.im)
     }
+    /// The affine curve z1^n + z2^n = 1 is a closed surface of genus (n - 1)(n - 2)/2
+    /// without its n points at infinity; the strip keeps it but a disc around each:
+    /// χ = 2 - (n - 1)(n - 2) - n = n (2 - n).
     fn topology(&self) -> Topology {
+        let n = i64::from(self.n);
         Topology {
             closed: false,
             orientable: true,
-            euler_characteristic: None,
+            euler_characteristic: Some(n * (2 - n)),
         }
     }
     fn check(&self) -> Result<(), FieldError> {
@@ -381,11 +385,12 @@ impl Parametric for ProductPolynomial {
         let f = Cx::unit(-v) * ((-u).exp() * sign);
         enclosure([e, e, e], [f, -f, f])
     }
+    /// Two annuli.
     fn topology(&self) -> Topology {
         Topology {
             closed: false,
             orientable: true,
-            euler_characteristic: None,
+            euler_characteristic: Some(0),
         }
     }
     fn check(&self) -> Result<(), FieldError> {

@@ -222,7 +222,7 @@ pub struct Topology {
     pub closed: bool,
     /// Whether the surface is orientable.
     pub orientable: bool,
-    /// The Euler characteristic, for closed surfaces.
+    /// The Euler characteristic (of the surface with its boundary, where it has one).
     pub euler_characteristic: Option<i64>,
 }
 

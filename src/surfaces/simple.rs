@@ -277,11 +277,12 @@ impl Parametric for Patches {
     fn enclose(&self, patch: usize, u: Interval, v: Interval) -> [Jet<Interval>; 4] {
         self.jets(patch, Jet::u(u), Jet::v(v))
     }
+    /// Discs apart.
     fn topology(&self) -> Topology {
         Topology {
             closed: false,
             orientable: true,
-            euler_characteristic: None,
+            euler_characteristic: Some(self.patch_count() as i64),
         }
     }
     fn check(&self) -> Result<(), FieldError> {

@@ -295,16 +295,19 @@ impl Model {
 }
 
 /// The explorer's moving hyperplane ⟨n, x⟩ = level: the slices of a model's surfaces as
-/// `halo4d slice` makes them ([`crate::motion::slice`]: the points moved onto the surfaces
-/// where the mesh has their parameters), with the surfaces' critical levels, so that the
-/// title can say between which events the level lies.
+/// `halo4d slice` makes them ([`crate::slicing::motion_through`]: on the mesh its motion
+/// picture is made of, sampled again through the surface's critical points where the
+/// scene's mesh changes its slices elsewhere; the points moved onto the surfaces where the
+/// mesh has their parameters), with the surfaces' critical levels, so that the title can
+/// say between which events the level lies.
 #[derive(Clone, Debug)]
 pub struct Hyperplane {
     /// The unit direction n, in the surfaces' own coordinates: the scene's `slicing`'s
     /// direction (the one `halo4d slice` cuts along), fixed while the view turns.
     pub direction: DVec4,
-    /// The lowest and highest of h = ⟨n, x⟩ over the surfaces' vertices and critical
-    /// points: the levels the hyperplane moves between.
+    /// The lowest and (one float above) the highest of h = ⟨n, x⟩ over the surfaces'
+    /// vertices and critical points: the levels the hyperplane moves between, where its
+    /// slice is empty.
     pub range: (f64, f64),
     /// Every surface's critical points, merged by level.
     pub critical: Vec<crate::motion::CriticalPoint>,
@@ -312,48 +315,59 @@ pub struct Hyperplane {
     pub level: f64,
     /// Each surface's slice at the level.
     pub slices: Vec<crate::motion::Slice>,
+    /// Each surface sampled again for its slices (as `halo4d slice` samples it), said in a
+    /// line.
+    pub notes: Vec<String>,
+    /// Each surface's mesh that is cut, with its analytic surface where it has one.
+    cut: Vec<(Mesh4, Option<crate::surfaces::Surface>)>,
 }
 
 impl Model {
-    /// Each surface's 4D mesh with its analytic surface where the mesh has its parameters
-    /// (a scene's own sampling; a mesh read from a `.glb` has none).
-    fn with_surfaces(&self) -> impl Iterator<Item = (&Mesh4, Option<&crate::surfaces::Surface>)> {
-        self.surfaces
-            .iter()
-            .zip(&self.scene.surfaces)
-            .map(|((_, mesh), entry)| {
-                let surface = match &entry.surface {
-                    crate::sample::Source::Parametric(s)
-                        if mesh.triangle_uv.len() == mesh.triangles.len() =>
-                    {
-                        Some(s)
-                    }
-                    _ => None,
-                };
-                (mesh, surface)
-            })
-    }
-
     /// The hyperplane of the scene's `slicing` (as `halo4d slice` takes it: its direction,
     /// else the one the scene's view turns onto w, tilted by its `perturb`) at `level`, or
     /// at the middle of the surfaces' heights; a level outside them is refused, with them.
     pub fn hyperplane(&self, level: Option<f64>) -> Result<Hyperplane, ViewerError> {
         let slicing = self.scene.slicing.unwrap_or_default();
-        let (direction, _) = slicing.direction_and_frame(self.scene.view.rotation.matrix());
+        let (direction, frame) = slicing.direction_and_frame(self.scene.view.rotation.matrix());
         let mut range = (f64::INFINITY, f64::NEG_INFINITY);
         let mut critical = Vec::new();
-        for (mesh, surface) in self.with_surfaces() {
-            let (lo, hi) = crate::motion::heights(mesh, direction);
+        let mut notes = Vec::new();
+        let mut cut = Vec::new();
+        for (index, ((name, mesh), entry)) in
+            self.surfaces.iter().zip(&self.scene.surfaces).enumerate()
+        {
+            let (surface, shape) = crate::slicing::surface_shape(&entry.surface, mesh);
+            let (picture, finest) = crate::slicing::motion_through(
+                mesh,
+                surface,
+                self.scene.surface_sampling(index),
+                (direction, frame, shape, 0),
+                &mut |_| {},
+            )
+            .map_err(|e| ViewerError::Setting(e.within("slicing")))?;
+            let mesh = finest.map_or_else(
+                || mesh.clone(),
+                |(again, finer)| {
+                    notes.push(format!(
+                        "{name} sliced as sampled again at {:.3e} of its diagonal ({} triangles)",
+                        again.relative_tolerance, again.triangles
+                    ));
+                    finer
+                },
+            );
+            let (lo, hi) = crate::motion::heights(&mesh, direction);
             range = (range.0.min(lo), range.1.max(hi));
-            let found = crate::motion::critical_points(mesh, surface, direction)
-                .map_err(|e| ViewerError::Setting(e.within("slicing")))?;
-            critical.extend(found.points);
+            critical.extend(picture.critical.points);
+            cut.push((mesh, surface.cloned()));
         }
         critical.sort_by(|a, b| a.level.total_cmp(&b.level));
         // The surfaces' highest point can lie above the mesh's (a refined maximum).
         if let (Some(first), Some(last)) = (critical.first(), critical.last()) {
             range = (range.0.min(first.level), range.1.max(last.level));
         }
+        // A vertex at the level counts as above it: at the highest vertex's own level its
+        // slice is a small loop, one float higher it is empty, as at the lowest.
+        range.1 = range.1.next_up();
         let level = match level {
             None => 0.5 * (range.0 + range.1),
             Some(c) if c >= range.0 && c <= range.1 => c,
@@ -374,25 +388,30 @@ impl Model {
             critical,
             level,
             slices: Vec::new(),
+            notes,
+            cut,
         };
-        plane.move_to(self, plane.level);
+        plane.move_to(plane.level);
         Ok(plane)
     }
 }
 
 impl Hyperplane {
     /// Moves the level to `level` (kept within the surfaces' heights) and slices again.
-    pub fn move_to(&mut self, model: &Model, level: f64) {
+    pub fn move_to(&mut self, level: f64) {
         self.level = level.clamp(self.range.0, self.range.1);
-        self.slices = model
-            .with_surfaces()
-            .map(|(mesh, surface)| crate::motion::slice(mesh, surface, self.direction, self.level))
+        self.slices = self
+            .cut
+            .iter()
+            .map(|(mesh, surface)| {
+                crate::motion::slice(mesh, surface.as_ref(), self.direction, self.level)
+            })
             .collect();
     }
 
     /// Moves the level by `share` of the surfaces' range of heights.
-    pub fn step(&mut self, model: &Model, share: f64) {
-        self.move_to(model, self.level + share * (self.range.1 - self.range.0));
+    pub fn step(&mut self, share: f64) {
+        self.move_to(self.level + share * (self.range.1 - self.range.0));
     }
 
     /// The slices' curves in the 4D `view`, projected as the build projects the surfaces;
@@ -419,8 +438,10 @@ impl Hyperplane {
     /// The level, its curves, and the critical levels either side with their events.
     pub fn describe(&self) -> String {
         let curves: usize = self.slices.iter().map(|s| s.curves.len()).sum();
-        let below = self.critical.iter().rev().find(|p| p.level <= self.level);
-        let above = self.critical.iter().find(|p| p.level > self.level);
+        // As the slice takes a vertex at the level to lie above it, an event at the level
+        // is still to come.
+        let below = self.critical.iter().rev().find(|p| p.level < self.level);
+        let above = self.critical.iter().find(|p| p.level >= self.level);
         let at = |p: Option<&crate::motion::CriticalPoint>, none: &str| {
             p.map_or_else(
                 || none.to_string(),

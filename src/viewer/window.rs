@@ -542,7 +542,7 @@ impl App {
         };
         if let Some(step) = step {
             if let Some(plane) = self.hyperplane.as_mut().filter(|_| self.slice_shown) {
-                plane.step(model, step * SLICE_STEP);
+                plane.step(step * SLICE_STEP);
                 self.slice_drawn = false;
             } else {
                 self.note = "no slice shown: press L first".into();
@@ -557,7 +557,10 @@ impl App {
             "l" => {
                 if self.hyperplane.is_none() {
                     match model.hyperplane(None) {
-                        Ok(plane) => self.hyperplane = Some(plane),
+                        Ok(plane) => {
+                            self.note = plane.notes.join("; ");
+                            self.hyperplane = Some(plane);
+                        }
                         Err(e) => self.note = format!("no slice: {e}"),
                     }
                 }

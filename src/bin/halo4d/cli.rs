@@ -77,11 +77,12 @@ pub enum Command {
     Check(CheckArgs),
     /// A motion picture of each surface of a scene: the surface cut by the hyperplanes
     /// <n, x> = c of the surface's own 4D coordinates, its critical levels (births, saddles,
-    /// deaths) found on the mesh and refined by Newton's method on the exact surface, one
-    /// still between each pair of consecutive critical levels drawn as a link diagram (seen
-    /// from the scene's camera, every under-strand broken), checked by Morse theory: on a
-    /// closed surface #births - #saddles + #deaths = χ, and across each critical level the
-    /// slice's components change as its event says. Writes <name>-motion.png and .svg (the
+    /// deaths; on a boundary, births, deaths, joins and splits of arcs) found on the mesh and
+    /// refined by Newton's method on the exact surface, one still between each pair of
+    /// consecutive critical levels drawn as a link diagram (seen from the scene's camera,
+    /// every under-strand broken), checked by Morse theory: #births - #saddles + #deaths = χ
+    /// (+ #boundary births - #boundary joins on a surface with boundary), and across each
+    /// critical level the slice's components change as its event says. Writes <name>-motion.png and .svg (the
     /// stills in one strip), <name>-motion.glb (their curves as tubes), <name>-still-NN.ply
     /// (each still's curves in the hyperplane's frame) and motion.json.
     ///

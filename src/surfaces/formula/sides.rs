@@ -157,7 +157,7 @@ pub(super) fn topology(kinds: [Kind; 4]) -> Topology {
     Topology {
         closed,
         orientable: !kinds.contains(&Kind::Flip) && !kinds.contains(&Kind::HalfTurn),
-        euler_characteristic: closed.then_some(v - e + 1),
+        euler_characteristic: Some(v - e + 1),
     }
 }
 
@@ -260,8 +260,10 @@ mod tests {
             t([HalfTurn, HalfTurn, Periodic, Periodic]),
             (true, false, Some(0))
         );
-        assert_eq!(t([Open, Open, Periodic, Periodic]), (false, true, None));
-        assert_eq!(t([Open, Open, Flip, Flip]), (false, false, None));
-        assert_eq!(t([Open; 4]), (false, true, None));
+        // With a boundary: an annulus, a Möbius band, a square and a disc (a cap).
+        assert_eq!(t([Open, Open, Periodic, Periodic]), (false, true, Some(0)));
+        assert_eq!(t([Open, Open, Flip, Flip]), (false, false, Some(0)));
+        assert_eq!(t([Open; 4]), (false, true, Some(1)));
+        assert_eq!(t([Pole, Open, Periodic, Periodic]), (false, true, Some(1)));
     }
 }

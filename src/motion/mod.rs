@@ -30,6 +30,11 @@
 //! #minima - #saddles + #maxima = χ, the surface's Euler characteristic
 //! ([`Critical::morse`]).
 
+pub mod boundary;
+pub mod proven;
+
+pub use proven::{ProvenCritical, ProvenPoint};
+
 use crate::limits::{self, FieldError};
 use crate::sample::Mesh4;
 use crate::surfaces::Surface;
@@ -42,6 +47,11 @@ const NEWTON_STEPS: usize = 60;
 /// A refined critical point whose surface gradient (dimensionless: n is a unit vector) is
 /// above this is not converged.
 pub const CRITICAL_RESIDUAL: f64 = 1e-10;
+
+/// A critical vertex whose height is within this share of the mesh's range of heights from
+/// its critical point's level stands on it ([`Critical::faithful`]): rounding, where a
+/// vertex sampled at the point differs from it by about 1e-16.
+const FAITHFUL: f64 = 1e-10;
 
 /// The Hessian's determinant below this share of its squared size is degenerate.
 const DEGENERATE: f64 = 1e-8;
@@ -57,18 +67,70 @@ pub enum Event {
     Saddle,
     /// A maximum: a component dies.
     Death,
+    /// On the boundary, a minimum of h where h rises into the surface: an arc is born at
+    /// the boundary.
+    BoundaryBirth,
+    /// On the boundary, a maximum of h where h falls into the surface: an arc dies at the
+    /// boundary.
+    BoundaryDeath,
+    /// A maximum of h along the boundary where h rises into the surface: two ends of arcs
+    /// meet there and join (two arcs become one, or an arc closes into a loop).
+    BoundaryJoin,
+    /// A minimum of h along the boundary where h falls into the surface: a curve is cut
+    /// there (an arc becomes two, or a loop opens into an arc).
+    BoundarySplit,
     /// The Hessian is singular: no Morse index (a critical circle, a degenerate point).
     Degenerate,
 }
 
 impl Event {
-    /// The Morse index: 0, 1 or 2; `None` when degenerate.
+    /// The Morse index of an interior point: 0, 1 or 2; `None` when degenerate or on the
+    /// boundary.
     pub fn index(self) -> Option<u32> {
         match self {
             Event::Birth => Some(0),
             Event::Saddle => Some(1),
             Event::Death => Some(2),
+            _ => None,
+        }
+    }
+
+    /// Whether it is an event of the boundary.
+    pub fn on_boundary(self) -> bool {
+        matches!(
+            self,
+            Event::BoundaryBirth
+                | Event::BoundaryDeath
+                | Event::BoundaryJoin
+                | Event::BoundarySplit
+        )
+    }
+
+    /// What the point adds to the Euler characteristic in the Morse count (the
+    /// [`boundary`] module's notes): `None` when degenerate.
+    pub fn euler(self) -> Option<i64> {
+        match self {
+            Event::Birth | Event::Death | Event::BoundaryBirth => Some(1),
+            Event::Saddle | Event::BoundaryJoin => Some(-1),
+            Event::BoundaryDeath | Event::BoundarySplit => Some(0),
             Event::Degenerate => None,
+        }
+    }
+
+    /// Whether the slice's components may change by `change` across the point, on a
+    /// surface of `shape`: a birth adds one, a death removes one; a saddle adds or removes
+    /// one, or on a non-orientable surface or one with boundary keeps the count (two arcs
+    /// that cross and reconnect stay two); a join removes one or closes an arc, a split
+    /// adds one or opens a loop.
+    pub fn allows(self, change: i64, shape: Shape) -> bool {
+        match self {
+            Event::Birth | Event::BoundaryBirth => change == 1,
+            Event::Death | Event::BoundaryDeath => change == -1,
+            Event::Saddle if shape.closed && shape.orientable => change.abs() == 1,
+            Event::Saddle => change.abs() <= 1,
+            Event::BoundaryJoin => change == -1 || change == 0,
+            Event::BoundarySplit => change == 1 || change == 0,
+            Event::Degenerate => true,
         }
     }
 
@@ -78,6 +140,10 @@ impl Event {
             Event::Birth => "birth",
             Event::Saddle => "saddle",
             Event::Death => "death",
+            Event::BoundaryBirth => "boundary birth",
+            Event::BoundaryDeath => "boundary death",
+            Event::BoundaryJoin => "boundary join",
+            Event::BoundarySplit => "boundary split",
             Event::Degenerate => "degenerate point",
         }
     }
@@ -115,8 +181,16 @@ pub struct DiscreteCounts {
     pub saddles: usize,
     /// Vertices whose neighbours are all lower.
     pub maxima: usize,
-    /// Vertices on the mesh's boundary, not classified.
-    pub boundary: usize,
+    /// Boundary vertices whose neighbours are all higher.
+    pub boundary_minima: usize,
+    /// Boundary vertices whose neighbours are all lower.
+    pub boundary_maxima: usize,
+    /// Boundary vertices whose two boundary neighbours are lower and some other higher.
+    pub boundary_joins: usize,
+    /// Boundary vertices whose two boundary neighbours are higher and some other lower.
+    pub boundary_splits: usize,
+    /// Vertices where the mesh is not a manifold with boundary, not classified.
+    pub unclassified: usize,
 }
 
 /// The critical points of h = ⟨n, X⟩ on one surface.
@@ -133,37 +207,127 @@ pub struct Critical {
     /// false), by level: pairs that the mesh's coarseness makes, or points the refinement
     /// cannot reach (then the count fails).
     pub not_converged: Vec<CriticalPoint>,
+    /// Critical vertices that Newton's method took onto a point found from another vertex
+    /// as well (one of a pair that the mesh makes beside the surface's point): the point,
+    /// with the vertex it was reached from. Of the vertices reaching a point, the one
+    /// nearest its level is the point's.
+    pub merged: Vec<CriticalPoint>,
 }
 
 impl Critical {
-    /// (minima, saddles, maxima, degenerate) among the points.
+    /// (minima, saddles, maxima, degenerate) among the points inside the surface.
     pub fn counts(&self) -> [usize; 4] {
         let mut c = [0; 4];
         for p in &self.points {
-            c[p.event.index().map_or(3, |i| i as usize)] += 1;
+            match p.event {
+                Event::Birth => c[0] += 1,
+                Event::Saddle => c[1] += 1,
+                Event::Death => c[2] += 1,
+                Event::Degenerate => c[3] += 1,
+                _ => {}
+            }
         }
         c
     }
 
-    /// The Morse check on a closed surface of Euler characteristic `euler`: no point
-    /// degenerate, and #minima - #saddles + #maxima = χ; else what fails.
+    /// (births, deaths, joins, splits) among the points on the boundary.
+    pub fn boundary_counts(&self) -> [usize; 4] {
+        let mut c = [0; 4];
+        for p in &self.points {
+            match p.event {
+                Event::BoundaryBirth => c[0] += 1,
+                Event::BoundaryDeath => c[1] += 1,
+                Event::BoundaryJoin => c[2] += 1,
+                Event::BoundarySplit => c[3] += 1,
+                _ => {}
+            }
+        }
+        c
+    }
+
+    /// Whether the slices of `mesh` (the one the points were found on) change where the
+    /// surface's do: each critical point stands on a critical vertex of its own (its level
+    /// the vertex's, to rounding), so that the mesh's critical levels are the surface's, in
+    /// its order; and every other critical vertex of the mesh is one of a pair the mesh
+    /// makes beside the surface's points: refined onto one of them, or, where the points are
+    /// `all` the surface's (proven), refined onto none. Gives the spans of heights where the
+    /// mesh's slices can hold a small loop the surface's has not (from each such vertex to
+    /// its point, or between two unrefined ones paired by distance): a still's level keeps
+    /// clear of them. Else what differs: points off their vertices (a coarse mesh meets two
+    /// close critical levels in the other order, and its slice between them is not the
+    /// surface's) and vertices refined onto no point.
+    pub fn faithful(&self, mesh: &Mesh4, all: bool) -> Result<Vec<[f64; 2]>, String> {
+        let height = |p: &CriticalPoint| mesh.positions[p.vertex as usize].dot(self.direction);
+        let (lowest, highest) = heights(mesh, self.direction);
+        let rounding = FAITHFUL * (highest - lowest).abs().max(f64::MIN_POSITIVE);
+        let (off, by) = self
+            .points
+            .iter()
+            .map(|p| (height(p) - p.level).abs())
+            .filter(|&d| d > rounding)
+            .fold((0, 0.0f64), |(k, m), d| (k + 1, m.max(d)));
+        let paired = if all {
+            pairs(&self.not_converged)
+        } else {
+            None
+        };
+        let unrefined = if paired.is_some() {
+            0
+        } else {
+            self.not_converged.len()
+        };
+        if off == 0 && unrefined == 0 {
+            let merged = self
+                .merged
+                .iter()
+                .map(|p| [p.level.min(height(p)), p.level.max(height(p))]);
+            return Ok(merged.chain(paired.into_iter().flatten()).collect());
+        }
+        let mut what = Vec::new();
+        if off > 0 {
+            what.push(format!(
+                "{off} critical points stand off the mesh's critical vertices (by up to \
+                 {by:.3e} in height)"
+            ));
+        }
+        if unrefined > 0 {
+            what.push(format!(
+                "{unrefined} critical vertices are refined onto no critical point"
+            ));
+        }
+        Err(format!(
+            "the mesh's slices change elsewhere than the surface's: {}; a still near them \
+             would be the mesh's, not the surface's",
+            what.join(", ")
+        ))
+    }
+
+    /// The Morse check on a surface of Euler characteristic `euler`: no point degenerate,
+    /// and #minima - #saddles + #maxima = χ, with a surface's boundary + #boundary births
+    /// - #boundary joins; else what fails.
     pub fn morse(&self, euler: i64) -> Result<(), String> {
         let [min, saddle, max, degenerate] = self.counts();
+        let [births, _, joins, _] = self.boundary_counts();
         if degenerate > 0 {
             return Err(format!(
                 "{degenerate} degenerate critical point(s): the height is not a Morse \
                  function in this direction; tilt the direction a little"
             ));
         }
-        let sum = min as i64 - saddle as i64 + max as i64;
+        let sum: i64 = self.points.iter().filter_map(|p| p.event.euler()).sum();
         if sum != euler {
             let unrefined = match self.not_converged.len() {
                 0 => String::new(),
                 k => format!(" ({k} critical vertices of the mesh not refined)"),
             };
+            let boundary = if births + joins > 0 {
+                format!(" + {births} boundary births - {joins} boundary joins")
+            } else {
+                String::new()
+            };
             return Err(format!(
-                "{min} minima - {saddle} saddles + {max} maxima = {sum}, not the Euler \
-                 characteristic {euler}{unrefined}"
+                "{min} minima - {saddle} saddles + {max} maxima{boundary} = {sum}, not the \
+                 Euler characteristic {euler}{unrefined}"
             ));
         }
         Ok(())
@@ -194,6 +358,7 @@ pub fn critical_points(
         .map_or(1.0, |(lo, hi)| (hi - lo).length().max(f64::MIN_POSITIVE));
     let mut points: Vec<CriticalPoint> = Vec::new();
     let mut not_converged = Vec::new();
+    let mut merged = Vec::new();
     for (vertex, event) in found {
         let v = vertex as usize;
         let start = CriticalPoint {
@@ -207,23 +372,26 @@ pub fn critical_points(
             vertex,
             refined: false,
         };
-        let point = match surface {
-            None => start,
-            Some(s) => match newton(s, n, start) {
-                Some(p) => p,
-                None => {
-                    not_converged.push(start);
-                    continue;
-                }
-            },
+        let refined = match surface {
+            None => Some(start),
+            // A boundary vertex is refined along its side, an interior one in the plane.
+            Some(s) if event.on_boundary() => boundary::newton(s, n, start),
+            Some(s) => newton(s, n, start),
         };
-        // Refined onto a point reached from another vertex already: one point.
-        let same = point.refined
-            && points
-                .iter()
-                .any(|q| q.point.distance(point.point) <= 1e-9 * diagonal);
-        if !same {
-            points.push(point);
+        let Some(point) = refined else {
+            not_converged.push(start);
+            continue;
+        };
+        // Refined onto a point reached from another vertex already: one point, the vertex
+        // nearest its level its own (the one sampled at it, on a mesh sampled through it).
+        let off = |p: &CriticalPoint| (h[p.vertex as usize] - p.level).abs();
+        let same = points
+            .iter_mut()
+            .find(|q| point.refined && q.point.distance(point.point) <= 1e-9 * diagonal);
+        match same {
+            Some(q) if off(&point) < off(q) => merged.push(std::mem::replace(q, point)),
+            Some(_) => merged.push(point),
+            None => points.push(point),
         }
     }
     let by_level = |a: &CriticalPoint, b: &CriticalPoint| {
@@ -231,11 +399,13 @@ pub fn critical_points(
     };
     points.sort_by(by_level);
     not_converged.sort_by(by_level);
+    merged.sort_by(by_level);
     Ok(Critical {
         direction: n,
         points,
         discrete,
         not_converged,
+        merged,
     })
 }
 
@@ -260,11 +430,19 @@ fn critical_vertices(mesh: &Mesh4, h: &[f64]) -> (Vec<(u32, Event)>, DiscreteCou
             *edges.entry((v.min(a), v.max(a))).or_default() += 1;
         }
     }
-    let mut boundary = vec![false; nv];
+    // A boundary vertex's link is a path between its two neighbours along the boundary.
+    let mut links: std::collections::HashMap<u32, Vec<[u32; 2]>> = std::collections::HashMap::new();
     for (&(a, b), &count) in &edges {
         if count != 2 {
-            boundary[a as usize] = true;
-            boundary[b as usize] = true;
+            links.entry(a).or_default();
+            links.entry(b).or_default();
+        }
+    }
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            if let Some(link) = links.get_mut(&t[k]) {
+                link.push([t[(k + 1) % 3], t[(k + 2) % 3]]);
+            }
         }
     }
     let mut counts = DiscreteCounts::default();
@@ -273,23 +451,39 @@ fn critical_vertices(mesh: &Mesh4, h: &[f64]) -> (Vec<(u32, Event)>, DiscreteCou
         if !used[v] {
             continue;
         }
-        if boundary[v] {
-            counts.boundary += 1;
-            continue;
-        }
-        let event = match changes[v] {
-            0 if !lower[v] => {
-                counts.minima += 1;
-                Event::Birth
+        let event = if let Some(link) = links.get(&(v as u32)) {
+            let Some((event, saddles)) = boundary_event(v as u32, link, &edges, &above) else {
+                counts.unclassified += 1;
+                continue;
+            };
+            counts.saddles += saddles;
+            let Some(event) = event else {
+                continue;
+            };
+            match event {
+                Event::BoundaryBirth => counts.boundary_minima += 1,
+                Event::BoundaryDeath => counts.boundary_maxima += 1,
+                Event::BoundaryJoin => counts.boundary_joins += 1,
+                Event::BoundarySplit => counts.boundary_splits += 1,
+                // A saddle beside the boundary is counted with its multiplicity above.
+                _ => {}
             }
-            0 => {
-                counts.maxima += 1;
-                Event::Death
-            }
-            2 => continue,
-            c => {
-                counts.saddles += (c / 2 - 1) as usize;
-                Event::Saddle
+            event
+        } else {
+            match changes[v] {
+                0 if !lower[v] => {
+                    counts.minima += 1;
+                    Event::Birth
+                }
+                0 => {
+                    counts.maxima += 1;
+                    Event::Death
+                }
+                2 => continue,
+                c => {
+                    counts.saddles += (c / 2 - 1) as usize;
+                    Event::Saddle
+                }
             }
         };
         found.push((v as u32, event));
@@ -297,36 +491,85 @@ fn critical_vertices(mesh: &Mesh4, h: &[f64]) -> (Vec<(u32, Event)>, DiscreteCou
     (found, counts)
 }
 
+/// The event of boundary vertex `v` from its link's edges (its triangles' far sides), with
+/// the saddles it holds besides (a link that goes below and above more often than its
+/// event needs); `None` where the link is not one path between two boundary neighbours
+/// (the mesh is not a manifold there). Walking the path, the runs of lower neighbours
+/// decide: both ends higher, none a boundary minimum, one a split; both ends lower, one
+/// run a boundary maximum, two a join; the ends apart, one run regular. Each run more is
+/// a saddle.
+fn boundary_event(
+    v: u32,
+    link: &[[u32; 2]],
+    edges: &std::collections::HashMap<(u32, u32), u32>,
+    above: &impl Fn(u32, u32) -> bool,
+) -> Option<(Option<Event>, usize)> {
+    let ends: Vec<u32> = link
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|&a| edges.get(&(v.min(a), v.max(a))) == Some(&1))
+        .collect();
+    let [start, end] = ends[..] else {
+        return None;
+    };
+    // Walk the path from `start`: each edge used once.
+    let mut used = vec![false; link.len()];
+    let mut path = vec![start];
+    let mut at = start;
+    while at != end {
+        let k = (0..link.len()).find(|&k| !used[k] && link[k].contains(&at))?;
+        used[k] = true;
+        at = if link[k][0] == at {
+            link[k][1]
+        } else {
+            link[k][0]
+        };
+        path.push(at);
+    }
+    if used.iter().any(|u| !u) {
+        return None;
+    }
+    let below: Vec<bool> = path.iter().map(|&a| !above(a, v)).collect();
+    let runs = below
+        .iter()
+        .enumerate()
+        .filter(|&(k, &b)| b && (k == 0 || !below[k - 1]))
+        .count();
+    let (first, last) = (below[0], below[below.len() - 1]);
+    Some(match (first, last) {
+        (false, false) if runs == 0 => (Some(Event::BoundaryBirth), 0),
+        (false, false) => (Some(Event::BoundarySplit), runs - 1),
+        (true, true) if runs == 1 => (Some(Event::BoundaryDeath), 0),
+        (true, true) => (Some(Event::BoundaryJoin), runs - 2),
+        _ if runs == 1 => (None, 0),
+        _ => (Some(Event::Saddle), runs - 1),
+    })
+}
+
 /// Newton's method on ∇h = 0 from `start`'s parameters; the refined point with its event
 /// from the Hessian, or `None` when it leaves the surface's domain, meets a singular step
 /// or does not converge.
 fn newton(surface: &Surface, n: DVec4, start: CriticalPoint) -> Option<CriticalPoint> {
     let (mut patch, [mut u, mut v]) = (start.patch, start.uv);
-    // Once converged, a few more steps take the residual down to rounding; the best point
-    // is kept.
-    let (mut best, mut polish): (Option<CriticalPoint>, usize) = (None, 0);
+    let mut polish = Polish::default();
     for _ in 0..NEWTON_STEPS {
         let e = surface.eval(patch, u, v);
         let g = [n.dot(e.du), n.dot(e.dv)];
         let hess = [n.dot(e.duu), n.dot(e.duv), n.dot(e.dvv)];
         let residual = surface_gradient(e.du, e.dv, g);
-        if residual <= CRITICAL_RESIDUAL && best.is_none_or(|b| residual < b.residual) {
-            best = Some(CriticalPoint {
-                event: event_of(hess),
-                level: n.dot(e.p),
-                patch,
-                uv: [u, v],
-                point: e.p,
-                residual,
-                refined: true,
-                ..start
-            });
-        }
-        if best.is_some() {
-            polish += 1;
-            if polish > 3 || residual == 0.0 {
-                break;
-            }
+        let done = polish.offer(residual, || CriticalPoint {
+            event: event_of(hess),
+            level: n.dot(e.p),
+            patch,
+            uv: [u, v],
+            point: e.p,
+            residual,
+            refined: true,
+            ..start
+        });
+        if done {
+            break;
         }
         let det = hess[0] * hess[2] - hess[1] * hess[1];
         if det == 0.0 || !det.is_finite() {
@@ -340,7 +583,30 @@ fn newton(surface: &Surface, n: DVec4, start: CriticalPoint) -> Option<CriticalP
         }
         (patch, u, v) = (p, nu, nv);
     }
-    best
+    polish.best
+}
+
+/// The best converged point of a Newton iteration: once one converges, a few more steps
+/// take the residual down to rounding, and the best point is kept.
+#[derive(Default)]
+struct Polish {
+    best: Option<CriticalPoint>,
+    steps: usize,
+}
+
+impl Polish {
+    /// Offers the point of this step, of residual `residual` (made only where it converged
+    /// and beats the best); whether to stop.
+    fn offer(&mut self, residual: f64, point: impl FnOnce() -> CriticalPoint) -> bool {
+        if residual <= CRITICAL_RESIDUAL && self.best.is_none_or(|b| residual < b.residual) {
+            self.best = Some(point());
+        }
+        if self.best.is_none() {
+            return false;
+        }
+        self.steps += 1;
+        self.steps > 3 || residual == 0.0
+    }
 }
 
 /// The norm of h's gradient on the surface from its coordinate gradient `g` (with the
@@ -660,12 +926,25 @@ pub type Polyline = (Vec<glam::DVec3>, bool);
 /// What is known of a surface's topology for the motion picture's checks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Shape {
-    /// The Euler characteristic of a closed surface; `None` for a surface with boundary,
-    /// whose counts are not checked.
+    /// The Euler characteristic the critical points are counted against; `None` where it is
+    /// not known (a mesh that is not a manifold), and nothing is counted.
     pub euler: Option<i64>,
+    /// Whether the surface is closed (else the critical points of its boundary count too).
+    pub closed: bool,
     /// Whether it is orientable (a saddle of a non-orientable surface may keep the slice's
     /// number of components).
     pub orientable: bool,
+}
+
+impl From<crate::surfaces::Topology> for Shape {
+    /// A catalogue or formula surface's own topology.
+    fn from(t: crate::surfaces::Topology) -> Shape {
+        Shape {
+            euler: t.euler_characteristic,
+            closed: t.closed,
+            orientable: t.orientable,
+        }
+    }
 }
 
 /// One still of a motion picture: the slice at a regular level.
@@ -700,6 +979,8 @@ pub struct MotionPicture {
     pub failures: Vec<String>,
     /// The surface's topology the checks took.
     pub shape: Shape,
+    /// The critical points proven on the surface ([`proven::prove`]), where it has one.
+    pub proven: Option<ProvenCritical>,
 }
 
 impl Still {
@@ -725,20 +1006,41 @@ impl Still {
 /// still in each interval between consecutive critical levels and `extra` more at evenly
 /// spaced levels between the lowest and the highest, and the checks:
 ///
-/// - on a closed surface, #minima - #saddles + #maxima = χ ([`Critical::morse`]);
+/// - #minima - #saddles + #maxima = χ, on a surface with boundary + #boundary births -
+///   #boundary joins ([`Critical::morse`]);
 /// - across each critical level the slice's number of components changes as the event
-///   says: a birth adds one, a death removes one, a saddle adds or removes one (or, on a
-///   non-orientable surface, keeps the count);
-/// - each evenly spaced still has its interval's number of components.
+///   says ([`Event::allows`]);
+/// - each evenly spaced still has its interval's number of components;
+/// - the mesh is faithful to the surface ([`Critical::faithful`]): its slices change at the
+///   surface's critical levels and nowhere else (sample it through the critical points,
+///   [`through_points`]);
+/// - its critical points are the ones proven on the surface ([`proven::prove`],
+///   [`ProvenCritical::agrees`]): none missed between the mesh's vertices.
 ///
-/// The mesh's slice changes where its critical vertices are, and the refined levels lie
-/// near them: a still's level keeps clear of both (the middle of the gap between one
-/// critical point's higher and the next one's lower level), and an evenly spaced level
-/// that falls between a critical point's two levels is not checked. A surface with
-/// boundary (its shape's `euler` `None`) gets the stills, its end intervals' too, without the checks.
+/// The mesh's slice changes where its critical vertices are: on a mesh that is not
+/// faithful, the refined levels lie near them, a still's level keeps clear of both (the
+/// middle of the gap between one critical point's higher and the next one's lower level),
+/// and an evenly spaced level that falls between a critical point's two levels is not
+/// checked. A surface whose χ is unknown (its shape's `euler` `None`: a mesh that is not a
+/// manifold) gets the stills and only the last two checks.
 pub fn motion_picture(
     mesh: &Mesh4,
     surface: Option<&Surface>,
+    n: DVec4,
+    frame: [DVec4; 3],
+    shape: Shape,
+    extra: usize,
+) -> Result<MotionPicture, FieldError> {
+    motion_picture_proven(mesh, surface, None, n, frame, shape, extra)
+}
+
+/// [`motion_picture`] with the critical points proven on the surface already (by
+/// [`proven::prove`] along the same direction, normalized): the proof does not depend on
+/// the mesh, and a surface sampled again keeps it.
+pub fn motion_picture_proven(
+    mesh: &Mesh4,
+    surface: Option<&Surface>,
+    proven: Option<ProvenCritical>,
     n: DVec4,
     frame: [DVec4; 3],
     shape: Shape,
@@ -770,16 +1072,31 @@ pub fn motion_picture(
         .collect();
     bands.sort_by(|a, b| a.vertex.total_cmp(&b.vertex));
     let cut = |c: f64| slice(mesh, surface, n, c);
-    let closed = shape.euler.is_some();
     let (lowest, highest) = heights(mesh, n);
     let mut stills = Vec::new();
     let mut components = Vec::with_capacity(bands.len() + 1);
-    let mut failures = Vec::new();
+    let proven = proven.or_else(|| surface.map(|s| proven::prove(s, n, proven::BUDGET)));
+    let agrees = proven.as_ref().map(|p| p.agrees(&critical));
+    // Where the points found are all the surface's, a vertex refined onto none is one of
+    // a pair the mesh makes.
+    let all = proven.as_ref().is_some_and(|p| p.complete) && matches!(agrees, Some(Ok(())));
+    let (spans, mut failures) = match critical.faithful(mesh, all) {
+        Ok(spans) => (spans, Vec::new()),
+        Err(e) => (Vec::new(), vec![e]),
+    };
+    failures.extend(agrees.and_then(Result::err));
     for k in 0..=bands.len() {
-        // On a closed surface the mesh's lowest and highest vertices are critical: nothing
-        // lies below the lowest critical point or above the highest. A surface with
-        // boundary reaches past them: its end intervals have stills too, between the
-        // critical levels and the mesh's extreme heights.
+        // Critical points whose vertices stand at one height (a symmetry ties them) pass
+        // together: no level lies between them, and the slice at theirs is the one below.
+        if k > 0 && k < bands.len() && bands[k - 1].vertex == bands[k].vertex {
+            components.push(components[k - 1]);
+            continue;
+        }
+        // The mesh's lowest and highest vertices are critical (inside or on the boundary):
+        // nothing lies below the lowest critical point or above the highest. Where they
+        // were not refined (a pair the mesh makes, a mesh that is not a manifold), the end
+        // intervals of a surface with boundary get stills too, between the critical levels
+        // and the mesh's extreme heights.
         let (lo, hi) = (
             if k == 0 { lowest } else { bands[k - 1].hi },
             if k == bands.len() {
@@ -788,14 +1105,24 @@ pub fn motion_picture(
                 bands[k].lo
             },
         );
-        let count = if closed && (k == 0 || k == bands.len()) {
+        let count = if (k == 0 || k == bands.len()) && (shape.closed || lo >= hi) {
             0
         } else {
             let level = if lo < hi || k == 0 || k == bands.len() {
-                0.5 * (lo + hi)
+                clear_of(lo, hi, &spans)
             } else {
                 0.5 * (bands[k - 1].vertex + bands[k].vertex)
             };
+            // A vertex at the level counts as above it: the mesh's slice is the interval's
+            // at a level past the lower vertex and up to the higher one, which two
+            // vertices one float apart leave no middle to.
+            let mut level = level;
+            if k > 0 && level <= bands[k - 1].vertex {
+                level = bands[k - 1].vertex.next_up();
+            }
+            if k < bands.len() && level > bands[k].vertex {
+                level = bands[k].vertex;
+            }
             let slice = cut(level);
             let count = slice.curves.len();
             stills.push(Still {
@@ -811,27 +1138,9 @@ pub fn motion_picture(
         if let Err(e) = critical.morse(euler) {
             failures.push(e);
         }
-        for (k, band) in bands.iter().enumerate() {
-            let (below, above) = (components[k] as i64, components[k + 1] as i64);
-            let change = above - below;
-            let event = band.point.event;
-            let ok = match event {
-                Event::Birth => change == 1,
-                Event::Death => change == -1,
-                Event::Saddle if shape.orientable => change.abs() == 1,
-                Event::Saddle => change.abs() <= 1,
-                Event::Degenerate => true,
-            };
-            if !ok {
-                failures.push(format!(
-                    "across the {} at level {} (its mesh vertex at {}): {below} component(s) \
-                     below, {above} above",
-                    event.name(),
-                    band.point.level,
-                    band.vertex
-                ));
-            }
-        }
+        let sequence: Vec<(CriticalPoint, f64)> =
+            bands.iter().map(|b| (b.point, b.vertex)).collect();
+        failures.extend(event_failures(&sequence, &components, shape));
     }
     let mut picture = MotionPicture {
         sequence: bands.iter().map(|b| b.point).collect(),
@@ -841,6 +1150,7 @@ pub fn motion_picture(
         components,
         failures,
         shape,
+        proven,
     };
     if extra > 0 && bands.len() >= 2 {
         let (lo, hi) = (bands[0].lo, bands[bands.len() - 1].hi);
@@ -865,11 +1175,194 @@ pub fn motion_picture(
     Ok(picture)
 }
 
+/// What fails where the slice's components change otherwise than the events allow
+/// ([`Event::allows`]): across each run of critical points of `sequence` (each with its mesh
+/// vertex's height, in their order) whose vertices stand at one height, from the interval
+/// below the run to the one above (one point, unless a symmetry ties several: their
+/// changes add up). `components` has one count per interval.
+fn event_failures(
+    sequence: &[(CriticalPoint, f64)],
+    components: &[usize],
+    shape: Shape,
+) -> Vec<String> {
+    let mut failures = Vec::new();
+    let mut k = 0;
+    while k < sequence.len() {
+        let run = sequence[k..]
+            .iter()
+            .take_while(|(_, v)| *v == sequence[k].1)
+            .count();
+        let (below, above) = (components[k] as i64, components[k + run] as i64);
+        let change = above - below;
+        // The changes the run's events allow together.
+        let mut sums = std::collections::BTreeSet::from([0i64]);
+        for (p, _) in &sequence[k..k + run] {
+            sums = sums
+                .iter()
+                .flat_map(|s| {
+                    (-1..=1)
+                        .filter(|&c| p.event.allows(c, shape))
+                        .map(move |c| s + c)
+                })
+                .collect();
+        }
+        let degenerate = sequence[k..k + run]
+            .iter()
+            .any(|(p, _)| p.event == Event::Degenerate);
+        if !degenerate && !sums.contains(&change) {
+            let (p, vertex) = sequence[k];
+            let what = if run == 1 {
+                format!("the {}", p.event.name())
+            } else {
+                let names: Vec<&str> = sequence[k..k + run]
+                    .iter()
+                    .map(|(p, _)| p.event.name())
+                    .collect();
+                format!("{run} points tied ({})", names.join(", "))
+            };
+            failures.push(format!(
+                "across {what} at level {} (mesh vertex at {vertex}): {below} component(s) \
+                 below, {above} above",
+                p.level
+            ));
+        }
+        k += run;
+    }
+    failures
+}
+
+/// The distance (a share of the surface's bounding diagonal) from a critical point of the
+/// four points beside it that [`through_points`] gives.
+const RING: f64 = 1e-5;
+
+/// The points (patch, parameters) to sample `surface` through so that each critical point
+/// of `picture` (found on its mesh, or proven where the mesh has none) is a critical vertex
+/// of the mesh, of its own event: the point itself, and four beside it, `RING` (1e-5) of
+/// the surface's `diagonal` away along the axes of h's Hessian in (u, v), or within half
+/// the distance to the patch's nearest side where that is closer (down to a hundredth of
+/// it; one past a seam then taken onto the patch beyond). Their heights differ from the
+/// point's by λ r² with the sign of each axis's eigenvalue λ, so the vertex's link changes
+/// sign four times around a saddle and never around an extremum, however thin the saddle's
+/// sectors. A point on the boundary has two beside it along its side and one into the
+/// surface; a corner is a vertex of every mesh. Gives the number of critical points and
+/// the points.
+pub fn through_points(
+    surface: &Surface,
+    picture: &MotionPicture,
+    diagonal: f64,
+) -> (usize, Vec<(usize, [f64; 2])>) {
+    let n = picture.critical.direction;
+    let found = picture.critical.points.iter().filter(|p| p.refined);
+    let missed = picture
+        .proven
+        .iter()
+        .flat_map(|p| p.missed(&picture.critical));
+    let points: Vec<(usize, [f64; 2])> = found
+        .map(|p| (p.patch, p.uv))
+        .chain(missed.map(|p| (p.patch, [p.u.mid(), p.v.mid()])))
+        .collect();
+    let mut out = Vec::new();
+    for &(patch, uv) in &points {
+        match boundary::open_sides(surface, patch, uv)[..] {
+            [] => {}
+            [side] => {
+                out.extend(boundary::beside(surface, patch, uv, side, RING * diagonal));
+                continue;
+            }
+            // A corner is a vertex of every mesh.
+            _ => continue,
+        }
+        out.push((patch, uv));
+        let e = surface.eval(patch, uv[0], uv[1]);
+        let [a, b, c] = [n.dot(e.duu), n.dot(e.duv), n.dot(e.dvv)];
+        // The symmetric 2 x 2 Hessian's eigenvectors: at angle θ with tan 2θ = 2b / (a - c).
+        let theta = 0.5 * (2.0 * b).atan2(a - c);
+        // Within half the distance to the patch's nearest side, where that leaves room: a
+        // vertex of the side between the point and a point beside it would be its
+        // neighbour instead (its link then not the Hessian's).
+        let d = surface.domain(patch);
+        let room = (uv[0] - d.u[0])
+            .min(d.u[1] - uv[0])
+            .min(uv[1] - d.v[0])
+            .min(d.v[1] - uv[1]);
+        for axis in [[theta.cos(), theta.sin()], [-theta.sin(), theta.cos()]] {
+            let length = (e.du * axis[0] + e.dv * axis[1]).length();
+            let mut r = RING * diagonal / length;
+            if !(r.is_finite() && r > 0.0) {
+                continue;
+            }
+            if 0.5 * room < r && 0.5 * room >= 0.01 * r {
+                r = 0.5 * room;
+            }
+            for sign in [1.0, -1.0] {
+                out.push((
+                    patch,
+                    [uv[0] + sign * r * axis[0], uv[1] + sign * r * axis[1]],
+                ));
+            }
+        }
+    }
+    // A point beside one near a seam can lie past it: it is taken onto the patch it lies
+    // on (the sampler inserts points of a patch's own rectangle).
+    let out = out
+        .into_iter()
+        .filter_map(|(patch, [u, v])| {
+            let (patch, u, v, inside) = surface.chart(patch, u, v);
+            inside.then_some((patch, [u, v]))
+        })
+        .collect();
+    (points.len(), out)
+}
+
+/// The critical vertices refined onto no critical point, paired each with the nearest one
+/// left (they come in pairs that cancel, a birth or a death beside a saddle): the span of
+/// heights between each pair's two; `None` when one is left without a pair.
+fn pairs(unrefined: &[CriticalPoint]) -> Option<Vec<[f64; 2]>> {
+    let mut left: Vec<&CriticalPoint> = unrefined.iter().collect();
+    let mut spans = Vec::new();
+    while let Some(a) = left.pop() {
+        let (k, b) = left
+            .iter()
+            .enumerate()
+            .min_by(|x, y| {
+                let d = |p: &CriticalPoint| p.point.distance(a.point);
+                d(x.1).total_cmp(&d(y.1))
+            })
+            .map(|(k, b)| (k, *b))?;
+        left.swap_remove(k);
+        spans.push([a.level.min(b.level), a.level.max(b.level)]);
+    }
+    Some(spans)
+}
+
+/// The middle of the longest part of (`lo`, `hi`) outside every span of `spans`; the
+/// middle of (`lo`, `hi`) where they cover it.
+fn clear_of(lo: f64, hi: f64, spans: &[[f64; 2]]) -> f64 {
+    let mut cuts: Vec<[f64; 2]> = spans
+        .iter()
+        .filter(|s| s[1] > lo && s[0] < hi)
+        .copied()
+        .collect();
+    cuts.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    let (mut best, mut from) = ([lo, lo], lo);
+    for [a, b] in cuts.into_iter().chain([[hi, hi]]) {
+        if a.min(hi) - from > best[1] - best[0] {
+            best = [from, a.min(hi)];
+        }
+        from = from.max(b);
+    }
+    if best[1] > best[0] {
+        0.5 * (best[0] + best[1])
+    } else {
+        0.5 * (lo + hi)
+    }
+}
+
 impl MotionPicture {
     /// The slice of `mesh` (the one the picture was made of, with its `surface`) at
     /// `level`, as a still of this picture: its interval (by the levels of the critical
     /// points' mesh vertices), and what fails when it does not have its interval's number
-    /// of components (not checked on a surface with boundary, nor at a level between a
+    /// of components (not checked where χ is unknown, nor at a level between a
     /// critical point's refined level and its vertex's).
     pub fn still_at(
         &self,
