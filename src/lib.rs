@@ -50,7 +50,6 @@
 //! # std::fs::remove_dir_all(&out)?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
-#![warn(missing_docs)]
 
 pub mod animate;
 mod animation;
@@ -105,6 +104,7 @@ pub use inspect::{
 
 /// What the tests and benches reach into beneath the API: stage internals with their own
 /// contracts, kept public so that they can be tested on their own, not for use.
+#[doc(hidden)]
 pub mod internals {
     pub use crate::convention::file_order;
     pub use crate::render::camera::{Camera, Placement};

@@ -1,7 +1,7 @@
 //! Every limit a user can meet, in one home, and the one shape of a validation failure.
 //!
-//! The scene's checks, the command line's flags, the viewer and the README's table of limits
-//! ([`table`], which a test compares with the README) all take their numbers from here, so
+//! The scene's checks, the command line's flags, the viewer and the table of limits in
+//! docs/SCENES.md ([`table`], which a test compares with it) all take their numbers from here, so
 //! that a limit written twice cannot drift. The range of a setting is a [`Bound`], and its
 //! check reads the bound: a value outside is a [`FieldError`] naming the field, what is
 //! allowed in the bound's own words and what was given, so that the message and the check
@@ -11,7 +11,7 @@
 
 use std::fmt;
 
-/// A number as a limit's message and the README's table write it: whole numbers without a
+/// A number as a limit's message and the table of limits write it: whole numbers without a
 /// decimal point, very small or large ones in exponent form.
 pub trait Number: Copy + PartialOrd + fmt::Display {
     /// The high end of a range with no limit above: the largest whole number, or infinity.
@@ -253,7 +253,7 @@ impl<T: Number> Bound<T> {
 }
 
 // The bounds of the settings: each checks a scene's field (or a flag, or the viewer's
-// setting) through `Bound::check`, and `all` lists it for the README.
+// setting) through `Bound::check`, and `all` lists it for the table of docs/SCENES.md.
 
 /// A sampling tolerance relative to the surface's 4D bounding diagonal (`sampling.tolerance`,
 /// `halo4d sweep --tolerances`). Below 1e-9 the mesh's error is rounding; above a half the
@@ -680,7 +680,7 @@ impl From<Bound<usize>> for Allowed {
     }
 }
 
-/// One limit, as the README's table lists it.
+/// One limit, as the table of docs/SCENES.md lists it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Limit {
     /// The constant's name in this module.
@@ -723,7 +723,7 @@ macro_rules! limit {
     };
 }
 
-/// Every limit, in the order of the README's table: each [`Bound`] with the settings it
+/// Every limit, in the order of the table of docs/SCENES.md: each [`Bound`] with the settings it
 /// bounds, then the sizes and tolerances that no setting sets.
 pub fn all() -> Vec<Limit> {
     let mut out = settings();
@@ -922,7 +922,7 @@ fn fixed() -> Vec<Limit> {
     ]
 }
 
-/// The limits as the README's table (Markdown), one row per limit of [`all`].
+/// The limits as the table of docs/SCENES.md (Markdown), one row per limit of [`all`].
 pub fn table() -> String {
     let mut out = String::from("| setting | allowed | unit |\n| --- | --- | --- |\n");
     for limit in all() {

@@ -191,23 +191,8 @@ fn rank(
     count: usize,
     area: f64,
 ) -> Vec<u32> {
-    let (lo, hi) = points
-        .par_iter()
-        .fold(
-            || (DVec4::INFINITY, DVec4::NEG_INFINITY),
-            |(lo, hi), &p| (lo.min(p), hi.max(p)),
-        )
-        .reduce(
-            || (DVec4::INFINITY, DVec4::NEG_INFINITY),
-            |a, b| (a.0.min(b.0), a.1.max(b.1)),
-        );
-    let first = (hi - lo).length().max(f64::MIN_POSITIVE);
-    // Below a quarter of the candidates' own spacing nothing is gained.
-    let last = 0.25 * poisson_radius(points.len(), area) / 0.75;
-    let levels = ((last / first).ln() / LEVEL_RATIO.ln()).ceil().max(1.0) as usize + 1;
-    let radii: Vec<f64> = (0..levels)
-        .map(|j| first * LEVEL_RATIO.powi(j as i32))
-        .collect();
+    let (lo, hi, radii) = radii(points, area);
+    let levels = radii.len();
     // The first level after j whose radius is at most d (at most a few levels on).
     let level_after = |j: usize, d: f64| {
         let mut k = j + 1;
@@ -218,30 +203,7 @@ fn rank(
     };
     let lattice = Lattice::new(lo, hi, CELL * radii[levels - 1]);
     let candidates = Candidates::new(&lattice, points, priority);
-    // Candidates join when a level needs them: OVERSAMPLE times as many as a Poisson-disc
-    // set of its radius holds, those of smallest priority first, so that the early levels,
-    // which accept few, do not look at every candidate again and again.
-    let n = points.len() as f64;
-    let joins: Vec<u64> = radii
-        .iter()
-        .map(|&r| {
-            let wanted = OVERSAMPLE as f64 * poisson_count(r, area) / n;
-            (wanted.min(1.0) * 2f64.powi(32)) as u64
-        })
-        .collect();
-    let join: Vec<usize> = candidates
-        .priority
-        .par_iter()
-        .map(|&p| joins.partition_point(|&t| t <= u64::from(p)))
-        .collect();
-    // Each level's list of waiting candidates (their places), in candidate order.
-    let mut waiting: Vec<Vec<u32>> = vec![Vec::new(); levels];
-    for (z, &j) in join.iter().enumerate() {
-        if let Some(list) = waiting.get_mut(j) {
-            list.push(z as u32);
-        }
-    }
-    drop(join);
+    let mut waiting = joining(&candidates, &radii, area);
     let mut accepted: Vec<u32> = Vec::with_capacity(count);
     // The accepted candidates of the earlier levels in candidate order.
     let mut earlier: Vec<u32> = Vec::new();
@@ -279,60 +241,8 @@ fn rank(
                 list.push(z);
             }
         }
-        // Those that pass: their order in priority (ties in candidate order, as `pass` is),
-        // and each one's place in it.
-        let mut by_priority: Vec<(u32, u32)> = pass
-            .par_iter()
-            .enumerate()
-            .map(|(k, &z)| (candidates.priority[z as usize], k as u32))
-            .collect();
-        by_priority.par_sort_unstable();
-        let mut place = vec![0u32; pass.len()];
-        for (n, &(_, k)) in (0u32..).zip(&by_priority) {
-            place[k as usize] = n;
-        }
-        // Those that pass against each other: for each, those before it in priority nearer
-        // than r (pairs of places in `pass`, with their distance, grouped by the first).
         own.build(&candidates, shift, &pass);
-        let pairs: Vec<(u32, u32, f64)> = (0..pass.len())
-            .into_par_iter()
-            .fold(Vec::new, |mut found, k| {
-                own.visit(&lattice, own.points[k], r, |m, d| {
-                    if place[m as usize] < place[k] {
-                        found.push((k as u32, m, d));
-                    }
-                    false
-                });
-                found
-            })
-            .flatten_iter()
-            .collect();
-        let mut from = vec![0u32; pass.len() + 1];
-        for &(k, _, _) in &pairs {
-            from[k as usize + 1] += 1;
-        }
-        for k in 0..pass.len() {
-            from[k + 1] += from[k];
-        }
-        // In priority order, each is accepted when none before it that it lists was; a
-        // rejected one keeps its distance to the nearest of those.
-        let mut taken = vec![false; pass.len()];
-        let mut nearest = vec![f64::INFINITY; pass.len()];
-        for &(_, k) in &by_priority {
-            let k = k as usize;
-            nearest[k] = pairs[from[k] as usize..from[k + 1] as usize]
-                .iter()
-                .filter(|&&(_, m, _)| taken[m as usize])
-                .map(|&(_, _, d)| d)
-                .fold(f64::INFINITY, f64::min);
-            if nearest[k].is_infinite() {
-                taken[k] = true;
-                accepted.push(pass[k]);
-                if accepted.len() >= count {
-                    break;
-                }
-            }
-        }
+        let (taken, nearest) = accept(&candidates, &lattice, &own, &pass, r, count, &mut accepted);
         // The rejected wait in candidate order.
         let mut new = Vec::new();
         for (k, &z) in pass.iter().enumerate() {
@@ -350,6 +260,124 @@ fn rank(
         .iter()
         .map(|&z| candidates.index[z as usize])
         .collect()
+}
+
+/// The bounds of `points` and the radii of the ranking's levels, from the bounds' diagonal
+/// down by [`LEVEL_RATIO`] to a quarter of the candidates' own spacing (below which nothing
+/// is gained).
+fn radii(points: &[DVec4], area: f64) -> (DVec4, DVec4, Vec<f64>) {
+    let (lo, hi) = points
+        .par_iter()
+        .fold(
+            || (DVec4::INFINITY, DVec4::NEG_INFINITY),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        )
+        .reduce(
+            || (DVec4::INFINITY, DVec4::NEG_INFINITY),
+            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+        );
+    let first = (hi - lo).length().max(f64::MIN_POSITIVE);
+    let last = 0.25 * poisson_radius(points.len(), area) / 0.75;
+    let levels = ((last / first).ln() / LEVEL_RATIO.ln()).ceil().max(1.0) as usize + 1;
+    let radii = (0..levels)
+        .map(|j| first * LEVEL_RATIO.powi(j as i32))
+        .collect();
+    (lo, hi, radii)
+}
+
+/// Each level's list of the candidates (their places, in candidate order) that join it.
+/// Candidates join when a level needs them: [`OVERSAMPLE`] times as many as a Poisson-disc
+/// set of its radius holds, those of smallest priority first, so that the early levels,
+/// which accept few, do not look at every candidate again and again.
+fn joining(candidates: &Candidates, radii: &[f64], area: f64) -> Vec<Vec<u32>> {
+    let n = candidates.index.len() as f64;
+    let joins: Vec<u64> = radii
+        .iter()
+        .map(|&r| {
+            let wanted = OVERSAMPLE as f64 * poisson_count(r, area) / n;
+            (wanted.min(1.0) * 2f64.powi(32)) as u64
+        })
+        .collect();
+    let join: Vec<usize> = candidates
+        .priority
+        .par_iter()
+        .map(|&p| joins.partition_point(|&t| t <= u64::from(p)))
+        .collect();
+    let mut waiting: Vec<Vec<u32>> = vec![Vec::new(); radii.len()];
+    for (z, &j) in join.iter().enumerate() {
+        if let Some(list) = waiting.get_mut(j) {
+            list.push(z as u32);
+        }
+    }
+    waiting
+}
+
+/// The candidates of one level that no earlier point is nearer than `r` to (`pass`, in
+/// candidate order, indexed by `own`), judged against each other in priority order: each is
+/// accepted (pushed onto `accepted`, up to `count`) when none before it nearer than `r`
+/// was. Gives which were taken and, for each rejected one, its distance to the nearest
+/// taken one before it.
+fn accept(
+    candidates: &Candidates,
+    lattice: &Lattice,
+    own: &Grid,
+    pass: &[u32],
+    r: f64,
+    count: usize,
+    accepted: &mut Vec<u32>,
+) -> (Vec<bool>, Vec<f64>) {
+    // Their order in priority (ties in candidate order, as `pass` is), and each one's place
+    // in it.
+    let mut by_priority: Vec<(u32, u32)> = pass
+        .par_iter()
+        .enumerate()
+        .map(|(k, &z)| (candidates.priority[z as usize], k as u32))
+        .collect();
+    by_priority.par_sort_unstable();
+    let mut place = vec![0u32; pass.len()];
+    for (n, &(_, k)) in (0u32..).zip(&by_priority) {
+        place[k as usize] = n;
+    }
+    // For each, those before it in priority nearer than r (pairs of places in `pass`, with
+    // their distance, grouped by the first).
+    let pairs: Vec<(u32, u32, f64)> = (0..pass.len())
+        .into_par_iter()
+        .fold(Vec::new, |mut found, k| {
+            own.visit(lattice, own.points[k], r, |m, d| {
+                if place[m as usize] < place[k] {
+                    found.push((k as u32, m, d));
+                }
+                false
+            });
+            found
+        })
+        .flatten_iter()
+        .collect();
+    let mut from = vec![0u32; pass.len() + 1];
+    for &(k, _, _) in &pairs {
+        from[k as usize + 1] += 1;
+    }
+    for k in 0..pass.len() {
+        from[k + 1] += from[k];
+    }
+    let mut taken = vec![false; pass.len()];
+    let mut nearest = vec![f64::INFINITY; pass.len()];
+    for &(_, k) in &by_priority {
+        let k = k as usize;
+        nearest[k] = pairs[from[k] as usize..from[k + 1] as usize]
+            .iter()
+            .filter(|&&(_, m, _)| taken[m as usize])
+            .map(|&(_, _, d)| d)
+            .fold(f64::INFINITY, f64::min);
+        if nearest[k].is_infinite() {
+            taken[k] = true;
+            accepted.push(pass[k]);
+            if accepted.len() >= count {
+                break;
+            }
+        }
+    }
+    (taken, nearest)
 }
 
 /// The candidates in the order of their fine cells along the Z curve (candidate order): for

@@ -15,6 +15,7 @@ mod fuzz_build;
 mod gallery;
 mod halo;
 mod halo_export;
+mod house;
 mod intersect;
 mod lines;
 mod motion;

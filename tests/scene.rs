@@ -593,13 +593,13 @@ fn truncated_and_mutated_scenes_never_panic() {
 }
 
 #[test]
-fn the_readme_lists_the_limits_of_the_code() {
-    let readme =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+fn the_scene_files_page_lists_the_limits_of_the_code() {
+    let page =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/SCENES.md")).unwrap();
     let table = halo4d::limits::table();
     assert!(
-        readme.contains(&table),
-        "the README's table of limits is not the code's; it should read:\n{table}"
+        page.contains(&table),
+        "the table of limits in docs/SCENES.md is not the code's; it should read:\n{table}"
     );
 }
 

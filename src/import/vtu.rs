@@ -352,59 +352,7 @@ impl Xml {
             match name.as_ref() {
                 b"VTKFile" => {
                     seen_file = true;
-                    match attr("type")?.as_deref() {
-                        Some("UnstructuredGrid") => {}
-                        Some("PUnstructuredGrid") => {
-                            return Err(fail.byte(
-                                at,
-                                "a parallel PUnstructuredGrid (.pvtu) only names its pieces' files: read it by its path (halo4d check FILE.pvtu, import::read), which reads the pieces beside it",
-                            ));
-                        }
-                        other => {
-                            return Err(fail.byte(
-                                at,
-                                format!(
-                                    "the file's type is {}, not UnstructuredGrid: halo4d reads tetrahedral meshes",
-                                    shorten(other.unwrap_or("missing"))
-                                ),
-                            ));
-                        }
-                    }
-                    x.little = match attr("byte_order")?.as_deref() {
-                        None | Some("LittleEndian") => true,
-                        Some("BigEndian") => false,
-                        Some(o) => {
-                            return Err(fail.byte(
-                                at,
-                                format!("byte_order `{}`: LittleEndian or BigEndian", shorten(o)),
-                            ));
-                        }
-                    };
-                    x.header64 = match attr("header_type")?.as_deref() {
-                        None | Some("UInt32") => false,
-                        Some("UInt64") => true,
-                        Some(h) => {
-                            return Err(fail.byte(
-                                at,
-                                format!("header_type `{}`: UInt32 or UInt64", shorten(h)),
-                            ));
-                        }
-                    };
-                    x.compressor = match attr("compressor")?.as_deref() {
-                        None | Some("") => Compressor::None,
-                        Some("vtkZLibDataCompressor") => Compressor::Zlib,
-                        Some("vtkLZ4DataCompressor") => Compressor::Lz4,
-                        Some("vtkLZMADataCompressor") => Compressor::Lzma,
-                        Some(c) => {
-                            return Err(fail.byte(
-                                at,
-                                format!(
-                                    "compressor `{}`: halo4d reads vtkZLibDataCompressor, vtkLZ4DataCompressor, vtkLZMADataCompressor or none; save the file with one of them",
-                                    shorten(c)
-                                ),
-                            ));
-                        }
-                    };
+                    x.file_attributes(&attr, &fail, at)?;
                 }
                 b"Piece" => {
                     if x.piece.is_some() {
@@ -474,31 +422,7 @@ impl Xml {
                     }
                 }
                 b"AppendedData" => {
-                    let base64 = match attr("encoding")?.as_deref() {
-                        Some("raw") => false,
-                        Some("base64") => true,
-                        other => {
-                            return Err(fail.byte(
-                                at,
-                                format!(
-                                    "AppendedData encoding `{}`: raw or base64",
-                                    shorten(other.unwrap_or("missing"))
-                                ),
-                            ));
-                        }
-                    };
-                    let end = pos(&reader);
-                    let rest = &bytes[end.min(bytes.len())..];
-                    let skip = rest
-                        .iter()
-                        .position(|b| !b.is_ascii_whitespace())
-                        .unwrap_or(rest.len());
-                    if rest.get(skip) != Some(&b'_') {
-                        return Err(
-                            fail.byte(end + skip, "the AppendedData's data must begin with `_`")
-                        );
-                    }
-                    x.appended = Some((base64, end + skip + 1));
+                    x.appended = Some(appended(&attr, &fail, at, bytes, pos(&reader))?);
                     // Raw data follow: no more XML to read.
                     break;
                 }
@@ -510,6 +434,105 @@ impl Xml {
         }
         Ok(x)
     }
+}
+
+impl Xml {
+    /// The VTKFile element's attributes: an UnstructuredGrid, its byte order, header type
+    /// and compressor.
+    fn file_attributes(
+        &mut self,
+        attr: &dyn Fn(&str) -> Result<Option<String>>,
+        fail: &Fail,
+        at: usize,
+    ) -> Result<()> {
+        match attr("type")?.as_deref() {
+            Some("UnstructuredGrid") => {}
+            Some("PUnstructuredGrid") => {
+                return Err(fail.byte(
+                    at,
+                    "a parallel PUnstructuredGrid (.pvtu) only names its pieces' files: read it by its path (halo4d check FILE.pvtu, import::read), which reads the pieces beside it",
+                ));
+            }
+            other => {
+                return Err(fail.byte(
+                    at,
+                    format!(
+                        "the file's type is {}, not UnstructuredGrid: halo4d reads tetrahedral meshes",
+                        shorten(other.unwrap_or("missing"))
+                    ),
+                ));
+            }
+        }
+        self.little = match attr("byte_order")?.as_deref() {
+            None | Some("LittleEndian") => true,
+            Some("BigEndian") => false,
+            Some(o) => {
+                return Err(fail.byte(
+                    at,
+                    format!("byte_order `{}`: LittleEndian or BigEndian", shorten(o)),
+                ));
+            }
+        };
+        self.header64 = match attr("header_type")?.as_deref() {
+            None | Some("UInt32") => false,
+            Some("UInt64") => true,
+            Some(h) => {
+                return Err(fail.byte(
+                    at,
+                    format!("header_type `{}`: UInt32 or UInt64", shorten(h)),
+                ));
+            }
+        };
+        self.compressor = match attr("compressor")?.as_deref() {
+            None | Some("") => Compressor::None,
+            Some("vtkZLibDataCompressor") => Compressor::Zlib,
+            Some("vtkLZ4DataCompressor") => Compressor::Lz4,
+            Some("vtkLZMADataCompressor") => Compressor::Lzma,
+            Some(c) => {
+                return Err(fail.byte(
+                    at,
+                    format!(
+                        "compressor `{}`: halo4d reads vtkZLibDataCompressor, vtkLZ4DataCompressor, vtkLZMADataCompressor or none; save the file with one of them",
+                        shorten(c)
+                    ),
+                ));
+            }
+        };
+        Ok(())
+    }
+}
+
+/// The AppendedData element (its tag read up to `end`): whether its data are base64 (else
+/// raw), and where they begin, after the `_` that must open them.
+fn appended(
+    attr: &dyn Fn(&str) -> Result<Option<String>>,
+    fail: &Fail,
+    at: usize,
+    bytes: &[u8],
+    end: usize,
+) -> Result<(bool, usize)> {
+    let base64 = match attr("encoding")?.as_deref() {
+        Some("raw") => false,
+        Some("base64") => true,
+        other => {
+            return Err(fail.byte(
+                at,
+                format!(
+                    "AppendedData encoding `{}`: raw or base64",
+                    shorten(other.unwrap_or("missing"))
+                ),
+            ));
+        }
+    };
+    let rest = &bytes[end.min(bytes.len())..];
+    let skip = rest
+        .iter()
+        .position(|b| !b.is_ascii_whitespace())
+        .unwrap_or(rest.len());
+    if rest.get(skip) != Some(&b'_') {
+        return Err(fail.byte(end + skip, "the AppendedData's data must begin with `_`"));
+    }
+    Ok((base64, end + skip + 1))
 }
 
 /// The own text of a DataArray whose start tag was just read, up to its end tag: the runs of
@@ -872,71 +895,13 @@ impl<'a> Decoder<'a> {
             .checked_mul(a.ty.size())
             .filter(|&w| w <= isize::MAX as usize)
             .ok_or_else(|| self.fail.byte(a.at, format!("{count} values: too many")))?;
-        let source = match a.format {
-            Format::Binary => Source::Bytes(Cow::Owned(self.base64_all(a)?), a.text_at),
-            Format::Appended(offset) => {
-                let Some((base64, start)) = self.appended else {
-                    return Err(self.fail.byte(
-                        a.at,
-                        "the DataArray is appended, but the file has no AppendedData",
-                    ));
-                };
-                let at = usize::try_from(offset)
-                    .ok()
-                    .and_then(|o| o.checked_add(start))
-                    .filter(|&at| at < self.bytes.len())
-                    .ok_or_else(|| {
-                        self.fail.byte(
-                            a.at,
-                            format!(
-                                "the DataArray's offset {offset} lies past the end of the file"
-                            ),
-                        )
-                    })?;
-                let rest = &self.bytes[at..];
-                if base64 {
-                    let run = rest
-                        .iter()
-                        .position(|&b| !(b.is_ascii_alphanumeric() || b"+/=".contains(&b)))
-                        .unwrap_or(rest.len());
-                    Source::Base64(&rest[..run], at)
-                } else {
-                    Source::Bytes(Cow::Borrowed(rest), at)
-                }
-            }
-            Format::Ascii => unreachable!("ascii arrays are read as text"),
-        };
+        let source = self.source(a)?;
         let at = match &source {
             Source::Bytes(_, at) | Source::Base64(_, at) => *at,
         };
         let hs = self.header;
         if self.compressor == Compressor::None {
-            let head = self.get(&source, hs)?;
-            let n = uint(&head[..hs], self.little);
-            if n != want as u64 {
-                return Err(self.fail.byte(
-                    at,
-                    format!(
-                        "the array's header says {n} bytes, but {count} values of {} bytes make {want}",
-                        a.ty.size()
-                    ),
-                ));
-            }
-            self.check_left(&source, hs + want, at)?;
-            let data = match source {
-                Source::Bytes(Cow::Borrowed(b), _) => Cow::Borrowed(&b[hs..hs + want]),
-                Source::Bytes(Cow::Owned(mut v), _) => {
-                    v.truncate(hs + want);
-                    v.drain(..hs);
-                    Cow::Owned(v)
-                }
-                Source::Base64(..) => {
-                    let mut v = self.get(&source, hs + want)?.into_owned();
-                    v.drain(..hs);
-                    Cow::Owned(v)
-                }
-            };
-            return Ok((data, at));
+            return self.uncompressed(source, a, count, want, at);
         }
         // Compressed: blocks, block size, last block's size, each block's compressed size.
         let head = self.get(&source, 3 * hs)?;
@@ -1023,6 +988,85 @@ impl<'a> Decoder<'a> {
                 })
             })?;
         Ok((Cow::Owned(out), at))
+    }
+
+    /// Where the data of a binary or appended array are: its own base64 text decoded, or
+    /// the AppendedData's bytes from its offset (base64 or raw), with the byte where they
+    /// are.
+    fn source(&self, a: &Array) -> Result<Source<'a>> {
+        Ok(match a.format {
+            Format::Binary => Source::Bytes(Cow::Owned(self.base64_all(a)?), a.text_at),
+            Format::Appended(offset) => {
+                let Some((base64, start)) = self.appended else {
+                    return Err(self.fail.byte(
+                        a.at,
+                        "the DataArray is appended, but the file has no AppendedData",
+                    ));
+                };
+                let at = usize::try_from(offset)
+                    .ok()
+                    .and_then(|o| o.checked_add(start))
+                    .filter(|&at| at < self.bytes.len())
+                    .ok_or_else(|| {
+                        self.fail.byte(
+                            a.at,
+                            format!(
+                                "the DataArray's offset {offset} lies past the end of the file"
+                            ),
+                        )
+                    })?;
+                let rest = &self.bytes[at..];
+                if base64 {
+                    let run = rest
+                        .iter()
+                        .position(|&b| !(b.is_ascii_alphanumeric() || b"+/=".contains(&b)))
+                        .unwrap_or(rest.len());
+                    Source::Base64(&rest[..run], at)
+                } else {
+                    Source::Bytes(Cow::Borrowed(rest), at)
+                }
+            }
+            Format::Ascii => unreachable!("ascii arrays are read as text"),
+        })
+    }
+
+    /// An uncompressed array of `count` values (`want` bytes) after its header, from
+    /// `source` at byte `at`.
+    fn uncompressed(
+        &self,
+        source: Source<'a>,
+        a: &Array,
+        count: usize,
+        want: usize,
+        at: usize,
+    ) -> Result<(Cow<'a, [u8]>, usize)> {
+        let hs = self.header;
+        let head = self.get(&source, hs)?;
+        let n = uint(&head[..hs], self.little);
+        if n != want as u64 {
+            return Err(self.fail.byte(
+                at,
+                format!(
+                    "the array's header says {n} bytes, but {count} values of {} bytes make {want}",
+                    a.ty.size()
+                ),
+            ));
+        }
+        self.check_left(&source, hs + want, at)?;
+        let data = match source {
+            Source::Bytes(Cow::Borrowed(b), _) => Cow::Borrowed(&b[hs..hs + want]),
+            Source::Bytes(Cow::Owned(mut v), _) => {
+                v.truncate(hs + want);
+                v.drain(..hs);
+                Cow::Owned(v)
+            }
+            Source::Base64(..) => {
+                let mut v = self.get(&source, hs + want)?.into_owned();
+                v.drain(..hs);
+                Cow::Owned(v)
+            }
+        };
+        Ok((data, at))
     }
 
     /// The first `n` bytes of a source (all of them where it has fewer).

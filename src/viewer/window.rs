@@ -29,6 +29,7 @@ use super::{
 };
 use crate::intersect::Curves;
 use crate::render::Style;
+use crate::scene::Scene;
 use crate::view::{Projection, View};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -584,86 +585,102 @@ impl App {
                 }
             }
             "f" => {
-                let (view, camera) = (*view, self.settings.camera);
-                self.saves += 1;
-                let path = PathBuf::from("exports/views")
-                    .join(format!("{}-{}.json", model.scene.name, self.saves));
-                self.note = match std::fs::create_dir_all("exports/views")
-                    .map_err(|e| ViewerError::Write {
-                        path: "exports/views".into(),
-                        message: e.to_string(),
-                    })
-                    .and_then(|()| super::save_scene(&model.scene, &view, &camera, &path))
-                {
-                    Ok(scene) => {
-                        let note = format!("saved {}", path.display());
-                        self.saved = Some((scene, path));
-                        note
-                    }
-                    Err(e) => e.to_string(),
-                };
+                let (scene, view) = (model.scene.clone(), *view);
+                self.save_view(&scene, view);
                 return true;
             }
             "a" => {
-                if self.search.is_some() {
-                    self.note = "a view search is running".into();
-                    return true;
-                }
-                // From the view and camera shown.
-                let mut scene = model.scene.clone();
-                scene.view = *view;
-                scene.camera.azimuth = self.settings.camera.azimuth;
-                scene.camera.elevation = self.settings.camera.elevation;
-                let window = self.state.as_ref().map(|s| Arc::clone(&s.window));
-                let (tx, rx) = channel();
-                self.note = "searching the view that shows the most of the curves".into();
-                std::thread::spawn(move || {
-                    let found = crate::viewsearch::search(&scene, true).map_err(|e| e.to_string());
-                    let _ = tx.send(found);
-                    if let Some(w) = window {
-                        w.request_redraw();
-                    }
-                });
-                self.search = Some(rx);
+                let (scene, view) = (model.scene.clone(), *view);
+                self.start_search(scene, view);
                 return true;
             }
             "b" => {
-                let Some((scene, path)) = self.saved.clone() else {
-                    self.note = "nothing saved to build: press F first".into();
-                    return true;
-                };
-                if self.build.is_some() {
-                    self.note = "a build is running".into();
-                    return true;
-                }
-                let out = PathBuf::from("exports").join(&scene.name);
-                let window = self.state.as_ref().map(|s| Arc::clone(&s.window));
-                let (tx, rx) = channel();
-                self.note = format!("building {}", path.display());
-                std::thread::spawn(move || {
-                    let outcome = match crate::pipeline::build(&scene, &out, true) {
-                        Ok(report) if report.verified => {
-                            format!("built {} from {}: verified", out.display(), path.display())
-                        }
-                        Ok(report) => format!(
-                            "built {}: NOT verified: {}",
-                            out.display(),
-                            report.failures.join("; ")
-                        ),
-                        Err(e) => format!("the build of {} failed: {e}", path.display()),
-                    };
-                    let _ = tx.send(outcome);
-                    if let Some(w) = window {
-                        w.request_redraw();
-                    }
-                });
-                self.build = Some(rx);
+                self.start_build();
                 return true;
             }
             _ => return false,
         }
         self.note.clear();
         true
+    }
+
+    /// `F`: saves the scene in the view and camera shown to `exports/views/`, for `B`.
+    fn save_view(&mut self, scene: &Scene, view: View) {
+        let camera = self.settings.camera;
+        self.saves += 1;
+        let path =
+            PathBuf::from("exports/views").join(format!("{}-{}.json", scene.name, self.saves));
+        self.note = match std::fs::create_dir_all("exports/views")
+            .map_err(|e| ViewerError::Write {
+                path: "exports/views".into(),
+                message: e.to_string(),
+            })
+            .and_then(|()| super::save_scene(scene, &view, &camera, &path))
+        {
+            Ok(scene) => {
+                let note = format!("saved {}", path.display());
+                self.saved = Some((scene, path));
+                note
+            }
+            Err(e) => e.to_string(),
+        };
+    }
+
+    /// `A`: searches, on a thread of its own, the view that shows the most of the curves,
+    /// from the view and camera shown.
+    fn start_search(&mut self, mut scene: Scene, view: View) {
+        if self.search.is_some() {
+            self.note = "a view search is running".into();
+            return;
+        }
+        scene.view = view;
+        scene.camera.azimuth = self.settings.camera.azimuth;
+        scene.camera.elevation = self.settings.camera.elevation;
+        let window = self.state.as_ref().map(|s| Arc::clone(&s.window));
+        let (tx, rx) = channel();
+        self.note = "searching the view that shows the most of the curves".into();
+        std::thread::spawn(move || {
+            let found = crate::viewsearch::search(&scene, true).map_err(|e| e.to_string());
+            let _ = tx.send(found);
+            if let Some(w) = window {
+                w.request_redraw();
+            }
+        });
+        self.search = Some(rx);
+    }
+
+    /// `B`: builds the scene last saved (`F`) into `exports/`, on a thread of its own.
+    fn start_build(&mut self) {
+        let Some((scene, path)) = self.saved.clone() else {
+            self.note = "nothing saved to build: press F first".into();
+            return;
+        };
+        if self.build.is_some() {
+            self.note = "a build is running".into();
+            return;
+        }
+        let out = PathBuf::from("exports").join(&scene.name);
+        let window = self.state.as_ref().map(|s| Arc::clone(&s.window));
+        let (tx, rx) = channel();
+        self.note = format!("building {}", path.display());
+        std::thread::spawn(move || {
+            let outcome = match crate::pipeline::build(&scene, &out, true) {
+                Ok(report) if report.verified => {
+                    format!("built {} from {}: verified", out.display(), path.display())
+                }
+                Ok(report) => format!(
+                    "built {}: NOT verified: {}",
+                    out.display(),
+                    report.failures.join("; ")
+                ),
+                Err(e) => format!("the build of {} failed: {e}", path.display()),
+            };
+            let _ = tx.send(outcome);
+            if let Some(w) = window {
+                w.request_redraw();
+            }
+        });
+        self.build = Some(rx);
     }
 
     /// Whether a Shift drag is turning the scene in 4D (every frame rebuilds the halos).
