@@ -432,3 +432,57 @@ fn a_mesh_sampled_through_points_has_a_vertex_at_each_and_keeps_its_topology() {
         assert!(plain.positions.iter().all(|q| q.distance(p) > 1e-9 * d));
     }
 }
+
+#[test]
+fn a_finer_rectangle_holds_its_triangles_to_its_tolerance_and_only_there() {
+    // The spun trefoil at 1e-3 of its diagonal, a rectangle of a tenth of its parameters
+    // held to a sixteenth of that: every triangle meeting the rectangle meets the finer
+    // tolerance as audited, the rest the surface's, and the mesh is much smaller than the
+    // whole surface at the finer tolerance.
+    use halo4d::sample::{ErrorBound, Finer, sample_adaptive_finer};
+    let surface = Surface::SpunTrefoil(SpunTrefoil::default());
+    let d = bounding_diagonal(&surface);
+    let domain = surface.domain(0);
+    let span = |r: [f64; 2], a: f64, b: f64| [r[0] + (r[1] - r[0]) * a, r[0] + (r[1] - r[0]) * b];
+    let (global, fine) = (1e-3 * d, 1e-3 * d / 16.0);
+    let rect = Finer {
+        patch: 0,
+        u: span(domain.u, 0.4, 0.5),
+        v: span(domain.v, 0.2, 0.3),
+        tolerance: fine,
+    };
+    let out = sample_adaptive_finer(&surface, global, ErrorBound::Audited, 2_000_000, &[rect]);
+    assert!(out.complete);
+    let mesh = out.mesh;
+    let meets = |t: &[[f64; 2]; 3]| {
+        let lo = |k: usize| t.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+        let hi = |k: usize| t.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
+        rect.u[0] <= hi(0) && lo(0) <= rect.u[1] && rect.v[0] <= hi(1) && lo(1) <= rect.v[1]
+    };
+    let inside: Vec<usize> = (0..mesh.triangles.len())
+        .filter(|&i| meets(&mesh.triangle_uv[i]))
+        .collect();
+    assert!(
+        inside.len() > 100,
+        "{} triangles meet the rectangle",
+        inside.len()
+    );
+    let sub = Mesh4 {
+        triangles: inside.iter().map(|&i| mesh.triangles[i]).collect(),
+        triangle_patch: inside.iter().map(|&i| mesh.triangle_patch[i]).collect(),
+        triangle_uv: inside.iter().map(|&i| mesh.triangle_uv[i]).collect(),
+        ..mesh.clone()
+    };
+    let audited = audit(&surface, &sub).max_error;
+    assert!(audited <= fine, "{audited} against {fine}");
+    assert!(audit(&surface, &mesh).max_error <= global);
+    let plain = sample_adaptive(&surface, global, 2_000_000).mesh;
+    let everywhere = sample_adaptive(&surface, fine, 2_000_000).mesh;
+    assert!(mesh.triangles.len() > plain.triangles.len());
+    assert!(
+        4 * mesh.triangles.len() < everywhere.triangles.len(),
+        "{} triangles, {} finer everywhere",
+        mesh.triangles.len(),
+        everywhere.triangles.len()
+    );
+}

@@ -12,6 +12,13 @@ use serde_json::json;
 /// axis, so that the lowest point (u, v) = (π/2, 3π/2 - 0.1) is inside the parameter
 /// rectangle), on a uniform grid of `cells` (even) whose vertices miss the lowest point.
 fn plane_and_sphere(dip: f64, cells: usize, certify: bool) -> serde_json::Value {
+    let mut scene = plane_and_sphere_sampled(dip, certify);
+    scene["sampling"] = json!({ "method": "uniform", "u": cells, "v": cells });
+    scene
+}
+
+/// [`plane_and_sphere`] sampled adaptively at 1e-3 of each surface's diagonal.
+fn plane_and_sphere_sampled(dip: f64, certify: bool) -> serde_json::Value {
     json!({
         "name": "plane-sphere",
         "surfaces": [
@@ -23,7 +30,7 @@ fn plane_and_sphere(dip: f64, cells: usize, certify: bool) -> serde_json::Value 
                 "sides": { "u_min": "pole", "u_max": "pole", "v": "periodic" },
                 "parameters": { "dip": dip } } }
         ],
-        "sampling": { "method": "uniform", "u": cells, "v": cells },
+        "sampling": { "method": "adaptive", "tolerance": 1e-3 },
         "view": { "rotation": {}, "projection": { "type": "orthographic" } },
         "curves": { "certify": certify },
         "outputs": { "glb": true, "ply": false, "obj": false, "report": true, "png": false }
@@ -213,6 +220,52 @@ fn a_build_whose_mesh_misses_a_certified_curve_is_not_verified_and_check_agrees(
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+}
+
+#[test]
+fn an_adaptive_build_samples_finer_around_a_certified_loop_until_its_mesh_has_it() {
+    // The sampler's triangles at 1e-3 of the sphere's diagonal may lie 3.5e-3 off it: at a
+    // dip of 1e-6 and below, the mesh of the sphere stays above the plane and its curves
+    // miss the circle. Held to the certificate, the build samples finer around the circle
+    // until its mesh crosses the plane there; the refined curve is the true circle.
+    for dip in [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8] {
+        let scene: Scene = serde_json::from_value(plane_and_sphere_sampled(dip, true)).unwrap();
+        let built = halo4d::Sampled::of(&scene)
+            .build(&scene, halo4d::Stages::of(&scene))
+            .unwrap();
+        assert!(
+            built.failures().is_empty(),
+            "dip {dip}: {:?}",
+            built.failures()
+        );
+        let report = &built.curves.report;
+        assert_eq!((report.closed, report.open), (1, 0), "dip {dip}");
+        let radius = (2.0 * dip - dip * dip).sqrt();
+        let circle = &built.shown_curves().curves[0];
+        assert!(circle.closed);
+        for p in &circle.points {
+            let r = p.position.x.hypot(p.position.y);
+            // A point off the circle by δ in z is off by δ / R in r near the sphere's bottom.
+            assert!(
+                (r - radius).abs() <= 1e-14 / radius + 1e-12,
+                "dip {dip}: r {r} against {radius}"
+            );
+            assert!(p.position.z.abs() <= 1e-12, "dip {dip}: z {}", p.position.z);
+        }
+        if dip <= 1e-6 {
+            assert!(
+                report.sampled_finer > 0,
+                "dip {dip}: no round of sampling finer"
+            );
+            // Planted: the same build without the certificate misses the circle.
+            let plain: Scene =
+                serde_json::from_value(plane_and_sphere_sampled(dip, false)).unwrap();
+            let built = halo4d::Sampled::of(&plain)
+                .build(&plain, halo4d::Stages::of(&plain))
+                .unwrap();
+            assert_eq!(built.curves.report.count, 0, "dip {dip}");
+        }
+    }
 }
 
 #[test]

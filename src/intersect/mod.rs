@@ -188,6 +188,15 @@ pub struct CurvesReport {
     /// scene asks (`curves.certify`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub certified: Option<certified::Certificate>,
+    /// The rounds in which the build sampled the surfaces again, finer around the certified
+    /// curves, for the meshes' curves to count as the certificate's (0: none needed).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub sampled_finer: usize,
+}
+
+/// Whether a count is 0 (left out of `report.json`).
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 impl CurvesReport {
@@ -217,8 +226,12 @@ impl CurvesReport {
                     )
                 })
                 .unwrap_or_default();
+            let tried = match self.sampled_finer {
+                0 => String::new(),
+                n => format!(", after {n} rounds of sampling finer around the certified curves"),
+            };
             out.push(format!(
-                "curves: the true surfaces cross in {} closed and {} open curves (certified), the meshes in {} closed and {} open: sample finer where they differ{through}",
+                "curves: the true surfaces cross in {} closed and {} open curves (certified), the meshes in {} closed and {} open{tried}: sample finer where they differ{through}",
                 c.closed, c.open, self.closed, self.open
             ));
         }
@@ -234,6 +247,12 @@ impl CurvesReport {
         );
         if let Some(c) = &self.certified {
             out += &format!("\ncurves certified: {}", c.summary());
+            if self.sampled_finer > 0 {
+                out += &format!(
+                    "\ncurves held to the certificate: the surfaces sampled finer around the certified curves in {} rounds",
+                    self.sampled_finer
+                );
+            }
         }
         if let Some(r) = &self.refinement {
             out += &format!(

@@ -194,7 +194,23 @@ pub(super) fn in_view(
         });
     }
     let mut timings = samples.timings;
-    let projections = project(scene, samples.surfaces, &mut timings, bar)?;
+    let mut projections = project(scene, samples.surfaces, &mut timings, bar)?;
+    // The certificate of the true surfaces' double curves, and the meshes held to it: their
+    // curves, made here from the sheets alone.
+    let mut held = None;
+    if stages.curves && scene.curves.certify {
+        bar.set_message("certifying the curves");
+        let start = Instant::now();
+        let surfaces: Vec<_> = projections
+            .iter()
+            .map(|p| p.entry.surface.parametric())
+            .collect();
+        let certificate = crate::intersect::certified::certify(&surfaces, &scene.view);
+        timings.certify = ms(start);
+        let (curves, rounds) =
+            super::hold::hold(scene, &certificate, &mut projections, &mut timings, bar)?;
+        held = Some((curves, certificate, rounds));
+    }
     bar.set_message("measuring the scene and how its triangles pile up");
     let start = Instant::now();
     let scale = Scale::of(scene, &projections, stages)?;
@@ -227,7 +243,12 @@ pub(super) fn in_view(
         timings.guards += ms(start);
     }
     let mut curves = Curves::default();
-    if stages.curves {
+    let mut certified = None;
+    if let Some((held, certificate, rounds)) = held {
+        curves = held;
+        curves.report.sampled_finer = rounds;
+        certified = Some(certificate);
+    } else if stages.curves {
         bar.set_message("intersection curves");
         let start = Instant::now();
         // The curves are made from the sheets alone.
@@ -246,15 +267,11 @@ pub(super) fn in_view(
         timings.refine = ms(start);
         refined
     });
-    if stages.curves && scene.curves.certify {
-        bar.set_message("certifying the curves");
-        let start = Instant::now();
-        let surfaces: Vec<_> = products.iter().map(|p| p.surface.parametric()).collect();
-        let certificate = crate::intersect::certified::certify(&surfaces, &scene.view);
-        timings.certify = ms(start);
+    if let Some(certificate) = certified {
         curves.report.certified = Some(certificate.clone());
         if let Some(r) = &mut refined {
             r.report.certified = Some(certificate);
+            r.report.sampled_finer = curves.report.sampled_finer;
         }
     }
     let mut verification = Verification::default();
@@ -340,36 +357,48 @@ fn project<'a>(
     timings: &mut Timings,
     bar: &ProgressBar,
 ) -> Result<Vec<InView<'a>>, Error> {
-    let mut projections = Vec::with_capacity(samples.len());
-    for (entry, sample) in scene.surfaces.iter().zip(samples) {
-        let name = &sample.name;
-        bar.set_message(format!("projecting {name}"));
-        let start = Instant::now();
-        let projected = scene
-            .view
-            .project(&sample.mesh)
-            .map_err(|source| Error::View {
-                scene: scene.name.clone(),
-                surface: name.clone(),
-                source,
-            })?;
-        timings.view += ms(start);
-        bar.inc(1);
-        if let Some(largest) = projected.out_of_range() {
-            return Err(Error::Scale {
-                scene: scene.name.clone(),
-                message: format!(
-                    "surface `{name}` reaches a coordinate of {largest:.3e} in the view, beyond {MAX_COORDINATE:e}, where the files' f32 and the exact predicates stay exact; make it smaller (its size parameters, or view.translation)"
-                ),
-            });
-        }
-        projections.push(InView {
-            entry,
-            sample,
-            projected,
+    scene
+        .surfaces
+        .iter()
+        .zip(samples)
+        .map(|(entry, sample)| project_one(scene, entry, sample, timings, bar))
+        .collect()
+}
+
+/// One surface's sample projected into the scene's view.
+pub(super) fn project_one<'a>(
+    scene: &Scene,
+    entry: &'a SceneSurface,
+    sample: Sample,
+    timings: &mut Timings,
+    bar: &ProgressBar,
+) -> Result<InView<'a>, Error> {
+    let name = &sample.name;
+    bar.set_message(format!("projecting {name}"));
+    let start = Instant::now();
+    let projected = scene
+        .view
+        .project(&sample.mesh)
+        .map_err(|source| Error::View {
+            scene: scene.name.clone(),
+            surface: name.clone(),
+            source,
+        })?;
+    timings.view += ms(start);
+    bar.inc(1);
+    if let Some(largest) = projected.out_of_range() {
+        return Err(Error::Scale {
+            scene: scene.name.clone(),
+            message: format!(
+                "surface `{name}` reaches a coordinate of {largest:.3e} in the view, beyond {MAX_COORDINATE:e}, where the files' f32 and the exact predicates stay exact; make it smaller (its size parameters, or view.translation)"
+            ),
         });
     }
-    Ok(projections)
+    Ok(InView {
+        entry,
+        sample,
+        projected,
+    })
 }
 
 /// The scene's size in the view and what follows from it: the diagonal the halos' rho is a

@@ -7,6 +7,7 @@
 //! timings.
 
 mod built;
+mod hold;
 pub mod report;
 mod sampled;
 mod work;

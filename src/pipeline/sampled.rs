@@ -5,7 +5,7 @@ use super::report::{SamplingReport, Timings, surface_warnings};
 use super::{Built, Stages, built::in_view, ms};
 use crate::error::Error;
 use crate::intersect::{self, Curves, Sheet};
-use crate::sample::{self, Audit, ErrorBound, Mesh4, MeshStats, Sampling, Source, audit};
+use crate::sample::{self, Audit, ErrorBound, Finer, Mesh4, MeshStats, Sampling, Source, audit};
 use crate::scene::Scene;
 use crate::stipple::Stipples;
 use glam::DVec3;
@@ -169,73 +169,92 @@ pub(super) fn refine_curves<'a>(
 pub(super) fn sample_with(scene: &Scene, bar: &ProgressBar) -> Sampled {
     let mut timings = Timings::default();
     let mut surfaces = Vec::with_capacity(scene.surfaces.len());
-    for (i, entry) in scene.surfaces.iter().enumerate() {
-        let name = scene.surface_name(i);
-        bar.set_message(format!("sampling {name}"));
-        let sampling = scene.surface_sampling(i);
-        let start = Instant::now();
-        let sampled = entry.surface.sample(sampling);
-        let sample_ms = ms(start);
-        timings.sample += sample_ms;
-        let start = Instant::now();
-        // Stopped by its budget: the uniform grid of as many triangles to compare with,
-        // audited too (and timed with the audit). A mesh file is the surface: nothing to
-        // audit.
-        let (audited, uniform, method) = match &entry.surface {
-            Source::Parametric(surface) => (
-                audit(surface, &sampled.mesh),
-                (!sampled.complete)
-                    .then(|| sample::uniform_error(surface, sampled.mesh.triangles.len())),
-                sampling.method(),
-            ),
-            Source::Mesh(_) => (Audit::default(), None, "file"),
-        };
-        let audit_ms = ms(start);
-        timings.audit += audit_ms;
-        let start = Instant::now();
-        let aimed = matches!(
-            sampling,
-            Sampling::Adaptive {
-                bound: ErrorBound::Proven,
-                ..
-            }
-        );
-        let proof = entry
-            .surface
-            .parametric()
-            .filter(|_| scene.outputs.prove || aimed)
-            .map(|surface| sample::prove(surface, &sampled.mesh));
-        let proven_ms = ms(start);
-        timings.prove += proven_ms;
-        let report = SamplingReport::new(
-            method,
-            sampling,
-            &sampled,
-            &audited,
-            proof.as_ref(),
-            uniform,
-            [sample_ms, audit_ms, proven_ms],
-        );
-        if let Some(w) = report.warning(&name) {
-            bar.suspend(|| eprintln!("warning: {w}"));
-        }
-        let start = Instant::now();
-        let mesh = sampled.mesh;
-        let stats = mesh.validate();
-        timings.audit += ms(start);
-        for w in surface_warnings(&name, &entry.surface, &stats) {
-            bar.suspend(|| eprintln!("warning: {w}"));
-        }
+    for i in 0..scene.surfaces.len() {
+        surfaces.push(sample_surface(scene, i, &[], &mut timings, bar));
         bar.inc(1);
-        surfaces.push(Sample {
-            name,
-            mesh,
-            stats,
-            report,
-            stipples: Arc::default(),
-        });
     }
     Sampled { surfaces, timings }
+}
+
+/// Samples surface `i` of the scene (an adaptive sampling holding the rectangles `finer` to
+/// their own tolerance), audits it, proves its bound where asked and validates its mesh,
+/// with the times added to `timings`.
+pub(super) fn sample_surface(
+    scene: &Scene,
+    i: usize,
+    finer: &[Finer],
+    timings: &mut Timings,
+    bar: &ProgressBar,
+) -> Sample {
+    let entry = &scene.surfaces[i];
+    let name = scene.surface_name(i);
+    bar.set_message(format!("sampling {name}"));
+    let sampling = scene.surface_sampling(i);
+    let start = Instant::now();
+    let sampled = match &entry.surface {
+        Source::Parametric(surface) if !finer.is_empty() => {
+            sample::sample_finer(surface, sampling, finer)
+        }
+        source => source.sample(sampling),
+    };
+    let sample_ms = ms(start);
+    timings.sample += sample_ms;
+    let start = Instant::now();
+    // Stopped by its budget: the uniform grid of as many triangles to compare with,
+    // audited too (and timed with the audit). A mesh file is the surface: nothing to
+    // audit.
+    let (audited, uniform, method) = match &entry.surface {
+        Source::Parametric(surface) => (
+            audit(surface, &sampled.mesh),
+            (!sampled.complete)
+                .then(|| sample::uniform_error(surface, sampled.mesh.triangles.len())),
+            sampling.method(),
+        ),
+        Source::Mesh(_) => (Audit::default(), None, "file"),
+    };
+    let audit_ms = ms(start);
+    timings.audit += audit_ms;
+    let start = Instant::now();
+    let aimed = matches!(
+        sampling,
+        Sampling::Adaptive {
+            bound: ErrorBound::Proven,
+            ..
+        }
+    );
+    let proof = entry
+        .surface
+        .parametric()
+        .filter(|_| scene.outputs.prove || aimed)
+        .map(|surface| sample::prove(surface, &sampled.mesh));
+    let proven_ms = ms(start);
+    timings.prove += proven_ms;
+    let report = SamplingReport::new(
+        method,
+        sampling,
+        &sampled,
+        &audited,
+        proof.as_ref(),
+        uniform,
+        [sample_ms, audit_ms, proven_ms],
+    );
+    if let Some(w) = report.warning(&name) {
+        bar.suspend(|| eprintln!("warning: {w}"));
+    }
+    let start = Instant::now();
+    let mesh = sampled.mesh;
+    let stats = mesh.validate();
+    timings.audit += ms(start);
+    for w in surface_warnings(&name, &entry.surface, &stats) {
+        bar.suspend(|| eprintln!("warning: {w}"));
+    }
+    Sample {
+        name,
+        mesh,
+        stats,
+        report,
+        stipples: Arc::default(),
+    }
 }
 
 #[cfg(test)]

@@ -92,6 +92,8 @@ struct Patch {
     p: Vec<DVec4>,
     /// Whether triangles are held to their proven bound ([`ErrorBound::Proven`]).
     proven: bool,
+    /// The rectangles of this patch sampled to a finer tolerance than the surface's.
+    finer: Vec<Finer>,
     /// Each point's own rounding ([`corner_error`]), when `proven`.
     error: Vec<f64>,
     /// Which sides are poles.
@@ -626,7 +628,33 @@ pub fn sample_adaptive_through(
     max_triangles: usize,
     through: &[(usize, [f64; 2])],
 ) -> AdaptiveMesh {
-    let mut sampler = Sampler::new(surface, tolerance * (1.0 - 1e-9), bound, max_triangles);
+    sample_adaptive_with(surface, tolerance, bound, max_triangles, through, &[])
+}
+
+/// The adaptive sampler with its two guides: points to pass through and finer rectangles.
+fn sample_adaptive_with(
+    surface: &Surface,
+    tolerance: f64,
+    bound: ErrorBound,
+    max_triangles: usize,
+    through: &[(usize, [f64; 2])],
+    finer: &[Finer],
+) -> AdaptiveMesh {
+    // Slightly under, so that a triangle measured at the tolerance passes.
+    let finer: Vec<Finer> = finer
+        .iter()
+        .map(|f| Finer {
+            tolerance: f.tolerance * (1.0 - 1e-9),
+            ..*f
+        })
+        .collect();
+    let mut sampler = Sampler::new(
+        surface,
+        tolerance * (1.0 - 1e-9),
+        bound,
+        max_triangles,
+        &finer,
+    );
     sampler.insert_through(through);
     let complete = sampler.refine(max_triangles);
     let failing = if complete { 0 } else { sampler.count_failing() };
@@ -635,6 +663,33 @@ pub fn sample_adaptive_through(
         complete: complete && failing == 0,
         failing,
     }
+}
+
+/// A rectangle of a patch's parameters to sample to a finer tolerance than the rest of its
+/// surface (see [`sample_adaptive_finer`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Finer {
+    /// The patch.
+    pub patch: usize,
+    /// The range of u.
+    pub u: [f64; 2],
+    /// The range of v.
+    pub v: [f64; 2],
+    /// The tolerance (an absolute length) of the triangles that meet the rectangle.
+    pub tolerance: f64,
+}
+
+/// [`sample_adaptive_to`] with every triangle that meets one of the rectangles `finer`
+/// held to that rectangle's tolerance: the build samples a surface again so, around the
+/// double curves its mesh missed ([`crate::intersect::certified`]).
+pub fn sample_adaptive_finer(
+    surface: &Surface,
+    tolerance: f64,
+    bound: ErrorBound,
+    max_triangles: usize,
+    finer: &[Finer],
+) -> AdaptiveMesh {
+    sample_adaptive_with(surface, tolerance, bound, max_triangles, &[], finer)
 }
 
 /// What a patch needs to refine itself.
@@ -823,12 +878,13 @@ impl Patch {
     }
 
     /// Tests a triangle at the audit's edge and interior points.
-    fn check(&self, surface: &Surface, tolerance: f64, t: [usize; 3]) -> Verdict {
+    fn check(&self, surface: &Surface, global: f64, t: [usize; 3]) -> Verdict {
         let patch = self.of;
         if self.collapses(t) {
             return Verdict::Pass;
         }
         let uv = t.map(|i| self.uv(self.st[i]));
+        let tolerance = self.tolerance_at(&uv, global);
         let corners = t.map(|i| self.p[i]);
         let mut worst = 0.0f64;
         let mut edge_error = [0.0f64; 3];
@@ -898,7 +954,20 @@ impl Patch {
             3 => over,
             _ => vec![(0..3).fold(0, |m, k| if edge_score[k] > edge_score[m] { k } else { m })],
         };
+        // The score in units of the surface's tolerance, which the queue's levels count in.
+        let score = score * (global / tolerance);
         Verdict::Split { edges, score }
+    }
+
+    /// The tolerance a triangle of parameters `uv` is held to: the finest of the [`Finer`]
+    /// rectangles its parameters' box meets, else the surface's `global` one.
+    fn tolerance_at(&self, uv: &[[f64; 2]; 3], global: f64) -> f64 {
+        let lo = |k: usize| uv[0][k].min(uv[1][k]).min(uv[2][k]);
+        let hi = |k: usize| uv[0][k].max(uv[1][k]).max(uv[2][k]);
+        self.finer
+            .iter()
+            .filter(|f| f.u[0] <= hi(0) && lo(0) <= f.u[1] && f.v[0] <= hi(1) && lo(1) <= f.v[1])
+            .fold(global, |t, f| t.min(f.tolerance))
     }
 }
 
@@ -913,7 +982,13 @@ impl<'a> Sampler<'a> {
     /// from a coarse grid shaped like its
     /// warped rectangle, with the rectangle's sides as constraint edges, and makes the
     /// glued sides conform.
-    fn new(surface: &'a Surface, tolerance: f64, bound: ErrorBound, max_triangles: usize) -> Self {
+    fn new(
+        surface: &'a Surface,
+        tolerance: f64,
+        bound: ErrorBound,
+        max_triangles: usize,
+        finer: &[Finer],
+    ) -> Self {
         let [min_u, min_v] = surface.min_cells();
         let mut patches = Vec::new();
         for Tile {
@@ -938,6 +1013,7 @@ impl<'a> Sampler<'a> {
                 st: Vec::new(),
                 p: Vec::new(),
                 proven: bound == ErrorBound::Proven,
+                finer: finer.iter().filter(|f| f.patch == of).copied().collect(),
                 error: Vec::new(),
                 pole,
                 sides: Default::default(),

@@ -21,7 +21,10 @@ mod proven;
 mod source;
 mod uniform;
 
-pub use adaptive::{metric_aspect, sample_adaptive, sample_adaptive_through, sample_adaptive_to};
+pub use adaptive::{
+    Finer, metric_aspect, sample_adaptive, sample_adaptive_finer, sample_adaptive_through,
+    sample_adaptive_to,
+};
 pub use audit::{AUDIT_POINTS, Audit, audit};
 pub use proven::{Proof, corner_error, prove, triangle_bound};
 pub use source::{MeshData4, MeshSurface, Source, mesh_from_data, mesh_tangents, mesh_topology};
@@ -212,6 +215,12 @@ fn absolute(relative: Option<f64>, absolute: Option<f64>, diagonal: f64) -> f64 
 
 /// Samples a surface as `sampling` says.
 pub fn sample(surface: &Surface, sampling: &Sampling) -> Sampled {
+    sample_finer(surface, sampling, &[])
+}
+
+/// [`sample`], an adaptive sampling holding the triangles that meet the rectangles `finer`
+/// to their own tolerance ([`sample_adaptive_finer`]); a grid is sampled as it is.
+pub fn sample_finer(surface: &Surface, sampling: &Sampling, finer: &[Finer]) -> Sampled {
     let diagonal = bounding_diagonal(surface);
     match *sampling {
         Sampling::Uniform { u, v } => Sampled {
@@ -227,7 +236,7 @@ pub fn sample(surface: &Surface, sampling: &Sampling) -> Sampled {
             bound,
         } => {
             let tolerance = absolute(tolerance, absolute_tolerance, diagonal);
-            let out = sample_adaptive_to(surface, tolerance, bound, max_triangles);
+            let out = sample_adaptive_finer(surface, tolerance, bound, max_triangles, finer);
             Sampled {
                 mesh: out.mesh,
                 tolerance: Some(tolerance),

@@ -36,6 +36,23 @@ pub struct Component {
     pub points: Vec<[f64; 3]>,
     /// The widest enclosure of those points.
     pub width: f64,
+    /// Where it passes on the two sheets that cross there: for each of its points, the box
+    /// of parameters on each sheet in which its arc's end was proven the only one (for the
+    /// sampler to refine around a curve a mesh missed).
+    pub boxes: Vec<[SheetBox; 2]>,
+}
+
+/// A box of parameters on a patch of one of the certificate's surfaces.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SheetBox {
+    /// The surface (its index in the certificate's list).
+    pub surface: usize,
+    /// The patch.
+    pub patch: usize,
+    /// The range of u.
+    pub u: [f64; 2],
+    /// The range of v.
+    pub v: [f64; 2],
 }
 
 /// How a component of double curve ends.
@@ -223,12 +240,20 @@ pub(super) fn components(arcs: &[Arc], surfaces: &[&Projector]) -> Vec<Component
             arcs: 0,
             points: Vec::new(),
             width: 0.0,
+            boxes: Vec::new(),
         });
         if i % 2 == 0 {
             c.arcs += 1;
         }
         let k = keys[i];
         c.points.push(k.map(I::mid));
+        let (w, unique) = (own(i), end(i).unique);
+        c.boxes.push([0, 1].map(|sheet| SheetBox {
+            surface: w.surfaces[sheet],
+            patch: w.patches[sheet],
+            u: [unique[2 * sheet].lo(), unique[2 * sheet].hi()],
+            v: [unique[2 * sheet + 1].lo(), unique[2 * sheet + 1].hi()],
+        }));
         c.width = c.width.max(pad(&k));
         let ok = match (&places[i], matches[i].len()) {
             (Place::Open, 0) => {

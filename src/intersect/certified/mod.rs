@@ -32,7 +32,7 @@ mod graph;
 mod near;
 mod system;
 
-pub use graph::{Component, ComponentKind};
+pub use graph::{Component, ComponentKind, SheetBox};
 
 use crate::surfaces::{Interval, Surface};
 use crate::view::View;
