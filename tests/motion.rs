@@ -593,22 +593,13 @@ fn a_pair_of_critical_points_between_the_meshs_vertices_is_proven_and_sampled_th
     // height, between the vertices of the mesh at 1e-3 of its diagonal: that mesh's picture
     // fails naming them; sampled through the proven points, the picture passes with both,
     // and its components are those of a mesh ten times finer.
-    let surface = Surface::TwistSpunTrefoil(TwistSpunTrefoil::default());
     let n = DVec4::new(
         0.2843133853585957,
         0.4878505895601343,
         -0.5027285237724977,
         -0.6545469674189082,
     );
-    let frame = hyperplane_frame(DMat4::IDENTITY, n);
-    let shape = Shape {
-        euler: Some(2),
-        closed: true,
-        orientable: true,
-    };
-    let d = bounding_diagonal(&surface);
-    let mesh = sample_adaptive(&surface, 1e-3 * d, 4_000_000).mesh;
-    let plain = motion_picture(&mesh, Some(&surface), n, frame, shape, 0).unwrap();
+    let (surface, shape, _, plain) = twist_spun_along(n);
     let proof = plain.proven.as_ref().unwrap();
     assert!(proof.complete);
     assert_eq!(proof.points.len(), 24);
@@ -636,17 +627,8 @@ fn the_still_between_two_close_critical_levels_is_the_surfaces() {
     // slice between them has 3 curves where the surface's has 5 (4 -> 5 -> 4). Sampled
     // through its critical points, the picture's components are 4, 5, 4 there and its
     // still between the two has 5.
-    let surface = Surface::TwistSpunTrefoil(TwistSpunTrefoil::default());
     let n = DVec4::ONE.normalize();
-    let frame = hyperplane_frame(DMat4::IDENTITY, n);
-    let shape = Shape {
-        euler: Some(2),
-        closed: true,
-        orientable: true,
-    };
-    let d = bounding_diagonal(&surface);
-    let mesh = sample_adaptive(&surface, 1e-3 * d, 4_000_000).mesh;
-    let plain = motion_picture(&mesh, Some(&surface), n, frame, shape, 0).unwrap();
+    let (surface, shape, mesh, plain) = twist_spun_along(n);
     assert!(
         plain
             .failures
@@ -671,6 +653,29 @@ fn the_still_between_two_close_critical_levels_is_the_surfaces() {
     // The scene's mesh at that level: the 3 curves the issue saw.
     let on_mesh = slice(&mesh, Some(&surface), n, still.slice.level);
     assert_eq!(on_mesh.curves.len(), 3);
+}
+
+/// The twist-spun trefoil (a sphere) sliced along `n`: the surface, its shape, its mesh at
+/// 1e-3 of its diagonal and that mesh's motion picture (not sampled again).
+fn twist_spun_along(
+    n: DVec4,
+) -> (
+    Surface,
+    Shape,
+    halo4d::sample::Mesh4,
+    halo4d::motion::MotionPicture,
+) {
+    let surface = Surface::TwistSpunTrefoil(TwistSpunTrefoil::default());
+    let frame = hyperplane_frame(DMat4::IDENTITY, n);
+    let shape = Shape {
+        euler: Some(2),
+        closed: true,
+        orientable: true,
+    };
+    let d = bounding_diagonal(&surface);
+    let mesh = sample_adaptive(&surface, 1e-3 * d, 4_000_000).mesh;
+    let plain = motion_picture(&mesh, Some(&surface), n, frame, shape, 0).unwrap();
+    (surface, shape, mesh, plain)
 }
 
 /// A formula surface of the coordinates `xyzw` over `u` x `v`, its sides as `sides` say

@@ -145,15 +145,8 @@ pub(super) fn newton(surface: &Surface, n: DVec4, start: CriticalPoint) -> Optio
         let first = n.dot(t);
         let residual = first.abs() / t.length();
         let across = if on_u { e.dv } else { e.du };
-        let done = polish.offer(residual, || CriticalPoint {
-            event: event_on_side(second, inward * normal, (d2.length(), across.length())),
-            level: n.dot(e.p),
-            patch,
-            uv: [u, v],
-            point: e.p,
-            residual,
-            refined: true,
-            ..start
+        let done = polish.offer(&start, (patch, [u, v]), n.dot(e.p), e.p, residual, || {
+            event_on_side(second, inward * normal, (d2.length(), across.length()))
         });
         if done {
             break;

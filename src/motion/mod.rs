@@ -558,15 +558,8 @@ fn newton(surface: &Surface, n: DVec4, start: CriticalPoint) -> Option<CriticalP
         let g = [n.dot(e.du), n.dot(e.dv)];
         let hess = [n.dot(e.duu), n.dot(e.duv), n.dot(e.dvv)];
         let residual = surface_gradient(e.du, e.dv, g);
-        let done = polish.offer(residual, || CriticalPoint {
-            event: event_of(hess),
-            level: n.dot(e.p),
-            patch,
-            uv: [u, v],
-            point: e.p,
-            residual,
-            refined: true,
-            ..start
+        let done = polish.offer(&start, (patch, [u, v]), n.dot(e.p), e.p, residual, || {
+            event_of(hess)
         });
         if done {
             break;
@@ -595,11 +588,29 @@ struct Polish {
 }
 
 impl Polish {
-    /// Offers the point of this step, of residual `residual` (made only where it converged
-    /// and beats the best); whether to stop.
-    fn offer(&mut self, residual: f64, point: impl FnOnce() -> CriticalPoint) -> bool {
+    /// Offers this step's point for `start`: at `patch` and `uv`, the surface point `point`
+    /// at height `level`, of residual `residual`, its event made only where it converged and
+    /// beats the best; whether to stop.
+    fn offer(
+        &mut self,
+        start: &CriticalPoint,
+        (patch, uv): (usize, [f64; 2]),
+        level: f64,
+        point: DVec4,
+        residual: f64,
+        event: impl FnOnce() -> Event,
+    ) -> bool {
         if residual <= CRITICAL_RESIDUAL && self.best.is_none_or(|b| residual < b.residual) {
-            self.best = Some(point());
+            self.best = Some(CriticalPoint {
+                event: event(),
+                level,
+                patch,
+                uv,
+                point,
+                residual,
+                refined: true,
+                ..*start
+            });
         }
         if self.best.is_none() {
             return false;
