@@ -72,7 +72,7 @@ pub struct Piece {
     pub tets: usize,
     /// Those with a fault.
     pub faulty: usize,
-    /// How many have each fault, by the fault's name ([`Fault::NAMES`]), the faults none
+    /// How many have each fault, by the fault's name ([`Fault::ALL`]), the faults none
     /// has left out.
     pub faults: Vec<(&'static str, usize)>,
 }
@@ -430,7 +430,7 @@ impl Checked {
                 faults: Vec::new(),
             })
             .collect();
-        let mut counts = vec![[0usize; Fault::NAMES.len()]; out.len()];
+        let mut counts = vec![[0usize; Fault::ALL.len()]; out.len()];
         for (&k, &bits) in mesh.piece_of.iter().zip(c.cell_faults()) {
             let Some(piece) = out.get_mut(k as usize) else {
                 continue;
@@ -439,17 +439,17 @@ impl Checked {
             let bits = bits & !Fault::CAVITY;
             if bits != 0 {
                 piece.faulty += 1;
-                for (i, &(bit, _)) in Fault::NAMES.iter().enumerate() {
-                    counts[k as usize][i] += usize::from(bits & bit != 0);
+                for (i, f) in Fault::ALL.iter().enumerate() {
+                    counts[k as usize][i] += usize::from(bits & f.bit != 0);
                 }
             }
         }
         for (piece, counts) in out.iter_mut().zip(&counts) {
-            piece.faults = Fault::NAMES
+            piece.faults = Fault::ALL
                 .iter()
                 .zip(counts)
                 .filter(|(_, n)| **n > 0)
-                .map(|(&(_, name), &n)| (name, n))
+                .map(|(f, &n)| (f.name, n))
                 .collect();
         }
         out
@@ -460,12 +460,12 @@ impl Checked {
         let Some(c) = &self.certificate else {
             return Vec::new();
         };
-        Fault::NAMES
+        Fault::ALL
             .iter()
-            .map(|&(bit, name)| {
+            .map(|f| {
                 (
-                    name,
-                    c.cell_faults().iter().filter(|&&f| f & bit != 0).count(),
+                    f.name,
+                    c.cell_faults().iter().filter(|&&b| b & f.bit != 0).count(),
                 )
             })
             .filter(|&(_, n)| n > 0)
@@ -497,22 +497,21 @@ fn certificate_text(c: &Certificate) -> String {
         ("boundary faces", b.faces.to_string()),
         ("components", b.components.to_string()),
         ("cavities", b.cavities.to_string()),
-        ("nonmanifold_edges", b.nonmanifold_edges.to_string()),
-        ("misoriented_edges", b.misoriented_edges.to_string()),
-        ("nonmanifold_vertices", b.nonmanifold_vertices.to_string()),
-        ("hanging_vertices", b.hanging_vertices.to_string()),
-        ("self_intersections", b.self_intersections.to_string()),
-        ("wrong_winding", b.wrong_winding.to_string()),
-        ("undecided_windings", b.undecided_windings.to_string()),
-        (
-            "windings just inside",
-            if windings.len() > 12 {
-                format!("{} ...", windings[..12].join(" "))
-            } else {
-                windings.join(" ")
-            },
-        ),
-    ];
+    ]
+    .into_iter()
+    .chain(
+        b.fault_counts()
+            .into_iter()
+            .map(|(name, count, _)| (name, count.to_string())),
+    )
+    .chain([(
+        "windings just inside",
+        if windings.len() > 12 {
+            format!("{} ...", windings[..12].join(" "))
+        } else {
+            windings.join(" ")
+        },
+    )]);
     if let Some(cells) = &c.cells {
         out += &cells_text(cells);
     }

@@ -532,3 +532,31 @@ fn a_partitioned_mesh_is_certified_as_one_and_a_fault_between_pieces_names_both(
         assert!(text.contains(&format!("piece {file}: ")), "{text}");
     }
 }
+
+#[test]
+fn the_fault_bits_are_declared_once_and_the_readme_and_the_help_list_them() {
+    // The bits are the powers of two in order, each named once.
+    for (k, f) in Fault::ALL.iter().enumerate() {
+        assert_eq!(f.bit, 1 << k, "{}", f.name);
+    }
+    let names: std::collections::BTreeSet<&str> = Fault::ALL.iter().map(|f| f.name).collect();
+    assert_eq!(names.len(), Fault::ALL.len());
+    assert_eq!(Fault::NONCONFORMING, Fault::ALL[12].bit);
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    let table = Fault::table();
+    assert!(
+        readme.contains(&table),
+        "the README's table of fault bits is not the code's; it should read:\n{table}"
+    );
+    // `halo4d check --help` lists every bit.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_halo4d"))
+        .args(["check", "--help"])
+        .output()
+        .unwrap();
+    let help = String::from_utf8_lossy(&out.stdout)
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    assert!(help.contains(&Fault::legend()), "{help}");
+}

@@ -53,6 +53,50 @@ pub struct Boundary {
     pub windings: Vec<Option<i64>>,
 }
 
+impl Boundary {
+    /// The counts that fail a mesh, each with its name (as [`super::Certificate::failures`]
+    /// and `halo4d check`'s table write it) and what it counts: declared once, here.
+    pub fn fault_counts(&self) -> [(&'static str, usize, &'static str); 7] {
+        [
+            (
+                "nonmanifold_edges",
+                self.nonmanifold_edges,
+                "edges in more than two boundary faces",
+            ),
+            (
+                "misoriented_edges",
+                self.misoriented_edges,
+                "boundary edges whose faces face opposite ways",
+            ),
+            (
+                "nonmanifold_vertices",
+                self.nonmanifold_vertices,
+                "boundary vertices where pieces touch",
+            ),
+            (
+                "hanging_vertices",
+                self.hanging_vertices,
+                "vertices on a face or edge not their own",
+            ),
+            (
+                "self_intersections",
+                self.self_intersections,
+                "pairs of boundary faces that meet",
+            ),
+            (
+                "wrong_winding",
+                self.wrong_winding,
+                "boundary components around which the mesh does not wind once",
+            ),
+            (
+                "undecided_windings",
+                self.undecided_windings,
+                "components whose winding number could not be decided",
+            ),
+        ]
+    }
+}
+
 /// Fault bits of boundary faces ([`super::Fault`]), by boundary face (in the order given).
 pub type FaceMarks = Vec<u32>;
 

@@ -191,7 +191,7 @@ pub struct FaultyCell {
     /// Its number: a tetrahedron's index among the tetrahedra, another cell's number in
     /// the file (VTK's cell id, Gmsh's element tag).
     pub id: u64,
-    /// Its faults' names ([`Fault::NAMES`]).
+    /// Its faults' names ([`Fault::ALL`]).
     pub faults: Vec<&'static str>,
 }
 
@@ -463,10 +463,10 @@ fn faulty_cells(faults: &[u32], nt: usize, solids: &[(SolidKind, u64)]) -> Vec<F
             FaultyCell {
                 kind,
                 id,
-                faults: Fault::NAMES
+                faults: Fault::ALL
                     .iter()
-                    .filter(|(bit, _)| b & bit != 0 && *bit != Fault::CAVITY)
-                    .map(|&(_, name)| name)
+                    .filter(|f| b & f.bit != 0 && f.bit != Fault::CAVITY)
+                    .map(|f| f.name)
                     .collect(),
             }
         })

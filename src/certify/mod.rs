@@ -45,53 +45,88 @@ use serde::Serialize;
 use std::collections::HashMap;
 
 /// The faults a tetrahedron can have, as bits of [`Certificate::faults`] (the `fault` cell
-/// field `halo4d check --mark` writes).
+/// field `halo4d check --mark` writes). Each is declared once, below: its bit, its
+/// documentation, its name and what it marks, from which [`Fault::ALL`], the `--mark`
+/// legend ([`Fault::legend`]) and the README's table ([`Fault::table`]) are made.
 pub struct Fault;
 
-impl Fault {
-    /// Negatively oriented (in the convention the mesh is read in).
-    pub const INVERTED: u32 = 1;
-    /// Flat: zero volume, exactly.
-    pub const FLAT: u32 = 1 << 1;
-    /// A coordinate too small, against the mesh's largest, for the exact predicates.
-    pub const UNDECIDABLE: u32 = 1 << 2;
-    /// A vertex repeated.
-    pub const DEGENERATE: u32 = 1 << 3;
-    /// Listed more than once.
-    pub const DUPLICATE: u32 = 1 << 4;
-    /// A face in more than two tetrahedra.
-    pub const OVERSHARED: u32 = 1 << 5;
-    /// A face whose other tetrahedron lies on the same side of it.
-    pub const FOLDED: u32 = 1 << 6;
-    /// A boundary face with a vertex of another face on it.
-    pub const HANGING: u32 = 1 << 7;
-    /// A boundary face at a non-manifold or misoriented edge or vertex.
-    pub const NONMANIFOLD: u32 = 1 << 8;
-    /// A boundary face that meets another beyond what they share.
-    pub const SELF_INTERSECTION: u32 = 1 << 9;
-    /// A boundary face of a component whose winding number just inside is not 1.
-    pub const WINDING: u32 = 1 << 10;
-    /// A boundary face of a cavity (not a fault: reported).
-    pub const CAVITY: u32 = 1 << 11;
-    /// A cell with a bent quadrilateral against two triangles of other cells (mixed meshes).
-    pub const NONCONFORMING: u32 = 1 << 12;
+/// One fault bit: its value, its name and what a cell marked with it is (empty where the
+/// name says it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FaultBit {
+    /// The bit.
+    pub bit: u32,
+    /// Its name, as `--mark`'s legend and `halo4d check` give it.
+    pub name: &'static str,
+    /// What a cell marked with it is, where the name does not say it all.
+    pub note: &'static str,
+}
 
-    /// Every bit with its name, as `--mark`'s legend and the README give them.
-    pub const NAMES: [(u32, &'static str); 13] = [
-        (Self::INVERTED, "inverted"),
-        (Self::FLAT, "flat"),
-        (Self::UNDECIDABLE, "undecidable"),
-        (Self::DEGENERATE, "degenerate"),
-        (Self::DUPLICATE, "duplicate"),
-        (Self::OVERSHARED, "overshared face"),
-        (Self::FOLDED, "folded face"),
-        (Self::HANGING, "hanging vertex"),
-        (Self::NONMANIFOLD, "non-manifold boundary"),
-        (Self::SELF_INTERSECTION, "self-intersecting boundary"),
-        (Self::WINDING, "wrong winding"),
-        (Self::CAVITY, "cavity (not a fault)"),
-        (Self::NONCONFORMING, "non-conforming quadrilateral"),
-    ];
+/// Declares the fault bits: each its constant (with its documentation), name and note.
+macro_rules! faults {
+    ($($(#[doc = $doc:literal])* $constant:ident = $bit:literal, $name:literal, $note:literal;)*) => {
+        impl Fault {
+            $($(#[doc = $doc])* pub const $constant: u32 = $bit;)*
+
+            /// Every fault bit, in the order of the bits.
+            pub const ALL: [FaultBit; [$($bit),*].len()] =
+                [$(FaultBit { bit: $bit, name: $name, note: $note }),*];
+        }
+    };
+}
+
+faults! {
+    /// Negatively oriented (in the convention the mesh is read in).
+    INVERTED = 1, "inverted", "";
+    /// Flat: zero volume, exactly.
+    FLAT = 2, "flat", "";
+    /// A coordinate too small, against the mesh's largest, for the exact predicates.
+    UNDECIDABLE = 4, "undecidable", "a coordinate 1e80 times smaller than the largest";
+    /// A vertex repeated.
+    DEGENERATE = 8, "degenerate", "a vertex repeated";
+    /// Listed more than once.
+    DUPLICATE = 16, "duplicate", "";
+    /// A face in more than two tetrahedra.
+    OVERSHARED = 32, "overshared face", "in more than two tetrahedra";
+    /// A face whose other tetrahedron lies on the same side of it.
+    FOLDED = 64, "folded face", "";
+    /// A boundary face with a vertex of another face on it.
+    HANGING = 128, "hanging vertex", "the face it hangs on";
+    /// A boundary face at a non-manifold or misoriented edge or vertex.
+    NONMANIFOLD = 256, "non-manifold boundary", "or misoriented";
+    /// A boundary face that meets another beyond what they share.
+    SELF_INTERSECTION = 512, "self-intersecting boundary", "";
+    /// A boundary face of a component whose winding number just inside is not 1.
+    WINDING = 1024, "wrong winding", "every face of the component";
+    /// A boundary face of a cavity (not a fault: reported).
+    CAVITY = 2048, "cavity (not a fault)", "";
+    /// A cell with a bent quadrilateral against two triangles of other cells (mixed meshes).
+    NONCONFORMING = 4096, "non-conforming quadrilateral", "a mixed mesh's cell";
+}
+
+impl Fault {
+    /// The bits as `--mark`'s help lists them: `1 inverted, 2 flat, ...`.
+    pub fn legend() -> String {
+        let bits: Vec<String> = Fault::ALL
+            .iter()
+            .map(|f| format!("{} {}", f.bit, f.name))
+            .collect();
+        bits.join(", ")
+    }
+
+    /// The bits as the README's table (Markdown), one row a bit.
+    pub fn table() -> String {
+        let mut out = String::from("| bit | fault |\n| --- | --- |\n");
+        for f in Fault::ALL {
+            let note = if f.note.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", f.note)
+            };
+            out += &format!("| {} | {}{note} |\n", f.bit, f.name);
+        }
+        out
+    }
 }
 
 /// The convention a mesh's tetrahedra were read in.
@@ -140,50 +175,13 @@ impl Certificate {
     /// tetrahedra among them), then each non-zero count of the boundary's faults as `<count> <name>`;
     /// empty when it passes.
     pub fn failures(&self) -> Vec<String> {
-        let b = &self.boundary;
         let mut out = self.stats.failures();
-        for (name, count, what) in [
-            (
-                "nonmanifold_edges",
-                b.nonmanifold_edges,
-                "edges in more than two boundary faces",
-            ),
-            (
-                "misoriented_edges",
-                b.misoriented_edges,
-                "boundary edges whose faces face opposite ways",
-            ),
-            (
-                "nonmanifold_vertices",
-                b.nonmanifold_vertices,
-                "boundary vertices where pieces touch",
-            ),
-            (
-                "hanging_vertices",
-                b.hanging_vertices,
-                "vertices on a face or edge not their own",
-            ),
-            (
-                "self_intersections",
-                b.self_intersections,
-                "pairs of boundary faces that meet",
-            ),
-            (
-                "wrong_winding",
-                b.wrong_winding,
-                "boundary components around which the mesh does not wind once",
-            ),
-            (
-                "undecided_windings",
-                b.undecided_windings,
-                "components whose winding number could not be decided",
-            ),
-            (
-                "nonconforming_quads",
-                self.cells.as_ref().map_or(0, |c| c.nonconforming_quads),
-                "bent quadrilaterals against two triangles of other cells",
-            ),
-        ] {
+        let quads = self.cells.as_ref().map_or(0, |c| c.nonconforming_quads);
+        for (name, count, what) in self.boundary.fault_counts().into_iter().chain([(
+            "nonconforming_quads",
+            quads,
+            "bent quadrilaterals against two triangles of other cells",
+        )]) {
             if count > 0 {
                 out.push(format!("{count} {name} ({what})"));
             }

@@ -248,12 +248,18 @@ pub struct CheckArgs {
     #[arg(long)]
     pub json: bool,
     /// Write the checked mesh (one without halo4d's layout) to this .vtu, each cell with its
-    /// faults as the cell field `fault` (bits: 1 inverted, 2 flat, 4 undecidable, 8
-    /// degenerate, 16 duplicate, 32 overshared face, 64 folded face, 128 hanging vertex, 256
-    /// non-manifold boundary, 512 self-intersecting boundary, 1024 wrong winding, 2048
-    /// cavity, 4096 non-conforming quadrilateral), and its dihedral angles and radius ratio.
-    #[arg(long, value_name = "OUT.vtu")]
+    /// faults as the cell field `fault` (its bits: `Fault::legend`), and its dihedral angles
+    /// and radius ratio.
+    #[arg(long, value_name = "OUT.vtu", help = mark_help())]
     pub mark: Option<PathBuf>,
+}
+
+/// `--mark`'s help, its bits listed from the one declaration of the faults.
+fn mark_help() -> String {
+    format!(
+        "Write the checked mesh (one without halo4d's layout) to this .vtu, each cell with its faults as the cell field `fault` (bits: {}), and its dihedral angles and radius ratio",
+        halo4d::certify::Fault::legend()
+    )
 }
 
 /// The arguments of `halo4d slice`.
