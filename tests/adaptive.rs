@@ -434,55 +434,67 @@ fn a_mesh_sampled_through_points_has_a_vertex_at_each_and_keeps_its_topology() {
 }
 
 #[test]
-fn a_finer_rectangle_holds_its_triangles_to_its_tolerance_and_only_there() {
-    // The spun trefoil at 1e-3 of its diagonal, a rectangle of a tenth of its parameters
-    // held to a sixteenth of that: every triangle meeting the rectangle meets the finer
-    // tolerance as audited, the rest the surface's, and the mesh is much smaller than the
-    // whole surface at the finer tolerance.
+fn finer_rectangles_hold_their_triangles_to_their_tolerance_and_only_there() {
+    // The spun trefoil at 1e-3 of its diagonal; one rectangle of a tenth of its parameters,
+    // then 40 small squares along a diagonal of them (as a curve's boxes are), held to a
+    // sixteenth of that: every triangle meeting one meets the finer tolerance as audited,
+    // the rest the surface's, and the mesh is much smaller than the whole surface at the
+    // finer tolerance.
     use halo4d::sample::{ErrorBound, Finer, sample_adaptive_finer};
     let surface = Surface::SpunTrefoil(SpunTrefoil::default());
     let d = bounding_diagonal(&surface);
     let domain = surface.domain(0);
     let span = |r: [f64; 2], a: f64, b: f64| [r[0] + (r[1] - r[0]) * a, r[0] + (r[1] - r[0]) * b];
     let (global, fine) = (1e-3 * d, 1e-3 * d / 16.0);
-    let rect = Finer {
+    let rect = |a: [f64; 2], b: [f64; 2]| Finer {
         patch: 0,
-        u: span(domain.u, 0.4, 0.5),
-        v: span(domain.v, 0.2, 0.3),
+        u: span(domain.u, a[0], a[1]),
+        v: span(domain.v, b[0], b[1]),
         tolerance: fine,
     };
-    let out = sample_adaptive_finer(&surface, global, ErrorBound::Audited, 2_000_000, &[rect]);
-    assert!(out.complete);
-    let mesh = out.mesh;
-    let meets = |t: &[[f64; 2]; 3]| {
-        let lo = |k: usize| t.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
-        let hi = |k: usize| t.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
-        rect.u[0] <= hi(0) && lo(0) <= rect.u[1] && rect.v[0] <= hi(1) && lo(1) <= rect.v[1]
-    };
-    let inside: Vec<usize> = (0..mesh.triangles.len())
-        .filter(|&i| meets(&mesh.triangle_uv[i]))
+    let one = vec![rect([0.4, 0.5], [0.2, 0.3])];
+    let squares: Vec<Finer> = (0..40)
+        .map(|k| {
+            let t = 0.1 + 0.02 * k as f64;
+            rect([t, t + 0.01], [t, t + 0.01])
+        })
         .collect();
-    assert!(
-        inside.len() > 100,
-        "{} triangles meet the rectangle",
-        inside.len()
-    );
-    let sub = Mesh4 {
-        triangles: inside.iter().map(|&i| mesh.triangles[i]).collect(),
-        triangle_patch: inside.iter().map(|&i| mesh.triangle_patch[i]).collect(),
-        triangle_uv: inside.iter().map(|&i| mesh.triangle_uv[i]).collect(),
-        ..mesh.clone()
-    };
-    let audited = audit(&surface, &sub).max_error;
-    assert!(audited <= fine, "{audited} against {fine}");
-    assert!(audit(&surface, &mesh).max_error <= global);
-    let plain = sample_adaptive(&surface, global, 2_000_000).mesh;
     let everywhere = sample_adaptive(&surface, fine, 2_000_000).mesh;
-    assert!(mesh.triangles.len() > plain.triangles.len());
-    assert!(
-        4 * mesh.triangles.len() < everywhere.triangles.len(),
-        "{} triangles, {} finer everywhere",
-        mesh.triangles.len(),
-        everywhere.triangles.len()
-    );
+    let plain = sample_adaptive(&surface, global, 2_000_000).mesh;
+    for rects in [one, squares] {
+        let out = sample_adaptive_finer(&surface, global, ErrorBound::Audited, 2_000_000, &rects);
+        assert!(out.complete);
+        let mesh = out.mesh;
+        let meets = |t: &[[f64; 2]; 3]| {
+            let lo = |k: usize| t.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+            let hi = |k: usize| t.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
+            rects
+                .iter()
+                .any(|r| r.u[0] <= hi(0) && lo(0) <= r.u[1] && r.v[0] <= hi(1) && lo(1) <= r.v[1])
+        };
+        let inside: Vec<usize> = (0..mesh.triangles.len())
+            .filter(|&i| meets(&mesh.triangle_uv[i]))
+            .collect();
+        assert!(
+            inside.len() > 100,
+            "{} triangles meet the rectangles",
+            inside.len()
+        );
+        let sub = Mesh4 {
+            triangles: inside.iter().map(|&i| mesh.triangles[i]).collect(),
+            triangle_patch: inside.iter().map(|&i| mesh.triangle_patch[i]).collect(),
+            triangle_uv: inside.iter().map(|&i| mesh.triangle_uv[i]).collect(),
+            ..mesh.clone()
+        };
+        let audited = audit(&surface, &sub).max_error;
+        assert!(audited <= fine, "{audited} against {fine}");
+        assert!(audit(&surface, &mesh).max_error <= global);
+        assert!(mesh.triangles.len() > plain.triangles.len());
+        assert!(
+            4 * mesh.triangles.len() < everywhere.triangles.len(),
+            "{} triangles, {} finer everywhere",
+            mesh.triangles.len(),
+            everywhere.triangles.len()
+        );
+    }
 }

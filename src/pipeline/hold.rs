@@ -17,8 +17,8 @@ use crate::scene::Scene;
 use indicatif::ProgressBar;
 use std::time::Instant;
 
-/// The most rounds of sampling again: the tolerance around the curves goes down to 4^-6 of
-/// the surface's (1/4096).
+/// The most rounds of sampling again: the tolerance around the curves goes down to 4^-12 of
+/// the surface's (about 6e-8).
 pub(super) const ROUNDS: usize = 12;
 
 /// The curves of `projections`' meshes, with the surfaces sampled again (and projected) as
@@ -51,6 +51,8 @@ pub(super) fn hold<'a>(
                 Some(t * 0.25f64.powi(round as i32 + 1))
             })
             .collect();
+        // Each round's rectangles replace the last's: its tolerance is finer everywhere.
+        finer.iter_mut().for_each(Vec::clear);
         let mut more = false;
         for component in &certificate.components {
             for b in component.boxes.iter().flatten() {

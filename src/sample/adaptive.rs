@@ -93,7 +93,7 @@ struct Patch {
     /// Whether triangles are held to their proven bound ([`ErrorBound::Proven`]).
     proven: bool,
     /// The rectangles of this patch sampled to a finer tolerance than the surface's.
-    finer: Vec<Finer>,
+    finer: FinerIndex,
     /// Each point's own rounding ([`corner_error`]), when `proven`.
     error: Vec<f64>,
     /// Which sides are poles.
@@ -679,6 +679,79 @@ pub struct Finer {
     pub tolerance: f64,
 }
 
+/// A tile's [`Finer`] rectangles, bucketed in a grid over the tile's parameters, so that a
+/// triangle looks only at those near it (a curve's rectangles number in the thousands).
+#[derive(Default)]
+struct FinerIndex {
+    rects: Vec<Finer>,
+    u: [f64; 2],
+    v: [f64; 2],
+    /// Cells per side.
+    n: usize,
+    /// Each cell's rectangles (indices into `rects`), row by row along u.
+    cells: Vec<Vec<u32>>,
+}
+
+impl FinerIndex {
+    fn new<'a>(rects: impl Iterator<Item = &'a Finer>, domain: &Domain) -> FinerIndex {
+        let rects: Vec<Finer> = rects.copied().collect();
+        if rects.is_empty() {
+            return FinerIndex::default();
+        }
+        let n = (rects.len() as f64).sqrt().ceil().clamp(1.0, 64.0) as usize;
+        let mut index = FinerIndex {
+            rects,
+            u: domain.u,
+            v: domain.v,
+            n,
+            cells: vec![Vec::new(); n * n],
+        };
+        for (k, r) in index.rects.iter().enumerate() {
+            let ([i0, i1], [j0, j1]) = (index.span(r.u, index.u), index.span(r.v, index.v));
+            for j in j0..=j1 {
+                for i in i0..=i1 {
+                    index.cells[j * n + i].push(k as u32);
+                }
+            }
+        }
+        index
+    }
+
+    /// The cells a range of parameters `r` over the tile's `domain` range covers (clamped to
+    /// the grid: what lies beyond the tile falls into its edge cells).
+    fn span(&self, r: [f64; 2], domain: [f64; 2]) -> [usize; 2] {
+        let cell = |x: f64| {
+            let t = (x - domain[0]) / (domain[1] - domain[0]) * self.n as f64;
+            if t.is_nan() {
+                0
+            } else {
+                (t.floor().max(0.0) as usize).min(self.n - 1)
+            }
+        };
+        [cell(r[0]), cell(r[1])]
+    }
+
+    /// The finest tolerance of the rectangles that meet the box `u` x `v`, else `global`.
+    fn finest(&self, u: [f64; 2], v: [f64; 2], global: f64) -> f64 {
+        if self.rects.is_empty() {
+            return global;
+        }
+        let ([i0, i1], [j0, j1]) = (self.span(u, self.u), self.span(v, self.v));
+        let mut out = global;
+        for j in j0..=j1 {
+            for i in i0..=i1 {
+                for &k in &self.cells[j * self.n + i] {
+                    let r = &self.rects[k as usize];
+                    if r.u[0] <= u[1] && u[0] <= r.u[1] && r.v[0] <= v[1] && v[0] <= r.v[1] {
+                        out = out.min(r.tolerance);
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
 /// [`sample_adaptive_to`] with every triangle that meets one of the rectangles `finer`
 /// held to that rectangle's tolerance: the build samples a surface again so, around the
 /// double curves its mesh missed ([`crate::intersect::certified`]).
@@ -964,10 +1037,7 @@ impl Patch {
     fn tolerance_at(&self, uv: &[[f64; 2]; 3], global: f64) -> f64 {
         let lo = |k: usize| uv[0][k].min(uv[1][k]).min(uv[2][k]);
         let hi = |k: usize| uv[0][k].max(uv[1][k]).max(uv[2][k]);
-        self.finer
-            .iter()
-            .filter(|f| f.u[0] <= hi(0) && lo(0) <= f.u[1] && f.v[0] <= hi(1) && lo(1) <= f.v[1])
-            .fold(global, |t, f| t.min(f.tolerance))
+        self.finer.finest([lo(0), hi(0)], [lo(1), hi(1)], global)
     }
 }
 
@@ -1004,6 +1074,7 @@ impl<'a> Sampler<'a> {
             let aspect = warp.s.end() / warp.t.end();
             let nu = grid_cells(4.0 * aspect.sqrt(), min_u.div_ceil(k));
             let nv = grid_cells(4.0 / aspect.sqrt(), min_v.div_ceil(k));
+            let rects = FinerIndex::new(finer.iter().filter(|f| f.patch == of), &domain);
             let mut p = Patch {
                 of,
                 tile: (corner, k),
@@ -1013,7 +1084,7 @@ impl<'a> Sampler<'a> {
                 st: Vec::new(),
                 p: Vec::new(),
                 proven: bound == ErrorBound::Proven,
-                finer: finer.iter().filter(|f| f.patch == of).copied().collect(),
+                finer: rects,
                 error: Vec::new(),
                 pole,
                 sides: Default::default(),
