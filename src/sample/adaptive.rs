@@ -680,7 +680,8 @@ pub struct Finer {
 }
 
 /// A tile's [`Finer`] rectangles, bucketed in a grid over the tile's parameters, so that a
-/// triangle looks only at those near it (a curve's rectangles number in the thousands).
+/// triangle looks only at those near it (a long curve's rectangles can number in the
+/// thousands).
 #[derive(Default)]
 struct FinerIndex {
     rects: Vec<Finer>,
