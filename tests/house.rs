@@ -76,7 +76,10 @@ fn blank_literals(source: &str) -> String {
         } else if rest[0] == b'\'' {
             // A character literal ('x', '\n', '\u{7b}', '{'), else a lifetime.
             let len = if rest.get(1) == Some(&b'\\') {
-                rest[2..].iter().position(|&b| b == b'\'').map(|k| k + 3)
+                // The escaped character first ('\'' escapes a quote), then the closing quote.
+                rest.get(3..)
+                    .and_then(|r| r.iter().position(|&b| b == b'\''))
+                    .map(|k| k + 4)
             } else {
                 // A quote is never inside a character of several bytes: i + 1 is a boundary.
                 source[i + 1..]
@@ -240,6 +243,7 @@ fn a_planted_long_function_is_caught_and_braces_in_literals_are_not_code() {
     let tricky = r##"
 fn a<'b>(x: &'b str) -> char {
     let _ = "}\"}"; let _ = r#"}"#; let _ = b'{'; let _ = '\u{7d}'; /* } /* } */ */
+    let _ = ['\'','}', '{', '\\'];
     '}'
 }
 fn declared(&self);
@@ -249,7 +253,7 @@ mod tests {
     }
 }
 "##;
-    assert_eq!(functions(tricky), [("a".to_string(), 2, 4)]);
+    assert_eq!(functions(tricky), [("a".to_string(), 2, 5)]);
 }
 
 #[test]
