@@ -207,9 +207,12 @@ pub(super) fn in_view(
             .collect();
         let certificate = crate::intersect::certified::certify(&surfaces, &scene.view);
         timings.certify = ms(start);
-        let (curves, rounds) =
+        let (mut curves, rounds) =
             super::hold::hold(scene, &certificate, &mut projections, &mut timings, bar)?;
-        held = Some((curves, certificate, rounds));
+        // The refined curves copy this report.
+        curves.report.certified = Some(certificate);
+        curves.report.sampled_finer = rounds;
+        held = Some(curves);
     }
     bar.set_message("measuring the scene and how its triangles pile up");
     let start = Instant::now();
@@ -243,11 +246,8 @@ pub(super) fn in_view(
         timings.guards += ms(start);
     }
     let mut curves = Curves::default();
-    let mut certified = None;
-    if let Some((held, certificate, rounds)) = held {
+    if let Some(held) = held {
         curves = held;
-        curves.report.sampled_finer = rounds;
-        certified = Some(certificate);
     } else if stages.curves {
         bar.set_message("intersection curves");
         let start = Instant::now();
@@ -257,7 +257,7 @@ pub(super) fn in_view(
         timings.curves = ms(start);
     }
     bar.inc(1);
-    let mut refined = (stages.curves && scene.curves.refine).then(|| {
+    let refined = (stages.curves && scene.curves.refine).then(|| {
         bar.set_message("refining the curves");
         let start = Instant::now();
         let none = Curves::default();
@@ -267,13 +267,6 @@ pub(super) fn in_view(
         timings.refine = ms(start);
         refined
     });
-    if let Some(certificate) = certified {
-        curves.report.certified = Some(certificate.clone());
-        if let Some(r) = &mut refined {
-            r.report.certified = Some(certificate);
-            r.report.sampled_finer = curves.report.sampled_finer;
-        }
-    }
     let mut verification = Verification::default();
     if stages.verify {
         bar.set_message("verifying halos");
@@ -361,7 +354,11 @@ fn project<'a>(
         .surfaces
         .iter()
         .zip(samples)
-        .map(|(entry, sample)| project_one(scene, entry, sample, timings, bar))
+        .map(|(entry, sample)| {
+            let view = project_one(scene, entry, sample, timings, bar);
+            bar.inc(1);
+            view
+        })
         .collect()
 }
 
@@ -385,7 +382,6 @@ pub(super) fn project_one<'a>(
             source,
         })?;
     timings.view += ms(start);
-    bar.inc(1);
     if let Some(largest) = projected.out_of_range() {
         return Err(Error::Scale {
             scene: scene.name.clone(),

@@ -631,6 +631,10 @@ pub fn sample_adaptive_through(
     sample_adaptive_with(surface, tolerance, bound, max_triangles, through, &[])
 }
 
+/// The share of a tolerance the sampler holds triangles to: slightly under, so that a
+/// triangle measured at the tolerance passes.
+const UNDER: f64 = 1.0 - 1e-9;
+
 /// The adaptive sampler with its two guides: points to pass through and finer rectangles.
 fn sample_adaptive_with(
     surface: &Surface,
@@ -640,21 +644,7 @@ fn sample_adaptive_with(
     through: &[(usize, [f64; 2])],
     finer: &[Finer],
 ) -> AdaptiveMesh {
-    // Slightly under, so that a triangle measured at the tolerance passes.
-    let finer: Vec<Finer> = finer
-        .iter()
-        .map(|f| Finer {
-            tolerance: f.tolerance * (1.0 - 1e-9),
-            ..*f
-        })
-        .collect();
-    let mut sampler = Sampler::new(
-        surface,
-        tolerance * (1.0 - 1e-9),
-        bound,
-        max_triangles,
-        &finer,
-    );
+    let mut sampler = Sampler::new(surface, tolerance * UNDER, bound, max_triangles, finer);
     sampler.insert_through(through);
     let complete = sampler.refine(max_triangles);
     let failing = if complete { 0 } else { sampler.count_failing() };
@@ -695,7 +685,12 @@ struct FinerIndex {
 
 impl FinerIndex {
     fn new<'a>(rects: impl Iterator<Item = &'a Finer>, domain: &Domain) -> FinerIndex {
-        let rects: Vec<Finer> = rects.copied().collect();
+        let rects: Vec<Finer> = rects
+            .map(|f| Finer {
+                tolerance: f.tolerance * UNDER,
+                ..*f
+            })
+            .collect();
         if rects.is_empty() {
             return FinerIndex::default();
         }
