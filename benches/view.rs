@@ -6,7 +6,8 @@ use std::hint::black_box;
 
 fn view_search(c: &mut Criterion) {
     let scene = halo4d::Scene::default_scene();
-    let found = halo4d::search_view(&scene, true).expect("the default scene has a view");
+    let found = halo4d::search_view(&scene, halo4d::progress::Job::SILENT)
+        .expect("the default scene has a view");
     eprintln!(
         "view search of the default scene: {} 4D views on {} triangles, visible share of the curves {:.3} (the scene's own view {:.3}), score {:.0} ({:.0})",
         found.views,
@@ -19,7 +20,9 @@ fn view_search(c: &mut Criterion) {
     let mut group = c.benchmark_group("view_search");
     group.sample_size(10);
     group.bench_function("default", |b| {
-        b.iter(|| halo4d::search_view(black_box(&scene), true).expect("a view"))
+        b.iter(|| {
+            halo4d::search_view(black_box(&scene), halo4d::progress::Job::SILENT).expect("a view")
+        })
     });
     group.finish();
 }

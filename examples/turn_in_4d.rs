@@ -37,7 +37,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         return Err("STEPS: give a whole number of views, 1 or more".into());
     }
     // A scene whose view is "auto" starts from the view the search finds.
-    halo4d::resolve_view(&mut scene, true)?;
+    halo4d::resolve_view(&mut scene, halo4d::progress::Job::SILENT)?;
 
     // The 4D meshes do not depend on the view: sampled and audited once.
     let sampled = Sampled::of(&scene);

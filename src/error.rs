@@ -72,6 +72,10 @@ pub enum Error {
     /// Another build is writing into the output folder.
     #[error(transparent)]
     Busy(crate::export::StagedError),
+    /// The caller cancelled the build ([`crate::progress::Cancel`]): Ctrl-C, a timeout, a
+    /// closed window. Nothing of it was written.
+    #[error(transparent)]
+    Cancelled(#[from] crate::progress::Cancelled),
     /// A stage produced something it must not (a bug, not bad input).
     #[error("internal error in stage {stage}: {message}")]
     Internal {
@@ -80,4 +84,17 @@ pub enum Error {
         /// What went wrong.
         message: String,
     },
+}
+
+impl Error {
+    /// A picture's error as the build's: a cancelled picture is a cancelled build.
+    pub(crate) fn render(scene: &str, source: crate::render::RenderError) -> Error {
+        match source {
+            crate::render::RenderError::Cancelled(c) => Error::Cancelled(c),
+            source => Error::Render {
+                scene: scene.to_string(),
+                source,
+            },
+        }
+    }
 }

@@ -5,6 +5,7 @@
 
 use crate::export::write_atomic;
 use crate::pipeline::{self, Report};
+use crate::progress::Job;
 use crate::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
 
@@ -133,15 +134,11 @@ pub fn scenes(folder: &Path) -> Result<Vec<PathBuf>, GalleryError> {
 }
 
 /// Builds every scene of `figures` (its picture always, whatever its `outputs` say) into
-/// `out/<name>/`, then writes `out/index.html` and `out/gallery.png`. `progress` hears of
-/// each figure before it is built (index, count, file). The scenes are all read and checked
-/// before the first is built.
-pub fn make(
-    figures: &Path,
-    out: &Path,
-    quiet: bool,
-    mut progress: impl FnMut(usize, usize, &Path),
-) -> Result<Gallery, GalleryError> {
+/// `out/<name>/`, then writes `out/index.html` and `out/gallery.png`: a task `"gallery"` of
+/// `job`, a step per figure, with a note of each figure before it is built
+/// (`figure 2 of 5: file`), stopped once `job` is cancelled. The scenes are all read and
+/// checked before the first is built.
+pub fn make(figures: &Path, out: &Path, job: Job) -> Result<Gallery, GalleryError> {
     let files = scenes(figures)?;
     let mut scenes: Vec<(PathBuf, Scene)> = Vec::new();
     for file in files {
@@ -156,21 +153,24 @@ pub fn make(
         scenes.push((file, scene));
     }
     let (count, mut built) = (scenes.len(), Vec::new());
+    let task = job.task("gallery", count as u64);
     for (k, (file, mut scene)) in scenes.into_iter().enumerate() {
-        progress(k, count, &file);
-        crate::viewsearch::resolve(&mut scene, quiet).map_err(|source| GalleryError::Search {
+        job.note(&format!("figure {} of {count}: {}", k + 1, file.display()));
+        crate::viewsearch::resolve(&mut scene, job).map_err(|source| GalleryError::Search {
             file: file.clone(),
             source,
         })?;
         scene.outputs.png = true;
-        let report = pipeline::build(&scene, &out.join(&scene.name), quiet).map_err(|source| {
+        let report = pipeline::build(&scene, &out.join(&scene.name), job).map_err(|source| {
             GalleryError::Build {
                 file: file.clone(),
                 source,
             }
         })?;
         built.push(Figure { file, report });
+        task.step();
     }
+    drop(task);
     let write = |name: &str, bytes: &[u8]| {
         let path = out.join(name);
         write_atomic(&path, bytes).map_err(|e| GalleryError::Write {

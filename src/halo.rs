@@ -29,6 +29,7 @@
 
 use crate::check::{CheckStats, TetMesh, check_parts};
 use crate::limits::{DELTA_D, DELTA_T, FieldError, HALO_GAP_PX, HALO_RHO, Number};
+use crate::progress::Cancel;
 use crate::tets::{self, Corners, Split, SplitStats};
 use crate::view::Projected;
 use glam::DVec3;
@@ -596,6 +597,18 @@ pub fn build_halo(
     rho: f64,
     params: &HaloParams,
 ) -> (Halo, HaloReport) {
+    build_halo_until(projected, triangles, rho, params, Cancel::never())
+}
+
+/// [`build_halo`], stopping between its steps once `cancel` is cancelled (with an empty
+/// halo, which the caller drops).
+pub fn build_halo_until(
+    projected: &Projected,
+    triangles: &[[u32; 3]],
+    rho: f64,
+    params: &HaloParams,
+    cancel: &Cancel,
+) -> (Halo, HaloReport) {
     let start = Instant::now();
     let mut stage_ms = HaloStages::default();
     let mut lap = {
@@ -616,8 +629,14 @@ pub fn build_halo(
         .map(|(&tri, &flip)| offsets.corners(tri, flip))
         .collect();
     lap(&mut stage_ms.directions);
+    if cancel.is_cancelled() {
+        return Default::default();
+    }
     let (forward, stats) = tets::plan(&corners, &offsets.positions, n, params.split);
     lap(&mut stage_ms.plan);
+    if cancel.is_cancelled() {
+        return Default::default();
+    }
 
     if shrink {
         let surface = Surface {
@@ -628,6 +647,9 @@ pub fn build_halo(
         shrink_folds(&mut offsets, &mut corners, &forward, &surface, rho);
     }
     lap(&mut stage_ms.shrink);
+    if cancel.is_cancelled() {
+        return Default::default();
+    }
     let tets = tets::emit(&corners, &forward, &offsets.positions, n, stats);
 
     let (t, d_orig) = t_and_depth(&offsets.collapsed, &projected.w, triangles, &tets);
@@ -643,6 +665,9 @@ pub fn build_halo(
         inserted_in: tets.inserted_in,
     };
     lap(&mut stage_ms.split);
+    if cancel.is_cancelled() {
+        return Default::default();
+    }
     let checked = check_parts(&halo.positions, n, &halo.tets, triangles);
     lap(&mut stage_ms.check);
     let report = HaloReport {

@@ -3,9 +3,10 @@
 //! A [`Scene`] says what to build. [`Sampled::of`] samples and audits its surfaces once;
 //! [`Sampled::build`] builds them in the scene's view (any number of views from one
 //! sampling) into a [`Built`], whose verdict is [`Built::failures`]; [`write()`] makes the
-//! files the scene asks for and gives the [`report::Report`]. [`build`] does all three, with
-//! a progress bar, and [`render_to`] makes the scene's picture. The files are checked again
-//! by [`check_file`] and [`check_dir`].
+//! files the scene asks for and gives the [`report::Report`]. [`build`] does all three and
+//! [`render_to`] makes the scene's picture. The library prints nothing: a long operation
+//! reports to the [`progress::Job`] it is given and stops, with nothing written, when the
+//! job's token is cancelled. The files are checked again by [`check_file`] and [`check_dir`].
 //!
 //! The stages, each a module, in the order of the pipeline: a surface of the catalogue or
 //! a formula ([`surfaces`]: 4D, exact derivatives) is sampled to a tolerance ([`sample`]: a
@@ -68,6 +69,7 @@ mod memory;
 pub mod motion;
 mod parts;
 mod pipeline;
+pub mod progress;
 pub mod render;
 pub mod sample;
 mod scene;
@@ -88,7 +90,7 @@ pub use error::Error;
 pub use pipeline::report;
 pub use pipeline::{
     Built, Sampled, Stages, SurfaceProduct, build, build_since, glb_bytes, render_to, report_of,
-    shown_curves, write,
+    shown_curves, write, write_with,
 };
 pub use scene::{DEFAULT_SCENE, Outputs, Scene, SceneError, SceneSurface};
 pub use viewsearch::{Found, SearchError, resolve as resolve_view, search as search_view};

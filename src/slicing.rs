@@ -11,6 +11,7 @@ use crate::export::{Staged, StagedError};
 use crate::limits::FieldError;
 use crate::motion::{self, MotionPicture, Polyline, Shape, Slicing};
 use crate::pipeline::Sampled;
+use crate::progress::Job;
 use crate::render::diagram;
 use crate::render::text::compact;
 use crate::sample::{ErrorBound, Mesh4, Sampling, Source};
@@ -286,30 +287,29 @@ pub fn surface_shape<'a>(source: &'a Source, mesh: &Mesh4) -> (Option<&'a Surfac
 
 /// Makes the motion pictures of every surface of `scene` along `slicing` (the scene's
 /// `slicing`, or other settings) into `out` (files written under temporary names and moved
-/// into place together); unless `quiet`, says on stderr when a surface is sampled again
-/// and why.
+/// into place together): a task `"motion pictures"` of `job`, a step per surface, with a
+/// note when a surface is sampled again and why, stopped between surfaces once `job` is
+/// cancelled (nothing written).
 pub fn slice_scene(
     scene: &Scene,
     slicing: Slicing,
     out: &Path,
-    quiet: bool,
+    job: Job,
 ) -> Result<Motion, SliceError> {
     slicing
         .check()
         .map_err(|e| SliceError::Setting(e.within("slicing")))?;
     let (n, frame) = slicing.direction_and_frame(scene.view.rotation.matrix());
-    let sampled = Sampled::of(scene);
+    let sampled = Sampled::sample(scene, job)?;
+    let task = job.task("motion pictures", scene.surfaces.len() as u64);
     let staged = Staged::new(out).map_err(staged_error)?;
     let mut surfaces = Vec::new();
     let mut files = Vec::new();
     for (index, ((name, mesh), entry)) in sampled.meshes().zip(&scene.surfaces).enumerate() {
         let (surface, shape) = surface_shape(&entry.surface, mesh);
         let sampling = scene.surface_sampling(index);
-        let mut say = |m: String| {
-            if !quiet {
-                eprintln!("{name}: {m}");
-            }
-        };
+        task.doing(&format!("motion picture of {name}"));
+        let mut say = |m: String| job.note(&format!("{name}: {m}"));
         let (picture, finest) = motion_through(
             mesh,
             surface,
@@ -330,7 +330,10 @@ pub fn slice_scene(
             files.push(file);
         }
         surfaces.push(record);
+        job.check().map_err(Error::from)?;
+        task.step();
     }
+    drop(task);
     files.push("motion.json".into());
     let motion = Motion {
         scene: scene.name.clone(),

@@ -30,6 +30,7 @@
 use crate::intersect::broad;
 use crate::intersect::{Curves, End, Face, Sheet};
 use crate::parts::{HaloIndex, HaloPart, Parts, inserted_sets, tet_box};
+use crate::progress::Cancel;
 use glam::DVec3;
 use obvhs::aabb::Aabb;
 use rayon::prelude::*;
@@ -180,6 +181,12 @@ impl Verification {
 /// surface points it is built over lies within rho of them everywhere (the distance to a
 /// convex set is convex).
 pub fn verify(parts: &Parts) -> Verification {
+    verify_until(parts, Cancel::never())
+}
+
+/// [`verify`], stopping once `cancel` is cancelled (with partial counts, which the caller
+/// drops).
+pub fn verify_until(parts: &Parts, cancel: &Cancel) -> Verification {
     let start = Instant::now();
     let sheets = &parts.sheets();
     let (halos, curves) = (&parts.halos, parts.curves);
@@ -194,7 +201,9 @@ pub fn verify(parts: &Parts) -> Verification {
     let mut out = samples
         .par_iter()
         .fold(Verification::default, |mut v, s| {
-            index.classify_curve_sample(s, &mut v);
+            if !cancel.is_cancelled() {
+                index.classify_curve_sample(s, &mut v);
+            }
             v
         })
         .reduce(Verification::default, Verification::add);
@@ -205,12 +214,14 @@ pub fn verify(parts: &Parts) -> Verification {
         .iter()
         .map(|s| s.triangles.len() + used_vertices(s).count())
         .sum();
-    if out.far_tetrahedra > 0 {
+    if out.far_tetrahedra > 0 && !cancel.is_cancelled() {
         let far_index = HaloIndex::with(halos, |s, i| far[s].binary_search(&i).is_ok());
         let surface = surface_samples(sheets)
             .par_iter()
             .fold(Verification::default, |mut v, &(x, w, face)| {
-                index.classify_surface_sample(&far_index, x, w, face, tolerance, &mut v);
+                if !cancel.is_cancelled() {
+                    index.classify_surface_sample(&far_index, x, w, face, tolerance, &mut v);
+                }
                 v
             })
             .reduce(Verification::default, Verification::add);

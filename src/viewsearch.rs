@@ -21,11 +21,11 @@
 use crate::intersect::{self, Curves, Sheet};
 use crate::limits::{SEARCH_TRIANGLES, SEARCH_VIEWS};
 use crate::parts::{Parts, SurfacePart};
+use crate::progress::{Cancelled, Job};
 use crate::render::{self, CameraSettings, RenderSettings};
 use crate::sample::{Mesh4, Sampling, Source};
 use crate::scene::Scene;
 use crate::view::{Rotation4, View};
-use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -106,13 +106,13 @@ impl Found {
 }
 
 /// Finds the view of a scene whose view is left to the search (`"view": "auto"`,
-/// [`View::auto`]) with [`search`] (a progress bar unless `quiet`) and puts it into the
-/// scene; `None`, and the scene as it was, when the scene gives its view.
-pub fn resolve(scene: &mut Scene, quiet: bool) -> Result<Option<Found>, SearchError> {
+/// [`View::auto`]) with [`search`] (reporting to `job`) and puts it into the scene; `None`,
+/// and the scene as it was, when the scene gives its view.
+pub fn resolve(scene: &mut Scene, job: Job) -> Result<Option<Found>, SearchError> {
     if !scene.view.auto {
         return Ok(None);
     }
-    let found = search(scene, quiet)?;
+    let found = search(scene, job)?;
     *scene = found.apply(scene);
     Ok(Some(found))
 }
@@ -124,6 +124,9 @@ pub enum SearchError {
     /// draw.
     #[error("the view search found no view in which the scene can be drawn: {0}")]
     NoView(String),
+    /// The caller cancelled the search.
+    #[error("the view search {0}")]
+    Cancelled(#[from] Cancelled),
 }
 
 /// One candidate: the 8 angles.
@@ -134,20 +137,24 @@ struct Candidate {
     elevation: f64,
 }
 
-/// Searches the view of `scene` that shows the most of its curves, with a progress bar
-/// unless `quiet`.
-pub fn search(scene: &Scene, quiet: bool) -> Result<Found, SearchError> {
+/// Searches the view of `scene` that shows the most of its curves: a task `"view search"`
+/// of `job`, a step per 4D view, stopped once `job` is cancelled.
+pub fn search(scene: &Scene, job: Job) -> Result<Found, SearchError> {
     let start = std::time::Instant::now();
     let meshes = coarse_meshes(scene);
     let triangles = meshes.iter().map(|m| m.triangles.len()).sum();
-    let bar = progress_bar(quiet);
+    let task = job.task("view search", SEARCH_VIEWS as u64);
+    let cancel = job.cancel();
     let mut settings = scene.render;
     (settings.width, settings.height, settings.samples) = (SEARCH_SIDE, SEARCH_SIDE, 1);
     settings.halos = false;
     settings.stereo = false;
     let evaluate = |angles: [f64; 6], cameras: &[(f64, f64)]| -> Vec<(Candidate, f64, f64)> {
+        if cancel.is_cancelled() {
+            return Vec::new();
+        }
         let result = evaluate_view(scene, &meshes, &settings, angles, cameras);
-        bar.inc(1);
+        task.step();
         result
     };
     let own = scene.view.rotation.planes().map(|(_, a)| a);
@@ -195,7 +202,8 @@ pub fn search(scene: &Scene, quiet: bool) -> Result<Found, SearchError> {
             step *= 0.5;
         }
     }
-    bar.finish_and_clear();
+    drop(task);
+    job.check()?;
     let Some((found, share, score)) = best else {
         return Err(SearchError::NoView(
             "every view put a surface behind the 4D eye or left nothing to draw".into(),
@@ -213,21 +221,6 @@ pub fn search(scene: &Scene, quiet: bool) -> Result<Found, SearchError> {
         triangles,
         ms: start.elapsed().as_secs_f64() * 1e3,
     })
-}
-
-/// The search's progress bar over [`SEARCH_VIEWS`] views, hidden when `quiet`.
-fn progress_bar(quiet: bool) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(SEARCH_VIEWS as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} 4D views ({elapsed})")
-            .expect("a valid template")
-            .progress_chars("=> "),
-    );
-    bar.set_message("view search");
-    bar
 }
 
 /// The pattern search's moves from `centre` by `step` degrees: each 4D angle in turn moved

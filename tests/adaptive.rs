@@ -462,7 +462,14 @@ fn finer_rectangles_hold_their_triangles_to_their_tolerance_and_only_there() {
     let everywhere = sample_adaptive(&surface, fine, 2_000_000).mesh;
     let plain = sample_adaptive(&surface, global, 2_000_000).mesh;
     for rects in [one, squares] {
-        let out = sample_adaptive_finer(&surface, global, ErrorBound::Audited, 2_000_000, &rects);
+        let out = sample_adaptive_finer(
+            &surface,
+            global,
+            ErrorBound::Audited,
+            2_000_000,
+            &rects,
+            halo4d::progress::Cancel::never(),
+        );
         assert!(out.complete);
         let mesh = out.mesh;
         let meets = |t: &[[f64; 2]; 3]| {

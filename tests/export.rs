@@ -312,7 +312,7 @@ fn an_unwritable_output_folder_is_a_clear_error_and_writes_nothing() {
     // The output "folder" is a file: the build must fail with a clear error.
     let blocker = dir.path().join("occupied");
     std::fs::write(&blocker, b"x").unwrap();
-    let err = halo4d::build(&scene, &blocker, true)
+    let err = halo4d::build(&scene, &blocker, halo4d::progress::Job::SILENT)
         .unwrap_err()
         .to_string();
     assert!(

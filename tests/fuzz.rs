@@ -1006,7 +1006,7 @@ fn built() -> &'static Built {
         scene.outputs.png = false;
         scene.outputs.report = false;
         let dir = tempfile::tempdir().unwrap();
-        halo4d::build(&scene, dir.path(), true).unwrap();
+        halo4d::build(&scene, dir.path(), halo4d::progress::Job::SILENT).unwrap();
         Built {
             glb: std::fs::read(dir.path().join("patches.glb")).unwrap(),
             vtk: std::fs::read(dir.path().join("patches-halo.vtk")).unwrap(),

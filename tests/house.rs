@@ -1,7 +1,10 @@
 //! The house rules that are easy to break one line at a time, held by the tests so that they
 //! do not grow back unnoticed: no production function over [`MAX_FUNCTION_LINES`] lines
-//! (anywhere in `src/`, the binaries and the viewer included; unit tests aside), and the
-//! README under [`MAX_README_LINES`] lines (the rest belongs in `docs/`).
+//! (anywhere in `src/`, the binaries and the viewer included; unit tests aside), the
+//! README under [`MAX_README_LINES`] lines (the rest belongs in `docs/`), and a library
+//! that prints nothing: no `print!`, `eprintln!`, `indicatif` or thread of its own outside
+//! the binaries (`src/bin/`) and the explorer's window (its background work), no `quiet`
+//! flag (it reports to the caller's `halo4d::progress::Observer`).
 
 use std::path::{Path, PathBuf};
 
@@ -265,4 +268,93 @@ fn the_readme_is_under_700_lines() {
         "README.md has {lines} lines: move the detail to docs/ and link it (at most {})",
         MAX_README_LINES - 1
     );
+}
+
+/// What `source` (a library file) does that only a program may: prints, draws a bar, starts
+/// a thread, takes a `quiet` flag; as (line, what), comments, literals and unit tests aside.
+fn printing(source: &str, threads_allowed: bool) -> Vec<(usize, &'static str)> {
+    let code = blank_literals(source);
+    let code = code
+        .split("#[cfg(test)]\nmod tests")
+        .next()
+        .unwrap_or_default();
+    let mut out = Vec::new();
+    let words: &[&str] = &[
+        "print!",
+        "println!",
+        "eprint!",
+        "eprintln!",
+        "indicatif",
+        "quiet",
+    ];
+    for (n, line) in code.lines().enumerate() {
+        let starts = |at: usize| {
+            at == 0
+                || !line.as_bytes()[at - 1].is_ascii_alphanumeric()
+                    && line.as_bytes()[at - 1] != b'_'
+        };
+        for &word in words {
+            let found = line.match_indices(word).any(|(at, _)| {
+                let end = at + word.len();
+                let whole = word.ends_with('!')
+                    || !line[end..].starts_with(|c: char| c.is_ascii_alphanumeric() || c == '_');
+                starts(at) && whole
+            });
+            if found {
+                out.push((n + 1, word));
+            }
+        }
+        if !threads_allowed && (line.contains("thread::spawn") || line.contains("thread::Builder"))
+        {
+            out.push((n + 1, "a thread"));
+        }
+    }
+    out
+}
+
+#[test]
+fn the_library_prints_nothing_and_starts_no_thread() {
+    let src = root().join("src");
+    let mut found = Vec::new();
+    for path in sources(&src) {
+        let rel = path
+            .strip_prefix(root())
+            .unwrap()
+            .to_string_lossy()
+            .replace('\\', "/");
+        if rel.starts_with("src/bin/") {
+            continue;
+        }
+        let source = std::fs::read_to_string(&path).unwrap();
+        for (line, what) in printing(&source, rel == "src/viewer/window.rs") {
+            found.push(format!("{rel}:{line}: {what}"));
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "the library reports to its caller's observer (halo4d::progress) and prints nothing:\n{}",
+        found.join("\n")
+    );
+}
+
+#[test]
+fn a_planted_print_is_caught_and_one_in_a_literal_or_a_test_is_not() {
+    let planted = r#"
+fn a(quiet: bool) {
+    let s = "eprintln!(\"x\") and quiet";
+    // eprintln! in a comment
+    eprintln!("{s}");
+    std::thread::spawn(|| ());
+    let quietly = 1;
+}
+#[cfg(test)]
+mod tests {
+    fn t() { println!("fine in a test"); }
+}
+"#;
+    assert_eq!(
+        printing(planted, false),
+        [(2, "quiet"), (5, "eprintln!"), (6, "a thread")]
+    );
+    assert_eq!(printing(planted, true), [(2, "quiet"), (5, "eprintln!")]);
 }

@@ -20,6 +20,7 @@ mod intersect;
 mod lines;
 mod motion;
 mod own;
+mod progress;
 mod proven;
 mod readme;
 mod refine;

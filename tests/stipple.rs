@@ -353,7 +353,7 @@ fn the_stipples_files_hold_the_pictures_stipples() {
     let path = fixture("scenes/klein-bottle-stipples.json");
     let scene = Scene::load(&path).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let report = halo4d::build(&scene, dir.path(), true).unwrap();
+    let report = halo4d::build(&scene, dir.path(), halo4d::progress::Job::SILENT).unwrap();
     assert_eq!(report.surfaces[0].stipples, Some(200_000));
     let built = crate::common::built(&scene).unwrap();
     let drawn = stipples_drawn(&built.parts(&scene.halo), &scene.render, &scene.camera).unwrap();

@@ -255,8 +255,13 @@ fn the_explorer_shows_the_slices_halo4d_slice_makes_over_the_surfaces() {
     // The hyperplane is `halo4d slice`'s: the same direction and critical levels, and at
     // each still's level as many curves.
     let dir = tempfile::tempdir().unwrap();
-    let motion =
-        halo4d::slicing::slice_scene(&scene, scene.slicing.unwrap(), dir.path(), true).unwrap();
+    let motion = halo4d::slicing::slice_scene(
+        &scene,
+        scene.slicing.unwrap(),
+        dir.path(),
+        halo4d::progress::Job::SILENT,
+    )
+    .unwrap();
     let surface = &motion.surfaces[0];
     // The scene's mesh changes its slices off the surface's critical levels: both cut the
     // surface sampled again through its critical points, and the explorer says so.
@@ -1130,7 +1135,8 @@ fn a_glb_turns_in_4d_as_its_scene_does_and_one_without_the_4d_mesh_in_3d() {
         }
         assert_eq!(mesh.triangles, product.mesh.triangles);
     }
-    let (from_file, notes) = viewer::Source::open(Some(&path)).unwrap();
+    let (from_file, notes) =
+        viewer::Source::open(Some(&path), halo4d::progress::Job::SILENT).unwrap();
     assert!(notes.is_empty(), "{notes:?}");
     assert!(matches!(from_file, viewer::Source::Model(_)));
     let from_scene = viewer::Source::Model(Model::new(scene.clone()).unwrap().into());
@@ -1158,7 +1164,7 @@ fn a_glb_turns_in_4d_as_its_scene_does_and_one_without_the_4d_mesh_in_3d() {
     // with the reason.
     let flat = dir.path().join("flat.glb");
     std::fs::write(&flat, without_4d(&std::fs::read(&path).unwrap())).unwrap();
-    let (source, notes) = viewer::Source::open(Some(&flat)).unwrap();
+    let (source, notes) = viewer::Source::open(Some(&flat), halo4d::progress::Job::SILENT).unwrap();
     assert!(matches!(source, viewer::Source::Asset(_)));
     assert!(
         notes
@@ -1368,7 +1374,7 @@ fn the_stipple_style_is_refused_for_a_glb_without_its_4d_mesh() {
     let bytes = std::fs::read(dir.path().join(format!("{}.glb", scene.name))).unwrap();
     let path = dir.path().join("without-4d.glb");
     std::fs::write(&path, without_4d(&bytes)).unwrap();
-    let (source, _) = viewer::Source::open(Some(&path)).unwrap();
+    let (source, _) = viewer::Source::open(Some(&path), halo4d::progress::Job::SILENT).unwrap();
     assert!(matches!(source, viewer::Source::Asset(_)));
     let e = viewer::screenshot_of(
         gpu(),

@@ -40,7 +40,7 @@ fn the_view_search_is_deterministic_no_worse_than_the_scenes_view_and_keeps_the_
     // The library's search: the same view, scored no lower than the scene's own.
     let searched = halo4d::search_view(
         &Scene::load(&fixture("scenes/flat-torus.json")).unwrap(),
-        true,
+        halo4d::progress::Job::SILENT,
     )
     .unwrap();
     assert!(searched.score >= searched.start_score);
@@ -94,12 +94,16 @@ fn a_scene_whose_view_is_auto_builds_in_the_view_the_search_finds() {
         err.contains("its view is \"auto\"") && err.contains("resolve_view"),
         "{err}"
     );
-    let found = halo4d::resolve_view(&mut scene, true)
+    let found = halo4d::resolve_view(&mut scene, halo4d::progress::Job::SILENT)
         .unwrap()
         .expect("searched");
     assert!(!scene.view.auto);
     assert_eq!(scene.view.rotation, found.rotation);
-    assert!(halo4d::resolve_view(&mut scene, true).unwrap().is_none());
+    assert!(
+        halo4d::resolve_view(&mut scene, halo4d::progress::Job::SILENT)
+            .unwrap()
+            .is_none()
+    );
     // The command line finds it, builds in it and records it.
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("auto.json"), &text).unwrap();

@@ -31,7 +31,7 @@ class Entry:
 
     def __init__(self, key, scene):
         self.key = key
-        self.sampled = scene.sample()
+        self.sampled = scene.sample(progress=progress())
         self.rest = None
         self.other = scene
         self.built = None
@@ -101,6 +101,28 @@ def settings_scene(settings):
     return scenes.effective_scene(stored, angles, translation, width, tolerance)
 
 
+def progress():
+    """A `progress=` function for halo4d's work that moves Blender's progress indicator (the
+    number on the cursor) through the steps of each task."""
+    wm = bpy.context.window_manager
+    tasks = []
+
+    def hear(event):
+        kind = event["kind"]
+        if kind == "begin":
+            tasks.append(event["steps"])
+            wm.progress_begin(0, event["steps"])
+        elif kind == "done" and tasks:
+            wm.progress_update(event["done"])
+        elif kind == "end" and tasks:
+            tasks.pop()
+            wm.progress_end()
+            if tasks:
+                wm.progress_begin(0, tasks[-1])
+
+    return hear
+
+
 def build(root):
     """Builds the root's scene in its view, re-using its sampling where the surfaces and the
     sampling are unchanged. Raises halo4d.SceneError or halo4d.BuildError."""
@@ -115,7 +137,7 @@ def build(root):
         _cache[root.name] = entry
     elif entry.rest != rest:
         entry.other, entry.rest = h.Scene(scene), rest
-    entry.built = entry.sampled.build(view=scene["view"], scene=entry.other)
+    entry.built = entry.sampled.build(view=scene["view"], scene=entry.other, progress=progress())
     entry.scene = scene
     return entry.built
 

@@ -11,7 +11,11 @@ True
 A scene comes from a dict, a JSON string or a scene file (`halo4d.Scene(...)`), validated as
 the command line validates it (`halo4d.SceneError`, whose `field` names the field at fault).
 `scene.sample()` samples it in 4D once; `.build(view=...)` builds any number of 4D views of
-it. The work runs with the GIL released; Ctrl-C interrupts a call at once.
+it. The work runs with the GIL released; Ctrl-C stops it within a fraction of a second (its
+memory freed, nothing written) and raises KeyboardInterrupt. halo4d prints nothing: pass
+`progress=` a function to hear what it does, or `halo4d.tqdm_progress()` for tqdm bars:
+
+>>> built = halo4d.Scene().build(progress=halo4d.tqdm_progress())
 
 `halo4d.check` certifies any tetrahedral mesh, from a file or from memory:
 
@@ -22,7 +26,7 @@ it. The work runs with the GIL released; Ctrl-C interrupts a call at once.
 """
 
 import os
-from typing import Any
+from typing import Any, Callable
 
 from ._native import (
     BuildError,
@@ -164,6 +168,35 @@ def check(source: Any) -> dict[str, Any]:
     return result
 
 
+def tqdm_progress(**options: Any) -> Callable[[dict[str, Any]], None]:
+    """A `progress=` function that draws each task of halo4d's work (a build, its sampling,
+    a view search) as a tqdm bar (`tqdm.auto`: a widget in a notebook, text in a terminal),
+    what it is doing as the bar's postfix, its notes with `tqdm.write` and its warnings with
+    `warnings.warn`. `options` go to each `tqdm` (`file=`, `disable=`, ...)."""
+    import warnings
+
+    from tqdm.auto import tqdm
+
+    bars: list = []
+
+    def progress(event: dict[str, Any]) -> None:
+        kind = event["kind"]
+        if kind == "begin":
+            bars.append(tqdm(total=event["steps"], desc=event["task"], leave=False, **options))
+        elif kind == "doing" and bars:
+            bars[-1].set_postfix_str(event["text"])
+        elif kind == "done" and bars:
+            bars[-1].update(event["done"] - bars[-1].n)
+        elif kind == "end" and bars:
+            bars.pop().close()
+        elif kind == "note":
+            tqdm.write(event["text"], file=options.get("file"))
+        elif kind == "warning":
+            warnings.warn(event["text"], stacklevel=2)
+
+    return progress
+
+
 __all__ = [
     "BuildError",
     "Built",
@@ -176,4 +209,5 @@ __all__ = [
     "__version__",
     "catalogue",
     "check",
+    "tqdm_progress",
 ]

@@ -1,7 +1,7 @@
 """Type stubs of halo4d's native module (re-exported by `halo4d`)."""
 
 import os
-from typing import Any, Literal, Optional, Union
+from typing import Any, Callable, Literal, Optional, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -10,6 +10,9 @@ __version__: str
 
 SceneSource = Union[dict[str, Any], str, "os.PathLike[str]", None]
 View = Optional[dict[str, Any]]
+Progress = Optional[Callable[[dict[str, Any]], None]]
+"""Called with each event of the work: a dict whose `kind` is "begin" (with `task` and
+`steps`), "doing" (`text`), "done" (`done`), "end", "warning" or "note" (`text`)."""
 
 class SceneError(ValueError):
     """A scene that is not valid; the message is the command line's."""
@@ -34,15 +37,15 @@ class Scene:
     def name(self) -> str: ...
     def to_json(self) -> str: ...
     def to_dict(self) -> dict[str, Any]: ...
-    def sample(self) -> Sampled:
+    def sample(self, progress: Progress = None) -> Sampled:
         """Samples the surfaces in 4D once, to build any number of views."""
-    def build(self, view: View = None) -> Built:
+    def build(self, view: View = None, progress: Progress = None) -> Built:
         """Samples and builds the scene in `view` (a scene file's `view`), nothing written."""
 
 class Sampled:
     """A scene's surfaces sampled in 4D."""
 
-    def build(self, view: View = None, scene: Optional[Scene] = None) -> Built:
+    def build(self, view: View = None, scene: Optional[Scene] = None, progress: Progress = None) -> Built:
         """Builds in `view`; `scene`: another scene of the same surfaces and sampling."""
     @property
     def triangles(self) -> int: ...
@@ -65,7 +68,7 @@ class Built:
         """(n, 3)."""
     @property
     def report(self) -> dict[str, Any]: ...
-    def write(self, dir: Union[str, "os.PathLike[str]"]) -> dict[str, Any]:
+    def write(self, dir: Union[str, "os.PathLike[str]"], progress: Progress = None) -> dict[str, Any]:
         """Writes the scene's outputs into `dir`; the report."""
     def render(
         self,

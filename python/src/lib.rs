@@ -5,12 +5,13 @@
 //! (`built.surfaces[0].positions` twice is two arrays with the same values), never by a
 //! loop over elements in Python: a `memcpy` of the build's vector where it keeps the array
 //! as such; the halo's tetrahedra put in the files' vertex order, and each curve's points
-//! gathered from its point records, in one loop. The work runs with the GIL released, on a thread of its
-//! own, while the calling thread waits in slices of 50 ms and checks for signals between
-//! them: Ctrl-C raises `KeyboardInterrupt` at once (the work itself finishes in the
-//! background and its result is dropped, since a build has no point at which it can stop
-//! part-way without leaving half a result).
+//! gathered from its point records, in one loop. The work runs with the GIL released, on a
+//! thread of its own, while the calling thread waits in slices of 50 ms, calls the
+//! `progress` function it was given with each of the work's events and checks for signals:
+//! Ctrl-C cancels the work (`halo4d::progress::Cancel`), waits the fraction of a second it
+//! takes to stop, its memory freed and nothing written, and raises `KeyboardInterrupt`.
 
+use halo4d::progress::{Cancel, Event, Job, Observer, Silent};
 use halo4d::render::{RenderSettings, Style};
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::create_exception;
@@ -36,24 +37,119 @@ create_exception!(
     "A build, picture or write that failed: the message is the command line's."
 );
 
-/// `f` on a thread of its own with the GIL released, the calling thread checking for
-/// signals every 50 ms (Ctrl-C raises `KeyboardInterrupt` at once; the thread finishes in
-/// the background and its result is dropped).
+/// [`run_job`] of work that reports nothing.
 fn run<T: Send + 'static>(py: Python<'_>, f: impl FnOnce() -> T + Send + 'static) -> PyResult<T> {
+    run_job(py, None, move |_| f())
+}
+
+/// What crosses from the work's thread to the calling one: an event for `progress`, or
+/// the result.
+enum Message<T> {
+    Event(Owned),
+    Done(T),
+}
+
+/// A [`halo4d::progress::Event`] owned, to send across threads.
+struct Owned {
+    kind: &'static str,
+    task: Option<String>,
+    steps: Option<u64>,
+    done: Option<u64>,
+    text: Option<String>,
+}
+
+impl Owned {
+    fn of(event: &Event<'_>) -> Owned {
+        let mut o = Owned {
+            kind: "end",
+            task: None,
+            steps: None,
+            done: None,
+            text: None,
+        };
+        match *event {
+            Event::Begin { task, steps } => {
+                (o.kind, o.task, o.steps) = ("begin", Some(task.into()), Some(steps));
+            }
+            Event::Doing(text) => (o.kind, o.text) = ("doing", Some(text.into())),
+            Event::Done(done) => (o.kind, o.done) = ("done", Some(done)),
+            Event::Warning(text) => (o.kind, o.text) = ("warning", Some(text.into())),
+            Event::Note(text) => (o.kind, o.text) = ("note", Some(text.into())),
+            _ => {}
+        }
+        o
+    }
+
+    /// The event as `progress` gets it: a dict with `kind` and the event's own keys.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("kind", self.kind)?;
+        for (key, value) in [("task", &self.task), ("text", &self.text)] {
+            if let Some(v) = value {
+                d.set_item(key, v)?;
+            }
+        }
+        for (key, value) in [("steps", self.steps), ("done", self.done)] {
+            if let Some(v) = value {
+                d.set_item(key, v)?;
+            }
+        }
+        Ok(d)
+    }
+}
+
+/// `f` on a thread of its own with the GIL released, given a job that sends its events to
+/// the calling thread when `progress` is given; the calling thread waits in slices of
+/// 50 ms, calls `progress` with each event (a dict: `kind` "begin" with `task` and
+/// `steps`, "doing" with `text`, "done" with `done`, "end", "warning" and "note" with
+/// `text`) and checks for signals. Ctrl-C (or `progress` raising) cancels the work and
+/// waits for it to stop (a fraction of a second: its memory is freed, nothing of it is
+/// written) before raising.
+fn run_job<T: Send + 'static>(
+    py: Python<'_>,
+    progress: Option<&Bound<'_, PyAny>>,
+    f: impl FnOnce(Job) -> T + Send + 'static,
+) -> PyResult<T> {
     let (tx, rx) = channel();
-    std::thread::Builder::new()
+    let cancel = Cancel::new();
+    let stop = cancel.clone();
+    let report = progress.is_some();
+    let worker = std::thread::Builder::new()
         .name("halo4d".into())
         .spawn(move || {
-            let _ = tx.send(f());
+            let events = tx.clone();
+            let send = move |e: &Event<'_>| {
+                let _ = events.send(Message::Event(Owned::of(e)));
+            };
+            let observer: &dyn Observer = if report { &send } else { &Silent };
+            let value = f(Job::new(observer, &stop));
+            let _ = tx.send(Message::Done(value));
         })
         .map_err(|e| PyOSError::new_err(format!("cannot start a thread for halo4d: {e}")))?;
     let mut rx = rx;
+    let stopped = |py: Python<'_>, err: PyErr| {
+        cancel.cancel();
+        // The work stops at its next check; its result (an error) is dropped with it.
+        let _ = py.detach(|| worker.join());
+        Err(err)
+    };
     loop {
         let (received, back) = py.detach(move || (rx.recv_timeout(Duration::from_millis(50)), rx));
         rx = back;
         match received {
-            Ok(value) => return Ok(value),
-            Err(RecvTimeoutError::Timeout) => py.check_signals()?,
+            Ok(Message::Done(value)) => return Ok(value),
+            Ok(Message::Event(event)) => {
+                if let Some(progress) = progress
+                    && let Err(err) = event.to_dict(py).and_then(|d| progress.call1((d,)))
+                {
+                    return stopped(py, err);
+                }
+            }
+            Err(RecvTimeoutError::Timeout) => {
+                if let Err(err) = py.check_signals() {
+                    return stopped(py, err);
+                }
+            }
             Err(RecvTimeoutError::Disconnected) => {
                 return Err(BuildError::new_err(
                     "halo4d's work stopped without a result (a panic: please report it)",
@@ -248,10 +344,15 @@ impl Scene {
     }
 
     /// Samples the scene's surfaces in 4D (adaptively, as its `sampling` says), once: the
-    /// result builds any number of 4D views without sampling again.
-    fn sample(&self, py: Python<'_>) -> PyResult<Sampled> {
+    /// result builds any number of 4D views without sampling again. `progress` is called
+    /// with each of the work's events (`halo4d.tqdm_progress()` draws them as bars).
+    #[pyo3(signature = (progress = None))]
+    fn sample(&self, py: Python<'_>, progress: Option<&Bound<'_, PyAny>>) -> PyResult<Sampled> {
         let scene = Arc::clone(&self.scene);
-        let sampled = run(py, move || halo4d::Sampled::of(&scene))?;
+        let sampled = run_job(py, progress, move |job| {
+            halo4d::Sampled::sample(&scene, job)
+        })?
+        .map_err(build_error)?;
         Ok(Sampled {
             scene: self.sibling(Arc::clone(&self.scene)),
             sampled: Arc::new(sampled),
@@ -260,10 +361,15 @@ impl Scene {
 
     /// Samples and builds the scene (in the 4D `view`, a dict as a scene file's `view`,
     /// else the scene's): surfaces, halos, curves and their verification, as `halo4d
-    /// build` makes them, nothing written.
-    #[pyo3(signature = (view = None))]
-    fn build(&self, py: Python<'_>, view: Option<&Bound<'_, PyAny>>) -> PyResult<Built> {
-        self.sample(py)?.build(py, view, None)
+    /// build` makes them, nothing written. `progress` as `sample` takes it.
+    #[pyo3(signature = (view = None, progress = None))]
+    fn build(
+        &self,
+        py: Python<'_>,
+        view: Option<&Bound<'_, PyAny>>,
+        progress: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Built> {
+        self.sample(py, progress)?.build(py, view, None, progress)
     }
 
     fn __repr__(&self) -> String {
@@ -289,12 +395,14 @@ impl Sampled {
     /// projected surfaces, halos, curves and their verification. `scene` builds another
     /// scene with the same surfaces and sampling (another halo, camera, picture or
     /// outputs) without sampling again; one with other surfaces or sampling is refused.
-    #[pyo3(signature = (view = None, scene = None))]
+    /// `progress` as `Scene.sample` takes it.
+    #[pyo3(signature = (view = None, scene = None, progress = None))]
     fn build(
         &self,
         py: Python<'_>,
         view: Option<&Bound<'_, PyAny>>,
         scene: Option<PyRef<'_, Scene>>,
+        progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Built> {
         let base = match &scene {
             None => &self.scene,
@@ -311,11 +419,12 @@ impl Sampled {
         };
         let scene = base.in_view(py, view)?;
         let sampled = Arc::clone(&self.sampled);
-        let (scene, built) = run(py, move || {
+        let (scene, built) = run_job(py, progress, move |job| {
             let mut scene = (*scene).clone();
-            halo4d::resolve_view(&mut scene, true).map_err(build_error)?;
-            let built = sampled
-                .build(&scene, halo4d::Stages::of(&scene))
+            halo4d::resolve_view(&mut scene, job).map_err(build_error)?;
+            let built = (*sampled)
+                .clone()
+                .into_built_with(&scene, halo4d::Stages::of(&scene), job)
                 .map_err(build_error)?;
             Ok::<_, PyErr>((scene, built))
         })??;
@@ -414,9 +523,19 @@ impl Built {
 
     /// Writes the files the scene's `outputs` ask for into `dir` (created if need be; every
     /// file written whole or not at all), and gives the report (`report.json`) as a dict.
-    fn write<'py>(&self, py: Python<'py>, dir: PathBuf) -> PyResult<Bound<'py, PyAny>> {
+    /// `progress` as `Scene.sample` takes it.
+    #[pyo3(signature = (dir, progress = None))]
+    fn write<'py>(
+        &self,
+        py: Python<'py>,
+        dir: PathBuf,
+        progress: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let (scene, built) = (Arc::clone(&self.scene.scene), Arc::clone(&self.built));
-        let report = run(py, move || halo4d::write(&scene, &built, &dir))?.map_err(build_error)?;
+        let report = run_job(py, progress, move |job| {
+            halo4d::write_with(&scene, &built, &dir, job)
+        })?
+        .map_err(build_error)?;
         to_python(py, &report)
     }
 
@@ -461,8 +580,9 @@ impl Built {
             ));
         }
         let (scene, built) = (Arc::clone(&self.scene.scene), Arc::clone(&self.built));
-        let picture = run(py, move || {
-            built.render(&scene.halo, &settings, &scene.camera)
+        let picture = run_job(py, None, move |job| {
+            let parts = built.parts(&scene.halo);
+            halo4d::render::render_until(&parts, &settings, &scene.camera, job.cancel())
         })?
         .map_err(build_error)?;
         PyArray1::from_slice(py, &picture.rgb).reshape([

@@ -34,12 +34,11 @@ use crate::error::Error;
 use crate::export;
 use crate::limits::{Bound, FieldError, SHARDS};
 use crate::pipeline::{self, Sampled, Stages, Timings};
-use crate::render::CameraSettings;
+use crate::progress::{Cancel, Cancelled, Job, Silent, Task};
+use crate::render::{self, CameraSettings};
 use crate::scene::Scene;
 use crate::view::View;
-use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 use std::time::Instant;
@@ -156,8 +155,6 @@ pub struct Request<'a> {
     pub shard: Shard,
     /// Write each frame's `.glb` too.
     pub glb: bool,
-    /// No progress output.
-    pub quiet: bool,
 }
 
 /// Why frames could not be made or read (a frame whose build fails is not one: its record
@@ -192,6 +189,10 @@ pub enum AnimateError {
         /// The cause.
         source: std::io::Error,
     },
+    /// The caller cancelled the run: the frames done before are kept, the one under way
+    /// is not written.
+    #[error("the animation {0}")]
+    Cancelled(#[from] Cancelled),
 }
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> AnimateError + '_ {
@@ -279,7 +280,7 @@ pub struct Summary {
 /// Makes the frames of `request` that are not yet done: the scene sampled once, then per
 /// frame the build in its view, verified, its picture and record. See the module's
 /// guarantees.
-pub fn animate(request: &Request) -> Result<Summary, AnimateError> {
+pub fn animate(request: &Request, job: Job) -> Result<Summary, AnimateError> {
     let start = Instant::now();
     let scene = request.scene;
     let animation = scene
@@ -328,7 +329,7 @@ pub fn animate(request: &Request) -> Result<Summary, AnimateError> {
             None => todo.push(k),
         }
     }
-    let progress = Progress::new(todo.len(), summary.skipped, request.quiet);
+    let progress = Progress::new(job, todo.len(), summary.skipped);
     if !todo.is_empty() {
         progress.note(&format!(
             "{} frames to make of {} in this run ({} already done); sampling the surfaces",
@@ -337,7 +338,13 @@ pub fn animate(request: &Request) -> Result<Summary, AnimateError> {
             summary.skipped
         ));
         let sampled = Instant::now();
-        let samples = Sampled::of(scene);
+        let samples = Sampled::sample(scene, job).map_err(|e| match e {
+            Error::Cancelled(c) => AnimateError::Cancelled(c),
+            e => AnimateError::Folder {
+                dir: dir.to_path_buf(),
+                message: e.to_string(),
+            },
+        })?;
         summary.sample_ms = ms(sampled);
         progress.note(&format!(
             "sampled {} triangles in {:.1} s",
@@ -345,15 +352,15 @@ pub fn animate(request: &Request) -> Result<Summary, AnimateError> {
             summary.sample_ms / 1e3
         ));
         for &k in &todo {
-            let record = make_frame(scene, k, &samples, dir, request.glb)?;
+            let record = make_frame(scene, k, &samples, dir, request.glb, job.cancel())?;
             summary.made += 1;
             if !record.verified {
                 summary.failed.push((k, record.failures.join("; ")));
             }
             progress.frame(&record);
         }
-        progress.finish();
     }
+    drop(progress);
     summary.failed.sort_by_key(|f| f.0);
     gather(dir, animation.frames)?;
     summary.ms = ms(start);
@@ -438,6 +445,7 @@ fn make_frame(
     samples: &Sampled,
     dir: &Path,
     glb: bool,
+    cancel: &Cancel,
 ) -> Result<FrameRecord, AnimateError> {
     let start = Instant::now();
     let animation = scene.animation.as_ref().expect("an animated scene");
@@ -457,20 +465,20 @@ fn make_frame(
         timings_ms: Timings::default(),
         files: Vec::new(),
     };
-    let made = samples
-        .build(&frame, Stages::verified_picture(&frame))
+    // The run's own task says how the frames go; a frame's build says nothing.
+    let silent = Job::new(&Silent, cancel);
+    let made = (samples.clone())
+        .into_built_with(&frame, Stages::verified_picture(&frame), silent)
         .and_then(|built| {
             let rendered = Instant::now();
-            let picture = built
-                .render(&frame.halo, &frame.render, &frame.camera)
-                .map_err(|source| Error::Render {
-                    scene: frame.name.clone(),
-                    source,
-                })?;
+            let parts = built.parts(&frame.halo);
+            let picture = render::render_until(&parts, &frame.render, &frame.camera, cancel)
+                .map_err(|source| Error::render(&frame.name, source))?;
             Ok((built, picture, ms(rendered)))
         });
     let (built, picture, render_ms) = match made {
         Ok(made) => made,
+        Err(Error::Cancelled(c)) => return Err(c.into()),
         Err(e) => {
             // The frame cannot be built in its view (an eye inside the surfaces, a scale
             // beyond the files' precision): its record says so, and the run goes on.
@@ -547,33 +555,21 @@ fn gather(dir: &Path, frames: u32) -> Result<bool, AnimateError> {
     Ok(true)
 }
 
-/// A run's progress on stderr: a bar on a terminal, a line per frame otherwise (a batch
-/// engine's log), nothing when quiet.
-struct Progress {
-    bar: Option<ProgressBar>,
-    lines: bool,
+/// A run's progress, a task `"animation"` of the run's job, a step per frame made: a note
+/// per frame (its verdict, the rate and the time left), the time left as what it is doing.
+struct Progress<'a> {
+    task: Task<'a>,
     start: Instant,
     total: usize,
     done: std::cell::Cell<usize>,
 }
 
-impl Progress {
-    fn new(total: usize, skipped: usize, quiet: bool) -> Progress {
-        let terminal = std::io::stderr().is_terminal();
-        let bar = (!quiet && terminal).then(|| {
-            let bar = ProgressBar::new(total as u64);
-            bar.set_style(
-                ProgressStyle::with_template(
-                    "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} frames  {msg}",
-                )
-                .unwrap_or_else(|_| ProgressStyle::default_bar()),
-            );
-            bar.set_message(format!("({skipped} done before)"));
-            bar
-        });
+impl<'a> Progress<'a> {
+    fn new(job: Job<'a>, total: usize, skipped: usize) -> Progress<'a> {
+        let task = job.task("animation", total as u64);
+        task.doing(&format!("({skipped} done before)"));
         Progress {
-            bar,
-            lines: !quiet && !terminal,
+            task,
             start: Instant::now(),
             total,
             done: std::cell::Cell::new(0),
@@ -581,11 +577,7 @@ impl Progress {
     }
 
     fn note(&self, text: &str) {
-        match &self.bar {
-            Some(bar) => bar.suspend(|| eprintln!("{text}")),
-            None if self.lines => eprintln!("{text}"),
-            None => {}
-        }
+        self.task.job().note(text);
     }
 
     /// A frame is done.
@@ -606,28 +598,14 @@ impl Progress {
         } else {
             format!("NOT verified: {}", record.failures.join("; "))
         };
-        match &self.bar {
-            Some(bar) => {
-                if !record.verified {
-                    bar.suspend(|| eprintln!("frame {}: {verdict}", record.frame));
-                }
-                bar.set_message(eta);
-                bar.inc(1);
-            }
-            None if self.lines => eprintln!(
-                "frame {} ({done} of {}) in {:.1} s: {verdict}; {eta}",
-                record.frame,
-                self.total,
-                record.timings_ms.total / 1e3
-            ),
-            None => {}
-        }
-    }
-
-    fn finish(&self) {
-        if let Some(bar) = &self.bar {
-            bar.finish_and_clear();
-        }
+        self.note(&format!(
+            "frame {} ({done} of {}) in {:.1} s: {verdict}; {eta}",
+            record.frame,
+            self.total,
+            record.timings_ms.total / 1e3
+        ));
+        self.task.doing(&eta);
+        self.task.step();
     }
 }
 

@@ -26,6 +26,7 @@ pub(crate) mod exact;
 pub(crate) mod refine;
 pub(crate) mod sos;
 
+use crate::progress::Cancel;
 pub use exact::Node;
 use exact::{Pair, Segment, Soup};
 use glam::DVec3;
@@ -312,8 +313,17 @@ pub fn curves(sheets: &[Sheet]) -> Curves {
     curves_with(sheets, BroadPhase::Bvh)
 }
 
+/// [`curves`], stopping once `cancel` is cancelled (with no curve, which the caller drops).
+pub fn curves_until(sheets: &[Sheet], cancel: &Cancel) -> Curves {
+    curves_of(sheets, BroadPhase::Bvh, cancel)
+}
+
 /// The intersection curves of `sheets`, with the given broad phase.
 pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
+    curves_of(sheets, broad_phase, Cancel::never())
+}
+
+fn curves_of(sheets: &[Sheet], broad_phase: BroadPhase, cancel: &Cancel) -> Curves {
     let start = Instant::now();
     let mut report = CurvesReport::default();
     let (mut soup, tri_start) = merge(sheets);
@@ -327,9 +337,12 @@ pub fn curves_with(sheets: &[Sheet], broad_phase: BroadPhase) -> Curves {
     // tasks' results are joined in the order a descent on one core finds them, so the curves
     // do not depend on the number of threads.
     let found = match broad_phase {
-        BroadPhase::Bvh => bvh_segments(&soup, start, &mut report),
+        BroadPhase::Bvh => bvh_segments(&soup, start, &mut report, cancel),
         BroadPhase::AllPairs => all_pairs_segments(&soup),
     };
+    if cancel.is_cancelled() {
+        return Curves::default();
+    }
     let Found {
         candidates,
         segments,
@@ -372,7 +385,7 @@ fn proper(t: &[u32; 3]) -> bool {
 /// The segments of the pairs of triangles whose boxes touch, found with a BVH over runs of
 /// neighbouring triangles: within each run, then across the runs whose boxes touch. Puts
 /// the time since `start` to build the BVH and the time to traverse it in the report.
-fn bvh_segments(soup: &Soup, start: Instant, report: &mut CurvesReport) -> Found {
+fn bvh_segments(soup: &Soup, start: Instant, report: &mut CurvesReport, cancel: &Cancel) -> Found {
     let boxes: Vec<_> = soup
         .tris
         .iter()
@@ -398,7 +411,7 @@ fn bvh_segments(soup: &Soup, start: Instant, report: &mut CurvesReport) -> Found
     report.bvh_ms = ms(start);
     let t = Instant::now();
     let test = |found: &mut Found, a: u32, b: u32| {
-        if boxes[a as usize].intersect_aabb(&boxes[b as usize]) {
+        if !cancel.is_cancelled() && boxes[a as usize].intersect_aabb(&boxes[b as usize]) {
             found.push(soup, a.min(b), a.max(b));
         }
     };

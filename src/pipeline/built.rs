@@ -6,10 +6,11 @@ use super::sampled::{Sample, Sampled, refine_curves};
 use super::{Stages, ms, work};
 use crate::error::Error;
 use crate::export::SurfaceData;
-use crate::halo::{Halo, HaloParams, HaloReport, build_halo};
+use crate::halo::{Halo, HaloParams, HaloReport};
 use crate::intersect::{self, Curves};
 use crate::limits::{MAX_COORDINATE, MIN_EXTENT};
 use crate::parts::{HaloPart, Parts, SurfacePart};
+use crate::progress::Task;
 use crate::render::{self, CameraSettings, Picture, RenderError, RenderSettings};
 use crate::sample::{Mesh4, MeshStats, Source};
 use crate::scene::{Scene, SceneSurface};
@@ -17,7 +18,6 @@ use crate::stipple::Stipples;
 use crate::verify::{self, Verification};
 use crate::view::Projected;
 use glam::DVec3;
-use indicatif::ProgressBar;
 use std::time::Instant;
 
 /// One surface after sampling and projection.
@@ -186,35 +186,39 @@ pub(super) fn in_view(
     scene: &Scene,
     samples: Sampled,
     stages: Stages,
-    bar: &ProgressBar,
+    task: &Task,
 ) -> Result<Built, Error> {
+    let job = task.job();
+    let cancel = job.cancel();
     if scene.view.auto {
         return Err(Error::UnresolvedView {
             scene: scene.name.clone(),
         });
     }
     let mut timings = samples.timings;
-    let mut projections = project(scene, samples.surfaces, &mut timings, bar)?;
+    let mut projections = project(scene, samples.surfaces, &mut timings, task)?;
     // The certificate of the true surfaces' double curves, and the meshes held to it: their
     // curves, made here from the sheets alone.
     let mut held = None;
     if stages.curves && scene.curves.certify {
-        bar.set_message("certifying the curves");
+        task.doing("certifying the curves");
         let start = Instant::now();
         let surfaces: Vec<_> = projections
             .iter()
             .map(|p| p.entry.surface.parametric())
             .collect();
-        let certificate = crate::intersect::certified::certify(&surfaces, &scene.view);
+        let certificate =
+            crate::intersect::certified::certify_until(&surfaces, &scene.view, cancel);
+        job.check()?;
         timings.certify = ms(start);
         let (mut curves, rounds) =
-            super::hold::hold(scene, &certificate, &mut projections, &mut timings, bar)?;
+            super::hold::hold(scene, &certificate, &mut projections, &mut timings, task)?;
         // The refined curves copy this report.
         curves.report.certified = Some(certificate);
         curves.report.sampled_finer = rounds;
         held = Some(curves);
     }
-    bar.set_message("measuring the scene and how its triangles pile up");
+    task.doing("measuring the scene and how its triangles pile up");
     let start = Instant::now();
     let scale = Scale::of(scene, &projections, stages)?;
     // Measured for the stages that query the triangles; a build of the report alone (an
@@ -235,12 +239,20 @@ pub(super) fn in_view(
         rho,
         memory,
     } = scale;
+    job.check()?;
     let mut products = Vec::with_capacity(projections.len());
     for view in projections {
-        products.push(surface_product(scene, view, stages, rho, &mut timings, bar));
+        products.push(surface_product(
+            scene,
+            view,
+            stages,
+            rho,
+            &mut timings,
+            task,
+        )?);
     }
     if stages.halos {
-        bar.set_message("measuring how the halos pile up");
+        task.doing("measuring how the halos pile up");
         let start = Instant::now();
         crowding.halos = work::halo_crowding(scene, &products, &probes, diagonal)?;
         timings.guards += ms(start);
@@ -249,16 +261,18 @@ pub(super) fn in_view(
     if let Some(held) = held {
         curves = held;
     } else if stages.curves {
-        bar.set_message("intersection curves");
+        task.doing("intersection curves");
         let start = Instant::now();
         // The curves are made from the sheets alone.
         let none = Curves::default();
-        curves = intersect::curves(&parts(&products, &scene.halo, &none).sheets());
+        let sheets = parts(&products, &scene.halo, &none).sheets();
+        curves = intersect::curves_until(&sheets, cancel);
+        job.check()?;
         timings.curves = ms(start);
     }
-    bar.inc(1);
+    task.step();
     let refined = (stages.curves && scene.curves.refine).then(|| {
-        bar.set_message("refining the curves");
+        task.doing("refining the curves");
         let start = Instant::now();
         let none = Curves::default();
         let sheets = parts(&products, &scene.halo, &none).sheets();
@@ -269,9 +283,10 @@ pub(super) fn in_view(
     });
     let mut verification = Verification::default();
     if stages.verify {
-        bar.set_message("verifying halos");
+        task.doing("verifying halos");
         let start = Instant::now();
-        verification = verify::verify(&parts(&products, &scene.halo, &curves));
+        verification = verify::verify_until(&parts(&products, &scene.halo, &curves), cancel);
+        job.check()?;
         timings.verify = ms(start);
     }
     Ok(Built {
@@ -290,15 +305,17 @@ pub(super) fn in_view(
 }
 
 /// One surface's product: its halo at half-width `rho` and its stipples, where the stages
-/// ask for them, with their times added to `timings`.
+/// ask for them, with their times added to `timings`; stopped once `task`'s job is
+/// cancelled.
 fn surface_product(
     scene: &Scene,
     view: InView,
     stages: Stages,
     rho: f64,
     timings: &mut Timings,
-    bar: &ProgressBar,
-) -> SurfaceProduct {
+    task: &Task,
+) -> Result<SurfaceProduct, Error> {
+    let job = task.job();
     let InView {
         entry,
         sample,
@@ -306,17 +323,24 @@ fn surface_product(
     } = view;
     let name = &sample.name;
     let (halo, halo_report) = if stages.halos {
-        bar.set_message(format!("halo of {name}"));
+        task.doing(&format!("halo of {name}"));
         let start = Instant::now();
-        let built = build_halo(&projected, &sample.mesh.triangles, rho, &scene.halo);
+        let built = crate::halo::build_halo_until(
+            &projected,
+            &sample.mesh.triangles,
+            rho,
+            &scene.halo,
+            job.cancel(),
+        );
+        job.check()?;
         timings.halo += ms(start);
         built
     } else {
         Default::default()
     };
-    bar.inc(1);
+    task.step();
     let stipples = stages.stipples.then(|| {
-        bar.set_message(format!("stipples of {name}"));
+        task.doing(&format!("stipples of {name}"));
         let start = Instant::now();
         let st = &scene.render.stipple;
         let set = sample.stipples(st.count, st.seed);
@@ -330,7 +354,8 @@ fn surface_product(
         report,
         ..
     } = sample;
-    SurfaceProduct {
+    job.check()?;
+    Ok(SurfaceProduct {
         name,
         surface: entry.surface.clone(),
         mesh,
@@ -340,7 +365,7 @@ fn surface_product(
         halo,
         halo_report,
         stipples,
-    }
+    })
 }
 
 /// Each sample in the scene's view, its coordinates checked against the files' range.
@@ -348,15 +373,15 @@ fn project<'a>(
     scene: &'a Scene,
     samples: Vec<Sample>,
     timings: &mut Timings,
-    bar: &ProgressBar,
+    task: &Task,
 ) -> Result<Vec<InView<'a>>, Error> {
     scene
         .surfaces
         .iter()
         .zip(samples)
         .map(|(entry, sample)| {
-            let view = project_one(scene, entry, sample, timings, bar);
-            bar.inc(1);
+            let view = project_one(scene, entry, sample, timings, task);
+            task.step();
             view
         })
         .collect()
@@ -368,10 +393,11 @@ pub(super) fn project_one<'a>(
     entry: &'a SceneSurface,
     sample: Sample,
     timings: &mut Timings,
-    bar: &ProgressBar,
+    task: &Task,
 ) -> Result<InView<'a>, Error> {
     let name = &sample.name;
-    bar.set_message(format!("projecting {name}"));
+    task.job().check()?;
+    task.doing(&format!("projecting {name}"));
     let start = Instant::now();
     let projected = scene
         .view

@@ -12,9 +12,9 @@ use super::sampled::sample_surface;
 use crate::error::Error;
 use crate::intersect::certified::{Certificate, SheetBox};
 use crate::intersect::{self, Curves, Sheet};
+use crate::progress::Task;
 use crate::sample::Finer;
 use crate::scene::Scene;
-use indicatif::ProgressBar;
 use std::time::Instant;
 
 /// The most rounds of sampling again: the tolerance around the curves goes down to 4^-12 of
@@ -28,14 +28,15 @@ pub(super) fn hold<'a>(
     certificate: &Certificate,
     projections: &mut [InView<'a>],
     timings: &mut Timings,
-    bar: &ProgressBar,
+    task: &Task,
 ) -> Result<(Curves, usize), Error> {
     let mut finer: Vec<Vec<Finer>> = vec![Vec::new(); projections.len()];
     let mut round = 0;
     loop {
-        bar.set_message("intersection curves");
+        task.doing("intersection curves");
         let start = Instant::now();
-        let curves = intersect::curves(&sheets(projections));
+        let curves = intersect::curves_until(&sheets(projections), task.job().cancel());
+        task.job().check()?;
         timings.curves += ms(start);
         let agree =
             (curves.report.closed, curves.report.open) == (certificate.closed, certificate.open);
@@ -65,7 +66,7 @@ pub(super) fn hold<'a>(
         if !more {
             return Ok((curves, round));
         }
-        bar.set_message(format!(
+        task.doing(&format!(
             "sampling finer around the certified curves (round {})",
             round + 1
         ));
@@ -73,8 +74,8 @@ pub(super) fn hold<'a>(
             if finer[i].is_empty() {
                 continue;
             }
-            let sample = sample_surface(scene, i, &finer[i], timings, bar);
-            *view = project_one(scene, view.entry, sample, timings, bar)?;
+            let sample = sample_surface(scene, i, &finer[i], timings, task)?;
+            *view = project_one(scene, view.entry, sample, timings, task)?;
         }
         round += 1;
     }

@@ -17,19 +17,18 @@ pub use built::{Built, SurfaceProduct};
 pub use report::{Report, Timings};
 pub use sampled::{Sampled, shown_curves};
 pub(crate) use write::staged_error;
-pub use write::{glb_bytes, report_of, write};
+pub use write::{glb_bytes, report_of, write, write_with};
 
 use crate::error::Error;
 use crate::export;
+use crate::progress::Job;
 use crate::render::{self, Picture, RenderError, Style};
 use crate::scene::Scene;
 use built::in_view;
-use indicatif::{ProgressBar, ProgressStyle};
 use sampled::sample_with;
 use serde::Serialize;
-use std::io::IsTerminal;
 use std::path::Path;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// Which stages after the projection a build runs: those whose products an output the
 /// scene asks for uses (`report.json`'s `stages`).
@@ -87,39 +86,36 @@ impl Stages {
 
 /// Renders the scene's picture (the stages it needs, then its `render` and `camera`) and
 /// writes it to `out` as PNG, whole or not at all, making its folder when missing. Gives the
-/// picture and the milliseconds the rendering took.
-pub fn render_to(scene: &Scene, out: &Path, quiet: bool) -> Result<(Picture, f64), Error> {
-    let render_error = |source| Error::Render {
-        scene: scene.name.clone(),
-        source,
-    };
+/// picture and the milliseconds the rendering took. Reports to `job` and stops when it is
+/// cancelled.
+pub fn render_to(scene: &Scene, out: &Path, job: Job) -> Result<(Picture, f64), Error> {
+    let render_error = |source| Error::render(&scene.name, source);
     // The settings first: a bad one stops the command before the build.
     (scene.render.check()).map_err(|e| render_error(RenderError::Setting(e.within("render"))))?;
-    let (built, picture, took) = run_stages(
-        scene,
-        Stages::picture(scene),
-        quiet,
-        "the picture",
-        |built| {
+    let (built, picture, took) =
+        run_stages(scene, Stages::picture(scene), job, "the picture", |built| {
             let start = Instant::now();
-            let picture = built
-                .render(&scene.halo, &scene.render, &scene.camera)
-                .map_err(render_error)?;
+            let picture = render::render_until(
+                &built.parts(&scene.halo),
+                &scene.render,
+                &scene.camera,
+                job.cancel(),
+            )
+            .map_err(render_error)?;
             Ok((built, picture, ms(start)))
-        },
-    )?;
+        })?;
     if scene.render.style == Style::Stipple {
         let parts = built.parts(&scene.halo);
         let drawn =
             render::stipples_drawn(&parts, &scene.render, &scene.camera).map_err(render_error)?;
         let saturated = drawn.iter().filter(|d| d.saturated).count();
         if saturated * 100 > drawn.len() {
-            eprintln!(
-                "warning: {saturated} of {} stipples are where the tone asks for more than render.stipple.count = {} ranks; those places are drawn lighter: raise the count (about 0.6 per pixel of the picture: {})",
+            job.warn(&format!(
+                "{saturated} of {} stipples are where the tone asks for more than render.stipple.count = {} ranks; those places are drawn lighter: raise the count (about 0.6 per pixel of the picture: {})",
                 drawn.len(),
                 scene.render.stipple.count,
                 (0.6 * f64::from(scene.render.width) * f64::from(scene.render.height)).ceil()
-            );
+            ));
         }
     }
     let write_error = |path: &Path| {
@@ -137,74 +133,27 @@ fn ms(since: Instant) -> f64 {
     since.elapsed().as_secs_f64() * 1e3
 }
 
-/// A progress bar on stderr (hidden when stderr is not a terminal or `quiet`).
-fn progress(len: usize, quiet: bool) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(len as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    // Redrawn on its own: a stage of many seconds (sampling a fine tolerance, the halos of
-    // a million triangles) shows its time passing, never a frozen line.
-    bar.enable_steady_tick(Duration::from_millis(250));
-    if !std::io::stderr().is_terminal() {
-        heartbeat(bar.clone());
-    }
-    bar
-}
-
-/// Where stderr is not a terminal (a log, a pipe), indicatif draws nothing: a line every
-/// [`HEARTBEAT`] with the stage and the time, until the bar finishes, so that a long build
-/// never sits silent in a log.
-fn heartbeat(bar: ProgressBar) {
-    std::thread::spawn(move || {
-        let start = Instant::now();
-        let mut next = HEARTBEAT;
-        while !bar.is_finished() {
-            std::thread::sleep(Duration::from_millis(100));
-            if start.elapsed() >= next {
-                eprintln!(
-                    "halo4d: {:.0} s, stage {}/{}: {}",
-                    start.elapsed().as_secs_f64(),
-                    bar.position(),
-                    bar.length().unwrap_or(0),
-                    bar.message()
-                );
-                next += HEARTBEAT;
-            }
-        }
-    });
-}
-
-/// How often a build whose stderr is not a terminal says what it is doing.
-const HEARTBEAT: Duration = Duration::from_secs(10);
-
 /// The stages `stages` of a build of `scene`, then `finish` (the files, the picture) with
-/// the bar at its last step and `last` as its message; with a progress bar unless `quiet`.
+/// the task at its last step and `last` as what it is doing: a task `"build"` of `job`.
 fn run_stages<T>(
     scene: &Scene,
     stages: Stages,
-    quiet: bool,
+    job: Job,
     last: &str,
     finish: impl FnOnce(Built) -> Result<T, Error>,
 ) -> Result<T, Error> {
-    let bar = progress(scene.surfaces.len() * 3 + 3, quiet);
-    let samples = sample_with(scene, &bar);
-    let done = in_view(scene, samples, stages, &bar).and_then(|built| {
-        bar.set_position(bar.length().unwrap_or(1) - 1);
-        bar.set_message(last.to_string());
-        finish(built)
-    });
-    bar.finish_and_clear();
-    done
+    let task = job.task("build", (scene.surfaces.len() * 3 + 3) as u64);
+    let samples = sample_with(scene, &task)?;
+    let built = in_view(scene, samples, stages, &task)?;
+    task.at_last();
+    task.doing(last);
+    finish(built)
 }
 
-/// Builds a scene into `out_dir`: runs the stages and writes the outputs the scene asks for.
-pub fn build(scene: &Scene, out_dir: &Path, quiet: bool) -> Result<Report, Error> {
-    build_since(scene, out_dir, quiet, Instant::now())
+/// Builds a scene into `out_dir`: runs the stages and writes the outputs the scene asks for,
+/// reporting to `job` and stopping, with nothing written, when it is cancelled.
+pub fn build(scene: &Scene, out_dir: &Path, job: Job) -> Result<Report, Error> {
+    build_since(scene, out_dir, job, Instant::now())
 }
 
 /// [`build`], for a program that started its work (reading the scene, finding its view)
@@ -214,7 +163,7 @@ pub fn build(scene: &Scene, out_dir: &Path, quiet: bool) -> Result<Report, Error
 pub fn build_since(
     scene: &Scene,
     out_dir: &Path,
-    quiet: bool,
+    job: Job,
     started: Instant,
 ) -> Result<Report, Error> {
     let setup = ms(started);
@@ -223,9 +172,9 @@ pub fn build_since(
     } else {
         "the files"
     };
-    run_stages(scene, Stages::of(scene), quiet, last, |mut built| {
+    run_stages(scene, Stages::of(scene), job, last, |mut built| {
         built.timings.setup = setup;
-        let (staged, mut report) = write::stage(scene, &built, out_dir)?;
+        let (staged, mut report) = write::stage(scene, &built, out_dir, job)?;
         let start = Instant::now();
         drop(built);
         report.timings_ms.free = ms(start);

@@ -5,11 +5,11 @@ use super::report::{SamplingReport, Timings, surface_warnings};
 use super::{Built, Stages, built::in_view, ms};
 use crate::error::Error;
 use crate::intersect::{self, Curves, Sheet};
-use crate::sample::{self, Audit, ErrorBound, Finer, Mesh4, MeshStats, Sampling, Source, audit};
+use crate::progress::{Job, Task};
+use crate::sample::{self, Audit, ErrorBound, Finer, Mesh4, MeshStats, Sampling, Source};
 use crate::scene::Scene;
 use crate::stipple::Stipples;
 use glam::DVec3;
-use indicatif::ProgressBar;
 use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
@@ -54,10 +54,20 @@ impl Sample {
 }
 
 impl Sampled {
-    /// Samples (or reads) and audits every surface of the scene, printing the warnings a
-    /// build prints.
+    /// Samples (or reads) and audits every surface of the scene, saying nothing (the
+    /// warnings are in each surface's report) and never stopped.
     pub fn of(scene: &Scene) -> Sampled {
-        sample_with(scene, &ProgressBar::hidden())
+        match Sampled::sample(scene, Job::SILENT) {
+            Ok(sampled) => sampled,
+            Err(e) => unreachable!("a silent job is never cancelled: {e}"),
+        }
+    }
+
+    /// [`Sampled::of`] as a task `"sampling"` of `job`, a step per surface, with the
+    /// warnings a build gives; `Err(Error::Cancelled)` once `job` is cancelled.
+    pub fn sample(scene: &Scene, job: Job) -> Result<Sampled, Error> {
+        let task = job.task("sampling", scene.surfaces.len() as u64);
+        sample_with(scene, &task)
     }
 
     /// The build of `scene` from these samples (of a scene with the same surfaces and
@@ -69,7 +79,14 @@ impl Sampled {
 
     /// [`Sampled::build`], the samples moved into the build.
     pub fn into_built(self, scene: &Scene, stages: Stages) -> Result<Built, Error> {
-        in_view(scene, self, stages, &ProgressBar::hidden())
+        self.into_built_with(scene, stages, Job::SILENT)
+    }
+
+    /// [`Sampled::into_built`] as a task `"view"` of `job` (its stages as steps), stopped
+    /// once `job` is cancelled.
+    pub fn into_built_with(self, scene: &Scene, stages: Stages, job: Job) -> Result<Built, Error> {
+        let task = job.task("view", (self.surfaces.len() * 2 + 1) as u64);
+        in_view(scene, self, stages, &task)
     }
 
     /// Each surface's name and 4D mesh, in the scene's order.
@@ -166,37 +183,40 @@ pub(super) fn refine_curves<'a>(
     intersect::refine(curves, sheets, &analytic, &scene.view, diagonal)
 }
 
-pub(super) fn sample_with(scene: &Scene, bar: &ProgressBar) -> Sampled {
+/// Every surface of the scene sampled, a step of `task` each.
+pub(super) fn sample_with(scene: &Scene, task: &Task) -> Result<Sampled, Error> {
     let mut timings = Timings::default();
     let mut surfaces = Vec::with_capacity(scene.surfaces.len());
     for i in 0..scene.surfaces.len() {
-        surfaces.push(sample_surface(scene, i, &[], &mut timings, bar));
-        bar.inc(1);
+        surfaces.push(sample_surface(scene, i, &[], &mut timings, task)?);
+        task.step();
     }
-    Sampled { surfaces, timings }
+    Ok(Sampled { surfaces, timings })
 }
 
 /// Samples surface `i` of the scene (an adaptive sampling holding the rectangles `finer` to
 /// their own tolerance), audits it, proves its bound where asked and validates its mesh,
-/// with the times added to `timings`.
+/// with the times added to `timings`; its warnings said to `task`'s job, which stops it
+/// once cancelled.
 pub(super) fn sample_surface(
     scene: &Scene,
     i: usize,
     finer: &[Finer],
     timings: &mut Timings,
-    bar: &ProgressBar,
-) -> Sample {
+    task: &Task,
+) -> Result<Sample, Error> {
     let entry = &scene.surfaces[i];
     let name = scene.surface_name(i);
-    bar.set_message(format!("sampling {name}"));
+    task.doing(&format!("sampling {name}"));
+    let job = task.job();
+    let cancel = job.cancel();
     let sampling = scene.surface_sampling(i);
     let start = Instant::now();
     let sampled = match &entry.surface {
-        Source::Parametric(surface) if !finer.is_empty() => {
-            sample::sample_finer(surface, sampling, finer)
-        }
+        Source::Parametric(surface) => sample::sample_finer(surface, sampling, finer, cancel),
         source => source.sample(sampling),
     };
+    job.check()?;
     let sample_ms = ms(start);
     timings.sample += sample_ms;
     let start = Instant::now();
@@ -205,13 +225,14 @@ pub(super) fn sample_surface(
     // audit.
     let (audited, uniform, method) = match &entry.surface {
         Source::Parametric(surface) => (
-            audit(surface, &sampled.mesh),
-            (!sampled.complete)
+            sample::audit_until(surface, &sampled.mesh, cancel),
+            (!sampled.complete && !cancel.is_cancelled())
                 .then(|| sample::uniform_error(surface, sampled.mesh.triangles.len())),
             sampling.method(),
         ),
         Source::Mesh(_) => (Audit::default(), None, "file"),
     };
+    job.check()?;
     let audit_ms = ms(start);
     timings.audit += audit_ms;
     let start = Instant::now();
@@ -226,7 +247,8 @@ pub(super) fn sample_surface(
         .surface
         .parametric()
         .filter(|_| scene.outputs.prove || aimed)
-        .map(|surface| sample::prove(surface, &sampled.mesh));
+        .map(|surface| sample::prove_until(surface, &sampled.mesh, cancel));
+    job.check()?;
     let proven_ms = ms(start);
     timings.prove += proven_ms;
     let report = SamplingReport::new(
@@ -239,22 +261,22 @@ pub(super) fn sample_surface(
         [sample_ms, audit_ms, proven_ms],
     );
     if let Some(w) = report.warning(&name) {
-        bar.suspend(|| eprintln!("warning: {w}"));
+        job.warn(&w);
     }
     let start = Instant::now();
     let mesh = sampled.mesh;
     let stats = mesh.validate();
     timings.audit += ms(start);
     for w in surface_warnings(&name, &entry.surface, &stats) {
-        bar.suspend(|| eprintln!("warning: {w}"));
+        job.warn(&w);
     }
-    Sample {
+    Ok(Sample {
         name,
         mesh,
         stats,
         report,
         stipples: Arc::default(),
-    }
+    })
 }
 
 #[cfg(test)]

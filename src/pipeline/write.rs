@@ -5,6 +5,7 @@ use super::report::{PictureReport, Report, Timings, surface_report, surface_warn
 use super::{Built, ms};
 use crate::error::Error;
 use crate::export::{self, SurfaceData};
+use crate::progress::Job;
 use crate::render;
 use crate::scene::Scene;
 use rayon::prelude::*;
@@ -15,7 +16,13 @@ use std::time::Instant;
 /// `out_dir`, and returns the report (also written as `report.json` when asked for). The
 /// export time is added to the build's timings, and the total is the sum of the stages.
 pub fn write(scene: &Scene, built: &Built, out_dir: &Path) -> Result<Report, Error> {
-    let (staged, report) = stage(scene, built, out_dir)?;
+    write_with(scene, built, out_dir, Job::SILENT)
+}
+
+/// [`write()`], stopped once `job` is cancelled (its picture between rows, its files
+/// before each is begun), with nothing written.
+pub fn write_with(scene: &Scene, built: &Built, out_dir: &Path, job: Job) -> Result<Report, Error> {
+    let (staged, report) = stage(scene, built, out_dir, job)?;
     finish(scene, staged, report, Timings::sum)
 }
 
@@ -29,11 +36,13 @@ pub fn report_of(scene: &Scene, built: &Built) -> Report {
 }
 
 /// Writes every output but `report.json` under a temporary name (a failure leaves the
-/// folder as it was), and assembles the report, its total not yet set.
+/// folder as it was, and so does `job` cancelled: each file is begun only while it is not),
+/// and assembles the report, its total not yet set.
 pub(super) fn stage(
     scene: &Scene,
     built: &Built,
     out_dir: &Path,
+    job: Job,
 ) -> Result<(export::Staged, Report), Error> {
     let mut timings = built.timings;
     let export_start = Instant::now();
@@ -41,10 +50,10 @@ pub(super) fn stage(
     let data: Vec<SurfaceData> = built.surfaces.iter().map(|p| p.data(&scene.halo)).collect();
     let failures = built.failures();
     let stipples = file_stipples(scene, built)?;
-    let mut files = write_meshes(scene, built, &staged, &data, &stipples, &failures)?;
+    let mut files = write_meshes(scene, built, &staged, &data, &stipples, &failures, job)?;
     let mut picture_report = None;
     if scene.outputs.png || scene.outputs.svg {
-        let (picture, written) = write_picture(scene, built, &staged, &mut timings.render)?;
+        let (picture, written) = write_picture(scene, built, &staged, &mut timings.render, job)?;
         files.extend(written);
         picture_report = Some(picture);
     }
@@ -54,6 +63,7 @@ pub(super) fn stage(
         files.push("report.json".into());
     }
     let report = assemble_report(scene, built, timings, picture_report, failures, files);
+    job.check()?;
     Ok((staged, report))
 }
 
@@ -95,6 +105,7 @@ fn write_meshes(
     data: &[SurfaceData],
     stipples: &[render::stipple::Drawn],
     failures: &[String],
+    job: Job,
 ) -> Result<Vec<String>, Error> {
     let write = |file: String, bytes: &[u8]| -> Result<String, Error> {
         staged.write(file, bytes).map_err(staged_error)
@@ -103,8 +114,8 @@ fn write_meshes(
     // The files are made on the cores side by side, each written as it is made (a halo's
     // `.vtk` streamed, the `.glb`'s chunks written as they are, with no copy of the whole
     // file in memory); the report lists them in this order.
-    type Job<'a> = Box<dyn FnOnce() -> Result<Vec<String>, Error> + Send + 'a>;
-    let mut jobs: Vec<Job> = Vec::new();
+    type Writer<'a> = Box<dyn FnOnce() -> Result<Vec<String>, Error> + Send + 'a>;
+    let mut jobs: Vec<Writer> = Vec::new();
     if scene.outputs.glb {
         jobs.push(Box::new(|| {
             let (text, bin) = glb_chunks(scene, built, data, stipples, failures)?;
@@ -176,7 +187,13 @@ fn write_meshes(
             }));
         }
     }
-    let written: Result<Vec<Vec<String>>, Error> = jobs.into_par_iter().map(|job| job()).collect();
+    let written: Result<Vec<Vec<String>>, Error> = jobs
+        .into_par_iter()
+        .map(|writer| {
+            job.check()?;
+            writer()
+        })
+        .collect();
     Ok(written?.into_iter().flatten().collect())
 }
 
@@ -187,6 +204,7 @@ fn write_picture(
     built: &Built,
     staged: &export::Staged,
     render_ms: &mut f64,
+    job: Job,
 ) -> Result<(PictureReport, Vec<String>), Error> {
     let write = |file: String, bytes: &[u8]| -> Result<String, Error> {
         staged.write(file, bytes).map_err(staged_error)
@@ -199,11 +217,9 @@ fn write_picture(
         &scene.render,
         &scene.camera,
         scene.outputs.svg,
+        job.cancel(),
     )
-    .map_err(|source| Error::Render {
-        scene: scene.name.clone(),
-        source,
-    })?;
+    .map_err(|source| Error::render(&scene.name, source))?;
     *render_ms = ms(start);
     if scene.outputs.png {
         files.push(write(format!("{name}.png"), &rendered.picture.png())?);

@@ -35,6 +35,7 @@ pub use clip::{Clip, ClipPlane};
 pub use compare::Comparison;
 
 use crate::parts::{HaloIndex, Parts, TriangleHiders};
+use crate::progress::{Cancel, Cancelled};
 use camera::Camera;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -395,6 +396,9 @@ pub enum RenderError {
     /// Nothing to draw.
     #[error("the scene has no triangles to render")]
     Empty,
+    /// The caller cancelled the picture ([`render_until`]).
+    #[error(transparent)]
+    Cancelled(#[from] Cancelled),
     /// The stipple style asked of a surface without stipples.
     #[error(
         "render.style stipple: surface {surface} has no stipples (they are made from its 4D mesh by a build; a file read back without its 4D mesh has none): use render.style shaded"
@@ -472,7 +476,18 @@ pub fn render(
     settings: &RenderSettings,
     camera: &CameraSettings,
 ) -> Result<Picture, RenderError> {
-    Ok(render_eyes(input, settings, camera, Want::default())?.picture)
+    render_until(input, settings, camera, Cancel::never())
+}
+
+/// [`render`], stopping between rows of pixels once `cancel` is cancelled
+/// ([`RenderError::Cancelled`]).
+pub fn render_until(
+    input: &Parts,
+    settings: &RenderSettings,
+    camera: &CameraSettings,
+    cancel: &Cancel,
+) -> Result<Picture, RenderError> {
+    Ok(render_eyes(input, settings, camera, Want::default(), cancel)?.picture)
 }
 
 /// [`render`], and per pixel of the first eye the ray distance of the first surface the
@@ -491,6 +506,7 @@ pub fn render_with_depth(
             depth: true,
             ..Want::default()
         },
+        Cancel::never(),
     )?;
     Ok((eyes.picture, eyes.depth))
 }
@@ -516,6 +532,7 @@ pub fn render_for_build(
     settings: &RenderSettings,
     camera: &CameraSettings,
     svg: bool,
+    cancel: &Cancel,
 ) -> Result<Rendered, RenderError> {
     let eyes = render_eyes(
         input,
@@ -526,6 +543,7 @@ pub fn render_for_build(
             seen: true,
             ..Want::default()
         },
+        cancel,
     )?;
     let (camera, curves) = eyes
         .seen
@@ -567,14 +585,18 @@ pub fn picture_bytes(settings: &RenderSettings) -> f64 {
     pixels * (48.0 + 3.0 * eyes(settings).len() as f64 + 12.0 * f64::from(settings.samples))
 }
 
-/// The picture of every eye, and of the first eye what `want` asks for.
-fn render_eyes(
-    input: &Parts,
-    settings: &RenderSettings,
+/// The picture of every eye, and of the first eye what `want` asks for; stopped between
+/// rows once `cancel` is cancelled.
+fn render_eyes<'a>(
+    input: &'a Parts<'a>,
+    settings: &'a RenderSettings,
     camera: &CameraSettings,
     want: Want,
+    cancel: &'a Cancel,
 ) -> Result<Eyes, RenderError> {
-    let (placement, scene) = prepare(input, settings, camera)?;
+    let (placement, mut scene) = prepare(input, settings, camera)?;
+    scene.cancel = cancel;
+    cancel.check()?;
     let eyes = eyes(settings);
     let mut depth = Vec::new();
     let (mut svg, mut seen) = (None, None);
@@ -588,6 +610,7 @@ fn render_eyes(
             Style::Shaded => scene.view(&primary),
             Style::Stipple => scene.view_stipples(&primary, want.depth && e == 0)?,
         };
+        cancel.check()?;
         if e == 0 && want.depth {
             depth.clone_from(&view.front);
         }
@@ -980,6 +1003,9 @@ struct Scene<'a> {
     centre: DVec3,
     radius: f64,
     background: DVec3,
+    /// Checked before each row of pixels: once cancelled, the rows left are not drawn (and
+    /// the caller drops the picture).
+    cancel: &'a Cancel,
 }
 
 impl<'a> Scene<'a> {
@@ -1013,6 +1039,7 @@ impl<'a> Scene<'a> {
             centre: (lo + hi) * 0.5,
             radius: (hi - lo).length() * 0.5,
             background: DVec3::from(settings.background),
+            cancel: Cancel::never(),
         }
     }
 
@@ -1174,6 +1201,9 @@ impl<'a> Scene<'a> {
             .par_chunks_mut(w)
             .enumerate()
             .for_each_init(Vec::new, |hits, (y, row)| {
+                if self.cancel.is_cancelled() {
+                    return;
+                }
                 for (x, probe) in row.iter_mut().enumerate() {
                     *probe = sample(hits, (x, y), centre, &mut 0);
                 }
@@ -1188,6 +1218,9 @@ impl<'a> Scene<'a> {
             .zip(gap.par_chunks_mut(w))
             .enumerate()
             .for_each_init(Vec::new, |hits, (y, ((rgb, front), gap))| {
+                if self.cancel.is_cancelled() {
+                    return;
+                }
                 for (x, ((c, f), g)) in rgb
                     .iter_mut()
                     .zip(front.iter_mut())

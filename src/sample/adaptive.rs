@@ -52,6 +52,7 @@
 
 use super::{AUDIT_POINTS, Classes, ErrorBound, Mesh4, corner_error, triangle_bound};
 use crate::limits::MIN_EDGE;
+use crate::progress::Cancel;
 use crate::surfaces::{Domain, Glue, Side, SideRule, Surface};
 use glam::DVec4;
 use rayon::prelude::*;
@@ -628,26 +629,55 @@ pub fn sample_adaptive_through(
     max_triangles: usize,
     through: &[(usize, [f64; 2])],
 ) -> AdaptiveMesh {
-    sample_adaptive_with(surface, tolerance, bound, max_triangles, through, &[])
+    let guides = Guides {
+        through,
+        ..Guides::default()
+    };
+    sample_adaptive_with(surface, tolerance, bound, max_triangles, guides)
 }
 
 /// The share of a tolerance the sampler holds triangles to: slightly under, so that a
 /// triangle measured at the tolerance passes.
 const UNDER: f64 = 1.0 - 1e-9;
 
-/// The adaptive sampler with its two guides: points to pass through and finer rectangles.
+/// What guides the adaptive sampler besides its tolerance, and what stops it.
+#[derive(Clone, Copy)]
+struct Guides<'a> {
+    /// Points to pass through.
+    through: &'a [(usize, [f64; 2])],
+    /// Rectangles held to a finer tolerance.
+    finer: &'a [Finer],
+    /// Checked between the refinement's batches: once cancelled, the sampler stops and
+    /// gives the mesh it has.
+    cancel: &'a Cancel,
+}
+
+impl Default for Guides<'_> {
+    fn default() -> Self {
+        Guides {
+            through: &[],
+            finer: &[],
+            cancel: Cancel::never(),
+        }
+    }
+}
+
+/// The adaptive sampler with its guides.
 fn sample_adaptive_with(
     surface: &Surface,
     tolerance: f64,
     bound: ErrorBound,
     max_triangles: usize,
-    through: &[(usize, [f64; 2])],
-    finer: &[Finer],
+    guides: Guides,
 ) -> AdaptiveMesh {
-    let mut sampler = Sampler::new(surface, tolerance * UNDER, bound, max_triangles, finer);
-    sampler.insert_through(through);
+    let mut sampler = Sampler::new(surface, tolerance * UNDER, bound, max_triangles, guides);
+    sampler.insert_through(guides.through);
     let complete = sampler.refine(max_triangles);
-    let failing = if complete { 0 } else { sampler.count_failing() };
+    let failing = if complete || guides.cancel.is_cancelled() {
+        0
+    } else {
+        sampler.count_failing()
+    };
     AdaptiveMesh {
         mesh: sampler.weld(),
         complete: complete && failing == 0,
@@ -750,21 +780,29 @@ impl FinerIndex {
 
 /// [`sample_adaptive_to`] with every triangle that meets one of the rectangles `finer`
 /// held to that rectangle's tolerance: the build samples a surface again so, around the
-/// double curves its mesh missed ([`crate::intersect::certified`]).
+/// double curves its mesh missed ([`crate::intersect::certified`]). Once `cancel` is
+/// cancelled it stops refining and gives the mesh it has, which the caller drops.
 pub fn sample_adaptive_finer(
     surface: &Surface,
     tolerance: f64,
     bound: ErrorBound,
     max_triangles: usize,
     finer: &[Finer],
+    cancel: &Cancel,
 ) -> AdaptiveMesh {
-    sample_adaptive_with(surface, tolerance, bound, max_triangles, &[], finer)
+    let guides = Guides {
+        finer,
+        cancel,
+        ..Guides::default()
+    };
+    sample_adaptive_with(surface, tolerance, bound, max_triangles, guides)
 }
 
 /// What a patch needs to refine itself.
 struct Context<'a> {
     surface: &'a Surface,
     tolerance: f64,
+    cancel: &'a Cancel,
     /// Edges shorter than this (4D) are not split: [`MIN_EDGE`] of the extent.
     min_edge: f64,
 }
@@ -857,6 +895,7 @@ impl Patch {
                 continue;
             }
             let split = match q.check {
+                Check::Due if cx.cancel.is_cancelled() => return true,
                 Check::Due => {
                     self.queue[at].push_front(q);
                     self.check_level(cx, at);
@@ -1041,6 +1080,7 @@ struct Sampler<'a> {
     surface: &'a Surface,
     tolerance: f64,
     patches: Vec<Patch>,
+    cancel: &'a Cancel,
 }
 
 impl<'a> Sampler<'a> {
@@ -1053,7 +1093,7 @@ impl<'a> Sampler<'a> {
         tolerance: f64,
         bound: ErrorBound,
         max_triangles: usize,
-        finer: &[Finer],
+        guides: Guides<'a>,
     ) -> Self {
         let [min_u, min_v] = surface.min_cells();
         let mut patches = Vec::new();
@@ -1070,7 +1110,7 @@ impl<'a> Sampler<'a> {
             let aspect = warp.s.end() / warp.t.end();
             let nu = grid_cells(4.0 * aspect.sqrt(), min_u.div_ceil(k));
             let nv = grid_cells(4.0 / aspect.sqrt(), min_v.div_ceil(k));
-            let rects = FinerIndex::new(finer.iter().filter(|f| f.patch == of), &domain);
+            let rects = FinerIndex::new(guides.finer.iter().filter(|f| f.patch == of), &domain);
             let mut p = Patch {
                 of,
                 tile: (corner, k),
@@ -1119,6 +1159,7 @@ impl<'a> Sampler<'a> {
             surface,
             tolerance,
             patches,
+            cancel: guides.cancel,
         };
         sampler.exchange();
         sampler
@@ -1202,6 +1243,7 @@ impl<'a> Sampler<'a> {
         let cx = Context {
             surface: self.surface,
             tolerance: self.tolerance,
+            cancel: self.cancel,
             min_edge: MIN_EDGE * if extent.is_finite() { extent } else { 0.0 },
         };
         // Below the highest level of a finite error (folded triangles, on the top level,
@@ -1214,6 +1256,9 @@ impl<'a> Sampler<'a> {
             .unwrap_or(1)
             - 1;
         loop {
+            if self.cancel.is_cancelled() {
+                return false;
+            }
             let work: Vec<usize> = self.patches.iter().map(|p| p.work(floor)).collect();
             let total: usize = work.iter().sum();
             if total == 0 {

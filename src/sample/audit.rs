@@ -8,6 +8,7 @@
 //! R^4; orthographic projection never lengthens it, so the bound holds in every view.
 
 use super::Mesh4;
+use crate::progress::Cancel;
 use crate::surfaces::Surface;
 use glam::DVec4;
 use rayon::prelude::*;
@@ -74,12 +75,23 @@ struct Partial {
 /// Measures the distance between `mesh` and `surface` (see the module documentation). Uses
 /// every core of the machine.
 pub fn audit(surface: &Surface, mesh: &Mesh4) -> Audit {
+    audit_until(surface, mesh, Cancel::never())
+}
+
+/// [`audit`], stopping early once `cancel` is cancelled (its figures then partial: the
+/// caller drops them).
+pub fn audit_until(surface: &Surface, mesh: &Mesh4, cancel: &Cancel) -> Audit {
     let n = mesh.triangles.len();
     // Runs of AUDIT_RUN triangles on the cores, summed in order.
     let partials: Vec<Partial> = (0..n)
         .into_par_iter()
         .step_by(AUDIT_RUN)
-        .map(|start| audit_range(surface, mesh, start..(start + AUDIT_RUN).min(n)))
+        .map(|start| {
+            if cancel.is_cancelled() {
+                return Partial::default();
+            }
+            audit_range(surface, mesh, start..(start + AUDIT_RUN).min(n))
+        })
         .collect();
     let mut total = Partial::default();
     for p in partials {

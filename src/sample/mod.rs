@@ -25,12 +25,13 @@ pub use adaptive::{
     Finer, metric_aspect, sample_adaptive, sample_adaptive_finer, sample_adaptive_through,
     sample_adaptive_to,
 };
-pub use audit::{AUDIT_POINTS, Audit, audit};
-pub use proven::{Proof, corner_error, prove, triangle_bound};
+pub use audit::{AUDIT_POINTS, Audit, audit, audit_until};
+pub use proven::{Proof, corner_error, prove, prove_until, triangle_bound};
 pub use source::{MeshData4, MeshSurface, Source, mesh_from_data, mesh_tangents, mesh_topology};
 pub use uniform::sample_uniform;
 
 use crate::limits::{ABSOLUTE_TOLERANCE, FieldError, GRID_CELLS, RELATIVE_TOLERANCE, TRIANGLES};
+use crate::progress::Cancel;
 use crate::surfaces::{Eval4, Surface};
 use glam::DVec4;
 use rayon::prelude::*;
@@ -215,12 +216,19 @@ fn absolute(relative: Option<f64>, absolute: Option<f64>, diagonal: f64) -> f64 
 
 /// Samples a surface as `sampling` says.
 pub fn sample(surface: &Surface, sampling: &Sampling) -> Sampled {
-    sample_finer(surface, sampling, &[])
+    sample_finer(surface, sampling, &[], Cancel::never())
 }
 
 /// [`sample`], an adaptive sampling holding the triangles that meet the rectangles `finer`
-/// to their own tolerance ([`sample_adaptive_finer`]); a grid is sampled as it is.
-pub fn sample_finer(surface: &Surface, sampling: &Sampling, finer: &[Finer]) -> Sampled {
+/// to their own tolerance ([`sample_adaptive_finer`]); a grid is sampled as it is. Once
+/// `cancel` is cancelled the adaptive sampler stops with the mesh it has, which the caller
+/// drops.
+pub fn sample_finer(
+    surface: &Surface,
+    sampling: &Sampling,
+    finer: &[Finer],
+    cancel: &Cancel,
+) -> Sampled {
     let diagonal = bounding_diagonal(surface);
     match *sampling {
         Sampling::Uniform { u, v } => Sampled {
@@ -236,7 +244,8 @@ pub fn sample_finer(surface: &Surface, sampling: &Sampling, finer: &[Finer]) -> 
             bound,
         } => {
             let tolerance = absolute(tolerance, absolute_tolerance, diagonal);
-            let out = sample_adaptive_finer(surface, tolerance, bound, max_triangles, finer);
+            let out =
+                sample_adaptive_finer(surface, tolerance, bound, max_triangles, finer, cancel);
             Sampled {
                 mesh: out.mesh,
                 tolerance: Some(tolerance),

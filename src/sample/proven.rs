@@ -29,6 +29,7 @@
 //! understated. The distance is Euclidean in R^4, as the audit's.
 
 use super::Mesh4;
+use crate::progress::Cancel;
 use crate::surfaces::{Interval, Jet, Surface};
 use glam::DVec4;
 use rayon::prelude::*;
@@ -51,6 +52,11 @@ pub struct Proof {
 /// core. A mesh without its triangles' and vertices' parameters (a sampled mesh has them;
 /// one read back from a file may not) has no triangle proven.
 pub fn prove(surface: &Surface, mesh: &Mesh4) -> Proof {
+    prove_until(surface, mesh, Cancel::never())
+}
+
+/// [`prove`], stopping once `cancel` is cancelled (with no bound, which the caller drops).
+pub fn prove_until(surface: &Surface, mesh: &Mesh4, cancel: &Cancel) -> Proof {
     let n = mesh.triangles.len();
     let v = mesh.positions.len();
     if mesh.triangle_uv.len() != n
@@ -69,6 +75,9 @@ pub fn prove(surface: &Surface, mesh: &Mesh4) -> Proof {
     let vertex_error: Vec<f64> = (0..mesh.positions.len())
         .into_par_iter()
         .map(|v| {
+            if cancel.is_cancelled() {
+                return f64::INFINITY;
+            }
             corner_error(
                 surface,
                 mesh.patch[v] as usize,
@@ -80,6 +89,9 @@ pub fn prove(surface: &Surface, mesh: &Mesh4) -> Proof {
     let bounds: Vec<f64> = (0..mesh.triangles.len())
         .into_par_iter()
         .map(|t| {
+            if cancel.is_cancelled() {
+                return f64::INFINITY;
+            }
             let patch = mesh.triangle_patch[t] as usize;
             let uv = mesh.triangle_uv[t];
             let corners = mesh.triangles[t].map(|i| mesh.positions[i as usize]);

@@ -58,6 +58,7 @@ use crate::import::{ImportError, ImportedScene};
 use crate::limits::{
     FieldError, PICTURE_SIDE, VIEWER_SLICES, VIEWER_TETRAHEDRA, VIEWER_TRIANGLES, check_samples,
 };
+use crate::progress::Job;
 use crate::render::camera::{Camera, Placement, bounding_radius};
 use crate::render::overlay::{AGREE, interior_edges};
 use crate::render::{
@@ -662,7 +663,7 @@ impl Source {
     /// Opens `path`: a scene file (sampled in 4D), a scene's `.glb` (turned in 4D when it
     /// carries the 4D mesh and the scene, else in 3D, with a note saying why), or with no
     /// path the default scene. Gives the source and the notes for the user.
-    pub fn open(path: Option<&Path>) -> Result<(Source, Vec<String>), ViewerError> {
+    pub fn open(path: Option<&Path>, job: Job) -> Result<(Source, Vec<String>), ViewerError> {
         use crate::scene::Scene;
         let Some(path) = path else {
             return Ok((
@@ -676,7 +677,7 @@ impl Source {
         {
             let mut scene = Scene::load(path).map_err(crate::error::Error::from)?;
             // A view left to the search ("view": "auto") opens on the view it finds.
-            let notes = crate::viewsearch::resolve(&mut scene, false)
+            let notes = crate::viewsearch::resolve(&mut scene, job)
                 .map_err(|e| ViewerError::View(e.to_string()))?
                 .map(|found| found.summary())
                 .into_iter()

@@ -28,6 +28,7 @@ use super::{
     ViewerError,
 };
 use crate::intersect::Curves;
+use crate::progress::{Cancel, Job, Silent};
 use crate::render::Style;
 use crate::scene::Scene;
 use crate::view::{Projection, View};
@@ -88,6 +89,7 @@ pub fn run(
         saved: None,
         saves: 0,
         build: None,
+        work: Cancel::new(),
         search: None,
         note: String::new(),
         stipples: None,
@@ -144,6 +146,9 @@ struct App {
     saves: u32,
     /// A build running in the background: its outcome in words.
     build: Option<Receiver<String>>,
+    /// Stops the build and the view search running in the background when the window
+    /// closes.
+    work: Cancel,
     /// A view search running in the background (`A`): the view found, or why none.
     search: Option<Receiver<Result<crate::viewsearch::Found, String>>>,
     /// The last message for the title (a save, a build's outcome, a refused view).
@@ -639,8 +644,10 @@ impl App {
         let window = self.state.as_ref().map(|s| Arc::clone(&s.window));
         let (tx, rx) = channel();
         self.note = "searching the view that shows the most of the curves".into();
+        let cancel = self.work.clone();
         std::thread::spawn(move || {
-            let found = crate::viewsearch::search(&scene, true).map_err(|e| e.to_string());
+            let job = Job::new(&Silent, &cancel);
+            let found = crate::viewsearch::search(&scene, job).map_err(|e| e.to_string());
             let _ = tx.send(found);
             if let Some(w) = window {
                 w.request_redraw();
@@ -663,8 +670,10 @@ impl App {
         let window = self.state.as_ref().map(|s| Arc::clone(&s.window));
         let (tx, rx) = channel();
         self.note = format!("building {}", path.display());
+        let cancel = self.work.clone();
         std::thread::spawn(move || {
-            let outcome = match crate::pipeline::build(&scene, &out, true) {
+            let job = Job::new(&Silent, &cancel);
+            let outcome = match crate::pipeline::build(&scene, &out, job) {
                 Ok(report) if report.verified => {
                     format!("built {} from {}: verified", out.display(), path.display())
                 }
@@ -768,7 +777,10 @@ impl ApplicationHandler for App {
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
         let mut redraw = false;
         match event {
-            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::CloseRequested => {
+                self.work.cancel();
+                event_loop.exit();
+            }
             WindowEvent::Resized(size) => {
                 if let Some(state) = &mut self.state
                     && size.width > 0

@@ -3,6 +3,8 @@
 
 mod cli;
 mod measure;
+#[path = "../halo4d/terminal.rs"]
+mod terminal;
 
 use clap::Parser;
 use cli::Args;
@@ -40,7 +42,10 @@ fn run(args: &Args) -> Result<(), ViewerError> {
             "is drawn in a screenshot or the window, not in --bench or --compare",
         )));
     }
-    let (source, notes) = Source::open(args.file.as_deref())?;
+    // The view search of a scene whose view is "auto" shows its bar.
+    let terminal = terminal::Terminal::new(false);
+    let job = halo4d::progress::Job::new(&terminal, halo4d::progress::Cancel::never());
+    let (source, notes) = Source::open(args.file.as_deref(), job)?;
     for note in notes {
         eprintln!("note: {note}");
     }

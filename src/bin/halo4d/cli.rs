@@ -104,6 +104,10 @@ pub struct BuildArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Stop the build after SECONDS (the view search's and the build's time, from the
+    /// start): nothing of it is written, and the exit status is 124.
+    #[arg(long, value_name = "SECONDS", value_parser = seconds)]
+    pub timeout: Option<f64>,
     /// Exit 0 even when the build's own verification fails (the files are written, and
     /// marked `verified: false`, either way).
     #[arg(long)]
@@ -307,4 +311,14 @@ fn direction(s: &str) -> Result<[f64; 4], String> {
     numbers
         .try_into()
         .map_err(|v: Vec<f64>| format!("{} numbers; give four: x,y,z,w", v.len()))
+}
+
+/// A `--timeout`: a positive, finite number of seconds.
+fn seconds(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(s) if s.is_finite() && s > 0.0 && s <= 1e9 => Ok(s),
+        _ => Err(format!(
+            "`{text}` is not a number of seconds above 0 (e.g. --timeout 60 or --timeout 0.5)"
+        )),
+    }
 }

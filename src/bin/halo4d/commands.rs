@@ -4,8 +4,10 @@
 use crate::cli::{
     AnimateArgs, BuildArgs, CheckArgs, GalleryArgs, RenderArgs, SliceArgs, SweepArgs, ViewArgs,
 };
+use crate::terminal::Terminal;
 use clap::ValueEnum;
 use halo4d::limits::{FieldError, shorten};
+use halo4d::progress::{Cancel, Job};
 use halo4d::{Scene, animate::Shard, render::Comparison, sweep};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -16,19 +18,33 @@ pub type Outcome = Result<ExitCode, Box<dyn std::error::Error>>;
 /// The exit status of a build whose own verification failed.
 const UNVERIFIED: u8 = 3;
 
+/// The exit status of work stopped by `--timeout`, as `timeout(1)` gives.
+const TIMED_OUT: u8 = 124;
+
 /// The scene file (the default scene without one), its view found by the view search when
-/// it is `"auto"`.
-fn load(scene: Option<PathBuf>, quiet: bool) -> Result<Scene, Box<dyn std::error::Error>> {
+/// it is `"auto"`, which says what it found unless `quiet`.
+fn load(
+    scene: Option<PathBuf>,
+    quiet: bool,
+    job: Job,
+) -> Result<Scene, Box<dyn std::error::Error>> {
     let mut scene = match scene {
         Some(path) => Scene::load(&path)?,
         None => Scene::default_scene(),
     };
-    if let Some(found) = halo4d::resolve_view(&mut scene, quiet)?
+    if let Some(found) = halo4d::resolve_view(&mut scene, job)?
         && !quiet
     {
         eprintln!("{}", found.summary());
     }
     Ok(scene)
+}
+
+/// Exit 124, saying so, where `--timeout` stopped the work of `watch`.
+fn timed_out(watch: &Watch) -> Option<ExitCode> {
+    let seconds = watch.timed_out()?;
+    eprintln!("error: not finished within --timeout {seconds} s; nothing of it was written");
+    Some(ExitCode::from(TIMED_OUT))
 }
 
 /// `halo4d build`.
@@ -39,11 +55,21 @@ pub fn build(args: BuildArgs) -> Outcome {
         scene,
         out,
         quiet,
+        timeout,
         allow_unverified,
     } = args;
-    let scene = load(scene, quiet)?;
+    let watch = Watch::new(quiet, timeout);
+    let loaded = load(scene, quiet, watch.job());
+    if let (Err(_), Some(code)) = (&loaded, timed_out(&watch)) {
+        return Ok(code);
+    }
+    let scene = loaded?;
     let out = out.unwrap_or_else(|| PathBuf::from("exports").join(&scene.name));
-    let report = halo4d::build_since(&scene, &out, quiet, started)?;
+    let built = halo4d::build_since(&scene, &out, watch.job(), started);
+    if let (Err(_), Some(code)) = (&built, timed_out(&watch)) {
+        return Ok(code);
+    }
+    let report = built?;
     eprint!("{}", report.summary());
     for f in &report.files {
         println!("{}", out.join(f).display());
@@ -88,6 +114,7 @@ pub fn build(args: BuildArgs) -> Outcome {
 /// `halo4d view`.
 pub fn view(args: ViewArgs) -> Outcome {
     let ViewArgs { scene, out, quiet } = args;
+    let watch = Watch::new(quiet, None);
     // Read once: parsed here, and written back with the view found.
     let (text, parsed) = match &scene {
         Some(path) => {
@@ -98,7 +125,7 @@ pub fn view(args: ViewArgs) -> Outcome {
         }
         None => (halo4d::DEFAULT_SCENE.to_string(), Scene::default_scene()),
     };
-    let found = halo4d::search_view(&parsed, quiet)?;
+    let found = halo4d::search_view(&parsed, watch.job())?;
     eprintln!("{}", found.summary());
     let mut json: serde_json::Value = serde_json::from_str(&text)?;
     let rotation = serde_json::to_value(found.rotation)?;
@@ -143,7 +170,8 @@ pub fn render(args: RenderArgs) -> Outcome {
     if let Some(out) = &out {
         png_path(out)?;
     }
-    let mut scene = load(scene, quiet)?;
+    let watch = Watch::new(quiet, None);
+    let mut scene = load(scene, quiet, watch.job())?;
     let r = &mut scene.render;
     r.width = width.unwrap_or(r.width);
     r.height = height.unwrap_or(r.height);
@@ -157,7 +185,7 @@ pub fn render(args: RenderArgs) -> Outcome {
             .join(&scene.name)
             .join(format!("{}-render.png", scene.name))
     });
-    let (picture, ms) = halo4d::render_to(&scene, &out, quiet)?;
+    let (picture, ms) = halo4d::render_to(&scene, &out, watch.job())?;
     eprintln!(
         "{} x {} {} picture, {} halos, in {ms:.0} ms",
         picture.width,
@@ -201,7 +229,7 @@ pub fn sweep(args: SweepArgs) -> Outcome {
         slices,
         quiet,
     } = args;
-    let scene = load(scene, quiet)?;
+    let scene = load(scene, quiet, Watch::new(quiet, None).job())?;
     let files = if render {
         let mut progress = |r: &Comparison| {
             if !quiet {
@@ -291,7 +319,8 @@ pub fn animate(args: AnimateArgs) -> Outcome {
         return Ok(ExitCode::SUCCESS);
     }
     let quiet = args.quiet;
-    let mut scene = load(args.scene, quiet)?;
+    let watch = Watch::new(quiet, None);
+    let mut scene = load(args.scene, quiet, watch.job())?;
     let r = &mut scene.render;
     r.width = args.width.unwrap_or(r.width);
     r.height = args.height.unwrap_or(r.height);
@@ -300,14 +329,16 @@ pub fn animate(args: AnimateArgs) -> Outcome {
         .check()
         .map_err(|e| flag_field(e.field.as_str(), e.message))?;
     let out = (args.out).unwrap_or_else(|| Path::new("exports").join(&scene.name).join("frames"));
-    let summary = halo4d::animate::animate(&halo4d::animate::Request {
-        scene: &scene,
-        out: &out,
-        frames: args.frames,
-        shard: args.shard.unwrap_or(Shard::ALL),
-        glb: args.glb,
-        quiet,
-    })?;
+    let summary = halo4d::animate::animate(
+        &halo4d::animate::Request {
+            scene: &scene,
+            out: &out,
+            frames: args.frames,
+            shard: args.shard.unwrap_or(Shard::ALL),
+            glb: args.glb,
+        },
+        watch.job(),
+    )?;
     if !quiet {
         eprintln!(
             "{} frames in this run: {} made, {} done before; {} not verified; {:.1} s",
@@ -336,11 +367,8 @@ pub fn gallery(args: GalleryArgs) -> Outcome {
         out,
         quiet,
     } = args;
-    let gallery = halo4d::gallery::make(&figures, &out, quiet, |k, n, file| {
-        if !quiet {
-            eprintln!("figure {} of {n}: {}", k + 1, file.display());
-        }
-    })?;
+    let watch = Watch::new(quiet, None);
+    let gallery = halo4d::gallery::make(&figures, &out, watch.job())?;
     for f in &gallery.figures {
         let share = f
             .report
@@ -482,7 +510,8 @@ pub fn slice(args: SliceArgs) -> Outcome {
         field: format!("--{}", e.field),
         ..e
     })?;
-    let scene = load(scene, quiet)?;
+    let watch = Watch::new(quiet, None);
+    let scene = load(scene, quiet, watch.job())?;
     let out = out.unwrap_or_else(|| PathBuf::from("exports").join(&scene.name).join("motion"));
     let from_scene = scene.slicing.unwrap_or_default();
     let slicing = halo4d::motion::Slicing {
@@ -491,7 +520,7 @@ pub fn slice(args: SliceArgs) -> Outcome {
         perturb: perturb.unwrap_or(from_scene.perturb),
         film: film.unwrap_or(from_scene.film),
     };
-    let motion = halo4d::slicing::slice_scene(&scene, slicing, &out, quiet)?;
+    let motion = halo4d::slicing::slice_scene(&scene, slicing, &out, watch.job())?;
     eprint!("{}", motion.summary());
     for f in &motion.files {
         println!("{}", out.join(f).display());
@@ -503,4 +532,41 @@ pub fn slice(args: SliceArgs) -> Outcome {
         "the motion picture fails its checks: its files are written, motion.json lists the failures; exit status 3"
     );
     Ok(ExitCode::from(UNVERIFIED))
+}
+
+/// A command's observer and its cancel token, cancelled after `timeout` seconds when given.
+struct Watch {
+    terminal: Terminal,
+    cancel: Cancel,
+    timeout: Option<f64>,
+}
+
+impl Watch {
+    /// The terminal (quiet or not) and a token that a timer cancels after `timeout`
+    /// seconds.
+    fn new(quiet: bool, timeout: Option<f64>) -> Watch {
+        let cancel = Cancel::new();
+        if let Some(seconds) = timeout {
+            let timer = cancel.clone();
+            std::thread::spawn(move || {
+                std::thread::sleep(std::time::Duration::from_secs_f64(seconds));
+                timer.cancel();
+            });
+        }
+        Watch {
+            terminal: Terminal::new(quiet),
+            cancel,
+            timeout,
+        }
+    }
+
+    /// The timeout, once it has passed (and cancelled the work).
+    fn timed_out(&self) -> Option<f64> {
+        self.timeout.filter(|_| self.cancel.is_cancelled())
+    }
+
+    /// The job the library's work reports to.
+    fn job(&self) -> Job<'_> {
+        Job::new(&self.terminal, &self.cancel)
+    }
 }

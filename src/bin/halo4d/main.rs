@@ -3,6 +3,7 @@
 
 mod cli;
 mod commands;
+mod terminal;
 
 use clap::Parser;
 use cli::{Cli, Command};

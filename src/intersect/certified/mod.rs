@@ -34,6 +34,7 @@ mod system;
 
 pub use graph::{Component, ComponentKind, SheetBox};
 
+use crate::progress::Cancel;
 use crate::surfaces::{Interval, Surface};
 use crate::view::View;
 use near::{Near, Poles, Rect};
@@ -395,9 +396,24 @@ pub fn certify(surfaces: &[Option<&Surface>], view: &View) -> Certificate {
     certify_within(surfaces, view, BUDGET)
 }
 
+/// [`certify`], stopping at its next level of boxes once `cancel` is cancelled (with a
+/// certificate that decides nothing more, which the caller drops).
+pub fn certify_until(surfaces: &[Option<&Surface>], view: &View, cancel: &Cancel) -> Certificate {
+    certify_of(surfaces, view, BUDGET, cancel)
+}
+
 /// [`certify`] within `budget` enclosures of the surfaces (and 400,000 pairs of boxes
 /// waiting at a level): what is left when either runs out is undecided (`budget`).
 pub fn certify_within(surfaces: &[Option<&Surface>], view: &View, budget: usize) -> Certificate {
+    certify_of(surfaces, view, budget, Cancel::never())
+}
+
+fn certify_of(
+    surfaces: &[Option<&Surface>],
+    view: &View,
+    budget: usize,
+    cancel: &Cancel,
+) -> Certificate {
     let start = Instant::now();
     let setting = Setting {
         projectors: surfaces
@@ -412,7 +428,7 @@ pub fn certify_within(surfaces: &[Option<&Surface>], view: &View, budget: usize)
         mut undecided,
         box_pairs,
         work,
-    } = setting.levels(pending, budget);
+    } = setting.levels(pending, budget, cancel);
     let (branch, all_branch_points) = setting.branch_points(&mut undecided);
     let projectors: Vec<&Projector> = setting.projectors.iter().flatten().collect();
     let index: Vec<usize> = (0..surfaces.len())
@@ -513,7 +529,7 @@ struct Levels {
 impl Setting<'_> {
     /// The pairs level by level, each level's on the cores and taken in order, until none
     /// is left or the budget runs out.
-    fn levels(&self, mut pending: Vec<(Piece, Piece)>, budget: usize) -> Levels {
+    fn levels(&self, mut pending: Vec<(Piece, Piece)>, budget: usize, cancel: &Cancel) -> Levels {
         let mut out = Levels {
             arcs: Vec::new(),
             undecided: Vec::new(),
@@ -522,7 +538,7 @@ impl Setting<'_> {
         };
         let mut depth = START;
         while !pending.is_empty() {
-            if out.work > budget || pending.len() > PENDING {
+            if out.work > budget || pending.len() > PENDING || cancel.is_cancelled() {
                 let left = pending.drain(..).map(|(a, b)| (a, b, Reason::Budget));
                 out.undecided.extend(left);
                 break;
@@ -533,6 +549,9 @@ impl Setting<'_> {
                 .with_min_len(4)
                 .map(|(a, b)| {
                     let mut w = 0;
+                    if cancel.is_cancelled() {
+                        return (Step::Free, w);
+                    }
                     let s = self.step(a, b, depth, &mut w);
                     (s, w)
                 })
