@@ -40,6 +40,7 @@
 //! folded faces, and the volume; [`crate::certify`] goes on from there to the boundary.
 
 use crate::limits::VOLUME_DEFECT;
+use crate::progress::Cancel;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -822,6 +823,25 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
     tets: &[[u32; 4]],
     surface_triangles: &[[u32; 3]],
 ) -> CheckStats {
+    check_parts_until(
+        positions,
+        surface_vertices,
+        tets,
+        surface_triangles,
+        Cancel::never(),
+    )
+}
+
+/// [`check_parts`], stopping between its passes once `cancel` is cancelled (with empty
+/// statistics, which the caller drops).
+pub fn check_parts_until<P: Copy + Into<[f64; 3]> + Sync>(
+    positions: &[P],
+    surface_vertices: usize,
+    tets: &[[u32; 4]],
+    surface_triangles: &[[u32; 3]],
+    cancel: &Cancel,
+) -> CheckStats {
+    let stopped = || cancel.is_cancelled();
     let n = surface_vertices;
     let nv = positions.len();
     let layout = Layout::new(positions, n);
@@ -837,8 +857,14 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
         tiny,
         centre,
     } = scaled(positions, &tets);
+    if stopped() {
+        return CheckStats::default();
+    }
     let (mut s, signs) = tet_stats(&tets, &odd, &scaled, &tiny);
     drop(odd);
+    if stopped() {
+        return CheckStats::default();
+    }
     s.collapsed_vertices = layout.collapsed.iter().filter(|&&c| c).count();
 
     // Every face counted at its smallest vertex; boundary faces kept with their
@@ -847,11 +873,17 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
     drop((tets, signs));
     merge_faces(&mut s, &faces);
     let boundary = faces.boundary;
+    if stopped() {
+        return CheckStats::default();
+    }
 
     let (boundary_volume, offset_faces, others) =
         classify_boundary(boundary, &scaled, centre, &layout);
     s.boundary_volume = boundary_volume;
     let offset_faces = bucket_sort(offset_faces, n, |f| f.0[0]);
+    if stopped() {
+        return CheckStats::default();
+    }
     if !surface_triangles.is_empty() {
         count_missing_given(
             &mut s,
@@ -862,6 +894,9 @@ pub fn check_parts<P: Copy + Into<[f64; 3]> + Sync>(
         );
     }
     let edges = surface_edges(&mut s, offset_faces, &layout, &incidence);
+    if stopped() {
+        return CheckStats::default();
+    }
     let open = check_quads(&mut s, edges, &layout, &incidence);
     s.unexpected_boundary_faces = unexpected_boundary_faces(&others, &open, &layout);
     finish_volumes(&mut s, volume_exp2);

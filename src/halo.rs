@@ -27,7 +27,7 @@
 //! surface vertex too). With `fold: report` rho stays as asked and the inverted tetrahedra
 //! are counted. Vertices are rounded to f32, what the files store, before they are checked.
 
-use crate::check::{CheckStats, TetMesh, check_parts};
+use crate::check::{CheckStats, TetMesh, check_parts_until};
 use crate::limits::{DELTA_D, DELTA_T, FieldError, HALO_GAP_PX, HALO_RHO, Number};
 use crate::progress::Cancel;
 use crate::tets::{self, Corners, Split, SplitStats};
@@ -668,7 +668,7 @@ pub fn build_halo_until(
     if cancel.is_cancelled() {
         return Default::default();
     }
-    let checked = check_parts(&halo.positions, n, &halo.tets, triangles);
+    let checked = check_parts_until(&halo.positions, n, &halo.tets, triangles, cancel);
     lap(&mut stage_ms.check);
     let report = HaloReport {
         split: params.split.name(),
