@@ -1374,6 +1374,9 @@ impl<'a> Scene<'a> {
             .map_init(Vec::new, |hits, y| {
                 let mut counts = Vec::with_capacity(w);
                 let mut probes = Vec::new();
+                if self.cancel.is_cancelled() {
+                    return (vec![0; w], probes);
+                }
                 for x in 0..w {
                     let pixel = y * w + x;
                     let before = probes.len();
@@ -1407,6 +1410,10 @@ impl<'a> Scene<'a> {
                 pixel += 1;
             }
             probes.extend(row);
+        }
+        if self.cancel.is_cancelled() {
+            // Every row is left undrawn: the caller drops the picture.
+            return self.view_with(primary, false, false, |_, _, _, _, _| false);
         }
         let depth = (self.centre - cam.eye).dot(cam.forward);
         let hidden = slices::hidden(
