@@ -9,7 +9,9 @@
 //! thread of its own, while the calling thread waits in slices of 50 ms, calls the
 //! `progress` function it was given with each of the work's events and checks for signals:
 //! Ctrl-C cancels the work (`halo4d::progress::Cancel`), waits the fraction of a second it
-//! takes to stop, its memory freed and nothing written, and raises `KeyboardInterrupt`.
+//! takes to stop, its memory freed and nothing written, and raises `KeyboardInterrupt`
+//! (work that checks no token, reading a scene or checking a mesh, raises at once and
+//! finishes in the background).
 
 use halo4d::progress::{Cancel, Event, Job, Observer, Silent};
 use halo4d::render::{RenderSettings, Style};
@@ -37,9 +39,26 @@ create_exception!(
     "A build, picture or write that failed: the message is the command line's."
 );
 
-/// [`run_job`] of work that reports nothing.
+/// Work that neither reports nor checks a token (reading a scene, checking a mesh) on a
+/// thread of its own, as [`run_job`] runs it, except that Ctrl-C raises at once: the work
+/// cannot be stopped, so it finishes in the background and its result is dropped.
 fn run<T: Send + 'static>(py: Python<'_>, f: impl FnOnce() -> T + Send + 'static) -> PyResult<T> {
-    run_job(py, None, move |_| f())
+    wait(py, None, move |_| f(), false)
+}
+
+/// `f` on a thread of its own with the GIL released, given a job that sends its events to
+/// the calling thread when `progress` is given; the calling thread waits in slices of
+/// 50 ms, calls `progress` with each event (a dict: `kind` "begin" with `task` and
+/// `steps`, "doing" with `text`, "done" with `done`, "end", "warning" and "note" with
+/// `text`) and checks for signals. Ctrl-C (or `progress` raising) cancels the work and
+/// waits for it to stop (a fraction of a second: its memory is freed, nothing of it is
+/// written) before raising.
+fn run_job<T: Send + 'static>(
+    py: Python<'_>,
+    progress: Option<&Bound<'_, PyAny>>,
+    f: impl FnOnce(Job) -> T + Send + 'static,
+) -> PyResult<T> {
+    wait(py, progress, f, true)
 }
 
 /// What crosses from the work's thread to the calling one: an event for `progress`, or
@@ -98,17 +117,13 @@ impl Owned {
     }
 }
 
-/// `f` on a thread of its own with the GIL released, given a job that sends its events to
-/// the calling thread when `progress` is given; the calling thread waits in slices of
-/// 50 ms, calls `progress` with each event (a dict: `kind` "begin" with `task` and
-/// `steps`, "doing" with `text`, "done" with `done`, "end", "warning" and "note" with
-/// `text`) and checks for signals. Ctrl-C (or `progress` raising) cancels the work and
-/// waits for it to stop (a fraction of a second: its memory is freed, nothing of it is
-/// written) before raising.
-fn run_job<T: Send + 'static>(
+/// [`run_job`] and [`run`]: on Ctrl-C, the work is cancelled and, where it checks its token
+/// (`stoppable`), waited for.
+fn wait<T: Send + 'static>(
     py: Python<'_>,
     progress: Option<&Bound<'_, PyAny>>,
     f: impl FnOnce(Job) -> T + Send + 'static,
+    stoppable: bool,
 ) -> PyResult<T> {
     let (tx, rx) = channel();
     let cancel = Cancel::new();
@@ -130,7 +145,9 @@ fn run_job<T: Send + 'static>(
     let stopped = |py: Python<'_>, err: PyErr| {
         cancel.cancel();
         // The work stops at its next check; its result (an error) is dropped with it.
-        let _ = py.detach(|| worker.join());
+        if stoppable {
+            let _ = py.detach(|| worker.join());
+        }
         Err(err)
     };
     loop {
