@@ -5,10 +5,11 @@ use super::report::{PictureReport, Report, Timings, surface_report, surface_warn
 use super::{Built, ms};
 use crate::error::Error;
 use crate::export::{self, SurfaceData};
-use crate::progress::Job;
+use crate::progress::{Cancel, Cancelled, Job};
 use crate::render;
 use crate::scene::Scene;
 use rayon::prelude::*;
+use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
@@ -115,13 +116,16 @@ fn write_meshes(
     // `.vtk` streamed, the `.glb`'s chunks written as they are, with no copy of the whole
     // file in memory); the report lists them in this order.
     type Writer<'a> = Box<dyn FnOnce() -> Result<Vec<String>, Error> + Send + 'a>;
+    // A file streamed (the `.glb`, the halos' `.vtk`: hundreds of megabytes at millions of
+    // triangles) stops at its next write once the job is cancelled.
+    let cancel = job.cancel();
     let mut jobs: Vec<Writer> = Vec::new();
     if scene.outputs.glb {
         jobs.push(Box::new(|| {
             let (text, bin) = glb_chunks(scene, built, data, stipples, failures)?;
             let file = staged
                 .stream(format!("{name}.glb"), |w| {
-                    export::write_glb_container(w, &text, &bin)
+                    export::write_glb_container(&mut Stoppable { out: w, cancel }, &text, &bin)
                 })
                 .map_err(staged_error)?;
             Ok(vec![file])
@@ -134,7 +138,12 @@ fn write_meshes(
             let glb = export::glb_container(text, bin);
             let file = staged
                 .stream(format!("{name}.html"), |w| {
-                    export::write_html(w, name, &glb, scene.render.background)
+                    export::write_html(
+                        &mut Stoppable { out: w, cancel },
+                        name,
+                        &glb,
+                        scene.render.background,
+                    )
                 })
                 .map_err(staged_error)?;
             Ok(vec![file])
@@ -181,7 +190,9 @@ fn write_meshes(
             let file = per_surface(name, d.name, data.len(), "-halo.vtk");
             jobs.push(Box::new(move || {
                 let file = staged
-                    .stream(file, |w| export::write_vtk(w, d, name))
+                    .stream(file, |w| {
+                        export::write_vtk(&mut Stoppable { out: w, cancel }, d, name)
+                    })
                     .map_err(staged_error)?;
                 Ok(vec![file])
             }));
@@ -194,7 +205,29 @@ fn write_meshes(
             writer()
         })
         .collect();
+    // A file stopped by the token fails as cancelled, not as a write that failed.
+    job.check()?;
     Ok(written?.into_iter().flatten().collect())
+}
+
+/// A writer that fails once `cancel` is cancelled, so that a file being streamed stops at
+/// its next write (its partial file is removed with the build's others).
+struct Stoppable<'a, 'w> {
+    out: &'a mut (dyn Write + 'w),
+    cancel: &'a Cancel,
+}
+
+impl Write for Stoppable<'_, '_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if self.cancel.is_cancelled() {
+            return Err(std::io::Error::other(Cancelled));
+        }
+        self.out.write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.out.flush()
+    }
 }
 
 /// Renders the picture and writes it as `.png` and/or `.svg`, staged, with the render time

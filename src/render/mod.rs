@@ -594,6 +594,9 @@ fn render_eyes<'a>(
     want: Want,
     cancel: &'a Cancel,
 ) -> Result<Eyes, RenderError> {
+    // Before the indexes too: the halos' takes seconds at millions of tetrahedra, and obvhs
+    // cannot be stopped inside it.
+    cancel.check()?;
     let (placement, mut scene) = prepare(input, settings, camera)?;
     scene.cancel = cancel;
     cancel.check()?;
