@@ -48,7 +48,9 @@ except KeyboardInterrupt:
     print("interrupted", stopped, cpu() - used, peak[0], at, rss(), flush=True)
 """
 
-for wait in map(float, sys.argv[1:] or ["2.5", "5", "12", "20", "30"]):
+def interrupt(wait: float) -> dict:
+    """One run: SIGINT `wait` seconds into the build; what the interrupted process measured
+    (`finished` true where the build ended first)."""
     child = subprocess.Popen([sys.executable, "-c", CHILD], stdout=subprocess.PIPE, text=True)
     _, before = child.stdout.readline().split()
     time.sleep(wait)
@@ -56,12 +58,29 @@ for wait in map(float, sys.argv[1:] or ["2.5", "5", "12", "20", "30"]):
     child.send_signal(signal.SIGINT)
     out, _ = child.communicate(timeout=300)
     fields = out.split()
-    if fields[0] != "interrupted":
-        print(f"SIGINT at {wait:g} s: the build {fields[0]} first")
-        continue
+    if fields[:1] != ["interrupted"]:
+        return {"finished": True, "output": out}
     stopped, cpu_after, peak, at, after = map(float, fields[1:])
-    print(
-        f"SIGINT at {wait:g} s: KeyboardInterrupt {stopped - sent:.3f} s later; "
-        f"{cpu_after:.3f} s of CPU in the next second; resident {float(before):.0f} MB before, "
-        f"{peak:.0f} MB at the peak, {at:.0f} MB at the interrupt, {after:.0f} MB a second later"
-    )
+    return {
+        "finished": False,
+        "after_signal": stopped - sent,
+        "cpu_next_second": cpu_after,
+        "rss_before": float(before),
+        "rss_peak": peak,
+        "rss_at_interrupt": at,
+        "rss_after": after,
+    }
+
+
+if __name__ == "__main__":
+    for wait in map(float, sys.argv[1:] or ["2.5", "5", "12", "20", "30"]):
+        r = interrupt(wait)
+        if r["finished"]:
+            print(f"SIGINT at {wait:g} s: the build finished first: {r['output']}")
+            continue
+        print(
+            f"SIGINT at {wait:g} s: KeyboardInterrupt {r['after_signal']:.3f} s later; "
+            f"{r['cpu_next_second']:.3f} s of CPU in the next second; resident "
+            f"{r['rss_before']:.0f} MB before, {r['rss_peak']:.0f} MB at the peak, "
+            f"{r['rss_at_interrupt']:.0f} MB at the interrupt, {r['rss_after']:.0f} MB a second later"
+        )

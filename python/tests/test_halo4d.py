@@ -9,7 +9,6 @@ Run with the package installed (`pip install ./python`) and the release binary b
 
 import json
 import os
-import signal
 import subprocess
 import sys
 import threading
@@ -321,50 +320,22 @@ def test_the_catalogue_lists_every_surface_with_its_topology():
 
 
 def test_ctrl_c_stops_a_long_build_and_frees_its_memory():
-    # A build of 3M triangles, far longer than the wait: SIGINT after it started must raise
-    # KeyboardInterrupt in the calling thread within a fraction of a second, with the work
-    # stopped (the process's CPU time no longer grows) and its memory given back.
-    code = f"""
-import json, os, sys, time, halo4d
-import signal
-# Ctrl-C raises KeyboardInterrupt even where the parent ignores SIGINT (a background job).
-signal.signal(signal.SIGINT, signal.default_int_handler)
-def rss():
-    return int(open("/proc/self/statm").read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 1e6
-def cpu():
-    t = os.times()
-    return t.user + t.system
-d = json.load(open({str(DEFAULT)!r}))
-d["surfaces"][0]["sampling"] = {{"method": "uniform", "u": 1500, "v": 1000}}
-scene = halo4d.Scene(d)
-print("ready", rss(), flush=True)
-try:
-    scene.build()
-    print("finished", flush=True)
-except KeyboardInterrupt:
-    stopped = time.monotonic()
-    used, peak = cpu(), rss()
-    time.sleep(1.0)
-    print("interrupted", stopped, cpu() - used, peak, rss(), flush=True)
-"""
-    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
-    word, before = p.stdout.readline().split()
-    assert word == "ready"
-    import time
-    time.sleep(4.0)
-    sent = time.monotonic()
-    p.send_signal(signal.SIGINT)
-    out, _ = p.communicate(timeout=120)
-    fields = out.split()
-    assert fields[:1] == ["interrupted"], out
-    stopped, cpu_after, rss_at_stop, rss_after = fields[1:]
+    # A build of 3M triangles, far longer than the wait (python/bench/interrupt.py): SIGINT
+    # after it started must raise KeyboardInterrupt in the calling thread within a fraction
+    # of a second, with the work stopped (the process's CPU time no longer grows) and its
+    # memory given back.
+    sys.path.insert(0, str(ROOT / "python" / "bench"))
+    from interrupt import interrupt
+
+    r = interrupt(4.0)
+    assert not r["finished"], r
     # Raised once the work was cancelled and joined: a fraction of a second after the signal
     # (the build had tens of seconds to go; the bound leaves room for a loaded machine).
-    assert float(stopped) - sent < 2.0, out
+    assert r["after_signal"] < 2.0, r
     # Nothing runs on after: a few hundredths of a CPU second in the next second at most.
-    assert float(cpu_after) < 0.2, out
+    assert r["cpu_next_second"] < 0.2, r
     # The build's memory is freed: the process holds less than 200 MB more than before it.
-    assert float(rss_after) < float(before) + 200, (before, out)
+    assert r["rss_after"] < r["rss_before"] + 200, r
 
 
 def test_a_build_reports_its_progress_and_prints_nothing():
