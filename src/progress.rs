@@ -207,6 +207,11 @@ impl<'a> Task<'a> {
         self.job.observer.event(&Event::Doing(what));
     }
 
+    /// The steps done so far.
+    pub fn done(&self) -> u64 {
+        self.done.load(Ordering::Relaxed)
+    }
+
     /// One more step done.
     pub fn step(&self) {
         let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;

@@ -144,7 +144,10 @@ fn the_other_long_operations_stop_when_cancelled() {
         levels: 4,
         ..Default::default()
     };
-    assert!(halo4d::slicing::slice_scene(&scene, slicing, dir.path(), job).is_err());
+    assert!(matches!(
+        halo4d::slicing::slice_scene(&scene, slicing, dir.path(), job),
+        Err(halo4d::slicing::SliceError::Build(Error::Cancelled(_)))
+    ));
     assert!(!png.exists() && std::fs::read_dir(dir.path()).unwrap().next().is_none());
 }
 

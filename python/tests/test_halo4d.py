@@ -338,10 +338,20 @@ def test_ctrl_c_stops_a_long_build_and_frees_its_memory():
     assert r["rss_after"] < r["rss_before"] + 200, r
 
 
-def test_a_build_reports_its_progress_and_prints_nothing():
-    # The events of a build, in order, to the function given; a tqdm bar draws them.
+def test_a_build_reports_its_progress_and_prints_nothing(capfd):
+    # The events of a build, in order, to the function given; a tqdm bar draws them. A
+    # budget too small for the tolerance: its warning is an event, never a line on stderr.
     import io
 
+    short = json.loads(FLAT_TORUS.read_text())
+    short["sampling"] = {"method": "adaptive", "tolerance": 1e-6, "max_triangles": 2000}
+    capfd.readouterr()
+    halo4d.Scene(short).build()
+    assert capfd.readouterr().err == ""
+    events = []
+    halo4d.Scene(short).build(progress=events.append)
+    assert any(e["kind"] == "warning" and "max_triangles = 2000" in e["text"] for e in events)
+    assert capfd.readouterr().err == ""
     events = []
     scene = halo4d.Scene(FLAT_TORUS)
     scene.build(progress=events.append)

@@ -561,7 +561,6 @@ struct Progress<'a> {
     task: Task<'a>,
     start: Instant,
     total: usize,
-    done: std::cell::Cell<usize>,
 }
 
 impl<'a> Progress<'a> {
@@ -572,7 +571,6 @@ impl<'a> Progress<'a> {
             task,
             start: Instant::now(),
             total,
-            done: std::cell::Cell::new(0),
         }
     }
 
@@ -582,8 +580,7 @@ impl<'a> Progress<'a> {
 
     /// A frame is done.
     fn frame(&self, record: &FrameRecord) {
-        let done = self.done.get() + 1;
-        self.done.set(done);
+        let done = self.task.done() as usize + 1;
         let minutes = self.start.elapsed().as_secs_f64() / 60.0;
         let rate = done as f64 / minutes.max(1e-9);
         let left = (self.total - done) as f64 / rate;
